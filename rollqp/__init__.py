@@ -1,0 +1,47 @@
+"""rollqp: 2D transient rolling contact of elastic cylinders.
+
+Every step is posed two ways — as convex QPs solved by external solvers (Clarabel, OSQP,
+cvxpy) and as a complementarity system for a generalized Newton method — so that each
+holds the other to account (González & Abascal 2002; see ``docs/``).
+
+Public API
+----------
+load_scene, builtin_scenes, Scene        scenes (SPEC.md)
+run, Model                               the transient driver
+Result, load_result                      result files
+Strip                                    strip discretization
+halfspace_influence, Influence           influence matrices
+NormalStep, TangentialStep, Scales       step problems built from arrays
+StepSolution, Residuals, classify, compare
+solve_step                               solve one step with any method
+get_method, available_methods            the method registry
+closedforms                              Hertz, Cattaneo, Carter, creep law
+"""
+__version__ = "0.1.0"
+
+from . import closedforms
+from .errors import InputError, MissingBackendError, RollqpError, SolverError
+from .influence import Influence, halfspace_influence
+from .methods import available_methods, get_method
+from .problem import (NormalStep, Residuals, Scales, StepSolution, TangentialStep, classify,
+                      compare)
+from .result import Result, load_result
+from .scene import Scene, builtin_scenes, load_scene
+from .strip import Strip
+from .driver import Model, run
+
+
+def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> StepSolution:
+    """Solve one step problem (:class:`NormalStep` or :class:`TangentialStep`) with ``method``.
+
+    ``settings`` go to the method (``tolerance``, ``residual_limit``, …). For many steps of
+    the same matrices create the method once with :func:`get_method` and call its
+    ``solve`` repeatedly: solver objects are then built once and only updated.
+    """
+    return get_method(method, **settings).solve(problem, warm=warm)
+
+
+__all__ = ["load_scene", "builtin_scenes", "Scene", "run", "Model", "Result", "load_result", "Strip",
+           "halfspace_influence", "Influence", "NormalStep", "TangentialStep", "Scales", "StepSolution",
+           "Residuals", "classify", "compare", "solve_step", "get_method", "available_methods",
+           "closedforms", "InputError", "SolverError", "RollqpError", "MissingBackendError"]

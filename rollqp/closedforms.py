@@ -1,0 +1,562 @@
+"""Closed-form solutions of 2D (plane-strain) contact of cylinders, for checking the solvers.
+
+FORMULATION.md §11 restated as functions. Every function uses the project's sign convention
+(FORMULATION.md §1):
+
+* ``p ≥ 0`` is the contact pressure (compression positive);
+* ``t`` is the tangential traction acting on body A in ``+x`` (B receives ``-t``),
+  ``Q = ∫ t dx`` is the tangential load on A;
+* ``ξ = (V_A − V_B)/|V|`` is the creepage (rigid slip of A relative to B);
+* material moves through the contact with direction ``d = sgn(V)``: it enters at the
+  leading edge ``x = −d·a`` and leaves at the trailing edge ``x = +d·a``;
+* ``ratio = Q/(μP)`` is the signed tangential load ratio.
+
+Symbols: ``P`` normal load per unit length, ``R`` relative radius (``1/R = 1/R_A + 1/R_B``),
+``E*`` contact modulus (``1/E* = (1−ν_A²)/E_A + (1−ν_B²)/E_B``), ``a`` contact half-width,
+``p0`` peak Hertz pressure, ``μ`` Coulomb friction coefficient. Any consistent units.
+
+All traction and pressure functions are vectorized over ``x``: they accept a scalar or an
+array and return a float or an ndarray of the same shape; they are zero outside
+``|x| ≤ a``.
+
+The 2D Hertz approach (rigid-body approach of the axes) is deliberately *not* given: in
+plane strain it depends on how the bodies are supported far from the contact (the
+logarithmic rigid constant ``d_ref`` of FORMULATION.md §3), so there is no definite
+half-space formula to check against.
+
+Sources are in :data:`SOURCES` (function name → citation).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = [
+    "hertz_half_width",
+    "hertz_peak_pressure",
+    "hertz_pressure",
+    "cattaneo_stick_half_width",
+    "cattaneo_traction",
+    "carter_stick_zone",
+    "carter_traction",
+    "carter_creepage",
+    "creep_force_ratio",
+    "bentall_johnson_creepage",
+    "BENTALL_JOHNSON_COEFFICIENT",
+    "SOURCES",
+]
+
+_JOHNSON = "K. L. Johnson, Contact Mechanics, Cambridge University Press, 1985"
+_HERTZ = ("H. Hertz, Über die Berührung fester elastischer Körper, J. reine angew. Math. 92, "
+          "156–171 (1882); two-dimensional (cylinder) case as in " + _JOHNSON
+          + ", Ch. 4 (Hertz theory)")
+_CATTANEO = ("C. Cattaneo, Sul contatto di due corpi elastici: distribuzione locale degli sforzi, "
+             "Rend. Accad. Naz. Lincei 27 (1938); R. D. Mindlin, Compliance of elastic bodies in "
+             "contact, J. Appl. Mech. 16, 259–268 (1949); 2D form as in " + _JOHNSON
+             + ", Ch. 7 (incipient sliding)")
+_CARTER = ("F. W. Carter, On the action of a locomotive driving wheel, Proc. R. Soc. Lond. A 112, "
+           "151–157 (1926); as in " + _JOHNSON + ", Ch. 8 (tractive rolling of elastic cylinders)")
+_KALKER = ("J. J. Kalker, Three-Dimensional Elastic Bodies in Rolling Contact, Kluwer, 1990 "
+           "(2D theory: Carter's solution is the exact 2D steady state; its small-creepage slope is "
+           "the 2D linear creep coefficient)")
+_BENTALL = ("R. H. Bentall and K. L. Johnson, Slip in the rolling contact of two dissimilar elastic "
+            "rollers, Int. J. Mech. Sci. 9, 389–404 (1967); as in " + _JOHNSON
+            + ", Ch. 8 (free rolling of dissimilar bodies); μ → 0 limit quoted in FORMULATION.md §11")
+
+#: Citation of each function's closed form.
+SOURCES: dict[str, str] = {
+    "hertz_half_width": _HERTZ,
+    "hertz_peak_pressure": _HERTZ,
+    "hertz_pressure": _HERTZ,
+    "cattaneo_stick_half_width": _CATTANEO,
+    "cattaneo_traction": _CATTANEO,
+    "carter_stick_zone": _CARTER,
+    "carter_traction": _CARTER,
+    "carter_creepage": _CARTER,
+    "creep_force_ratio": _CARTER + "; " + _KALKER,
+    "bentall_johnson_creepage": _BENTALL,
+}
+
+
+def _bj_coefficient() -> float:
+    """Root u of u√(1−u²) + arcsin u = π/4 (bisection), returning √(1−u²)/2."""
+    lo, hi = 0.0, 1.0
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid * math.sqrt(1.0 - mid * mid) + math.asin(mid) < math.pi / 4:
+            lo = mid
+        else:
+            hi = mid
+    u = 0.5 * (lo + hi)
+    return 0.5 * math.sqrt(1.0 - u * u)
+
+
+#: Bentall–Johnson free-rolling coefficient at μ → 0, ``|ξ| = C·|κ|·a/R`` with
+#: ``C = ½√(1 − u²)`` and ``u`` the root of ``u√(1−u²) + arcsin u = π/4``
+#: (``C = 0.45739…``, the ``0.457`` of FORMULATION.md §11). See :func:`bentall_johnson_creepage`.
+BENTALL_JOHNSON_COEFFICIENT: float = _bj_coefficient()
+
+
+# --------------------------------------------------------------------------- validation
+def _scalar(name: str, value) -> float:
+    if isinstance(value, bool):
+        raise InputError(name, f"must be a real number, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(name, f"must be a real scalar, got {value!r}") from None
+    if not math.isfinite(v):
+        raise InputError(name, f"must be finite, got {value!r}")
+    return v
+
+
+def _positive(name: str, value) -> float:
+    v = _scalar(name, value)
+    if v <= 0.0:
+        raise InputError(name, f"must be > 0, got {value!r}")
+    return v
+
+
+def _nonnegative(name: str, value) -> float:
+    v = _scalar(name, value)
+    if v < 0.0:
+        raise InputError(name, f"must be >= 0, got {value!r}")
+    return v
+
+
+def _ratio(value) -> float:
+    v = _scalar("ratio", value)
+    if not abs(v) < 1.0:
+        raise InputError("ratio", f"Q/(mu P) must satisfy |ratio| < 1 (partial slip), got {value!r}")
+    return v
+
+
+def _ratio_array(value) -> np.ndarray:
+    try:
+        r = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("ratio", f"must be real, got {value!r}") from None
+    if not np.all(np.isfinite(r)) or not np.all(np.abs(r) < 1.0):
+        raise InputError("ratio", "Q/(mu P) must be finite with |ratio| < 1 (partial slip)")
+    return r
+
+
+def _direction(value) -> int:
+    if isinstance(value, bool):
+        raise InputError("direction", f"must be -1 or +1, got {value!r}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError("direction", f"must be -1 or +1, got {value!r}") from None
+    if v not in (-1.0, 1.0):
+        raise InputError("direction", f"must be -1 or +1, got {value!r}")
+    return int(v)
+
+
+def _coords(x) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("x", f"must be real, got {x!r}") from None
+
+
+def _out(values: np.ndarray):
+    return float(values) if values.ndim == 0 else values
+
+
+def _semi_ellipse(x: np.ndarray, centre: float, half_width: float) -> np.ndarray:
+    """√(1 − (x − centre)²/half_width²) inside the interval, 0 outside.
+
+    Written as √((1 − u)(1 + u)), which is exactly 0 at u = ±1 and accurate near the ends.
+    """
+    if half_width <= 0.0:
+        return np.zeros_like(x)
+    u = (x - centre) / half_width
+    return np.sqrt(np.clip((1.0 - u) * (1.0 + u), 0.0, None))
+
+
+def _leading_semi_ellipse(x: np.ndarray, a: float, c: float, d: int) -> np.ndarray:
+    """√(1 − (x − x_c)²/c²) on Carter's stick zone, x_c = −d(a − c), 0 outside.
+
+    Evaluated through the distance from the leading edge, e = d·x + a, as
+    √((e/c)(2 − e/c)): exactly 0 at the leading edge (no rounding of x_c ± c), and
+    mirror-exact (x, d) ↔ (−x, −d).
+    """
+    if c <= 0.0:
+        return np.zeros_like(x)
+    v = (d * x + a) / c
+    return np.sqrt(np.clip(v * (2.0 - v), 0.0, None))
+
+
+# --------------------------------------------------------------------------- Hertz
+def hertz_half_width(P, R, Estar):
+    """Hertz contact half-width of two cylinders, ``a = √(4PR/(πE*))``.
+
+    Parameters
+    ----------
+    P : float
+        Normal load per unit axial length, ``P ≥ 0`` (compression).
+    R : float
+        Relative radius, ``1/R = 1/R_A + 1/R_B``, ``R > 0``.
+    Estar : float
+        Contact modulus ``E*``, ``1/E* = (1−ν_A²)/E_A + (1−ν_B²)/E_B``, ``E* > 0``.
+
+    Returns
+    -------
+    float
+        ``a`` (same length unit as ``R``).
+
+    Notes
+    -----
+    Sign convention: FORMULATION.md §1 (``p ≥ 0`` compression). Equivalently
+    ``p0 = 2P/(πa) = aE*/(2R)``. Source: Hertz (1882); Johnson (1985) Ch. 4, see
+    ``SOURCES["hertz_half_width"]``.
+    """
+    P = _nonnegative("P", P)
+    R = _positive("R", R)
+    Estar = _positive("Estar", Estar)
+    return math.sqrt(4.0 * P * R / (math.pi * Estar))
+
+
+def hertz_peak_pressure(P, a):
+    """Peak Hertz pressure of a 2D contact, ``p0 = 2P/(πa)``.
+
+    Parameters
+    ----------
+    P : float
+        Normal load per unit axial length, ``P ≥ 0``.
+    a : float
+        Contact half-width, ``a > 0``.
+
+    Returns
+    -------
+    float
+        ``p0 ≥ 0`` (compression positive), such that ``∫ p0√(1 − x²/a²) dx = P``.
+
+    Notes
+    -----
+    With ``a`` from :func:`hertz_half_width`, ``p0 = aE*/(2R)``. Source: Hertz (1882);
+    Johnson (1985) Ch. 4, see ``SOURCES["hertz_peak_pressure"]``.
+    """
+    P = _nonnegative("P", P)
+    a = _positive("a", a)
+    return 2.0 * P / (math.pi * a)
+
+
+def hertz_pressure(x, a, p0):
+    """Hertz pressure distribution, ``p(x) = p0·√(1 − x²/a²)`` for ``|x| ≤ a``, 0 outside.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Coordinate along the contact strip, origin at the contact centre.
+    a : float
+        Contact half-width, ``a > 0``.
+    p0 : float
+        Peak pressure, ``p0 ≥ 0`` (:func:`hertz_peak_pressure`).
+
+    Returns
+    -------
+    float or ndarray
+        ``p(x) ≥ 0`` (compression positive, FORMULATION.md §1), shape of ``x``.
+
+    Notes
+    -----
+    Source: Hertz (1882); Johnson (1985) Ch. 4, see ``SOURCES["hertz_pressure"]``.
+    """
+    x = _coords(x)
+    a = _positive("a", a)
+    p0 = _nonnegative("p0", p0)
+    return _out(p0 * _semi_ellipse(x, 0.0, a))
+
+
+# --------------------------------------------------------------------------- Cattaneo
+def cattaneo_stick_half_width(a, ratio):
+    """Half-width of the central stick zone in Cattaneo–Mindlin, ``c = a√(1 − |ratio|)``.
+
+    Parameters
+    ----------
+    a : float
+        Hertz contact half-width, ``a > 0``.
+    ratio : float
+        Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
+
+    Returns
+    -------
+    float
+        ``c``, ``0 < c ≤ a``; the stick zone is ``|x| < c``.
+
+    Notes
+    -----
+    Similar materials, normal load ``P`` applied first, then ``Q`` increased monotonically
+    from 0 with no rolling. Source: Cattaneo (1938), Mindlin (1949); Johnson (1985) Ch. 7,
+    see ``SOURCES["cattaneo_stick_half_width"]``.
+    """
+    a = _positive("a", a)
+    ratio = _ratio(ratio)
+    return a * math.sqrt(1.0 - abs(ratio))
+
+
+def cattaneo_traction(x, a, p0, mu, ratio):
+    """Cattaneo–Mindlin tangential traction of a static (braked) 2D contact.
+
+    ``t(x) = sgn(ratio)·μ·p0·[√(1 − x²/a²) − (c/a)·√(1 − x²/c²)]``, the second term only in
+    the stick zone ``|x| < c``, ``c = a√(1 − |ratio|)``; so ``t = sgn(ratio)·μ·p(x)`` in the
+    slip zones ``c ≤ |x| ≤ a`` and ``t = 0`` for ``|x| > a``.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Coordinate along the strip, origin at the contact centre.
+    a : float
+        Hertz half-width, ``a > 0``.
+    p0 : float
+        Hertz peak pressure, ``p0 ≥ 0``.
+    mu : float
+        Coulomb friction coefficient, ``μ ≥ 0``.
+    ratio : float
+        Signed load ratio ``Q/(μP)``, ``|ratio| < 1``; ``Q`` is the tangential load on
+        body A in ``+x``.
+
+    Returns
+    -------
+    float or ndarray
+        ``t(x)``, the traction on body A in ``+x`` (FORMULATION.md §1), shape of ``x``. It is
+        even in ``x``, has the sign of ``ratio`` and ``∫ t dx = ratio·μ·P`` with
+        ``P = πa·p0/2``.
+
+    Raises
+    ------
+    InputError
+        ``|ratio| ≥ 1`` (gross sliding), ``a ≤ 0``, ``p0 < 0`` or ``μ < 0``.
+
+    Notes
+    -----
+    Similar materials (no normal–tangential coupling), ``P`` applied first, then ``Q``
+    monotonically from 0. In the stick zone the relative tangential displacement is
+    uniform (a rigid shift). Source: Cattaneo (1938), Mindlin (1949); Johnson (1985) Ch. 7,
+    see ``SOURCES["cattaneo_traction"]``.
+    """
+    x = _coords(x)
+    a = _positive("a", a)
+    p0 = _nonnegative("p0", p0)
+    mu = _nonnegative("mu", mu)
+    ratio = _ratio(ratio)
+    c = a * math.sqrt(1.0 - abs(ratio))
+    t = _semi_ellipse(x, 0.0, a) - (c / a) * _semi_ellipse(x, 0.0, c)
+    return _out(math.copysign(1.0, ratio) * (ratio != 0.0) * mu * p0 * t)
+
+
+# --------------------------------------------------------------------------- Carter
+def carter_stick_zone(a, ratio, direction):
+    """Stick zone ``(x_from, x_to)`` of Carter's steady rolling solution.
+
+    The stick zone has half-width ``c = a√(1 − |ratio|)`` and touches the leading edge
+    ``x = −d·a``; its centre is ``x_c = −d·(a − c)``.
+
+    Parameters
+    ----------
+    a : float
+        Hertz half-width, ``a > 0``.
+    ratio : float
+        Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
+    direction : {-1, +1}
+        ``d = sgn(V)``: material moves through the contact in ``+d·x`` and enters at the
+        leading edge ``x = −d·a`` (FORMULATION.md §1).
+
+    Returns
+    -------
+    tuple of float
+        ``(x_from, x_to)`` with ``x_from < x_to``: ``(−a, −a + 2c)`` for ``d = +1``,
+        ``(a − 2c, a)`` for ``d = −1``.
+
+    Notes
+    -----
+    Source: Carter (1926); Johnson (1985) Ch. 8, see ``SOURCES["carter_stick_zone"]``.
+    """
+    a = _positive("a", a)
+    ratio = _ratio(ratio)
+    d = _direction(direction)
+    c = a * math.sqrt(1.0 - abs(ratio))
+    return (-a, -a + 2.0 * c) if d == 1 else (a - 2.0 * c, a)
+
+
+def carter_traction(x, a, p0, mu, ratio, direction):
+    """Carter's steady-rolling tangential traction (similar cylinders).
+
+    ``t(x) = sgn(ratio)·μ·p0·[√(1 − x²/a²) − (c/a)·√(1 − (x − x_c)²/c²)]``, the second term
+    only inside the stick zone ``|x − x_c| < c``, with ``c = a√(1 − |ratio|)`` and
+    ``x_c = −d·(a − c)`` (the stick zone touches the leading edge ``x = −d·a``). Elsewhere
+    in the contact ``t = sgn(ratio)·μ·p(x)`` (slip towards the trailing edge); ``t = 0``
+    for ``|x| > a``.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Coordinate along the strip (Eulerian, fixed to the contact).
+    a : float
+        Hertz half-width, ``a > 0``.
+    p0 : float
+        Hertz peak pressure, ``p0 ≥ 0``.
+    mu : float
+        Coulomb friction coefficient, ``μ ≥ 0``.
+    ratio : float
+        Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
+    direction : {-1, +1}
+        ``d = sgn(V)``; material enters at ``x = −d·a`` (FORMULATION.md §1).
+
+    Returns
+    -------
+    float or ndarray
+        ``t(x)``, the traction on body A in ``+x``, shape of ``x``;
+        ``∫ t dx = ratio·μ·P`` with ``P = πa·p0/2``. Mirror symmetry:
+        ``carter_traction(x, …, d) = carter_traction(−x, …, −d)``.
+
+    Raises
+    ------
+    InputError
+        ``|ratio| ≥ 1``, ``a ≤ 0``, ``p0 < 0``, ``μ < 0`` or ``direction`` not ``±1``.
+
+    Notes
+    -----
+    In the stick zone the strain difference ``∂w/∂x`` is uniform, so the steady slip
+    ``s = ξ + d·∂w/∂x`` vanishes there for the creepage of :func:`carter_creepage`. Source:
+    Carter (1926); Johnson (1985) Ch. 8, see ``SOURCES["carter_traction"]``.
+    """
+    x = _coords(x)
+    a = _positive("a", a)
+    p0 = _nonnegative("p0", p0)
+    mu = _nonnegative("mu", mu)
+    ratio = _ratio(ratio)
+    d = _direction(direction)
+    c = a * math.sqrt(1.0 - abs(ratio))
+    t = _semi_ellipse(x, 0.0, a) - (c / a) * _leading_semi_ellipse(x, a, c, d)
+    return _out(math.copysign(1.0, ratio) * (ratio != 0.0) * mu * p0 * t)
+
+
+def carter_creepage(a, R, mu, ratio):
+    """Carter's steady-rolling creepage for a given load ratio.
+
+    ``ξ = −sgn(ratio)·(μa/R)·(1 − √(1 − |ratio|))``.
+
+    Parameters
+    ----------
+    a : float
+        Hertz half-width, ``a > 0``.
+    R : float
+        Relative radius, ``R > 0``.
+    mu : float
+        Coulomb friction coefficient, ``μ ≥ 0``.
+    ratio : float or array_like
+        Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
+
+    Returns
+    -------
+    float or ndarray
+        ``ξ = (V_A − V_B)/|V|`` (FORMULATION.md §1), shape of ``ratio``. ``ξ`` and ``Q`` have
+        opposite signs; ``ξ`` does not depend on the rolling direction.
+
+    Notes
+    -----
+    Requires ``p0 = aE*/(2R)`` (Hertz). Derivation in the project's convention: the steady
+    slip is ``s = ξ + d·∂w/∂x`` and, inside Carter's stick zone,
+    ``∂w/∂x = −(2/(πE*))·PV∫ t(s)/(x − s) ds = −(μ/R)·x_c = d·μ(a − c)/R``, so ``s = 0`` gives
+    ``ξ = −μ(a − c)/R`` for ``ratio > 0``. Source: Carter (1926); Johnson (1985) Ch. 8, see
+    ``SOURCES["carter_creepage"]``.
+    """
+    a = _positive("a", a)
+    R = _positive("R", R)
+    mu = _nonnegative("mu", mu)
+    r = _ratio_array(ratio)
+    xi = -np.sign(r) * (mu * a / R) * (1.0 - np.sqrt(1.0 - np.abs(r)))
+    return _out(xi)
+
+
+def creep_force_ratio(xi, a, R, mu):
+    """Carter's creep-force law: load ratio ``Q/(μP)`` for a given creepage.
+
+    ``Q/(μP) = −sgn(ξ)·[1 − (1 − |ξ|R/(μa))²]`` for ``|ξ| ≤ μa/R``, and ``−sgn(ξ)`` (full
+    sliding) for ``|ξ| > μa/R``. The inverse of :func:`carter_creepage` on ``|ratio| < 1``.
+
+    Parameters
+    ----------
+    xi : float or array_like
+        Creepage ``ξ = (V_A − V_B)/|V|`` (finite).
+    a : float
+        Hertz half-width, ``a > 0``.
+    R : float
+        Relative radius, ``R > 0``.
+    mu : float
+        Coulomb friction coefficient, ``μ ≥ 0``; with ``μ = 0`` every nonzero ``ξ`` is
+        full sliding.
+
+    Returns
+    -------
+    float or ndarray
+        ``Q/(μP)`` in ``[−1, 1]``, of sign opposite to ``ξ``, shape of ``xi``. Monotone
+        non-increasing in ``ξ``; the small-creepage slope is ``d(Q/μP)/dξ = −2R/(μa)``,
+        i.e. ``dQ/dξ = −2PR/a = −πaE*/2`` (the 2D linear creep coefficient).
+
+    Notes
+    -----
+    Source: Carter (1926); Johnson (1985) Ch. 8; Kalker's 2D theory, see
+    ``SOURCES["creep_force_ratio"]``.
+    """
+    try:
+        xi_arr = np.asarray(xi, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("xi", f"must be real, got {xi!r}") from None
+    if not np.all(np.isfinite(xi_arr)):
+        raise InputError("xi", "must be finite")
+    a = _positive("a", a)
+    R = _positive("R", R)
+    mu = _nonnegative("mu", mu)
+    if mu == 0.0:
+        return _out(-np.sign(xi_arr))
+    u = np.minimum(np.abs(xi_arr) * R / (mu * a), 1.0)
+    return _out(-np.sign(xi_arr) * (1.0 - (1.0 - u) ** 2))
+
+
+# --------------------------------------------------------------------------- Bentall–Johnson
+def bentall_johnson_creepage(kappa, a, R):
+    """Magnitude of the free-rolling creepage of dissimilar cylinders as ``μ → 0``.
+
+    ``|ξ| = C·|κ|·a/R`` with ``C =`` :data:`BENTALL_JOHNSON_COEFFICIENT` ``= 0.45739… ≈ 0.457``.
+
+    Parameters
+    ----------
+    kappa : float
+        Bentall–Johnson's dissimilarity constant ``κ = 2β`` (``β`` Dundurs' parameter,
+        FORMULATION.md §3; the paper's eq. 92 constant), ``|κ| ≤ 1``.
+    a : float
+        Hertz half-width, ``a > 0``.
+    R : float
+        Relative radius, ``R > 0``.
+
+    Returns
+    -------
+    float
+        ``|ξ| ≥ 0``. **This is a magnitude**: the sign of ``ξ`` depends on which body is
+        the softer one (the sign of ``κ``) and on the rolling direction.
+
+    Notes
+    -----
+    Free rolling (``Q = 0``) in the limit ``μ → 0`` quoted in FORMULATION.md §11 (for finite
+    μ the creepage is smaller). Derivation: as ``μ → 0``, ``t → 0``, so ``w`` comes from the
+    pressure alone, ``∂w/∂x = −(κ/E*)·p(x)`` with §3's ``A_tn``; the steady slip
+    ``s = ξ − d·κ·p(x)/E*`` changes sign where ``p(x) = d·ξ·E*/κ``, i.e. at ``|x| = b``, and
+    ``t = −μ·p·sgn(s)`` carries no net force only if the central part ``|x| < b`` carries
+    half the load: ``u√(1−u²) + arcsin u = π/4``, ``u = b/a = 0.40397…``, whence
+    ``|ξ| = κ·p(b)/E* = ½√(1 − u²)·κ·a/R``. With §3's kernel signs this gives
+    ``sgn(ξ) = d·sgn(κ)``. Source: Bentall & Johnson (1967); Johnson (1985) Ch. 8, see
+    ``SOURCES["bentall_johnson_creepage"]``.
+    """
+    kappa = _scalar("kappa", kappa)
+    if abs(kappa) > 1.0:
+        raise InputError("kappa", f"must satisfy |kappa| <= 1 (kappa = 2*beta, |beta| <= 1/2), got {kappa!r}")
+    a = _positive("a", a)
+    R = _positive("R", R)
+    return BENTALL_JOHNSON_COEFFICIENT * abs(kappa) * a / R

@@ -1,0 +1,32 @@
+"""Influence matrices of the two bodies at the strip nodes (paper eq. 23–30; FORMULATION.md §3).
+
+``MODELS`` maps a scene's ``contact.model`` to a builder ``f(strip, **kw) -> Influence``;
+:func:`build_influence` dispatches on it.
+"""
+from __future__ import annotations
+
+from ..errors import InputError
+from .halfspace import Influence, halfspace_influence, min_eigenvalue
+
+__all__ = ["Influence", "halfspace_influence", "min_eigenvalue", "MODELS", "build_influence"]
+
+#: Available influence models (``contact.model``).
+MODELS = {"halfspace": halfspace_influence}
+
+
+def build_influence(model: str, strip, **kw) -> Influence:
+    """Build the influence of ``model`` on ``strip``; keyword arguments go to the builder.
+
+    Raises
+    ------
+    InputError
+        ``contact.model`` for an unknown model, or ``"bem"`` (not available yet).
+    """
+    if model == "bem" and "bem" not in MODELS:
+        raise InputError("contact.model", "the BEM model is not available yet (issue 4); use 'halfspace'")
+    try:
+        builder = MODELS[model]
+    except (KeyError, TypeError):
+        raise InputError("contact.model",
+                         f"must be one of {', '.join(sorted(MODELS))}, got {model!r}") from None
+    return builder(strip, **kw)

@@ -1,0 +1,551 @@
+"""Half-space influence matrices of two elastic cylinders (paper eq. 23–30; FORMULATION.md §3).
+
+For both bodies together, at the strip nodes (collocation at ``x_i``),
+
+.. math::
+
+    g = h - \\delta e + A_{nn} p + A_{nt} t \\qquad \\text{(eq. 25, 30)}
+
+    w = A_{tn} p + A_{tt} t \\qquad \\text{(eq. 28)}
+
+with ``w = u_x^A - u_x^B``, ``p`` the pressure (≥ 0 in compression) and ``t`` the traction on
+body A in +x (sign convention of FORMULATION.md §1). In the half-space approximation
+(plane strain) the combined compliances are (the paper's eq. 26 and 29 with ``S^α`` of eq. 24
+replaced by the half-space Green's functions):
+
+.. math::
+
+    A_{nn}[i,j] = A_{tt}[i,j] = \\frac{2}{\\pi E^*} K[i,j], \\quad
+    K[i,j] = \\int N_j(s)\\,\\bigl(-\\ln(|x_i - s| / d_{ref})\\bigr)\\,ds
+
+    A_{nt} = \\frac{\\beta}{E^*} S, \\quad A_{tn} = -\\frac{\\beta}{E^*} S, \\quad
+    S[i,j] = \\int N_j(s)\\,\\operatorname{sgn}(x_i - s)\\,ds
+
+``1/E* = (1-ν_A²)/E_A + (1-ν_B²)/E_B``; ``β`` is Dundurs' parameter (the paper's constant of
+eq. 92 is ``2β``, Bentall–Johnson's ``κ``). The kernels are reciprocal,
+``A_tn(x, s) = A_nt(s, x)``; in the discrete form this reads ``F A_tn = (F A_nt)ᵀ`` with
+``F = diag(f)``, ``f_j = ∫ N_j dx``.
+
+The reference distance ``d_ref``
+--------------------------------
+In 2D the surface displacements of a half-space are defined only up to a rigid constant: the
+log kernel carries an arbitrary length ``d_ref``. Changing ``d → d'`` adds
+``c e fᵀ`` with ``c = (2/(πE*)) ln(d'/d)`` to ``A_nn`` and ``A_tt`` (``S`` has no such constant):
+a rigid normal displacement ``c P e`` and a rigid tangential one ``c Q e``.
+
+* With ``P`` and ``Q`` prescribed the constants cancel: ``c P`` is absorbed by the approach
+  ``δ`` (a multiplier), and ``c Q`` (which reaches the slip only as ``c (Q^k - Q^{k-1})/Δq``, and
+  not at all in steady rolling, where ``D_up e = 0``) by the creepage ``ξ``. The tractions do
+  not depend on ``d_ref``; ``δ`` and ``ξ`` do, by these rigid amounts.
+* With ``δ`` or ``ξ`` prescribed they do not cancel: the tractions then depend on ``d_ref``.
+  The 2D half-space approach is **undetermined** (it grows like ``ln(d_ref)``); only a
+  finite-body model (BEM, FORMULATION.md §8) fixes it. Results with prescribed ``δ`` hold for
+  the chosen ``d_ref`` only.
+
+The QP of each step needs a positive definite Hessian ``sym(F A)``. The operator with kernel
+``-ln(|x - s| / d)`` is positive definite on an interval only if the interval is shorter than
+``4 d`` (its logarithmic capacity is a quarter of its length), i.e. ``d_ref > L/2`` on
+``[-L, L]``. The default ``d_ref = R`` (the relative radius) satisfies this with a wide margin
+(``L ≪ R`` in the half-space approximation), is fixed by the geometry rather than by the mesh,
+and is the natural length of the cylinder problem: it makes ``δ`` the textbook-like
+``(a²/2R)(ln(2R/a) + 1/2)`` for a Hertz pressure. :func:`halfspace_influence` checks the
+smallest eigenvalue and reports the smallest admissible ``d_ref`` of the discretization
+(:func:`minimum_reference_distance`) when the choice is too small.
+
+Element integrals
+-----------------
+On element ``e`` with centre ``c`` and half-length ``hl``, ``s = c + hl ξ`` and
+``ξ_i = (x_i - c)/hl``; the moments ``I_m(ξ_i) = ∫_{-1}^{1} ξ^m ln|ξ - ξ_i| dξ`` (m = 0, 1, 2)
+are evaluated in closed form with ``v = ξ - ξ_i`` and
+``∫ v^k ln|v| dv = v^{k+1}/(k+1) (ln|v| - 1/(k+1))`` (limit 0 at ``v = 0``). The closed form
+subtracts terms of size ``ξ_i² ln|ξ_i|`` to obtain a result of size ``ln|ξ_i|``, so it loses
+digits when ``|ξ_i|`` is large; for ``|ξ_i| > 4`` (the singularity at least three half-lengths
+outside the element) the moments are computed with 20-point Gauss–Legendre quadrature instead.
+There the integrand is analytic in a Bernstein ellipse of parameter
+``ρ = |ξ_i| + sqrt(ξ_i² - 1) > 7.8``, so the quadrature error ``~ρ^{-40} < 1e-35`` is far below
+round-off. (The quadrature is applied to ``log1p(-ξ/ξ_i) + ξ/ξ_i`` only, the terms
+``ln|ξ_i| - ξ/ξ_i`` being integrated exactly, so that the slightly inexact Gauss weights do not
+limit the accuracy: the moments are correct to a few ulps.) The sgn kernel is piecewise
+polynomial and is integrated exactly.
+
+The strip of :class:`rollqp.strip.Strip` is a uniform lattice; the offsets ``ξ_i`` then take only
+``O(n)`` distinct values (small integers), which are evaluated once and gathered. This makes the
+matrices translation invariant to the last bit (exactly symmetric ``F K`` for constant elements)
+and fast (a 2601-node strip in well under a second). Other node layouts (any object with ``x``,
+``edges``, ``connectivity``, ``coefficients`` and ``weights``) use the general path, evaluating
+every node–element pair.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg
+
+from ..errors import InputError
+
+__all__ = [
+    "Influence",
+    "halfspace_influence",
+    "log_kernel_matrix",
+    "sgn_kernel_matrix",
+    "undeformed_gap",
+    "min_eigenvalue",
+    "minimum_reference_distance",
+    "asymmetry",
+]
+
+COUPLINGS = ("auto", "full", "goodman", "off")
+
+#: ``|ξ_i|`` above which the log moments use Gauss–Legendre quadrature (see module docstring).
+FAR_FIELD = 4.0
+#: Number of Gauss–Legendre points of the far field.
+GAUSS_POINTS = 20
+_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(GAUSS_POINTS)
+# Largest deviation (in ξ) of actual offsets from the ideal lattice that is treated as round-off.
+_LATTICE_TOL = 1e-10
+_CHUNK = 1 << 18
+
+
+# ---------------------------------------------------------------------------------------------
+# Reference-element integrals
+# ---------------------------------------------------------------------------------------------
+def _log_moments(xi: np.ndarray) -> np.ndarray:
+    """``I_m(ξ_i) = ∫_{-1}^{1} ξ^m ln|ξ - ξ_i| dξ`` for m = 0, 1, 2; shape ``xi.shape + (3,)``.
+
+    Closed form for ``|ξ_i| <= FAR_FIELD``, Gauss–Legendre beyond (module docstring).
+    """
+    xi = np.asarray(xi, dtype=float)
+    flat = xi.ravel()
+    out = np.empty((flat.size, 3))
+    near = np.abs(flat) <= FAR_FIELD
+    if near.any():
+        z = flat[near]
+
+        def prim(v):
+            # G_k(v) = v^{k+1}/(k+1) (ln|v| - 1/(k+1)), k = 0, 1, 2; G_k(0) = 0.
+            av = np.abs(v)
+            lv = np.log(np.where(av > 0, av, 1.0))
+            return [v ** (k + 1) / (k + 1) * (lv - 1.0 / (k + 1)) for k in range(3)]
+
+        gp, gm = prim(1.0 - z), prim(-1.0 - z)
+        d0, d1, d2 = (gp[k] - gm[k] for k in range(3))
+        out[near, 0] = d0
+        out[near, 1] = d1 + z * d0
+        out[near, 2] = d2 + 2.0 * z * d1 + z * z * d0
+    # Far field: ln|ξ - ξ_i| = ln|ξ_i| - ξ/ξ_i + [log1p(-ξ/ξ_i) + ξ/ξ_i]. The first two terms
+    # are integrated exactly (moments ∫ξ^m = 2, 0, 2/3 and ∫ξ^{m+1} = 0, 2/3, 0); only the
+    # O((ξ/ξ_i)²) remainder (|ξ/ξ_i| < 1/4) goes to Gauss–Legendre, so the result is accurate to
+    # round-off relative to itself, also for the small odd moment.
+    far = np.flatnonzero(~near)
+    moments = _GAUSS_W[:, None] * _GAUSS_X[:, None] ** np.arange(3)[None, :]  # (ng, 3)
+    m0 = np.array([2.0, 0.0, 2.0 / 3.0])
+    m1 = np.array([0.0, 2.0 / 3.0, 0.0])
+    block = _CHUNK // GAUSS_POINTS + 1
+    for start in range(0, far.size, block):
+        idx = far[start:start + block]
+        z = flat[idx]
+        u = _GAUSS_X[None, :] / z[:, None]
+        rest = np.log1p(-u) + u
+        out[idx] = (np.log(np.abs(z))[:, None] * m0[None, :] - (1.0 / z)[:, None] * m1[None, :]
+                    + rest @ moments)
+    return out.reshape(xi.shape + (3,))
+
+
+def _sgn_moments(xi: np.ndarray) -> np.ndarray:
+    """``∫_{-1}^{1} ξ^m sgn(ξ_i - ξ) dξ`` for m = 0, 1, 2 (exact); shape ``xi.shape + (3,)``.
+
+    With ``t = clip(ξ_i, -1, 1)``: ``∫_{-1}^{t} ξ^m - ∫_{t}^{1} ξ^m = (2 t^{m+1} - 1 - (-1)^{m+1})/(m+1)``.
+    """
+    t = np.clip(np.asarray(xi, dtype=float), -1.0, 1.0)
+    return np.stack([2.0 * t, t * t - 1.0, (2.0 * t ** 3) / 3.0], axis=-1)
+
+
+# ---------------------------------------------------------------------------------------------
+# Geometry and assembly
+# ---------------------------------------------------------------------------------------------
+def _snap(value: float) -> float:
+    """``value`` rounded to a dyadic rational with a 2^-20 step (exact small lattice numbers)."""
+    return float(np.round(value * 2.0 ** 20) / 2.0 ** 20)
+
+
+def _offsets(strip, lattice: bool | None = None):
+    """Reference offsets ``ξ[i, e] = (x_i - c_e) / hl_e`` as ``(values, index, hl)``.
+
+    ``values[index]`` is the (n, n_elements) offset matrix. On a uniform lattice (nodes
+    ``x_0 + i·Δx``, equal elements of length ``r·Δx`` with integer ``r``) the offsets are
+    ``ξ_00 + (Δx/hl)(i - r e)``: only the distinct values are returned, computed from the ideal
+    lattice: the nodes and edges of :class:`~rollqp.strip.Strip` (``linspace``) deviate from it
+    by round-off only, checked to ``_LATTICE_TOL`` half-lengths.
+    ``lattice=None`` detects the lattice, ``False`` forces the general path, ``True`` requires it.
+    """
+    x = np.asarray(strip.x, dtype=float)
+    edges = np.asarray(strip.edges, dtype=float)
+    n, ne = x.size, edges.size - 1
+    hl = 0.5 * np.diff(edges)
+    if np.any(hl <= 0):
+        raise InputError("strip", "element edges must be strictly increasing")
+    if lattice is not False and n >= 2:
+        hl0 = 0.5 * (edges[-1] - edges[0]) / ne
+        dx = (x[-1] - x[0]) / (n - 1)
+        step = _snap(dx / hl0)                    # Δx / hl: 2 (constant, linear), 1 (quadratic)
+        r = int(round(2.0 / step)) if step > 0 else 0
+        xi00 = _snap((x[0] - 0.5 * (edges[0] + edges[1])) / hl0)
+        tol = _LATTICE_TOL * hl0
+        if (r >= 1 and abs(r * step - 2.0) < 1e-12
+                and abs(x[0] - 0.5 * (edges[0] + edges[1]) - xi00 * hl0) <= tol
+                and np.max(np.abs(x - x[0] - step * hl0 * np.arange(n))) <= tol
+                and np.max(np.abs(edges - edges[0] - 2.0 * hl0 * np.arange(ne + 1))) <= tol):
+            kmin = -r * (ne - 1)
+            values = xi00 + step * np.arange(kmin, n)
+            index = np.arange(n)[:, None] - r * np.arange(ne)[None, :] - kmin
+            return values, index, np.full(ne, hl0)
+        if lattice:
+            raise InputError("strip", "nodes are not a uniform lattice")
+    centre = 0.5 * (edges[:-1] + edges[1:])
+    xi = (x[:, None] - centre[None, :]) / hl[None, :]
+    return xi.ravel(), np.arange(n * ne).reshape(n, ne), hl
+
+
+def _assemble(strip, moments, offsets) -> np.ndarray:
+    """``M[i, j] = Σ_e hl_e ∫_{-1}^{1} N_a(ξ) k(ξ, ξ_ie) dξ`` over the ``(e, a)`` with node ``j``.
+
+    ``moments(values)`` returns the reference moments ``∫ ξ^m k dξ`` (m = 0, 1, 2);
+    ``offsets`` is the result of :func:`_offsets`.
+    """
+    values, index, hl = offsets
+    coef = np.asarray(strip.coefficients, dtype=float)          # (nen, 3)
+    local = moments(values) @ coef.T                            # (n_values, nen)
+    conn = np.asarray(strip.connectivity)
+    n = np.asarray(strip.x).size
+    M = np.zeros((n, n))
+    for a in range(conn.shape[1]):
+        # Within one local index a, every node appears at most once: plain fancy-index add.
+        M[:, conn[:, a]] += local[index, a] * hl[None, :]
+    return M
+
+
+def _check_positive(value, key, what):
+    value = float(value)
+    if not (np.isfinite(value) and value > 0):
+        raise InputError(key, f"{what} must be a finite number > 0, got {value!r}")
+    return value
+
+
+def log_kernel_matrix(strip, d_ref: float) -> np.ndarray:
+    """Collocation matrix of the 2D log kernel (the shape of ``A_nn``, eq. 25–26).
+
+    .. math::
+
+        K[i, j] = \\int N_j(s)\\,\\bigl(-\\ln(|x_i - s| / d_{ref})\\bigr)\\,ds
+
+    integrated over every element where ``N_j`` is nonzero, in closed form near the node and by
+    20-point Gauss–Legendre quadrature where ``|ξ_i| > 4`` (module docstring).
+
+    Parameters
+    ----------
+    strip : rollqp.strip.Strip
+        Nodes ``x``, ``edges``, ``connectivity``, reference ``coefficients``, ``weights``.
+    d_ref : float
+        Reference distance of the logarithm (> 0, same length unit as ``x``).
+
+    Returns
+    -------
+    K : ndarray, shape (n, n)
+        Not symmetric in general; ``F K`` (``F = diag(weights)``) is symmetric up to the
+        discretization error, exactly for constant elements on a uniform grid.
+
+    Notes
+    -----
+    On element ``e`` (``s = c + hl ξ``)
+    ``∫_e N_a (-ln(|x_i - s|/d)) ds = -hl ∫ N_a ln|ξ - ξ_i| dξ + hl ln(d/hl) ∫ N_a dξ``,
+    so ``K(d') = K(d) + ln(d'/d) e fᵀ``.
+    """
+    d_ref = _check_positive(d_ref, "contact.reference_distance", "the reference distance")
+    return _log_kernel(strip, d_ref)
+
+
+def _log_kernel(strip, d_ref, lattice=None):
+    offsets = _offsets(strip, lattice)
+    K = -_assemble(strip, _log_moments, offsets)
+    hl = offsets[2]
+    coef = np.asarray(strip.coefficients, dtype=float)
+    w_ref = 2.0 * coef[:, 0] + 2.0 * coef[:, 2] / 3.0            # ∫_{-1}^{1} N_a dξ
+    conn = np.asarray(strip.connectivity)
+    shift = np.zeros(K.shape[1])
+    np.add.at(shift, conn, (hl * np.log(d_ref / hl))[:, None] * w_ref[None, :])
+    return K + shift[None, :]
+
+
+def sgn_kernel_matrix(strip) -> np.ndarray:
+    """Collocation matrix of the sign kernel (the shape of ``A_nt``, ``A_tn``; eq. 26, 29).
+
+    .. math::
+
+        S[i, j] = \\int N_j(s)\\,\\operatorname{sgn}(x_i - s)\\,ds
+
+    exact (piecewise polynomial; ``x_i`` may be an element end or interior node).
+
+    Parameters
+    ----------
+    strip : rollqp.strip.Strip
+
+    Returns
+    -------
+    S : ndarray, shape (n, n)
+        ``Σ_j S[i, j] = (x_i + L) - (L - x_i) = 2 x_i``; ``F S`` is antisymmetric up to the
+        discretization error, exactly for constant elements on a uniform grid.
+    """
+    return _sgn_kernel(strip)
+
+
+def _sgn_kernel(strip, lattice=None):
+    return _assemble(strip, _sgn_moments, _offsets(strip, lattice))
+
+
+def undeformed_gap(x, R_A: float, R_B: float = np.inf) -> np.ndarray:
+    """Undeformed separation of two cylinders (eq. 10).
+
+    .. math::
+
+        h(x) = R_A\\bigl(1 - \\sqrt{1 - (x/R_A)^2}\\bigr) + R_B\\bigl(1 - \\sqrt{1 - (x/R_B)^2}\\bigr)
+
+    evaluated as ``x² / (R (1 + sqrt(1 - (x/R)²)))`` per body (no cancellation; ``R = inf``, a
+    plane, contributes 0). ``h ≈ x²/(2R)`` with ``1/R = 1/R_A + 1/R_B``.
+    """
+    x = np.asarray(x, dtype=float)
+    h = np.zeros_like(x)
+    for key, radius in (("R_A", R_A), ("R_B", R_B)):
+        radius = float(radius)
+        if not (radius > 0):
+            raise InputError(key, f"the radius must be > 0 (or inf for a plane), got {radius!r}")
+        if np.isinf(radius):
+            continue
+        u = x / radius
+        if np.any(np.abs(u) > 1):
+            raise InputError(key, f"the radius {radius:g} is smaller than the zone half-width "
+                                  f"{np.max(np.abs(x)):g}")
+        h = h + x * x / (radius * (1.0 + np.sqrt(1.0 - u * u)))
+    return h
+
+
+# ---------------------------------------------------------------------------------------------
+# Diagnostics
+# ---------------------------------------------------------------------------------------------
+def _weights(F) -> np.ndarray:
+    F = np.asarray(F, dtype=float)
+    return np.diag(F).copy() if F.ndim == 2 else F
+
+
+def asymmetry(F, A) -> float:
+    """``‖FA - (FA)ᵀ‖_F / ‖FA‖_F`` with ``F = diag(f)`` (``F`` the weights or the matrix)."""
+    FA = _weights(F)[:, None] * np.asarray(A, dtype=float)
+    norm = np.linalg.norm(FA)
+    return float(np.linalg.norm(FA - FA.T) / norm) if norm > 0 else 0.0
+
+
+def min_eigenvalue(F, A) -> float:
+    """Smallest eigenvalue of ``sym(F A)`` relative to the largest in magnitude.
+
+    ``sym(F A) = (F A + (F A)ᵀ)/2`` is the Hessian the QPs use (FORMULATION.md §7).
+
+    Parameters
+    ----------
+    F : ndarray, shape (n,) or (n, n)
+        The weights ``f`` or ``diag(f)``.
+    A : ndarray, shape (n, n)
+
+    Returns
+    -------
+    float
+        ``λ_min / max|λ|`` (scale-free; ``> 0`` iff positive definite).
+    """
+    FA = _weights(F)[:, None] * np.asarray(A, dtype=float)
+    ev = np.linalg.eigvalsh(0.5 * (FA + FA.T))
+    top = np.max(np.abs(ev))
+    return float(ev[0] / top) if top > 0 else 0.0
+
+
+def _threshold(f, K, d_ref):
+    """Smallest ``d`` with ``sym(F K(d))`` positive definite, from ``K = K(d_ref)``.
+
+    ``sym(F K(d)) = B + τ f fᵀ`` with ``B = sym(F K(d_ref))``, ``τ = ln(d/d_ref)``. If ``B`` is
+    positive definite on ``f^⊥`` (true for the log kernel), ``det(B + τ f fᵀ) =
+    det(B)(1 + τ fᵀB⁻¹f)`` vanishes only at ``τ* = -1/(fᵀB⁻¹f)``, and the matrix is positive
+    definite exactly for ``τ > τ*``. Returns ``nan`` when ``B`` is singular.
+    """
+    FK = f[:, None] * K
+    B = 0.5 * (FK + FK.T)
+    try:
+        y = scipy.linalg.cho_solve(scipy.linalg.cho_factor(B), f)     # B positive definite
+    except np.linalg.LinAlgError:
+        try:
+            y = scipy.linalg.solve(B, f, assume_a="sym")
+        except np.linalg.LinAlgError:
+            return float("nan")
+    q = float(f @ y)
+    return float(d_ref * np.exp(-1.0 / q)) if q != 0 else float("nan")
+
+
+def minimum_reference_distance(strip) -> float:
+    """Smallest ``d_ref`` for which ``sym(F K)`` of this discretization is positive definite.
+
+    The continuous bound is ``L/2``, the logarithmic capacity of ``[-L, L]`` (a quarter of its
+    length); the discrete threshold converges to it under refinement (0.6277 for 40 QCE on
+    ``L = 1.25``, bound 0.625). Any admissible ``d_ref`` must exceed it. Computed from
+    ``K(4L)`` with the rank-one formula of ``_threshold`` (one symmetric solve, ``O(n³)``).
+    """
+    L = 0.5 * float(np.asarray(strip.edges)[-1] - np.asarray(strip.edges)[0])
+    d0 = 4.0 * L
+    return _threshold(np.asarray(strip.weights, dtype=float), _log_kernel(strip, d0), d0)
+
+
+# ---------------------------------------------------------------------------------------------
+# The combined influence
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Influence:
+    """Combined influence of both bodies at the strip nodes (eq. 25, 28, 30).
+
+    .. math::
+
+        g = h - \\delta e + A_{nn} p + A_{nt} t, \\qquad w = A_{tn} p + A_{tt} t
+
+    with ``w = u_x^A - u_x^B``, ``p ≥ 0`` in compression, ``t`` on body A in +x.
+
+    Attributes
+    ----------
+    Ann, Att : ndarray, shape (n, n)
+        Normal–normal and tangential–tangential compliances.
+    Ant : ndarray, shape (n, n) or None
+        Normal displacement due to ``t``; ``None`` for coupling ``"goodman"`` and ``"off"``.
+    Atn : ndarray, shape (n, n) or None
+        Tangential displacement due to ``p``; ``None`` for coupling ``"off"``.
+    h : ndarray, shape (n,)
+        Undeformed gap at the nodes (eq. 10).
+    model : str
+        ``"halfspace"`` (or ``"bem"``).
+    info : dict
+        Model data and diagnostics (``d_ref``, ``coupling``, ``beta``, ``kappa = 2β``,
+        ``Estar``, ``R``, ``asymmetry_FA``, ``min_eig_rel``, ...).
+    """
+
+    Ann: np.ndarray
+    Att: np.ndarray
+    Ant: np.ndarray | None
+    Atn: np.ndarray | None
+    h: np.ndarray
+    model: str
+    info: dict = field(default_factory=dict)
+
+    @property
+    def coupled(self) -> bool:
+        """True when the normal problem sees ``t`` (``A_nt`` present: full coupling)."""
+        return self.Ant is not None
+
+    @property
+    def has_Atn(self) -> bool:
+        """True when the pressure displaces the surfaces tangentially (full or goodman)."""
+        return self.Atn is not None
+
+    @property
+    def n(self) -> int:
+        """Number of nodes."""
+        return int(self.h.size)
+
+
+def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: float = np.inf,
+                        coupling: str = "off", d_ref: float | None = None) -> Influence:
+    """Half-space influence of two cylinders (eq. 25–30; FORMULATION.md §3).
+
+    ``A_nn = A_tt = (2/(πE*)) K``, ``A_nt = (β/E*) S``, ``A_tn = -(β/E*) S`` with ``K`` of
+    :func:`log_kernel_matrix` and ``S`` of :func:`sgn_kernel_matrix`; ``h`` from eq. 10.
+
+    Parameters
+    ----------
+    strip : rollqp.strip.Strip
+    Estar : float
+        Combined modulus, ``1/E* = (1-ν_A²)/E_A + (1-ν_B²)/E_B``.
+    beta : float
+        Dundurs' ``β`` (``|β| ≤ 1/2``); the paper's constant (eq. 92) and Bentall–Johnson's
+        ``κ`` are ``2β``.
+    R_A, R_B : float
+        Cylinder radii; ``R_B = inf`` for a plane. ``1/R = 1/R_A + 1/R_B``.
+    coupling : {"off", "goodman", "full", "auto"}
+        ``"full"`` keeps ``A_nt`` and ``A_tn``; ``"goodman"`` only ``A_tn`` (shear does not change
+        the pressure); ``"off"`` neither; ``"auto"`` is ``"full"`` if ``β ≠ 0`` else ``"off"``.
+        ``β = 0`` with ``"full"``/``"goodman"`` gives zero matrices.
+    d_ref : float, optional
+        Reference distance of the log kernel; default ``R`` (module docstring).
+
+    Returns
+    -------
+    Influence
+
+    Raises
+    ------
+    InputError
+        ``contact.reference_distance`` when ``sym(F A_nn)`` is not positive definite (the message
+        gives the smallest admissible value), and for invalid arguments.
+
+    Notes
+    -----
+    The positive-definiteness check is a dense symmetric eigenvalue computation, ``O(n³)``: it
+    dominates the cost for large strips (≈ 0.3 s for 1281 nodes, ≈ 2 s for 2601), while the
+    matrices themselves take ``O(n²)``.
+    """
+    Estar = _check_positive(Estar, "Estar", "E*")
+    beta = float(beta)
+    if not (np.isfinite(beta) and abs(beta) <= 0.5):
+        raise InputError("beta", f"Dundurs' beta must lie in [-0.5, 0.5], got {beta!r}")
+    if coupling not in COUPLINGS:
+        raise InputError("contact.coupling", f"must be one of {', '.join(COUPLINGS)}, got {coupling!r}")
+    if coupling == "auto":
+        coupling = "full" if beta != 0 else "off"
+    x = np.asarray(strip.x, dtype=float)
+    h = undeformed_gap(x, R_A, R_B)
+    R = 1.0 / (1.0 / float(R_A) + 1.0 / float(R_B))
+    if d_ref is None:
+        d_ref = R
+    d_ref = _check_positive(d_ref, "contact.reference_distance", "the reference distance")
+    f = np.asarray(strip.weights, dtype=float)
+    L = 0.5 * float(np.asarray(strip.edges)[-1] - np.asarray(strip.edges)[0])
+
+    K = log_kernel_matrix(strip, d_ref)
+    lam = min_eigenvalue(f, K)
+    if not lam > 0:
+        d_min = _threshold(f, K, d_ref)
+        hint = (f"the smallest admissible value for this mesh is {d_min:.6g}"
+                if np.isfinite(d_min) else "no admissible value could be determined")
+        raise InputError(
+            "contact.reference_distance",
+            f"d_ref = {d_ref:.6g} makes the normal influence matrix indefinite "
+            f"(relative min eigenvalue {lam:.3e}); it must exceed L/2 = {L / 2:.6g} "
+            f"(continuous bound), {hint}; the default is the relative radius R")
+    d_min = _threshold(f, K, d_ref)
+
+    Ann = (2.0 / (np.pi * Estar)) * K
+    Att = Ann.copy()
+    Ant = Atn = None
+    info = {
+        "d_ref": d_ref, "d_ref_min": d_min, "d_ref_min_continuous": 0.5 * L,
+        "coupling": coupling, "beta": beta, "kappa": 2.0 * beta, "Estar": Estar,
+        "R": R, "R_A": float(R_A), "R_B": float(R_B),
+        "asymmetry_FA": asymmetry(f, K),
+        "asymmetry_A": float(np.linalg.norm(K - K.T) / np.linalg.norm(K)),
+        "min_eig_rel": lam,
+        "gauss_points": GAUSS_POINTS, "far_field": FAR_FIELD,
+    }
+    if coupling in ("full", "goodman"):
+        S = sgn_kernel_matrix(strip)
+        FS = f[:, None] * S
+        nFS = np.linalg.norm(FS)
+        # Reciprocity F A_tn = (F A_nt)ᵀ  <=>  F S antisymmetric.
+        info["reciprocity_defect"] = float(np.linalg.norm(FS + FS.T) / nFS) if nFS > 0 else 0.0
+        Atn = (-beta / Estar) * S
+        if coupling == "full":
+            Ant = (beta / Estar) * S
+    for M in (Ann, Att, Ant, Atn, h):
+        if M is not None:
+            M.setflags(write=False)
+    return Influence(Ann=Ann, Att=Att, Ant=Ant, Atn=Atn, h=h, model="halfspace", info=info)

@@ -1,0 +1,176 @@
+"""Shared machinery of the QP backends (FORMULATION.md §7).
+
+Each backend translates a :class:`~rollqp.problem.QPForm` into its solver's native form
+once per *structure* (problem kind, size, which bounds are finite, load or multiplier
+prescribed) and per Hessian, and afterwards only updates vectors and warm-starts.
+The solution is mapped back and evaluated with rollqp's own residuals on the problem the
+QP actually solves: the one with the symmetrized operator ``F⁻¹ sym(F A)``. The measured
+asymmetry ``‖FA − (FA)ᵀ‖/‖FA‖`` travels with the solution (``info["asymmetry"]``).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..errors import InputError, SolverError
+from ..problem import StepSolution
+
+
+class QPMethod:
+    """Base class: one instance per scene, holding one solver object per problem structure.
+
+    Parameters
+    ----------
+    tolerance : float
+        Target accuracy of the solver (its own convergence tolerances are set from it).
+    residual_limit : float, optional
+        Largest acceptable rollqp residual (nondimensional max norm); a solve whose
+        residual exceeds it is a :class:`~rollqp.errors.SolverError`. Default
+        ``max(100·tolerance, 1e-12)``: the solvers' stopping tests are on their scaled
+        KKT conditions, which bound rollqp's residuals up to the conditioning of the
+        scaling (measured factor below 100 on the paper's meshes).
+    max_iterations : int
+        Solver iteration limit.
+    operator : {"exact", "symmetrized"}
+        ``"exact"`` (default): solve the collocation problem itself by symmetric–skew
+        splitting (below). ``"symmetrized"``: one QP with ``F⁻¹ sym(F A)`` in place of
+        ``A``; the solution then belongs to that other discrete problem, and its residuals
+        are computed on it.
+
+    Notes
+    -----
+    A QP needs a symmetric Hessian, and the weighted collocation operator ``F A`` is
+    symmetric only for piecewise-constant elements on a uniform grid. Writing
+    ``F A = H + S`` (``H`` symmetric, ``S`` skew), the step is solved as a sequence of
+    convex QPs with Hessian ``H`` and the skew part moved to the linear term at the
+    previous iterate, ``q_k = q + S x_{k−1}``. Its fixed point satisfies the KKT
+    conditions of the collocation problem exactly. The solution map of a strongly
+    monotone variational inequality is 1-Lipschitz from ``H⁻¹``-norm data to ``H``-norm
+    solutions, so the error contracts by ``ρ = ‖H^{-1/2} S H^{-1/2}‖₂`` per QP; measured
+    ρ ≈ 0.05 for quadratic and 0.065 for linear elements, independent of the mesh
+    (``docs/validation.md``). The single symmetrized QP is *not* a small perturbation:
+    on 40 quadratic elements it puts a vertex/midnode checkerboard of 13 % of p0 on the
+    Hertz pressure, because ``S`` feeds the log kernel's weakest mode.
+    """
+
+    name = "qp"
+    extra = None  # pip extra that installs the backend, if optional
+    max_splitting = 60
+
+    def __init__(self, tolerance: float = 1e-10, residual_limit: float | None = None,
+                 max_iterations: int | None = None, operator: str = "exact", **options):
+        if not (np.isfinite(tolerance) and 0 < tolerance < 1):
+            raise InputError("solver.tolerance", f"must be in (0, 1), got {tolerance!r}")
+        if operator not in ("exact", "symmetrized"):
+            raise InputError("operator", f"must be 'exact' or 'symmetrized', got {operator!r}")
+        self.tolerance = float(tolerance)
+        self.residual_limit = float(residual_limit) if residual_limit is not None else max(100 * tolerance, 1e-12)
+        self.max_iterations = max_iterations
+        self.operator = operator
+        self.options = options
+        self._cache = {}
+
+    # --------------------------------------------------------------- public
+    def solve(self, problem, warm: StepSolution | None = None) -> StepSolution:
+        """Solve a normal or tangential step; raise :class:`SolverError` short of solved."""
+        t0 = time.perf_counter()
+        asym, Asym, Skew = self._split(problem)
+        sym_problem = problem.replace(A=Asym) if asym > 0 else problem
+        x_prev = None
+        if warm is not None:
+            w = warm.p if problem.kind == "normal" else warm.t
+            if w is not None and np.shape(w) == (problem.n,):
+                x_prev = np.asarray(w, dtype=float)
+        exact = self.operator == "exact" and asym > 0
+        iters, solver_time, outer, change = 0, 0.0, 0, np.inf
+        x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
+        while True:
+            outer += 1
+            prob = sym_problem
+            if exact:
+                extra = Skew @ x_phys  # F⁻¹ S x_{k−1}, in displacement units
+                prob = (sym_problem.replace(offset=extra if sym_problem.offset is None else sym_problem.offset + extra)
+                        if problem.kind == "normal" else sym_problem.replace(c=sym_problem.c + extra))
+            form = prob.qp_form()
+            x0 = None if x_prev is None else x_prev / problem.scales.stress
+            x, y, status, it, st, info = self._solve_form(form, x0)
+            iters += int(it)
+            solver_time += float(st)
+            if status != "solved":
+                sol = prob.solution_from_qp(form, x, y)
+                raise SolverError(f"the {problem.kind} QP was not solved", method=self.name, status=status,
+                                  residual=sol.residual, iterations=iters)
+            sol = prob.solution_from_qp(form, x, y)
+            x_new = sol.p if problem.kind == "normal" else sol.t
+            if not exact:
+                break
+            last, change = change, float(np.max(np.abs(x_new - x_phys))) / problem.scales.stress
+            x_phys = x_prev = x_new
+            if change <= self.tolerance or (change >= 0.5 * last and change <= self.residual_limit):
+                break  # converged, or stalled at the QP solver's own accuracy
+            if outer >= self.max_splitting:
+                raise SolverError("the symmetric-skew splitting did not converge", method=self.name,
+                                  status=f"change {change:.2e} after {outer} QPs", iterations=iters,
+                                  residual=self._evaluate(problem, sol).residual)
+        final = self._evaluate(problem if exact or asym == 0 else sym_problem, sol)
+        final.method, final.status, final.iterations = self.name, "solved", iters
+        final.solver_time = solver_time
+        final.time = time.perf_counter() - t0
+        final.info.update(info)
+        final.info.update(asymmetry=asym, operator="exact" if (exact or asym == 0) else "symmetrized",
+                          qp_solves=outer)
+        if not final.residual <= self.residual_limit:
+            raise SolverError(f"the {problem.kind} QP solution's residual is above {self.residual_limit:.1e}",
+                              method=self.name, status=status, residual=final.residual, iterations=iters)
+        return final
+
+    # --------------------------------------------------------------- helpers
+    @staticmethod
+    def _evaluate(problem, sol):
+        """Re-evaluate a QP solution on ``problem`` (rollqp's residuals, not the solver's)."""
+        if problem.kind == "normal":
+            return problem.solution(sol.p, sol.delta)
+        return problem.solution(sol.t, sol.xi)
+
+    def _split(self, problem):
+        """``(asymmetry, F⁻¹ sym(FA), F⁻¹ skew(FA))`` of the problem's operator, cached per matrix."""
+        key = ("split", id(problem.A), id(problem.f))
+        hit = self._cache.get(key)
+        if hit is None or hit[0] is not problem.A or hit[1] is not problem.f:
+            A, f = problem.A, problem.f
+            FA = f[:, None] * A
+            skew = 0.5 * (FA - FA.T)
+            asym = float(np.linalg.norm(skew) * 2 / np.linalg.norm(FA))
+            Asym = (FA - skew) / f[:, None] if asym > 0 else A
+            hit = (A, f, (asym, Asym, skew / f[:, None]))
+            self._cache[key] = hit
+        return hit[2]
+
+    def _solver_for(self, form, build):
+        """The cached solver object for this structure and Hessian, built on first use."""
+        key = form.structure
+        hit = self._cache.get(key)
+        if hit is not None and hit[0].shape == form.H.shape and np.array_equal(hit[0], form.H):
+            return hit[1], False
+        obj = build(form)
+        self._cache[key] = (form.H.copy(), obj)
+        return obj, True
+
+    def _solve_form(self, form, x0):  # pragma: no cover - abstract
+        """Return ``(x, y, status, iterations, solver_time, info)``; status 'solved' or the solver's."""
+        raise NotImplementedError
+
+
+def constraint_rows(form):
+    """Indices of the rows ``x_i <= u_i`` (finite ``u``), ``-x_i <= -l_i`` (finite ``l``) and
+    ``x_i = l_i`` (``l_i == u_i``: a node with a zero friction bound).
+
+    Fixed variables are equalities, not two opposite active inequalities: the latter make
+    an interior point's interior empty and an active-set polish's KKT system singular.
+    """
+    n = form.H.shape[0]
+    fixed = form.fixed
+    up = np.flatnonzero(np.isfinite(form.upper) & ~fixed)
+    lo = np.flatnonzero(np.isfinite(form.lower) & ~fixed)
+    return n, up, lo, np.flatnonzero(fixed)

@@ -1,0 +1,113 @@
+"""cvxpy: the textbook formulation, for readability and as a third opinion.
+
+.. code-block:: python
+
+    minimize    ½ xᵀ H x + qᵀ x
+    subject to  aᵀ x == b,   l <= x <= u
+
+``q``, ``b``, ``l`` and ``u`` are :class:`cvxpy.Parameter`\\ s, so the problem is
+DPP-compliant and compiled once per scene; each step only sets parameter values.
+The default solver is OSQP, with polishing passed explicitly (cvxpy turns it off on
+re-solves otherwise) and ``status_polish`` checked; ``solver="CLARABEL"`` is accepted.
+"""
+from __future__ import annotations
+
+import cvxpy as cp
+import numpy as np
+
+from ._qp import QPMethod, constraint_rows
+
+try:
+    import osqp as _osqp
+    _POLISH_KEY = "polish" if int(_osqp.__version__.split(".")[0]) < 1 else "polishing"
+except ImportError:  # pragma: no cover - osqp is a core dependency
+    _POLISH_KEY = "polishing"
+
+
+class CvxpyQP(QPMethod):
+    name = "qp-cvxpy"
+
+    def __init__(self, tolerance=1e-10, residual_limit=None, max_iterations=None, solver="OSQP", **options):
+        super().__init__(tolerance, residual_limit, max_iterations, **options)
+        if solver not in ("OSQP", "CLARABEL"):
+            from ..errors import InputError
+            raise InputError("solver", f"cvxpy backend solver must be 'OSQP' or 'CLARABEL', got {solver!r}")
+        self.solver = solver
+
+    def _build(self, form):
+        n, up, lo, fx = constraint_rows(form)
+        x = cp.Variable(n, name="x")
+        q = cp.Parameter(n, name="q")
+        objective = cp.Minimize(0.5 * cp.quad_form(x, cp.psd_wrap(form.H)) + q @ x)
+        cons, params = [], {"q": q}
+        if form.a is not None:
+            b = cp.Parameter(name="b")
+            cons.append(form.a @ x == b)
+            params["b"] = b
+        if fx.size:
+            cons.append(x[fx] == 0.0)  # nodes without friction bound carry no shear
+        if up.size:
+            u = cp.Parameter(up.size, name="u")
+            cons.append(x[up] <= u)
+            params["u"] = (u, up)
+        if lo.size:
+            l = cp.Parameter(lo.size, name="l")
+            cons.append(x[lo] >= l)
+            params["l"] = (l, lo)
+        prob = cp.Problem(objective, cons)
+        if not prob.is_dpp():  # pragma: no cover - a bug in this module, not bad input
+            raise RuntimeError("the cvxpy step problem is not DPP-compliant")
+        return prob, x, params, cons
+
+    def _solver_kwargs(self):
+        if self.solver == "OSQP":
+            eps = max(self.tolerance, 1e-7)
+            # cvxpy forwards this dict to OSQP; OSQP >= 1 calls the switch "polishing", and cvxpy
+            # defaults it to off on every re-solve that does not refactorize.
+            kw = dict(**{_POLISH_KEY: True}, polish_refine_iter=20, eps_abs=eps, eps_rel=eps, delta=1e-10,
+                      max_iter=int(self.max_iterations or 200000), warm_start=True)
+        else:
+            from .qp_clarabel import clarabel_tolerances
+            gap, feas = clarabel_tolerances(self.tolerance)
+            kw = dict(tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=feas, tol_ktratio=min(1e-6, gap),
+                      iterative_refinement_reltol=1e-14, iterative_refinement_abstol=1e-14,
+                      max_iter=int(self.max_iterations or 200))
+        kw.update(self.options)
+        return kw
+
+    def _solve_form(self, form, x0):
+        (prob, x, params, cons), _ = self._solver_for(form, self._build)
+        params["q"].value = form.q
+        if "b" in params:
+            params["b"].value = float(form.b)
+        if "u" in params:
+            params["u"][0].value = form.upper[params["u"][1]]
+        if "l" in params:
+            params["l"][0].value = form.lower[params["l"][1]]
+        if x0 is not None:
+            x.value = x0
+        kwargs = self._solver_kwargs()
+        info = {}
+        for attempt in range(3):
+            try:
+                prob.solve(solver=getattr(cp, self.solver), **kwargs)
+            except cp.error.SolverError as exc:
+                return (np.zeros(form.H.shape[0]), 0.0, f"solver error: {exc}", 0, 0.0, {})
+            status = prob.status
+            info = {"solver_status": status, "tries": attempt + 1}
+            if self.solver != "OSQP":
+                break
+            extra = prob.solver_stats.extra_stats
+            pol = getattr(getattr(extra, "info", None), "status_polish", None)
+            info["status_polish"] = pol
+            if status == cp.OPTIMAL and pol != 1 and attempt < 2:
+                # Polishing refused: its active-set guess was not better than the ADMM iterate.
+                # Tighten ADMM and retry; after the last try rollqp's own residual decides.
+                kwargs = dict(kwargs, eps_abs=kwargs["eps_abs"] * 1e-2, eps_rel=kwargs["eps_rel"] * 1e-2)
+                continue
+            break
+        ok = status == cp.OPTIMAL
+        y = float(cons[0].dual_value) if (form.a is not None and ok) else 0.0
+        xv = np.asarray(x.value) if x.value is not None else np.zeros(form.H.shape[0])
+        st = prob.solver_stats
+        return (xv, y, "solved" if ok else str(status), st.num_iters or 0, st.solve_time or 0.0, info)

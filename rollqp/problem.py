@@ -1,0 +1,471 @@
+r"""Step problems and their solutions (FORMULATION.md §5–7; paper eq. 49–71).
+
+A *step problem* is the data of one discrete step — influence matrices, weights, gap,
+friction bound, loads, history vector — and nothing about how it is solved. A
+*solution* carries the unknowns, the method that produced them, and residuals computed
+here, by rollqp, independently of any solver's self-reported accuracy (the split of
+``qpsolvers.Problem`` / ``qpsolvers.Solution``).
+
+Sign convention (the project's, FORMULATION.md §1): ``p >= 0`` is the pressure, ``t`` the
+tangential traction on body A in +x, ``g >= 0`` the deformed gap, ``s`` the slip of A
+relative to B per unit rolled distance, ``δ`` the rigid approach, ``ξ`` the creepage.
+
+Normal step (eq. 53 with the load equation eq. 67)::
+
+    g = h + o − δ e + A p,      p >= 0, g >= 0, p·g = 0,      fᵀp = P   (or δ given)
+
+with ``o = A_nt t̄`` the gap change due to a fixed shear (zero for similar materials).
+
+Tangential step (eq. 61/62 with eq. 67)::
+
+    s = ξ e + (c + A t) / Δq,   |t| <= μ p̄,  t = Proj_[−μp̄, μp̄](t − r s),   fᵀt = Q   (or ξ given)
+
+with ``c`` the history vector (eq. 37, 48) plus ``A_tn p̄``.
+
+Nondimensional form: lengths by ``a_H``, stresses by ``p0``. The elastic operator turns
+a stress into a displacement through ``1/E*``, so gaps are measured in
+``u0 = a_H p0 / E*`` and slips in ``p0 / E*``; this is the augmentation ``r = E*/p0``
+(the reciprocal of the scaled influence coefficients' size) applied to ``g`` and ``s``.
+The residuals (:class:`Residuals`) are the max-norms of
+
+* Signorini:      ``min(p̂, ĝ)``                              (eq. 51–52),
+* friction law:   ``t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)``             (eq. 60),
+* load equations: ``(fᵀp − P)/(a_H p0)``, ``(fᵀt − Q)/(a_H p0)``  (eq. 67).
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError
+
+# Node states in result files (SPEC.md): 0 separation, 1 stick, 2 slip.
+SEPARATION, STICK, SLIP = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class Scales:
+    """Units of the nondimensional form: ``length`` (a_H), ``stress`` (p0), ``modulus`` (E*).
+
+    The defaults (all 1) leave an array problem in the user's own units; pass the Hertz
+    scales (:meth:`hertz`) for residuals that mean the same in every unit system.
+    """
+
+    length: float = 1.0
+    stress: float = 1.0
+    modulus: float = 1.0
+
+    def __post_init__(self):
+        for name in ("length", "stress", "modulus"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InputError(f"scales.{name}", f"must be a finite number > 0, got {v!r}")
+
+    @classmethod
+    def hertz(cls, P: float, R: float, Estar: float) -> "Scales":
+        """Hertz half-width ``a`` and peak pressure ``p0`` for load ``P`` (FORMULATION.md §11)."""
+        a = np.sqrt(4.0 * P * R / (np.pi * Estar))
+        return cls(length=float(a), stress=float(2.0 * P / (np.pi * a)), modulus=float(Estar))
+
+    @property
+    def displacement(self) -> float:
+        """``u0 = a_H p0 / E*``: gaps, displacements, approach."""
+        return self.length * self.stress / self.modulus
+
+    @property
+    def slip(self) -> float:
+        """``p0 / E*``: slips and creepages."""
+        return self.stress / self.modulus
+
+    @property
+    def force(self) -> float:
+        """``a_H p0``: loads per unit axial length."""
+        return self.length * self.stress
+
+
+def _vec(name, v, n):
+    a = np.asarray(v, dtype=float)
+    if a.shape != (n,):
+        raise InputError(name, f"must have shape ({n},), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise InputError(name, "must be finite")
+    return a
+
+
+def _mat(name, M, n):
+    a = np.asarray(M, dtype=float)
+    if a.shape != (n, n):
+        raise InputError(name, f"must have shape ({n}, {n}), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise InputError(name, "must be finite")
+    return a
+
+
+def _exactly_one(names, values):
+    given = [n for n, v in zip(names, values) if v is not None]
+    if len(given) != 1:
+        raise InputError(" / ".join(names), f"give exactly one of {' or '.join(names)} (got {len(given)})")
+
+
+def symmetrized(A: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """``F⁻¹ sym(F A)``: the operator whose weighted form is the QP Hessian (FORMULATION.md §7)."""
+    FA = f[:, None] * A
+    return 0.5 * (FA + FA.T) / f[:, None]
+
+
+def asymmetry(A: np.ndarray, f: np.ndarray) -> float:
+    """``‖FA − (FA)ᵀ‖_F / ‖FA‖_F``."""
+    FA = f[:, None] * A
+    return float(np.linalg.norm(FA - FA.T) / np.linalg.norm(FA))
+
+
+@dataclass(frozen=True)
+class QPForm:
+    r"""A convex QP in rollqp's scaled variables, shared by all QP backends.
+
+    .. math::
+        \min_x \tfrac12 x^T H x + q^T x \quad\text{s.t.}\quad a^T x = b,\;
+        \ell \le x \le u
+
+    ``x`` is the nondimensional traction (``p/p0`` or ``t/p0``). ``H`` and ``q`` are
+    divided by ``obj_scale`` and the equality row by ``eq_scale`` so that their entries
+    are of order one (solver tolerances then mean what they say). The equality multiplier
+    ``y`` is defined by the Lagrangian ``½xᵀHx + qᵀx + y(aᵀx − b) − …`` (so ``∇ = −y a``
+    at an interior solution); :meth:`unscaled_multiplier` maps the solver's ``y`` back.
+    Infinite bounds are ``±inf``.
+    """
+
+    H: np.ndarray
+    q: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    a: np.ndarray | None
+    b: float | None
+    obj_scale: float
+    eq_scale: float
+    kind: str
+
+    def unscaled_multiplier(self, y: float) -> float:
+        """The multiplier of the unscaled problem (``−δ̂`` normal, ``ξ̂`` tangential)."""
+        return float(y) * self.obj_scale / self.eq_scale
+
+    @property
+    def structure(self) -> tuple:
+        """What fixes the constraint matrix: the solver object can be reused while it holds."""
+        return (self.kind, self.H.shape[0], self.a is not None,
+                tuple(np.isfinite(self.lower)), tuple(np.isfinite(self.upper)), tuple(self.fixed))
+
+    @property
+    def fixed(self) -> np.ndarray:
+        """Mask of variables with ``lower == upper`` (no friction bound: ``x_i = 0``)."""
+        return self.lower == self.upper
+
+
+# ---------------------------------------------------------------------------- problems
+@dataclass(frozen=True)
+class NormalStep:
+    """The normal (Signorini) step problem (paper eq. 53, 67; FORMULATION.md §6).
+
+    Parameters
+    ----------
+    A : (n, n) array
+        ``A_nn``: gap change at node i due to unit nodal pressure j.
+    f : (n,) array
+        Weights ``f_j = ∫ N_j`` (eq. 65–67), all > 0.
+    h : (n,) array
+        Undeformed gap ``h`` (eq. 10).
+    P, delta : float
+        The normal load ``P = fᵀp`` or the prescribed approach ``δ``: exactly one.
+    offset : (n,) array, optional
+        Fixed gap change ``A_nt t̄`` from a known shear (zero if absent).
+    scales : Scales
+        Units of the nondimensional residuals.
+    """
+
+    A: np.ndarray
+    f: np.ndarray
+    h: np.ndarray
+    P: float | None = None
+    delta: float | None = None
+    offset: np.ndarray | None = None
+    scales: Scales = field(default_factory=Scales)
+    kind = "normal"
+
+    def __post_init__(self):
+        n = np.asarray(self.f).shape[0] if np.ndim(self.f) == 1 else -1
+        if n < 1:
+            raise InputError("f", "must be a 1-D array of weights")
+        object.__setattr__(self, "f", _vec("f", self.f, n))
+        if np.any(self.f <= 0):
+            raise InputError("f", "weights must all be > 0")
+        object.__setattr__(self, "A", _mat("A", self.A, n))
+        object.__setattr__(self, "h", _vec("h", self.h, n))
+        if self.offset is not None:
+            object.__setattr__(self, "offset", _vec("offset", self.offset, n))
+        _exactly_one(("P", "delta"), (self.P, self.delta))
+        if self.P is not None and not (np.isfinite(self.P) and self.P > 0):
+            raise InputError("P", f"the normal load must be a finite number > 0, got {self.P!r}")
+
+    @property
+    def n(self) -> int:
+        return self.f.size
+
+    def replace(self, **kw) -> "NormalStep":
+        return dataclasses.replace(self, **kw)
+
+    @property
+    def h_total(self) -> np.ndarray:
+        return self.h if self.offset is None else self.h + self.offset
+
+    def gap(self, p, delta) -> np.ndarray:
+        """``g = h + o − δ e + A p`` (eq. 25, 30)."""
+        return self.h_total - delta + self.A @ p
+
+    def symmetrized(self) -> "NormalStep":
+        """The same problem with ``A`` replaced by ``F⁻¹ sym(F A)`` (what a QP solves)."""
+        return self.replace(A=symmetrized(self.A, self.f))
+
+    def residuals(self, p, delta) -> "Residuals":
+        sc = self.scales
+        g = self.gap(p, delta)
+        sig = np.minimum(p / sc.stress, g / sc.displacement)
+        load = 0.0 if self.P is None else (self.f @ p - self.P) / sc.force
+        return Residuals(signorini=float(np.max(np.abs(sig))), load_normal=abs(float(load)))
+
+    def qp_form(self) -> QPForm:
+        r"""``min ½ p̂ᵀ sym(F̂Â) p̂ + (F̂ ĥ)ᵀ p̂`` s.t. ``p̂ >= 0``, ``f̂ᵀp̂ = P̂``; ``δ̂ = −y``.
+
+        Hatted quantities are nondimensional (:class:`Scales`); KKT gives ``F̂ ĝ ⟂ p̂``.
+        """
+        sc = self.scales
+        fh = self.f / sc.length
+        Ah = self.A * sc.modulus / sc.length
+        FA = fh[:, None] * Ah
+        H = 0.5 * (FA + FA.T)
+        q = fh * self.h_total / sc.displacement
+        if self.delta is not None:
+            q = q - fh * (self.delta / sc.displacement)
+        obj = float(np.max(np.abs(np.diag(H))))
+        eq = float(np.max(fh))
+        a = b = None
+        if self.P is not None:
+            a, b = fh / eq, self.P / sc.force / eq
+        return QPForm(H=H / obj, q=q / obj, lower=np.zeros(self.n), upper=np.full(self.n, np.inf),
+                      a=a, b=b, obj_scale=obj, eq_scale=eq, kind="normal")
+
+    def solution_from_qp(self, form: QPForm, x, y, **meta) -> "StepSolution":
+        """Map a QP solution back (pressure, approach) and evaluate it on this problem."""
+        sc = self.scales
+        p = np.asarray(x, dtype=float) * sc.stress
+        delta = self.delta if self.delta is not None else -form.unscaled_multiplier(y) * sc.displacement
+        return self.solution(p, delta, **meta)
+
+    def solution(self, p, delta, **meta) -> "StepSolution":
+        p = np.asarray(p, dtype=float)
+        return StepSolution(p=p, g=self.gap(p, delta), delta=float(delta), residuals=self.residuals(p, delta),
+                            **meta)
+
+
+@dataclass(frozen=True)
+class TangentialStep:
+    """The tangential (friction) step problem (paper eq. 61/62, 67; FORMULATION.md §6).
+
+    Parameters
+    ----------
+    A : (n, n) array
+        ``A_tt``: relative tangential displacement ``w`` at node i due to unit shear at j.
+    f : (n,) array
+        Weights (eq. 65–67).
+    p : (n,) array
+        The fixed pressure ``p̄``; the friction bound is ``μ·max(p̄, 0)``.
+    mu : float
+        Coefficient of friction, >= 0.
+    c : (n,) array
+        History vector plus ``A_tn p̄``: ``Δq·s = Δq ξ e + c + A t``.
+    dq : float
+        Rolled distance of the step ``Δq`` (for a static shift: the shift's length unit).
+    Q, xi : float
+        Tangential load ``Q = fᵀt`` or prescribed creepage ``ξ``: exactly one.
+    scales : Scales
+    """
+
+    A: np.ndarray
+    f: np.ndarray
+    p: np.ndarray
+    mu: float
+    c: np.ndarray
+    dq: float
+    Q: float | None = None
+    xi: float | None = None
+    scales: Scales = field(default_factory=Scales)
+    kind = "tangential"
+
+    def __post_init__(self):
+        n = np.asarray(self.f).shape[0] if np.ndim(self.f) == 1 else -1
+        if n < 1:
+            raise InputError("f", "must be a 1-D array of weights")
+        object.__setattr__(self, "f", _vec("f", self.f, n))
+        if np.any(self.f <= 0):
+            raise InputError("f", "weights must all be > 0")
+        object.__setattr__(self, "A", _mat("A", self.A, n))
+        object.__setattr__(self, "p", _vec("p", self.p, n))
+        object.__setattr__(self, "c", _vec("c", self.c, n))
+        if not (np.isfinite(self.mu) and self.mu >= 0):
+            raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {self.mu!r}")
+        if not (np.isfinite(self.dq) and self.dq > 0):
+            raise InputError("dq", f"the step must be a finite number > 0, got {self.dq!r}")
+        _exactly_one(("Q", "xi"), (self.Q, self.xi))
+        if self.Q is not None:
+            cap = float(self.f @ self.bound)
+            if not abs(self.Q) < cap:
+                raise InputError("Q", f"|Q| = {abs(self.Q):.6g} must be below the sliding limit "
+                                      f"mu fᵀp = {cap:.6g} for a solution with stick")
+
+    @property
+    def n(self) -> int:
+        return self.f.size
+
+    @property
+    def bound(self) -> np.ndarray:
+        """``μ·max(p̄, 0)``."""
+        return self.mu * np.maximum(self.p, 0.0)
+
+    def replace(self, **kw) -> "TangentialStep":
+        return dataclasses.replace(self, **kw)
+
+    def slip(self, t, xi) -> np.ndarray:
+        """``s = ξ e + (c + A t)/Δq`` (eq. 36, 47)."""
+        return xi + (self.c + self.A @ t) / self.dq
+
+    def symmetrized(self) -> "TangentialStep":
+        """The same problem with ``A`` replaced by ``F⁻¹ sym(F A)`` (what a QP solves)."""
+        return self.replace(A=symmetrized(self.A, self.f))
+
+    def residuals(self, t, xi) -> "Residuals":
+        sc = self.scales
+        s = self.slip(t, xi)
+        th, sh, bh = t / sc.stress, s / sc.slip, self.bound / sc.stress
+        fr = th - np.clip(th - sh, -bh, bh)
+        load = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
+        return Residuals(friction=float(np.max(np.abs(fr))), load_tangential=abs(float(load)))
+
+    def qp_form(self) -> QPForm:
+        r"""``min ½ t̂ᵀ sym(F̂Â) t̂/Δq̂ + (F̂ĉ/Δq̂)ᵀ t̂`` s.t. ``|t̂| <= μp̂``, ``f̂ᵀt̂ = Q̂``; ``ξ̂ = y``.
+
+        KKT gives ``F̂ ŝ`` equal to the bound multipliers: ``ŝ = 0`` where ``|t| < μp̄``, and
+        ``ŝ`` opposite to ``t`` where the bound is active (eq. 57–60).
+        """
+        sc = self.scales
+        fh = self.f / sc.length
+        Ah = self.A * sc.modulus / sc.length
+        dqh = self.dq / sc.length
+        FA = fh[:, None] * Ah / dqh
+        H = 0.5 * (FA + FA.T)
+        q = fh * (self.c / sc.displacement) / dqh
+        if self.xi is not None:
+            q = q + fh * (self.xi / sc.slip)
+        obj = float(np.max(np.abs(np.diag(H))))
+        eq = float(np.max(fh))
+        bh = self.bound / sc.stress
+        a = b = None
+        if self.Q is not None:
+            a, b = fh / eq, self.Q / sc.force / eq
+        return QPForm(H=H / obj, q=q / obj, lower=-bh, upper=bh, a=a, b=b, obj_scale=obj,
+                      eq_scale=eq, kind="tangential")
+
+    def solution_from_qp(self, form: QPForm, x, y, **meta) -> "StepSolution":
+        """Map a QP solution back (traction, creepage) and evaluate it on this problem."""
+        sc = self.scales
+        t = np.clip(np.asarray(x, dtype=float) * sc.stress, -self.bound, self.bound)
+        xi = self.xi if self.xi is not None else form.unscaled_multiplier(y) * sc.slip
+        return self.solution(t, xi, **meta)
+
+    def solution(self, t, xi, **meta) -> "StepSolution":
+        t = np.asarray(t, dtype=float)
+        return StepSolution(t=t, s=self.slip(t, xi), xi=float(xi), p=self.p,
+                            residuals=self.residuals(t, xi), **meta)
+
+
+# ---------------------------------------------------------------------------- solutions
+@dataclass
+class Residuals:
+    """rollqp's own nondimensional residuals of a step (max norms; see module docstring)."""
+
+    signorini: float = 0.0
+    friction: float = 0.0
+    load_normal: float = 0.0
+    load_tangential: float = 0.0
+
+    @property
+    def max(self) -> float:
+        return max(self.signorini, self.friction, self.load_normal, self.load_tangential)
+
+    def __or__(self, other: "Residuals") -> "Residuals":
+        return Residuals(*(max(a, b) for a, b in zip(dataclasses.astuple(self), dataclasses.astuple(other))))
+
+
+@dataclass
+class StepSolution:
+    """The unknowns of one step, how they were obtained, and rollqp's residuals.
+
+    Absent parts are ``None`` (``g``/``delta`` for a tangential step, ``t``/``s``/``xi`` for
+    a normal one). ``iterations`` counts the method's own iterations; ``time`` is the wall
+    time of the solve in rollqp (``solver_time`` the external solver's own, if any).
+    """
+
+    p: np.ndarray | None = None
+    t: np.ndarray | None = None
+    g: np.ndarray | None = None
+    s: np.ndarray | None = None
+    delta: float | None = None
+    xi: float | None = None
+    residuals: Residuals = field(default_factory=Residuals)
+    method: str = ""
+    status: str = "solved"
+    iterations: int = 0
+    time: float = 0.0
+    solver_time: float = 0.0
+    info: dict = field(default_factory=dict)
+
+    @property
+    def residual(self) -> float:
+        return self.residuals.max
+
+
+def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7) -> np.ndarray:
+    """Node states: 0 separation (``p̂ <= tol``), 2 slip (``|ŝ| > tol`` at the bound), 1 stick.
+
+    ``t`` or ``s`` may be ``None`` (normal problem only): contact nodes are then stick.
+    """
+    p = np.asarray(p, dtype=float)
+    state = np.where(p / scales.stress > tol, STICK, SEPARATION).astype(np.int8)
+    if t is not None and s is not None:
+        at_bound = (mu * np.maximum(p, 0) - np.abs(t)) / scales.stress <= tol
+        slipping = (np.abs(s) / scales.slip > tol) & at_bound & (state == STICK)
+        state[slipping] = SLIP
+    return state
+
+
+def compare(a: StepSolution, b: StepSolution, mu: float | None = None, scales: Scales = Scales()) -> dict:
+    """Differences between two solutions of the same step, nondimensional.
+
+    Returns max |Δp|/p0, max |Δt|/(μ p0) (or /p0 if μ is not given), |Δδ|/u0, |Δξ|/(p0/E*),
+    and the indices of nodes whose stick/slip/separation state differs.
+    """
+    out = {}
+    if a.p is not None and b.p is not None:
+        out["p"] = float(np.max(np.abs(a.p - b.p)) / scales.stress)
+    if a.t is not None and b.t is not None:
+        tscale = scales.stress * (mu if mu else 1.0)
+        out["t"] = float(np.max(np.abs(a.t - b.t)) / tscale)
+    if a.delta is not None and b.delta is not None:
+        out["delta"] = abs(a.delta - b.delta) / scales.displacement
+    if a.xi is not None and b.xi is not None:
+        out["xi"] = abs(a.xi - b.xi) / scales.slip
+    if a.p is not None and b.p is not None:
+        sa = classify(a.p, a.t, a.s, mu or 0.0, scales)
+        sb = classify(b.p, b.t, b.s, mu or 0.0, scales)
+        out["state_differs"] = np.flatnonzero(sa != sb)
+    return out

@@ -1,0 +1,75 @@
+"""Errors against the closed forms (FORMULATION.md §11) and the run summary table."""
+from __future__ import annotations
+
+import numpy as np
+
+from . import closedforms as cf
+
+
+def _rms_in_contact(x, a, err):
+    m = np.abs(x) <= a
+    return float(np.sqrt(np.mean(err[m] ** 2)))
+
+
+def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
+    """``(name, value, what)`` for every closed form the scene has.
+
+    Applicable only to similar materials (β = 0 or coupling off) on the half-space model:
+    Hertz at the start (constant normal load), Cattaneo at the start of a braked scene,
+    Carter and the creep law at the end when the loads have been constant for the last
+    4 a_H (Carter's transient has died out by then: CONTACT's reference shows < 0.1 %
+    from 2.6 a_H).
+    """
+    out = []
+    if scene.coupling_level != "off" or scene.contact.model != "halfspace":
+        return out
+    x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
+    mu, lead = scene.contact.friction, int(res["leading_edge"])
+    P0 = float(res["P"][0])
+    a0 = cf.hertz_half_width(P0, R, scene.Estar)
+    p00 = cf.hertz_peak_pressure(P0, a0)
+    out.append(("hertz", _rms_in_contact(x, a0, res["pn"][0] - cf.hertz_pressure(x, a0, p00)) / p0,
+                "rms(pn - Hertz)/p0 at q = 0"))
+    if mu <= 0 or scene.load.tangential is None:
+        return out
+    if scene.load.start == "braked":
+        r0 = float(res["Q"][0]) / (mu * P0)
+        if abs(r0) < 1:
+            e = res["pt"][0] - cf.cattaneo_traction(x, a0, p00, mu, r0)
+            out.append(("cattaneo", _rms_in_contact(x, a0, e) / (mu * p0), "rms(pt - Cattaneo)/(mu p0) at q = 0"))
+    q = res["q"]
+    qa = q[-1] / a
+    tail = q >= q[-1] - 4 * a
+    if qa >= 4 and np.ptp(res["P"][tail]) == 0 and np.ptp(res["Q"][tail]) <= 1e-12 * abs(res["Q"][-1]) + 1e-300:
+        P1 = float(res["P"][-1])
+        a1 = cf.hertz_half_width(P1, R, scene.Estar)
+        p01 = cf.hertz_peak_pressure(P1, a1)
+        r1 = float(res["Q"][-1]) / (mu * P1)
+        e = res["pt"][-1] - cf.carter_traction(x, a1, p01, mu, r1, scene.load.direction)
+        out.append(("carter", _rms_in_contact(x, a1, e) / (mu * p0), f"rms(pt - Carter)/(mu p0) at q = {qa:.2f} a_H"))
+        xi = cf.carter_creepage(a1, R, mu, r1)
+        if xi != 0:
+            out.append(("creepage", abs(float(res["creepage"][-1]) / xi - 1),
+                        f"|xi/xi_Carter - 1| at q = {qa:.2f} a_H ({float(res['creepage'][-1]):.4e} vs {xi:.4e})"))
+    return out
+
+
+def summary(res: dict, scene, method: str, wall: float) -> str:
+    """The table ``rollqp run`` prints."""
+    K = len(res["q"]) - 1
+    rows = [("scene", f"{scene.name} ({scene.source})"),
+            ("method", method),
+            ("nodes", f"{res['x'].size} ({scene.discretization.elements} {scene.discretization.element} elements, "
+                      f"zone ±{scene.discretization.zone} a_H)"),
+            ("steps", f"{K} rolling steps of {scene.dq / scene.a_H:.5g} a_H + starting state"),
+            ("a_H, p0", f"{float(res['a_H']):.6g}, {float(res['p0']):.6g}"),
+            ("beta (2beta)", f"{float(res['beta']):.6g} ({2 * float(res['beta']):.6g}), coupling {scene.coupling_level}"),
+            ("iterations", f"{int(res['iterations'].sum())} in all, median {np.median(res['iterations'][1:] if K else res['iterations']):.0f} per step"),
+            ("wall time", f"{wall:.3f} s ({float(res['step_time'].sum()):.3f} s stepping, "
+                          f"median {1e3 * float(np.median(res['step_time'])):.2f} ms per step)"),
+            ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, FORMULATION.md §5)"),
+            ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
+    for name, val, what in closed_form_errors(res, scene):
+        rows.append((f"error: {name}", f"{val:.4f}  {what}"))
+    w = max(len(r[0]) for r in rows)
+    return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)

@@ -1,0 +1,93 @@
+"""The result file (SPEC.md): one ``.npz`` without pickled objects, written atomically."""
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError
+
+_PER_STATE = ("pn", "pt", "slip", "gap", "state")
+_PER_STEP = ("q", "P", "Q", "creepage", "approach", "shift", "iterations", "step_time", "residual")
+
+
+@dataclass
+class Result:
+    """States of a transient: index 0 is the starting state, 1..K the rolling steps.
+
+    Arrays follow SPEC.md's result file; ``shift`` (rigid static shift of the braked
+    start, zero for rolling states) and ``scalars`` (``a_H``, ``p0``, ``R``, ``Estar``,
+    ``beta``, ``leading_edge``) are kept beside them. ``meta`` is JSON-able.
+    """
+
+    x: np.ndarray
+    scalars: dict
+    meta: dict
+    rows: dict = field(default_factory=lambda: {k: [] for k in _PER_STATE + _PER_STEP})
+
+    def append(self, *, q, pn, pt, slip, gap, state, P, Q, creepage, approach, shift=0.0,
+               iterations=0, step_time=0.0, residual=0.0):
+        vals = dict(q=q, pn=pn, pt=pt, slip=slip, gap=gap, state=state, P=P, Q=Q, creepage=creepage,
+                    approach=approach, shift=shift, iterations=iterations, step_time=step_time,
+                    residual=residual)
+        for k, v in vals.items():
+            self.rows[k].append(np.array(v, copy=True))
+
+    def __len__(self):
+        return len(self.rows["q"])
+
+    def arrays(self) -> dict:
+        """All arrays of the result file, keyed as in SPEC.md."""
+        n = self.x.size
+        out = {"x": np.asarray(self.x, dtype=float)}
+        for k in _PER_STATE:
+            dtype = np.int8 if k == "state" else float
+            out[k] = np.asarray(self.rows[k], dtype=dtype).reshape(len(self), n)
+        for k in _PER_STEP:
+            dtype = np.int64 if k == "iterations" else float
+            out[k] = np.asarray(self.rows[k], dtype=dtype).reshape(len(self))
+        for k, v in self.scalars.items():
+            out[k] = np.asarray(v)
+        out["meta"] = np.asarray(json.dumps(self.meta, sort_keys=True, default=_json_default))
+        return out
+
+    def __getitem__(self, key):
+        return self.arrays()[key]
+
+    def save(self, path) -> str:
+        """Write the result file atomically (temporary file in the same folder, then rename)."""
+        path = os.fspath(path)
+        if not path.endswith(".npz"):
+            raise InputError("--out", f"the result file must end in .npz, got {path!r}")
+        folder = os.path.dirname(os.path.abspath(path))
+        if not os.path.isdir(folder):
+            raise InputError("--out", f"folder {folder!r} does not exist")
+        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=folder, prefix=".rollqp-")
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                np.savez(fh, **self.arrays())
+            os.replace(tmp, path)
+        except BaseException:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+            raise
+        return path
+
+
+def load_result(path) -> dict:
+    """Read a result file into a dict of arrays (``meta`` decoded from JSON)."""
+    with np.load(path, allow_pickle=False) as z:
+        out = {k: z[k] for k in z.files}
+    out["meta"] = json.loads(str(out["meta"]))
+    return out
+
+
+def _json_default(o):
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)
