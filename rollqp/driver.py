@@ -41,8 +41,9 @@ from .scene import Scene, load_scene
 from .strip import Strip
 
 #: Rolling start by marching: stop when max|Δt| per step is below this fraction of μp0
-#: (well under the solver tolerance's effect on any plotted quantity) …
-STEADY_TOL = 1e-10
+#: (a hundred times above the QP solvers' step-to-step noise of ~1e-10, and far below
+#: the discretization error of ~1e-3) …
+STEADY_TOL = 1e-8
 #: … or after this many a_H of rolling (Carter's transient dies out within ~3 a_H).
 STEADY_MAX_DISTANCE = 40.0
 
