@@ -36,7 +36,7 @@ def available_methods() -> list[str]:
     for name in _REGISTRY:
         try:
             _load(name)
-        except (MissingBackendError, InputError):
+        except (MissingBackendError, InputError, AttributeError):
             continue
         out.append(name)
     return out
@@ -54,7 +54,12 @@ def _load(name: str):
                              f"available: {', '.join(QP_METHODS)}") from exc
         hint = f" (pip install 'rollqp[{extra}]')" if extra else ""
         raise MissingBackendError(f"method {name!r} needs the package {exc.name!r}{hint}") from exc
-    return getattr(mod, cls)
+    try:
+        return getattr(mod, cls)
+    except AttributeError as exc:
+        raise InputError("solver.method", f"method {name!r} is not available in this version of rollqp "
+                         "(the coupled step and the N-T alternation arrive with issue 3); "
+                         "use newton, qp-clarabel, qp-osqp or qp-cvxpy") from exc
 
 
 def get_method(name: str, **settings):

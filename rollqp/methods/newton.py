@@ -1,0 +1,434 @@
+r"""Generalized Newton method with line search (GNMls; Pang 1990; paper §4, eq. 74–90).
+
+Solves the *uncoupled* normal and tangential step problems (:class:`~rollqp.problem.NormalStep`,
+:class:`~rollqp.problem.TangentialStep`) as the nonsmooth equations of FORMULATION.md §5–6,
+with the problem's own collocation operator ``A`` (no symmetrization), so that its solution is
+the one the QP backends reach by symmetric–skew splitting (``operator="exact"``).
+
+Nondimensional unknowns (:class:`~rollqp.problem.Scales`: ``p0``, ``a_H``, ``E*``;
+``u0 = a_H p0/E*``) with the linear rows eliminated — the "halved system" of FORMULATION.md §7:
+
+.. math::
+    \hat g = \hat h - \hat\delta\, e + \hat A \hat p, \qquad
+    \hat s = \hat\xi\, e + (\hat c + \hat A \hat t)/\Delta\hat q,
+
+    \Phi_N(\hat p, \hat\delta) = \begin{bmatrix} \min(\hat p,\; r \hat g) \\
+        \hat f^T \hat p - \hat P \end{bmatrix}, \qquad
+    \Phi_T(\hat t, \hat\xi) = \begin{bmatrix} \hat t - \mathrm{Proj}_{[-b, b]}(\hat t - r \hat s) \\
+        \hat f^T \hat t - \hat Q \end{bmatrix},\quad b = \mu \hat p^+ ,
+
+with ``Â = A E*/a_H``, ``f̂ = f/a_H``, ``ĥ = (h + o)/u0``, ``ĉ = c/u0``, ``Δq̂ = Δq/a_H``. With
+``δ`` (``ξ``) prescribed the load row and ``δ̂`` (``ξ̂``) are dropped.
+
+Newton direction (eq. 74, 80): ``J d = −Φ`` with ``J`` the Jacobian of the linear part plus the
+pseudo-Jacobian of the ``min``/``Proj`` rows chosen node by node (eq. 82–90, the paper's
+"modified" linear choice on the kinks); ``J`` is dense, assembled from cached rows and factored
+once per iteration (LAPACK ``gesv``). Step length (eq. 75–79): ``α = ρ^m`` (``s = 1``), the first
+``m`` with ``θ(z + αd) <= (1 − 2σα) θ(z)``, ``θ = ½‖Φ‖²``. Along the search line only the
+``min``/``Proj`` are re-evaluated: the linear parts ``r ĝ``, ``r ŝ`` move by ``α K d`` with
+``K d`` computed once per iteration.
+
+**The augmentation r.** The paper's ``r = 0.1 N/mm`` is dimensional. Here ``r`` is
+nondimensional and chosen so that the two arguments of ``min``/``Proj`` respond alike to a
+change of the traction at the node itself: ``∂p̂_i/∂p̂_i = 1`` against ``r ∂ĝ_i/∂p̂_i = r Â_ii``
+(normal) and ``∂t̂_i/∂t̂_i = 1`` against ``r ∂ŝ_i/∂t̂_i = r Â_ii/Δq̂`` (tangential), on average::
+
+    r_N = 1 / mean(diag Â),        r_T = Δq̂ / mean(diag Â)
+
+(``r_N ≈ 5.3``, ``r_T ≈ 0.17`` on 40 quadratic elements with ``Δq = Le/2``). Any ``r > 0`` has
+the same solutions (``min(p, r g) = 0`` and the friction projection are independent of
+``r``); only the path of the iteration changes. Pass ``r=`` to override.
+
+**Stopping.** ``‖Φ‖_∞ <= tolerance·min(1, r)``: rollqp's residuals (:class:`Residuals`) are the
+same functions with ``r = 1``, and ``|min(a, b)| <= |min(a, r b)|/min(1, r)`` (likewise for the
+projection residual), so the returned solution's ``residual`` is ``<= tolerance``. ``Φ`` is
+piecewise linear: once the active sets are right the next full step is exact, and the
+iteration ends at round-off (quadratic, indeed finite, termination).
+
+Deviations from the paper, both on degenerate iterates only:
+
+* if no node is in contact (normal) or in stick (tangential) while the load row is present,
+  the ``δ̂`` (``ξ̂``) column of ``J`` vanishes. ``δ̂`` (``ξ̂``) is then shifted until the node
+  nearest to switching lies on its kink — the shift moves every ``y_i`` alike, so no other node
+  changes case and ``Φ`` (and ``θ``) does not change — and that node gets the contact/stick row,
+  the one-sided derivative into contact/stick (counted in ``info["shifts"]``);
+* if the Armijo search fails (``α < 1e-10``; possible only on a kink, where the modified row is
+  not the directional derivative), the full step is taken (counted in ``info["nonmonotone"]``).
+
+References: J.-S. Pang, Newton's method for B-differentiable equations, Math. Oper. Res. 15
+(1990) 311–341; González & Abascal, IJNME 53 (2002) 843–874, §4.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from scipy.linalg.lapack import dgesv
+
+from ..errors import InputError, SolverError
+from ..problem import StepSolution
+
+#: Smallest Armijo step tried before the full step is taken anyway (see module docstring).
+ALPHA_MIN = 1e-10
+
+
+class _System:
+    """Cached, r-scaled matrices of one problem operator (per ``A``, ``f``, scales, ``Δq``, ``r``).
+
+    ``K`` (``n × (n+1)``) maps ``z = (x, δ̂|ξ̂)`` to the linear part of ``y = r ĝ`` or ``r ŝ``.
+    ``J = where(mask, JK, JI)`` row by row: ``JK`` holds the contact/stick rows (``K``), ``JI``
+    the identity rows (separation/slip); both end with the load row ``[f̂ᵀ, 0]``. They are
+    stored transposed (``JKT``, ``JIT``) so that ``where`` along columns gives ``Jᵀ`` in C order,
+    i.e. ``J`` in the Fortran order LAPACK wants, without a copy. ``*_nl``: the same without
+    the load row and last column (``δ``/``ξ`` prescribed).
+    """
+
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "JKT", "JIT", "K_nl", "JKT_nl", "JIT_nl")
+
+    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale):
+        n = fhat.size
+        self.A, self.f, self.Ahat, self.fhat, self.r = A, f, Ahat, fhat, r
+        K = np.empty((n, n + 1))
+        K[:, :n] = (r / t_scale) * Ahat
+        K[:, n] = r * last_column
+        JK = np.zeros((n + 1, n + 1))
+        JK[:n] = K
+        JK[n, :n] = fhat
+        JI = np.zeros((n + 1, n + 1))
+        JI[:n, :n] = np.eye(n)
+        JI[n, :n] = fhat
+        self.K, self.JKT, self.JIT = K, np.ascontiguousarray(JK.T), np.ascontiguousarray(JI.T)
+        self.K_nl = np.ascontiguousarray(K[:, :n])
+        self.JKT_nl, self.JIT_nl = np.ascontiguousarray(self.K_nl.T), np.eye(n)
+
+    def matrices(self, with_load):
+        """``(K, JKT, JIT)`` with or without the load row."""
+        if with_load:
+            return self.K, self.JKT, self.JIT
+        return self.K_nl, self.JKT_nl, self.JIT_nl
+
+
+class NewtonMethod:
+    r"""GNMls for one uncoupled step (paper §4, eq. 74–90); see the module docstring.
+
+    Parameters
+    ----------
+    tolerance : float
+        Target of ``‖Φ‖_∞`` (nondimensional; scaled by ``min(1, r)`` so that rollqp's own
+        residual of the result is below it).
+    max_iterations : int
+        Newton iterations (directions) per step before :class:`~rollqp.errors.SolverError`.
+    r : float, optional
+        Nondimensional augmentation; default ``1/mean(diag Â)`` for the normal and
+        ``Δq̂/mean(diag Â)`` for the tangential problem (module docstring).
+    rho, sigma : float
+        Armijo parameters (eq. 75–78): ``α = ρ^m``, accept when
+        ``θ(z + αd) <= (1 − 2σα) θ(z)``. Paper: ``ρ = 0.9``, ``σ = 0.1``.
+
+    Notes
+    -----
+    ``solve`` returns the :class:`~rollqp.problem.StepSolution` built by the problem itself
+    (``problem.solution``), so its residuals are rollqp's. ``info`` holds ``r``,
+    ``backtracks`` (Armijo reductions, all iterations), ``merit`` (final ``θ``),
+    ``history`` (``‖Φ‖_∞`` before each iteration and at the end), ``merits`` (``θ``, likewise),
+    ``steps`` (the accepted
+    ``α`` of each iteration), ``nonmonotone`` (full steps taken after a failed search),
+    ``shifts`` (degenerate iterates repaired) and
+    ``start`` (``"warm"`` or ``"cold"``).
+    """
+
+    name = "newton"
+    operator = "exact"  # the driver asks: the collocation operator itself, not F⁻¹ sym(F A)
+
+    def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, r: float | None = None,
+                 rho: float = 0.9, sigma: float = 0.1):
+        if not (np.isfinite(tolerance) and 0 < tolerance < 1):
+            raise InputError("solver.tolerance", f"must be in (0, 1), got {tolerance!r}")
+        if max_iterations is None:
+            max_iterations = 200
+        if int(max_iterations) != max_iterations or max_iterations < 1:
+            raise InputError("solver.max_iterations", f"must be an integer >= 1, got {max_iterations!r}")
+        if r is not None and not (np.isfinite(r) and r > 0):
+            raise InputError("r", f"the augmentation must be a finite number > 0, got {r!r}")
+        if not (0 < rho < 1):
+            raise InputError("rho", f"must be in (0, 1), got {rho!r}")
+        if not (0 < sigma < 0.5):
+            raise InputError("sigma", f"must be in (0, 1/2), got {sigma!r}")
+        self.tolerance = float(tolerance)
+        self.max_iterations = int(max_iterations)
+        self.r = None if r is None else float(r)
+        self.rho = float(rho)
+        self.sigma = float(sigma)
+        self._cache = {}
+
+    # ------------------------------------------------------------------ public
+    def solve(self, problem, warm: StepSolution | None = None) -> StepSolution:
+        """Solve a :class:`NormalStep` or :class:`TangentialStep`; raise :class:`SolverError` if short."""
+        t0 = time.perf_counter()
+        if problem.kind == "normal":
+            return self._solve_normal(problem, warm, t0)
+        if problem.kind == "tangential":
+            return self._solve_tangential(problem, warm, t0)
+        raise InputError("problem", f"the Newton method solves normal or tangential steps, not {problem.kind!r}")
+
+    # ------------------------------------------------------------ the two kinds
+    def _solve_normal(self, pb, warm, t0):
+        sc = pb.scales
+        u0 = sc.displacement
+        sys_ = self._system(pb, None)
+        n, r = pb.n, sys_.r
+        hhat = pb.h_total / u0
+        with_load = pb.P is not None
+        Phat = pb.P / sc.force if with_load else None
+        dhat_fixed = None if with_load else pb.delta / u0
+
+        # start (Step 1): previous step's pressure and approach, else a Hertz-like profile
+        start = "cold"
+        p0 = None
+        if warm is not None and warm.p is not None and np.shape(warm.p) == (n,):
+            p0, start = np.asarray(warm.p, dtype=float) / sc.stress, "warm"
+        if p0 is None:
+            # ĥ = x̂² for two cylinders in Hertz units: p̂ = √(1 − x̂²) is the Hertz solution
+            p0 = np.sqrt(np.maximum(0.0, 1.0 - (hhat - hhat.min())))
+        guess = p0 > 0
+        if not guess.any():
+            guess = hhat == hhat.min()
+        if with_load:
+            if start == "cold" and sys_.fhat @ p0 > 0:
+                p0 = p0 * (Phat / (sys_.fhat @ p0))
+            if start == "warm" and warm.delta is not None:
+                d0 = warm.delta / u0
+            else:  # the approach that closes the gap on average over the guessed contact
+                d0 = float(np.mean((hhat + sys_.Ahat @ p0)[guess]))
+            z = np.append(p0, d0)
+        else:
+            if start == "cold":  # scale the profile to close the gap on average over it
+                Ap = (sys_.Ahat @ p0)[guess].mean()
+                c = (dhat_fixed - hhat[guess].mean()) / Ap if Ap > 0 else 0.0
+                p0 = p0 * max(c, 0.0)
+            z = p0.copy()
+        k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
+
+        def phi_nodes(x, y):
+            return np.minimum(x, y)
+
+        def mask_of(x, y):
+            # eq. 84 (p̂_i > r ĝ_i: Φ_i = r ĝ_i, row r ∂ĝ_i); eq. 82/83 (p̂_i <= r ĝ_i: row ∂p̂_i)
+            return x > y
+
+        def nearest(x, y):
+            # all p̂ <= r ĝ: the node with the smallest r ĝ − p̂ reaches contact when r ĝ drops by it
+            j = int(np.argmin(y - x))
+            return j, -(y[j] - x[j])
+
+        z, it, info = self._iterate(pb, sys_, z, k0, Phat, phi_nodes, mask_of, nearest)
+        p = z[:n] * sc.stress
+        delta = z[n] * u0 if with_load else pb.delta
+        info["start"] = start
+        return self._finish(pb.solution(p, delta), it, info, t0)
+
+    def _solve_tangential(self, pb, warm, t0):
+        sc = pb.scales
+        sys_ = self._system(pb, pb.dq / sc.length)
+        n, r = pb.n, sys_.r
+        dqh = pb.dq / sc.length
+        b = pb.bound / sc.stress
+        with_load = pb.Q is not None
+        Qhat = pb.Q / sc.force if with_load else None
+        xi_fixed = None if with_load else pb.xi / sc.slip
+
+        start = "cold"
+        t = np.zeros(n)
+        xi0 = 0.0
+        if warm is not None and warm.t is not None and np.shape(warm.t) == (n,):
+            t, start = np.asarray(warm.t, dtype=float) / sc.stress, "warm"
+            if warm.xi is not None:
+                xi0 = warm.xi / sc.slip
+        z = np.append(t, xi0) if with_load else t.copy()
+        k0 = r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
+        sep = b <= 0.0
+
+        def phi_nodes(x, y):
+            return x - np.clip(x - y, -b, b)
+
+        def mask_of(x, y):
+            # eq. 86/87 (|t̂_i − r ŝ_i| <= b_i, stick: Φ_i = r ŝ_i, row r ∂ŝ_i);
+            # eq. 88 (> b_i, slip: Φ_i = t̂_i ∓ b_i with b fixed, row ∂t̂_i);
+            # eq. 85 (b_i = 0, separation: Φ_i = t̂_i, row ∂t̂_i).
+            return (np.abs(x - y) <= b) & ~sep
+
+        def nearest(x, y):
+            # all |t̂ − r ŝ| > b: the node with the smallest excess sticks when r ŝ moves by it
+            u = x - y
+            excess = np.abs(u) - b
+            excess[sep] = np.inf
+            j = int(np.argmin(excess))
+            if not np.isfinite(excess[j]):
+                raise SolverError("no node can stick: the friction bound is zero everywhere",
+                                  method=self.name, status="degenerate")
+            return j, float(np.sign(u[j]) * excess[j])
+
+        z, it, info = self._iterate(pb, sys_, z, k0, Qhat, phi_nodes, mask_of, nearest)
+        tt = z[:n] * sc.stress
+        xi = z[n] * sc.slip if with_load else pb.xi
+        info["start"] = start
+        return self._finish(pb.solution(tt, xi), it, info, t0)
+
+    # ------------------------------------------------------------ the iteration
+    def _iterate(self, pb, sys_, z, k0, load, phi_nodes, mask_of, nearest):
+        """GNMls Steps 2–7 on ``Φ(z) = [φ(x, y); f̂ᵀx − load]`` with ``y = K z + k0``.
+
+        ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z).
+        """
+        n = pb.n
+        r = sys_.r
+        with_load = load is not None
+        K, JKT, JIT = sys_.matrices(with_load)
+        fhat = sys_.fhat
+        stop = self.tolerance * min(1.0, r)
+        rho, two_sigma = self.rho, 2.0 * self.sigma
+        mask = np.ones(n + 1 if with_load else n, dtype=bool)  # last entry: load row (always the JK row)
+        history, merits, steps = [], [], []
+        backtracks = nonmono = shifts = 0
+        it = 0
+
+        def residual(x, y):
+            ph = phi_nodes(x, y)
+            return np.append(ph, fhat @ x - load) if with_load else ph
+
+        x = z[:n]
+        y = K @ z + k0
+        phi = residual(x, y)
+        while True:
+            nrm = float(np.max(np.abs(phi)))
+            history.append(nrm)
+            merits.append(0.5 * float(phi @ phi))
+            if nrm <= stop:
+                break
+            if it >= self.max_iterations:
+                theta = merits[-1]
+                raise SolverError(f"the {pb.kind} Newton iteration did not converge: merit θ = {theta:.3e} "
+                                  f"after {it} iterations (‖Φ‖∞ = {nrm:.3e} > {stop:.1e})",
+                                  method=self.name, status=f"merit {theta:.3e}", iterations=it,
+                                  residual=nrm)
+            it += 1
+            # pseudo-Jacobian (eq. 80–90), assembled by rows
+            m = mask_of(x, y)
+            if with_load and not m.any():
+                # no δ̂/ξ̂ column: move the nearest node onto its kink (module docstring)
+                j, dy = nearest(x, y)
+                z[n] += dy / K[j, n]
+                y = K @ z + k0
+                phi = residual(x, y)
+                m = mask_of(x, y)
+                m[j] = True
+                shifts += 1
+            mask[:n] = m
+            JT = np.where(mask[None, :], JKT, JIT)  # Jᵀ in C order = J in Fortran order
+            _, _, d, fail = dgesv(JT.T, -phi, overwrite_a=True)  # one LU factorization + solve
+            if fail != 0 or not np.all(np.isfinite(d)):
+                raise SolverError(f"the {pb.kind} Newton matrix is singular (LAPACK info {fail})",
+                                  method=self.name, status="singular", iterations=it, residual=nrm)
+            # Armijo (eq. 75–78), s = 1
+            dx = d[:n]
+            Kd = K @ d
+            theta = merits[-1]
+            alpha = 1.0
+            while True:
+                xa, ya = x + alpha * dx, y + alpha * Kd
+                pa = residual(xa, ya)
+                if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
+                    break
+                alpha *= rho
+                backtracks += 1
+                if alpha < ALPHA_MIN:
+                    nonmono += 1
+                    alpha = 1.0
+                    xa, ya = x + dx, y + Kd
+                    break
+            steps.append(alpha)
+            z = z + alpha * d  # eq. 79
+            x = z[:n]
+            y = K @ z + k0  # fresh, not accumulated: no drift of the linear part
+            phi = residual(x, y)
+        info = {"r": r, "backtracks": backtracks, "merit": merits[-1], "history": history, "merits": merits,
+                "steps": steps, "nonmonotone": nonmono, "shifts": shifts, "tolerance_phi": stop}
+        return z, it, info
+
+    # ------------------------------------------------------------ helpers
+    def _finish(self, sol, it, info, t0):
+        sol.method, sol.status, sol.iterations = self.name, "solved", it
+        sol.info.update(info)
+        sol.time = time.perf_counter() - t0
+        return sol
+
+    def augmentation(self, problem) -> float:
+        """The nondimensional ``r`` used for ``problem`` (module docstring)."""
+        dqh = problem.dq / problem.scales.length if problem.kind == "tangential" else None
+        return self._system(problem, dqh).r
+
+    def _system(self, pb, dqh):
+        """Scaled matrices of ``pb``, cached by the identity of ``A``/``f`` (as QPMethod._split)."""
+        sc = pb.scales
+        key = (pb.kind, id(pb.A), id(pb.f), sc, dqh, self.r)
+        hit = self._cache.get(key)
+        if hit is not None and hit.A is pb.A and hit.f is pb.f:
+            return hit
+        Ahat = pb.A * (sc.modulus / sc.length)
+        fhat = pb.f / sc.length
+        scale = float(np.mean(np.diag(Ahat)))
+        if not scale > 0:
+            raise InputError("A", "the influence matrix must have a positive mean diagonal")
+        if pb.kind == "normal":
+            r = self.r if self.r is not None else 1.0 / scale
+            last, t_scale = -np.ones(pb.n), 1.0  # ∂(r ĝ)/∂δ̂ = −r, ∂(r ĝ)/∂p̂ = r Â
+        else:
+            r = self.r if self.r is not None else dqh / scale
+            last, t_scale = np.ones(pb.n), dqh  # ∂(r ŝ)/∂ξ̂ = r, ∂(r ŝ)/∂t̂ = r Â/Δq̂
+        sys_ = _System(pb.A, pb.f, Ahat, fhat, r, last, t_scale)
+        if len(self._cache) >= 16:
+            self._cache.clear()
+        self._cache[key] = sys_
+        return sys_
+
+    # ------------------------------------------------------------ for tests and diagnostics
+    def residual_and_jacobian(self, problem, z):
+        """``(Φ(z), J(z), cases)`` in the nondimensional unknowns ``z`` (module docstring).
+
+        ``z = (p̂, δ̂)`` or ``(t̂, ξ̂)`` (without the last entry if ``δ``/``ξ`` is prescribed).
+        ``cases[i]`` names the pseudo-Jacobian row chosen for node ``i``: ``"eq82"``/``"eq83"``/
+        ``"eq84"`` (normal) or ``"eq85"``/``"eq86"``/``"eq87"``/``"eq88"`` (tangential).
+        """
+        z = np.asarray(z, dtype=float)
+        sc = problem.scales
+        n = problem.n
+        if problem.kind == "normal":
+            sys_ = self._system(problem, None)
+            with_load = problem.P is not None
+            k0 = sys_.r * (problem.h_total / sc.displacement - (0.0 if with_load else problem.delta / sc.displacement))
+            load = problem.P / sc.force if with_load else None
+            K = sys_.matrices(with_load)[0]
+            x, y = z[:n], K @ z + k0
+            ph = np.minimum(x, y)
+            m = x > y
+            cases = np.where(x < y, "eq82", np.where(x == y, "eq83", "eq84"))
+        else:
+            dqh = problem.dq / sc.length
+            sys_ = self._system(problem, dqh)
+            with_load = problem.Q is not None
+            b = problem.bound / sc.stress
+            k0 = sys_.r * (problem.c / sc.displacement / dqh + (0.0 if with_load else problem.xi / sc.slip))
+            load = problem.Q / sc.force if with_load else None
+            K = sys_.matrices(with_load)[0]
+            x, y = z[:n], K @ z + k0
+            ph = x - np.clip(x - y, -b, b)
+            u = np.abs(x - y)
+            sep = b <= 0
+            m = (u <= b) & ~sep
+            cases = np.where(sep, "eq85", np.where(u < b, "eq86", np.where(u == b, "eq87", "eq88")))
+        _, JKT, JIT = sys_.matrices(with_load)
+        mask = np.append(m, True) if with_load else m
+        J = np.where(mask[:, None], JKT.T, JIT.T)
+        phi = np.append(ph, sys_.fhat @ x - load) if with_load else ph
+        return phi, J, cases
+
