@@ -58,12 +58,12 @@ class OsqpQP(QPMethod):
             m.update(q=form.q, l=l, u=u)
         if x0 is not None:
             m.warm_start(x=x0)
-        res = m.solve()
+        res = m.solve(raise_error=False)  # statuses are checked here, not raised by OSQP
         tries = 1
         while res.info.status_polish != 1 and tries < 3:
             eps = self._eps() * 10.0 ** (-2 * tries)
             m.update_settings(eps_abs=eps, eps_rel=eps)
-            res = m.solve()
+            res = m.solve(raise_error=False)  # statuses are checked here, not raised by OSQP
             tries += 1
         if tries > 1:
             m.update_settings(eps_abs=self._eps(), eps_rel=self._eps())
