@@ -205,6 +205,8 @@ class NormalStep:
         if self.offset is not None:
             object.__setattr__(self, "offset", _vec("offset", self.offset, n))
         _exactly_one(("P", "delta"), (self.P, self.delta))
+        if self.delta is not None and not np.isfinite(self.delta):
+            raise InputError("delta", f"the prescribed approach must be finite, got {self.delta!r}")
         if self.P is not None and not (np.isfinite(self.P) and self.P > 0):
             raise InputError("P", f"the normal load must be a finite number > 0, got {self.P!r}")
 
@@ -317,6 +319,10 @@ class TangentialStep:
         if not (np.isfinite(self.dq) and self.dq > 0):
             raise InputError("dq", f"the step must be a finite number > 0, got {self.dq!r}")
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
+        if self.xi is not None and not np.isfinite(self.xi):
+            raise InputError("xi", f"the prescribed creepage must be finite, got {self.xi!r}")
+        if self.Q is not None and not np.isfinite(self.Q):
+            raise InputError("Q", f"the tangential load must be finite, got {self.Q!r}")
         if self.Q is not None:
             cap = float(self.f @ self.bound)
             if not abs(self.Q) < cap:
@@ -400,10 +406,13 @@ class Residuals:
 
     @property
     def max(self) -> float:
-        return max(self.signorini, self.friction, self.load_normal, self.load_tangential)
+        """The largest residual; NaN if any is NaN (so that no limit check can pass it)."""
+        return float(np.max(np.asarray(dataclasses.astuple(self), dtype=float)))
 
     def __or__(self, other: "Residuals") -> "Residuals":
-        return Residuals(*(max(a, b) for a, b in zip(dataclasses.astuple(self), dataclasses.astuple(other))))
+        a = np.asarray(dataclasses.astuple(self), dtype=float)
+        b = np.asarray(dataclasses.astuple(other), dtype=float)
+        return Residuals(*np.maximum(a, b).tolist())  # np.maximum propagates NaN
 
 
 @dataclass

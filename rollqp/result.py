@@ -69,6 +69,9 @@ class Result:
         try:
             with os.fdopen(fd, "wb") as fh:
                 np.savez(fh, **self.arrays())
+            umask = os.umask(0)
+            os.umask(umask)
+            os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual file mode
             os.replace(tmp, path)
         except BaseException:
             if os.path.exists(tmp):
