@@ -336,11 +336,23 @@ def section_runs(repeats, backends):
         r = runs[name]
         rows.append((f"`{name}`", f"{r['wall']:.2f}", f"{r['cpu']:.2f}", f"{r['stepping']:.2f}", _ms(r["median"]),
                      f"{r['iters']:.0f}", f"{r['residual']:.1e}", f"{r['carter']:.4f}"))
+    # QPs of the splitting along the transient (one march; OSQP when available, it is the fastest)
+    scene = rollqp.load_scene(SCENE)
+    probe_backend = "qp-osqp" if "qp-osqp" in backends else backends[0]
+    qps = []
+    march(scene, Model.build(scene, symmetric=False), new_method(probe_backend, scene), scene.n_steps,
+          lambda k, prob, warm, sol, times: qps.append((scene.q_steps[k] / scene.a_H, sol.info["qp_solves"])))
+    qps = np.array(qps)
+    bands = [(0.0, 0.5), (0.5, 1.5), (1.5, 3.0), (3.0, scene.q_steps[-1] / scene.a_H)]
+    along = ", ".join(f"{np.median(qps[(qps[:, 0] > lo) & (qps[:, 0] <= hi), 1]):.0f} for {lo:g} < q/a_H ≤ {hi:g}"
+                      for lo, hi in bands)
+    note = (f"\nQPs of the splitting per tangential step along the transient (`{probe_backend}`, medians): "
+            f"{along}.\n")
     head = (f"### B. The whole §6.1.1 run: `rollqp.run(\"{SCENE}\", method=m)`\n\n"
             f"{r['K']:.0f} rolling steps of Δq = Le/2 after the braked start (40 quadratic elements, 81 nodes); "
             f"medians over {repeats} run(s).\n")
     return head + "\n" + _table(["backend", "wall [s]", "CPU [s]", "stepping Σ`step_time` [s]", "median step [ms]",
-                                  "solver iterations", "max residual", "Carter error (rms/μp0)"], rows) + "\n"
+                                  "solver iterations", "max residual", "Carter error (rms/μp0)"], rows) + "\n" + note
 
 
 def section_splitting(repeats, backends):

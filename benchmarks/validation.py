@@ -51,6 +51,8 @@ FN_CONTACT = 178.896248
 MU_CONTACT = 0.1
 RATIO = 0.75
 QP_BACKENDS = ("qp-osqp", "qp-clarabel", "qp-cvxpy")
+#: The generalized Newton method (issue 3), run beside the QPs as a cross-check where present.
+NEWTON = ("newton",) if "newton" in rollqp.available_methods() else ()
 
 
 # =========================================================================== helpers
@@ -136,7 +138,7 @@ def paper_errors(r, scene):
 def section_paper():
     scene = rollqp.load_scene("cattaneo-carter")
     rows, runs = [], {}
-    for m in QP_BACKENDS:
+    for m in QP_BACKENDS + NEWTON:
         res, r, wall = timed_run(scene, m)
         runs[m] = r
         e = paper_errors(r, scene)
@@ -144,12 +146,13 @@ def section_paper():
                      pct(e["creep_law"]), f"{e['xi']:.6e}", f"{r['residual'].max():.1e}", f"{wall:.1f} s"])
     ref = runs[QP_BACKENDS[0]]
     mup0 = scene.contact.friction * scene.p0
-    agree = max(float(np.abs(runs[m]["pt"] - ref["pt"]).max()) / mup0 for m in QP_BACKENDS[1:])
-    agree_xi = max(float(np.abs(runs[m]["creepage"][1:] / ref["creepage"][1:] - 1).max()) for m in QP_BACKENDS[1:])
+    others = [m for m in runs if m != QP_BACKENDS[0]]
+    agree = max(float(np.abs(runs[m]["pt"] - ref["pt"]).max()) / mup0 for m in others)
+    agree_xi = max(float(np.abs(runs[m]["creepage"][1:] / ref["creepage"][1:] - 1).max()) for m in others)
     print("### §6.1.1 Cattaneo → Carter on the paper's mesh (40 QCE, zone ±1.25 a_H, Δq = Le/2, 6 a_H)\n")
     print(table(["method", "Hertz rms/p0", "Cattaneo rms/μp0 (q = 0)", "Carter rms/μp0 (q = 6 a_H)",
                  "ξ/ξ_Carter − 1", "creep law: Q/μP(ξ)/0.75 − 1", "ξ (6 a_H)", "max residual", "wall"], rows))
-    print(f"\nBackends against {QP_BACKENDS[0]}, all 193 states: max |Δt| = {agree:.1e} μp0, "
+    print(f"\n{', '.join(others)} against {QP_BACKENDS[0]}, all 193 states: max |Δt| = {agree:.1e} μp0, "
           f"max |Δξ/ξ| = {agree_xi:.1e}.\n")
     return runs
 
@@ -159,7 +162,7 @@ def section_ramp(paper_runs=None):
     scene = rollqp.load_scene("ramp")
     mup0 = scene.contact.friction * scene.p0
     rows = []
-    for m in ("qp-osqp", "qp-clarabel"):
+    for m in ("qp-osqp", "qp-clarabel") + NEWTON:
         _, r, wall = timed_run(scene, m)
         ref = paper_runs[m] if paper_runs and m in paper_runs else timed_run(base, m)[1]
         x, a, p0, mu = r["x"], scene.a_H, scene.p0, scene.contact.friction
@@ -210,7 +213,7 @@ def transient_metrics(q, xi_abs, pt, pt_steady, xi_steady):
 def section_contact_transient():
     ref = contact_reference_transient()
     rows, cmp_rows = [], []
-    for m in ("qp-osqp", "qp-clarabel"):
+    for m in ("qp-osqp", "qp-clarabel") + NEWTON:
         scene = contact_scene(method=m)
         res, r, wall = timed_run(scene)
         _, rs, _ = timed_run(contact_scene(method=m, start="rolling", distance=0.0))
@@ -266,12 +269,24 @@ def section_contact_steady():
                      f"{abs(xi) / float(row['creepage']) - 1:.1e}",
                      f"[{stick.min() - half:.2f}, {stick.max() + half:.2f}]",
                      f"[{float(row['adhesion_x_from']):.2f}, {float(row['adhesion_x_to']):.2f}]",
-                     f"{d_t:.1e}", f"{wall:.1f} s"])
+                     f"{d_t:.1e}", f"{wall:.1f} s"] + newton_check(scene, xi))
     print("### CONTACT: steady Carter rolling (220 constant elements on ±1.1 a_H, DX = 0.01 mm = a/100; "
           "rollqp: `start = \"rolling\"`, the transient marched to steady with Δq = DX)\n")
     print(table(["Q/(μP)", "rollqp ξ/ξ_Carter − 1", "CONTACT ξ/ξ_Carter − 1", "|ξ_rollqp|/ξ_CONTACT − 1",
-                 "rollqp stick zone (mm)", "CONTACT adhesion (mm)", "max |pt + px|/μp0", "wall (qp-osqp)"], rows))
+                 "rollqp stick zone (mm)", "CONTACT adhesion (mm)", "max |pt + px|/μp0", "wall (qp-osqp)"]
+                + NEWTON_COLUMNS, rows))
     print()
+
+
+NEWTON_COLUMNS = ["wall (newton)", "|ξ_newton/ξ_qp-osqp − 1|"] if NEWTON else []
+
+
+def newton_check(scene, xi_qp):
+    """The same steady state by the Newton method: its wall time and its creepage against the QP's."""
+    if not NEWTON:
+        return []
+    _, r, wall = timed_run(scene, NEWTON[0])
+    return [f"{wall:.1f} s", f"{abs(float(r['creepage'][0]) / xi_qp - 1):.0e}"]
 
 
 def section_contact_grid(full=False):
@@ -281,8 +296,8 @@ def section_contact_grid(full=False):
     for row in rows_in:
         n = int(row["mx"])
         if n > 440 and not full:
-            rows.append([row["dx_mm"], n, "(--full)", pct(float(row["creepage_rel_diff"])), "", "",
-                         row["wall_time_s"] + " s"])
+            rows.append([row["dx_mm"], n, "(--full)", pct(float(row["creepage_rel_diff"]), 4), "", ""]
+                        + ["" for _ in NEWTON_COLUMNS] + [row["wall_time_s"] + " s"])
             continue
         scene = contact_scene(elements=n, ratio=0.75, start="rolling", distance=0.0, mu=0.3)
         res, r, wall = timed_run(scene)
@@ -290,11 +305,12 @@ def section_contact_grid(full=False):
         rel = xi / cf.carter_creepage(scene.a_H, scene.R, 0.3, 0.75) - 1
         xi220, rel220 = (xi, rel) if n == 220 else (xi220, rel220)
         ns.append(n), er.append(abs(rel)), ec.append(abs(float(row["creepage_rel_diff"])))
-        rows.append([row["dx_mm"], n, pct(rel, 3), pct(float(row["creepage_rel_diff"]), 3),
-                     f"{abs(xi) / float(row['creepage']) - 1:.1e}", f"{wall:.1f} s", row["wall_time_s"] + " s"])
+        rows.append([row["dx_mm"], n, pct(rel, 4), pct(float(row["creepage_rel_diff"]), 4),
+                     f"{abs(xi) / float(row['creepage']) - 1:.1e}", f"{wall:.1f} s"] + newton_check(scene, xi)
+                    + [row["wall_time_s"] + " s"])
     print("### CONTACT's grid study (μ = 0.3, Q/(μP) = 0.75, steady; zone ±1.1 a_H, DY = 200 mm in CONTACT)\n")
     print(table(["DX (mm)", "elements", "rollqp ξ/ξ_Carter − 1", "CONTACT ξ/ξ_Carter − 1",
-                 "|ξ_rollqp|/ξ_CONTACT − 1", "rollqp wall (qp-osqp)", "CONTACT wall"], rows))
+                 "|ξ_rollqp|/ξ_CONTACT − 1", "rollqp wall (qp-osqp)"] + NEWTON_COLUMNS + ["CONTACT wall"], rows))
     if len(ns) >= 3:
         print(f"\nFitted order over the rows run (excluding DX = 0.04, where a_H is not on an element edge): "
               f"rollqp {slope(ns[1:], er[1:]):.3f}, CONTACT {slope(ns[1:], ec[1:]):.3f}.")

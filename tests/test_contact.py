@@ -27,10 +27,6 @@ from rollqp.scene import scene_from_dict
 
 REFDATA = Path(os.environ.get("ROLLQP_CONTACT_REFDATA",
                               Path(__file__).resolve().parents[1].parent / "shared" / "refdata" / "contact"))
-# rollqp's OSQP backend calls OSQP.solve() without ``raise_error`` and OSQP 1.x warns about it
-# on every solve; not what these tests are about (reported to the backend's owner).
-pytestmark = pytest.mark.filterwarnings("ignore:The default value of raise_error:PendingDeprecationWarning")
-
 if not REFDATA.is_dir():
     pytest.skip(f"CONTACT reference data not found at {REFDATA} (../shared/refdata/contact)",
                 allow_module_level=True)

@@ -16,10 +16,6 @@ import pytest
 import rollqp
 from rollqp import closedforms as cf
 
-# rollqp's OSQP backend calls OSQP.solve() without ``raise_error`` and OSQP 1.x warns about it
-# on every solve; not what these tests are about (reported to the backend's owner).
-pytestmark = pytest.mark.filterwarnings("ignore:The default value of raise_error:PendingDeprecationWarning")
-
 RATIO = 0.75
 
 
