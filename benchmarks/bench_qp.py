@@ -55,6 +55,7 @@ import rollqp  # noqa: E402  (imports clarabel, osqp, cvxpy)
 _THREAD_LIMIT = threadpool_limits(limits=1)
 
 import argparse  # noqa: E402
+import re  # noqa: E402
 import datetime  # noqa: E402
 import importlib.metadata as md  # noqa: E402
 import platform  # noqa: E402
@@ -114,7 +115,8 @@ def machine_table() -> str:
 # ----------------------------------------------------------------------------------- helpers
 def _table(header, rows) -> str:
     def cell(c):
-        return str(c).replace("|", "\\|")  # a literal bar inside a markdown table cell
+        # a literal bar, and a literal star (E*), inside a markdown table cell
+        return re.sub(r"(?<!\*)\*(?!\*)", r"\\*", str(c).replace("|", "\\|"))
 
     out = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "|".join("---" for _ in header) + "|"]
     out += ["| " + " | ".join(cell(c) for c in r) + " |" for r in rows]
@@ -471,8 +473,8 @@ def section_multipliers(backends):
     head = (f"### E. The equality multipliers (δ̂ = −y normal, ξ̂ = y tangential)\n\n"
             f"`{SCENE}`, the normal step and rolling step k = {k_probe} (q = {q:.3f} a_H). δ and ξ are "
             f"read from the solvers' equality multipliers (`QPForm.unscaled_multiplier`); the gap g "
-            f"(in u0 = a_H p0/E*) must vanish on the contact nodes (p > 1e-8 p0) and the slip s "
-            f"(in p0/E*) on the stick nodes (μp − |t| > 1e-6 p0).\n")
+            f"(in u0 = a_H p0/E\\*) must vanish on the contact nodes (p > 1e-8 p0) and the slip s "
+            f"(in p0/E\\*) on the stick nodes (μp − |t| > 1e-6 p0).\n")
     return head + "\n" + _table(["backend", "δ/u0", "max |g|/u0 in contact", "contact nodes", "ξ/(p0/E*)",
                                   "max |s|/(p0/E*) in stick", "stick nodes"], rows) + "\n"
 
