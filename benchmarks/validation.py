@@ -152,7 +152,7 @@ def section_paper():
     print("### §6.1.1 Cattaneo → Carter on the paper's mesh (40 QCE, zone ±1.25 a_H, Δq = Le/2, 6 a_H)\n")
     print(table(["method", "Hertz rms/p0", "Cattaneo rms/μp0 (q = 0)", "Carter rms/μp0 (q = 6 a_H)",
                  "ξ/ξ_Carter − 1", "creep law: Q/μP(ξ)/0.75 − 1", "ξ (6 a_H)", "max residual", "wall"], rows))
-    print(f"\n{', '.join(others)} against {QP_BACKENDS[0]}, all 193 states: max |Δt| = {agree:.1e} μp0, "
+    print(f"\n{', '.join(others)} against {QP_BACKENDS[0]}, all {len(ref['q'])} states: max |Δt| = {agree:.1e} μp0, "
           f"max |Δξ/ξ| = {agree_xi:.1e}.\n")
     return runs
 
@@ -213,6 +213,7 @@ def transient_metrics(q, xi_abs, pt, pt_steady, xi_steady):
 def section_contact_transient():
     ref = contact_reference_transient()
     rows, cmp_rows = [], []
+    mc = transient_metrics(ref["q"], np.r_[0.0, ref["cksi"][1:]], -ref["px"], -ref["px_steady"], ref["cksi_steady"])
     for m in ("qp-osqp", "qp-clarabel") + NEWTON:
         scene = contact_scene(method=m)
         res, r, wall = timed_run(scene)
@@ -227,15 +228,18 @@ def section_contact_transient():
         kx = int(np.argmax(d_xi))
         kt = np.unravel_index(int(np.argmax(d_t[1:])), d_t[1:].shape)
         rows.append([m, f"{dx:.1e}", f"{dq:.1e}", f"{d_xi.max():.2e} (q = {ref['q'][1 + kx]:.3f})",
-                     f"{d_t[0].max():.2e}", f"{d_t[1:].max():.2e} (q = {ref['q'][1 + kt[0]]:.3f}, x = {ref['x'][kt[1]]:.4f})",
+                     f"{d_t[0].max():.2e}",
+                     f"{d_t[1:].max():.2e} (q = {ref['q'][1 + kt[0]]:.3f}, x = {ref['x'][kt[1]]:.4f})",
                      f"{d_p:.2e}", f"{wall:.2f} s ({1e3 * wall / (len(r['q'])):.1f} ms/step)"])
         xs = float(abs(rs["creepage"][0]))
         mr = transient_metrics(r["q"] / a, xi, r["pt"], rs["pt"][0], xs)
-        cmp_rows.append([f"rollqp {m}", f"{xs:.6e}", pct(mr["peak"], 2), f"{mr['peak_q']:.3f}",
+        kp = int(np.argmin(np.abs(ref["q"] - mc["peak_q"])))  # CONTACT's peak step
+        cmp_rows.append([f"rollqp {m}", f"{xs:.6e}", pct(mr["peak"], 2),
+                         f"{(xi[kp] - ref['cksi'][kp]) / ref['cksi_steady']:.1e}",
+                         f"{mr['peak_q']:.3f}",
                          f"{mr['settle1']:.3f}", f"{mr['settle01']:.3f}", f"{mr['l2_1']:.3f}",
                          f"{float(np.abs(rs['pt'][0] + ref['px_steady']).max()) / mup0:.1e}"])
-    mc = transient_metrics(ref["q"], np.r_[0.0, ref["cksi"][1:]], -ref["px"], -ref["px_steady"], ref["cksi_steady"])
-    cmp_rows.insert(0, ["CONTACT", f"{ref['cksi_steady']:.6e}", pct(mc["peak"], 2), f"{mc['peak_q']:.3f}",
+    cmp_rows.insert(0, ["CONTACT", f"{ref['cksi_steady']:.6e}", pct(mc["peak"], 2), "—", f"{mc['peak_q']:.3f}",
                         f"{mc['settle1']:.3f}", f"{mc['settle01']:.3f}", f"{mc['l2_1']:.3f}", "—"])
     print("### CONTACT: Cattaneo → Carter transient on CONTACT's grid "
           "(88 constant elements on ±1.1 a_H, Δq = DX = a/40, material form, 160 steps to 4 a_H)\n")
@@ -244,8 +248,20 @@ def section_contact_transient():
     print(table(["method", "max |x − x_CONTACT| (mm)", "max |q/a − q_CONTACT/a|",
                  "max_k ||ξ_k| − cksi_k| / cksi_steady", "max_i |pt + px|/μp0, step 0 (Cattaneo)",
                  "max_k,i |pt + px|/μp0, steps 1–160", "max |pn − pn_CONTACT|/p0", "wall (161 states)"], rows))
+    # where the pressures differ (the last method's run; pn is the same for every method)
+    dp = (r["pn"][0] - ref["pn"][0]) / p0
+    edge = int(np.argmax(np.abs(dp)))
+    nxt = edge + (1 if ref["x"][edge] < 0 else -1)
+    inner = np.abs(ref["x"]) < 0.9 * a
+    print(f"\nPressure: the largest difference is at the outermost contact element, x = {ref['x'][edge]:+.4f} mm "
+          f"(rollqp {r['pn'][0][edge]:.4f}, CONTACT {ref['pn'][0][edge]:.4f} N/mm², {dp[edge]:+.1e} p0); "
+          f"{dp[nxt]:+.1e} p0 one element in; at most {np.abs(dp[inner]).max():.1e} p0 for |x| < 0.9 a. "
+          f"Step 0's rigid shift and approach (d_ref-dependent, not compared): rollqp "
+          f"{float(r['shift'][0]):+.3e} mm and {float(r['approach'][0]):.3e} mm; CONTACT shift "
+          f"{float(ref['cksi'][0]):+.3e} mm.")
     print("\nThe transient's shape (q in a_H; each code against its own steady state on this grid):\n")
-    print(table(["", "steady |ξ|", "overshoot peak", "at q", "|ξ| within 1 % of steady from q",
+    print(table(["", "steady |ξ|", "overshoot peak", "peak: (|ξ| − cksi)/cksi_steady", "at q",
+                 "|ξ| within 1 % of steady from q",
                  "within 0.1 % from q", "t within 1 % (L2) of steady from q", "steady max |pt + px|/μp0"],
                 cmp_rows))
     print()
