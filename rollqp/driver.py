@@ -35,7 +35,8 @@ import numpy as np
 from .errors import InputError, SolverError
 from .influence import build_influence
 from .methods import QP_METHODS, get_method
-from .problem import NormalStep, Scales, TangentialStep, asymmetry, classify, symmetrized
+from .methods.alternation import Alternation
+from .problem import CoupledStep, NormalStep, Scales, TangentialStep, asymmetry, classify, symmetrized
 from .result import Result
 from .scene import Scene, load_scene
 from .strip import Strip
@@ -63,6 +64,7 @@ class Model:
     history: np.ndarray
     symmetric: bool
     info: dict = field(default_factory=dict)
+    _cache: dict = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(cls, scene: Scene, symmetric: bool) -> "Model":
@@ -97,11 +99,34 @@ class Model:
         offset = None if (self.Ant is None or t is None) else self.Ant @ t
         return NormalStep(A=self.Ann, f=self.f, h=self.h, P=P, offset=offset, scales=self.scales)
 
-    def tangential_step(self, p, c, dq, Q=None, xi=None) -> TangentialStep:
-        if self.Atn is not None:
-            c = c + self.Atn @ p
-        return TangentialStep(A=self.Att, f=self.f, p=p, mu=self.scene.contact.friction, c=c, dq=dq,
+    def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False) -> TangentialStep:
+        Atn, Att = self.steady_operators() if steady else (self.Atn, self.Att)
+        if Atn is not None:
+            c = c + Atn @ p
+        return TangentialStep(A=Att, f=self.f, p=p, mu=self.scene.contact.friction, c=c, dq=dq,
                               Q=Q, xi=xi, scales=self.scales)
+
+    @property
+    def coupled(self) -> bool:
+        """Full coupling (``A_nt`` present): each step is one :class:`CoupledStep`."""
+        return self.Ant is not None
+
+    def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False) -> CoupledStep:
+        """The coupled step (FORMULATION.md §6); ``steady``: slip ``s = ξ e + d·D_up w``."""
+        Atn, Att = self.steady_operators() if steady else (self.Atn, self.Att)
+        return CoupledStep(Ann=self.Ann, Att=Att, Ant=self.Ant, Atn=Atn, f=self.f, h=self.h,
+                           mu=self.scene.contact.friction, c=c, dq=dq, P=P, Q=Q, xi=xi, scales=self.scales)
+
+    def steady_operators(self):
+        """``(Δ·d·D_up·A_tn, Δ·d·D_up·A_tt)`` with ``Δ = a_H``: the steady slip operators.
+
+        With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt t)/dq``
+        is then the steady-rolling slip ``ξ e + d·D_up w`` (FORMULATION.md §4). Built once.
+        """
+        if "steady" not in self._cache:
+            T = self.scales.length * self.strip.steady_operator(self.scene.load.direction)
+            self._cache["steady"] = (None if self.Atn is None else T @ self.Atn, T @ self.Att)
+        return self._cache["steady"]
 
     def w(self, p, t) -> np.ndarray:
         """Relative tangential displacement ``w = A_tn p + A_tt t`` (eq. 28)."""
@@ -119,18 +144,56 @@ class Model:
 
 
 class _State:
-    """The last accepted step: tractions, solutions (for warm starts), and w."""
+    """The last accepted step: tractions, solutions (for warm starts), and w.
+
+    For a coupled step ``nsol`` and ``tsol`` are the same :class:`StepSolution`.
+    """
 
     def __init__(self, p, t, nsol, tsol, w):
         self.p, self.t, self.nsol, self.tsol, self.w = p, t, nsol, tsol, w
 
 
+@dataclass
+class _Step:
+    """What one step (or a start phase) reports to the result file."""
+
+    iterations: int = 0
+    residual: float = 0.0
+    inner_normal: int = 0
+    inner_tangential: int = 0
+    backtracks: int = 0
+
+    def add(self, sol, half=None):
+        """Count a solution of a normal or tangential half (two-QP path)."""
+        self.iterations += sol.iterations
+        if half == "normal":
+            self.inner_normal += sol.iterations
+        elif half == "tangential":
+            self.inner_tangential += sol.iterations
+        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.residual = max(self.residual, sol.residual)
+
+    def add_coupled(self, sol):
+        """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
+        self.iterations += sol.iterations
+        self.inner_normal += int(sol.info.get("inner_normal", 0))
+        self.inner_tangential += int(sol.info.get("inner_tangential", 0))
+        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.residual = max(self.residual, sol.residual)
+
+
+#: Methods that solve non-symmetric step problems directly (the steady rolling start).
+DIRECT_STEADY = ("newton", "nt-newton")
+
+
 def _make_method(scene: Scene, name: str):
+    """The scene's step method; QP backends are wrapped in the N–T alternation for full coupling."""
+    settings = {"tolerance": scene.solver.tolerance}
     if name not in QP_METHODS:
-        # The Newton methods register under the same names once implemented (issue 3).
-        method = get_method(name, tolerance=scene.solver.tolerance, max_iterations=scene.solver.max_iterations)
-    else:
-        method = get_method(name, tolerance=scene.solver.tolerance)
+        settings["max_iterations"] = scene.solver.max_iterations
+    method = get_method(name, **settings)
+    if scene.coupling_level == "full" and name in QP_METHODS:
+        method = Alternation(method)
     return method
 
 
@@ -159,11 +222,6 @@ def run(scene, method: str | None = None, progress=None) -> Result:
     if method is not None and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     meth = _make_method(scene, name)
-    if scene.coupling_level == "full":
-        raise InputError("contact.coupling",
-                         f"full normal-tangential coupling (beta = {scene.beta:.4g}) needs the coupled Newton "
-                         "method or the N-T alternation, which this version does not have yet; "
-                         "use coupling = \"goodman\" or \"off\"")
     model = Model.build(scene, symmetric=getattr(meth, "operator", "exact") == "symmetrized")
     result = _new_result(scene, model, name)
     try:
@@ -183,7 +241,8 @@ def _new_result(scene, model, name) -> Result:
     import rollqp
     meta = {"scene": scene.to_dict(), "method": name, "model": {k: v for k, v in model.info.items()},
             "versions": _versions(), "rollqp": rollqp.__version__,
-            "dq": scene.dq, "n_nodes": model.strip.n,
+            "dq": scene.dq, "n_nodes": model.strip.n, "coupling": scene.coupling_level,
+            "step_problem": "coupled" if model.coupled else "normal + tangential",
             "slip_note": "step 0 of a braked start: static-shift slip per a_H of shift"}
     scalars = {"a_H": scene.a_H, "p0": scene.p0, "R": scene.R, "Estar": scene.Estar, "beta": scene.beta,
                "leading_edge": scene.leading_edge}
@@ -201,12 +260,13 @@ def _versions() -> dict:
     return out
 
 
-def _record(result, model, q, state: _State, *, P, Q, xi, delta, shift, iterations, step_time, residual):
+def _record(result, model, q, state: _State, st: _Step, *, P, shift, step_time):
     sc, mu = model.scales, model.scene.contact.friction
     s = state.tsol.s
     result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=classify(state.p, state.t, s, mu, sc),
-                  P=P, Q=Q, creepage=xi, approach=delta, shift=shift, iterations=iterations,
-                  step_time=step_time, residual=residual)
+                  P=P, Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
+                  iterations=st.iterations, step_time=step_time, residual=st.residual,
+                  inner_normal=st.inner_normal, inner_tangential=st.inner_tangential, backtracks=st.backtracks)
 
 
 def _loads(scene, q):
@@ -216,49 +276,59 @@ def _loads(scene, q):
     return P, float(scene.tangential_load(q)), None
 
 
-def _braked_start(scene, model, meth, result):
-    """Step 0 of a braked start: normal load, then tangential load by static shift (§4.4)."""
-    t0 = time.perf_counter()
-    P, Q, xi = _loads(scene, 0.0)
-    nsol = meth.solve(model.normal_step(P))
-    model.check_inside(nsol.p, 0)
-    p = nsol.p
-    n = model.strip.n
-    t = np.zeros(n)
-    w_prev = np.zeros(n)  # unloaded bodies
-    Qtarget = Q if Q is not None else 0.0
-    iters = nsol.iterations
-    tsol = None
-    shift = 0.0
-    N = scene.load.start_steps
-    for j in range(1, N + 1):
-        # static shift (V = 0): s = (w^j − w^{j−1})/Δ + ξ, Δ = a_H, ξ·Δ = rigid shift increment
-        prob = model.tangential_step(p, -w_prev, model.scales.length, Q=Qtarget * j / N)
-        tsol = meth.solve(prob, warm=tsol)
-        iters += tsol.iterations
-        shift += tsol.xi * model.scales.length
-        t = tsol.t
-        w_prev = model.w(p, t)
-    res = (nsol.residuals | tsol.residuals).max
-    state = _State(p, t, nsol, tsol, w_prev)
-    _record(result, model, 0.0, state, P=P, Q=float(model.f @ t), xi=0.0, delta=nsol.delta, shift=shift,
-            iterations=iters, step_time=time.perf_counter() - t0, residual=res)
-    return state
-
-
-def _rolling_step(scene, model, meth, state: _State, q, normal_fixed):
-    P, Q, xi = _loads(scene, q)
+def _step(model, meth, state: _State, st: _Step, *, P, c, dq, Q=None, xi=None, normal_fixed=False, steady=False):
+    """One step (rolling, static shift or steady): the coupled problem, or its two halves."""
+    if model.coupled:
+        sol = meth.solve(model.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady), warm=state.tsol)
+        st.add_coupled(sol)
+        return _State(sol.p, sol.t, sol, sol, model.w(sol.p, sol.t))
     nsol = state.nsol
-    it = 0
-    if not normal_fixed:
+    if not normal_fixed or nsol is None:
+        # goodman/off: the normal half does not see t (A_nt = 0); offset kept for generality
         nsol = meth.solve(model.normal_step(P, state.t), warm=state.nsol)
-        it += nsol.iterations
-    p = nsol.p
-    c = -(model.history @ state.w)
-    tsol = meth.solve(model.tangential_step(p, c, scene.dq, Q=Q, xi=xi), warm=state.tsol)
-    it += tsol.iterations
-    new = _State(p, tsol.t, nsol, tsol, model.w(p, tsol.t))
-    return new, P, it, (nsol.residuals | tsol.residuals).max
+        st.add(nsol, "normal")
+    tsol = meth.solve(model.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady), warm=state.tsol)
+    st.add(tsol, "tangential")
+    return _State(nsol.p, tsol.t, nsol, tsol, model.w(nsol.p, tsol.t))
+
+
+def _braked_start(scene, model, meth, result):
+    """Step 0 of a braked start (§2.2, §4.4; FORMULATION.md §9), by static shift.
+
+    1. The normal load in ``load.start_steps`` quasi-static increments at ``Q = 0``. With
+       coupling (β ≠ 0, ``goodman`` or ``full``) the pressure displaces the surfaces
+       tangentially and friction resists: the Goodman-type starting state. Without coupling
+       the shear stays zero and the normal load is applied at once (path independent).
+    2. The tangential load in ``load.start_steps`` increments (Cattaneo for similar bodies).
+
+    Static-shift slip: ``s = ξ + (w^j − w^{j−1})/Δ`` with ``Δ = a_H`` and ``ξ·Δ`` the rigid
+    shift increment, accumulated in the result's ``shift``.
+    """
+    t0 = time.perf_counter()
+    P, Q, _ = _loads(scene, 0.0)
+    Qtarget = Q if Q is not None else 0.0
+    n = model.strip.n
+    N = scene.load.start_steps
+    delta = model.scales.length
+    st = _Step()
+    state = _State(None, np.zeros(n), None, None, np.zeros(n))  # unloaded bodies
+    shift = 0.0
+    if model.Atn is not None:
+        loading = [(P * j / N, 0.0) for j in range(1, N + 1)]
+    else:  # no coupling: the shear of a normal load is zero, so go straight to Q (Hertz, then Cattaneo)
+        loading = [] if Qtarget != 0.0 else [(P, 0.0)]
+    if Qtarget != 0.0:
+        loading += [(P, Qtarget * j / N) for j in range(1, N + 1)]
+    Pprev = None
+    for Pj, Qj in loading:
+        # the normal half is re-solved only if P changed or the shear feeds back (A_nt)
+        state = _step(model, meth, state, st, P=Pj, c=-state.w, dq=delta, Q=Qj,
+                      normal_fixed=(Pj == Pprev and model.Ant is None))
+        Pprev = Pj
+        shift += state.tsol.xi * delta
+    model.check_inside(state.p, 0)
+    _record(result, model, 0.0, state, st, P=P, shift=shift, step_time=time.perf_counter() - t0)
+    return state
 
 
 def _normal_fixed(scene, model) -> bool:
@@ -274,31 +344,60 @@ def _march(scene, model, meth, result, progress):
     fixed = _normal_fixed(scene, model)
     state = _braked_start(scene, model, meth, result)
     if scene.load.start == "rolling":
-        state = _steady_by_marching(scene, model, meth, state, result, fixed)
+        if getattr(meth, "name", None) in DIRECT_STEADY:
+            state = _steady_direct(scene, model, meth, state, result)
+        else:
+            state = _steady_by_marching(scene, model, meth, state, result, fixed)
     qs = scene.q_steps
     K = qs.size - 1
     for k in range(1, K + 1):
         t0 = time.perf_counter()
-        state, P, it, res = _rolling_step(scene, model, meth, state, qs[k], fixed)
+        P, Q, xi = _loads(scene, qs[k])
+        st = _Step()
+        state = _step(model, meth, state, st, P=P, c=-(model.history @ state.w), dq=scene.dq, Q=Q, xi=xi,
+                      normal_fixed=fixed)
         if not fixed:
             model.check_inside(state.p, k)
-        _record(result, model, qs[k], state, P=P, Q=float(model.f @ state.t), xi=state.tsol.xi,
-                delta=state.nsol.delta, shift=0.0, iterations=it, step_time=time.perf_counter() - t0,
-                residual=res)
+        _record(result, model, qs[k], state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
         if progress is not None:
             progress(k, K)
 
 
-def _steady_by_marching(scene, model, meth, state, result, fixed):
-    """Roll at the initial loads until the tractions stop changing; replace state 0 with it."""
+def _steady_direct(scene, model, meth, state, result):
+    """Rolling start: the steady rolling problem ``s = ξ e + d·D_up w`` solved directly.
+
+    Not symmetric (``D_up A`` is not), so only the Newton methods pose it; warm-started from
+    the braked state. Replaces state 0.
+    """
     t0 = time.perf_counter()
-    q0 = 0.0
-    iters = 0
+    P, Q, xi = _loads(scene, 0.0)
+    st = _Step()
+    state = _step(model, meth, state, st, P=P, c=np.zeros(model.strip.n), dq=model.scales.length, Q=Q, xi=xi,
+                  steady=True)
+    model.check_inside(state.p, 0)
+    result.rows = {key: [] for key in result.rows}
+    result.meta["rolling_start"] = "direct steady solve"
+    _record(result, model, 0.0, state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
+    return state
+
+
+def _steady_by_marching(scene, model, meth, state, result, fixed):
+    """Rolling start: roll at the initial loads until the tractions stop changing; replace state 0.
+
+    The QP methods cannot pose the non-symmetric steady problem, so they march the
+    transient at constant loads (``STEADY_TOL``, ``STEADY_MAX_DISTANCE``).
+    """
+    t0 = time.perf_counter()
+    P, Q, xi = _loads(scene, 0.0)
+    st = _Step()
     max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
-    for k in range(max_steps):
-        new, P, it, res = _rolling_step(scene, model, meth, state, q0, fixed)
-        iters += it
+    change = np.inf
+    for _ in range(max_steps):
+        new = _step(model, meth, state, st, P=P, c=-(model.history @ state.w), dq=scene.dq, Q=Q, xi=xi,
+                    normal_fixed=fixed)
         change = np.max(np.abs(new.t - state.t)) / (max(scene.contact.friction, 1e-300) * model.scales.stress)
+        if not fixed:
+            change = max(change, np.max(np.abs(new.p - state.p)) / model.scales.stress)
         state = new
         if change < STEADY_TOL:
             break
@@ -306,6 +405,6 @@ def _steady_by_marching(scene, model, meth, state, result, fixed):
         raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
                           f"(last change {change:.2e} mu p0)", method=meth.name, step=0)
     result.rows = {key: [] for key in result.rows}
-    _record(result, model, 0.0, state, P=P, Q=float(model.f @ state.t), xi=state.tsol.xi, delta=state.nsol.delta,
-            shift=0.0, iterations=iters, step_time=time.perf_counter() - t0, residual=res)
+    result.meta["rolling_start"] = "marching to steady state"
+    _record(result, model, 0.0, state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
     return state

@@ -394,6 +394,141 @@ class TangentialStep:
                             residuals=self.residuals(t, xi), **meta)
 
 
+@dataclass(frozen=True)
+class CoupledStep:
+    r"""The coupled step (paper eq. 63–64, 67; FORMULATION.md §6): all rows of ``Φ``.
+
+    .. math::
+        g = h - \delta e + A_{nn} p + A_{nt} t, \qquad
+        s = \xi e + (c + A_{tn} p + A_{tt} t)/\Delta q,
+
+        p \ge 0,\ g \ge 0,\ p g = 0, \qquad
+        t = \mathrm{Proj}_{[-\mu p^+, \mu p^+]}(t - s), \qquad
+        f^T p = P\ (\text{or } \delta), \qquad f^T t = Q\ (\text{or } \xi).
+
+    The friction bound depends on the unknown pressure: a quasi-variational inequality, not
+    a QP. It is solved by the coupled Newton method or by the N–T alternation of its two
+    halves (:meth:`normal_half`, :meth:`tangential_half`), which are ordinary step problems.
+
+    Parameters
+    ----------
+    Ann, Att : (n, n) arrays
+        Normal and tangential influence (eq. 25, 28).
+    Ant, Atn : (n, n) arrays or None
+        Coupling: gap change per unit shear, tangential displacement per unit pressure
+        (``None``: zero; ``Ant = None`` is the Goodman level of FORMULATION.md §3).
+    f, h, mu : weights, undeformed gap, coefficient of friction.
+    c : (n,) array
+        History vector (eq. 37, 48): ``Δq·s = Δq ξ e + c + A_tn p + A_tt t``.
+    dq : float
+        Step length (for a static shift: its length unit; for steady rolling see below).
+    P, delta : exactly one;  Q, xi : exactly one.
+    scales : Scales
+
+    Notes
+    -----
+    ``Atn`` and ``Att`` are the *slip* operators: for transient steps the influence matrices
+    themselves; for steady rolling (``s = ξ e + d·D_up w``) the driver passes
+    ``Δ·d·D_up·A_tn`` and ``Δ·d·D_up·A_tt`` with ``dq = Δ`` and ``c = 0``.
+    """
+
+    Ann: np.ndarray
+    Att: np.ndarray
+    Ant: np.ndarray | None
+    Atn: np.ndarray | None
+    f: np.ndarray
+    h: np.ndarray
+    mu: float
+    c: np.ndarray
+    dq: float
+    P: float | None = None
+    delta: float | None = None
+    Q: float | None = None
+    xi: float | None = None
+    scales: Scales = field(default_factory=Scales)
+    kind = "coupled"
+
+    def __post_init__(self):
+        n = np.asarray(self.f).shape[0] if np.ndim(self.f) == 1 else -1
+        if n < 1:
+            raise InputError("f", "must be a 1-D array of weights")
+        object.__setattr__(self, "f", _vec("f", self.f, n))
+        if np.any(self.f <= 0):
+            raise InputError("f", "weights must all be > 0")
+        for name in ("Ann", "Att"):
+            object.__setattr__(self, name, _mat(name, getattr(self, name), n))
+        for name in ("Ant", "Atn"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, _mat(name, getattr(self, name), n))
+        object.__setattr__(self, "h", _vec("h", self.h, n))
+        object.__setattr__(self, "c", _vec("c", self.c, n))
+        if not (np.isfinite(self.mu) and self.mu >= 0):
+            raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {self.mu!r}")
+        if not (np.isfinite(self.dq) and self.dq > 0):
+            raise InputError("dq", f"the step must be a finite number > 0, got {self.dq!r}")
+        _exactly_one(("P", "delta"), (self.P, self.delta))
+        _exactly_one(("Q", "xi"), (self.Q, self.xi))
+        if self.P is not None and not (np.isfinite(self.P) and self.P > 0):
+            raise InputError("P", f"the normal load must be a finite number > 0, got {self.P!r}")
+        for name in ("delta", "xi", "Q"):
+            v = getattr(self, name)
+            if v is not None and not np.isfinite(v):
+                raise InputError(name, f"must be finite, got {v!r}")
+        if self.Q is not None and self.P is not None and not abs(self.Q) < self.mu * self.P:
+            raise InputError("Q", f"|Q| = {abs(self.Q):.6g} must be below the sliding limit "
+                                  f"mu P = {self.mu * self.P:.6g} for a solution with stick")
+
+    @property
+    def n(self) -> int:
+        return self.f.size
+
+    def replace(self, **kw) -> "CoupledStep":
+        return dataclasses.replace(self, **kw)
+
+    def gap(self, p, t, delta) -> np.ndarray:
+        """``g = h − δ e + A_nn p + A_nt t`` (eq. 25, 30)."""
+        g = self.h - delta + self.Ann @ p
+        return g if self.Ant is None else g + self.Ant @ t
+
+    def slip(self, p, t, xi) -> np.ndarray:
+        """``s = ξ e + (c + A_tn p + A_tt t)/Δq`` (eq. 36, 47)."""
+        w = self.c + self.Att @ t
+        if self.Atn is not None:
+            w = w + self.Atn @ p
+        return xi + w / self.dq
+
+    def normal_half(self, t) -> NormalStep:
+        """The normal step with the shear ``t`` fixed (eq. 53): offset ``A_nt t``."""
+        off = None if self.Ant is None else self.Ant @ t
+        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=self.P, delta=self.delta, offset=off,
+                          scales=self.scales)
+
+    def tangential_half(self, p) -> TangentialStep:
+        """The tangential step with the pressure ``p`` fixed (eq. 61/62): bound ``μ p⁺``."""
+        c = self.c if self.Atn is None else self.c + self.Atn @ p
+        return TangentialStep(A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q,
+                              xi=self.xi, scales=self.scales)
+
+    def residuals(self, p, t, delta, xi) -> "Residuals":
+        sc = self.scales
+        g, s = self.gap(p, t, delta), self.slip(p, t, xi)
+        sig = np.minimum(p / sc.stress, g / sc.displacement)
+        th, sh = t / sc.stress, s / sc.slip
+        bh = self.mu * np.maximum(p, 0.0) / sc.stress
+        fr = th - np.clip(th - sh, -bh, bh)
+        ln = 0.0 if self.P is None else (self.f @ p - self.P) / sc.force
+        lt = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
+        return Residuals(signorini=float(np.max(np.abs(sig))), friction=float(np.max(np.abs(fr))),
+                         load_normal=abs(float(ln)), load_tangential=abs(float(lt)))
+
+    def solution(self, p, t, delta, xi, **meta) -> "StepSolution":
+        p, t = np.asarray(p, dtype=float), np.asarray(t, dtype=float)
+        delta = self.delta if self.delta is not None else float(delta)
+        xi = self.xi if self.xi is not None else float(xi)
+        return StepSolution(p=p, t=t, g=self.gap(p, t, delta), s=self.slip(p, t, xi), delta=float(delta),
+                            xi=float(xi), residuals=self.residuals(p, t, delta, xi), **meta)
+
+
 # ---------------------------------------------------------------------------- solutions
 @dataclass
 class Residuals:

@@ -11,7 +11,9 @@ import numpy as np
 from .errors import InputError
 
 _PER_STATE = ("pn", "pt", "slip", "gap", "state")
-_PER_STEP = ("q", "P", "Q", "creepage", "approach", "shift", "iterations", "step_time", "residual")
+_PER_STEP = ("q", "P", "Q", "creepage", "approach", "shift", "iterations", "step_time", "residual",
+             "inner_normal", "inner_tangential", "backtracks")
+_COUNTS = ("iterations", "inner_normal", "inner_tangential", "backtracks")
 
 
 @dataclass
@@ -29,10 +31,11 @@ class Result:
     rows: dict = field(default_factory=lambda: {k: [] for k in _PER_STATE + _PER_STEP})
 
     def append(self, *, q, pn, pt, slip, gap, state, P, Q, creepage, approach, shift=0.0,
-               iterations=0, step_time=0.0, residual=0.0):
+               iterations=0, step_time=0.0, residual=0.0, inner_normal=0, inner_tangential=0, backtracks=0):
         vals = dict(q=q, pn=pn, pt=pt, slip=slip, gap=gap, state=state, P=P, Q=Q, creepage=creepage,
                     approach=approach, shift=shift, iterations=iterations, step_time=step_time,
-                    residual=residual)
+                    residual=residual, inner_normal=inner_normal, inner_tangential=inner_tangential,
+                    backtracks=backtracks)
         for k, v in vals.items():
             self.rows[k].append(np.array(v, copy=True))
 
@@ -47,7 +50,7 @@ class Result:
             dtype = np.int8 if k == "state" else float
             out[k] = np.asarray(self.rows[k], dtype=dtype).reshape(len(self), n)
         for k in _PER_STEP:
-            dtype = np.int64 if k == "iterations" else float
+            dtype = np.int64 if k in _COUNTS else float
             out[k] = np.asarray(self.rows[k], dtype=dtype).reshape(len(self))
         for k, v in self.scalars.items():
             out[k] = np.asarray(v)

@@ -222,16 +222,6 @@ def test_failing_step_reports_step_and_partial(builtin_scene, counting):
     assert isinstance(err.__cause__, SolverError), "the original error is chained"
 
 
-def test_full_coupling_is_refused(builtin_scene):
-    # aluminium on steel: β ≠ 0, coupling "auto" → "full", which the QP driver cannot do yet
-    scene = builtin_scene("cattaneo-carter", **{"bodies.B.E": 70000.0, "bodies.B.nu": 0.33,
-                                                 "discretization.distance": 0.0})
-    assert scene.coupling_level == "full", "precondition: a dissimilar pair"
-    with pytest.raises(rollqp.InputError) as info:
-        rollqp.run(scene, method=METHOD)
-    assert info.value.key == "contact.coupling", f"names the key: {info.value}"
-
-
 # ------------------------------------------------------------------------------- result
 SPEC_STATE = ("pn", "pt", "slip", "gap", "state")
 SPEC_STEP = ("q", "P", "Q", "creepage", "approach", "iterations", "step_time", "residual")

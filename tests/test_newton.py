@@ -393,9 +393,11 @@ def test_solution_is_rollqps(case):
 def test_registry():
     assert isinstance(get_method("newton", tolerance=1e-9, max_iterations=50), NewtonMethod)
     assert "newton" in available_methods()
-    assert "nt-newton" not in available_methods()
-    with pytest.raises(InputError, match="not available"):
-        get_method("nt-newton")
+    assert "nt-newton" in available_methods()
+    nt = get_method("nt-newton", tolerance=1e-9, max_iterations=50)
+    assert nt.name == "nt-newton" and nt.inner.tolerance == 1e-9 and nt.inner.max_iterations == 50
+    with pytest.raises(InputError, match="unknown method"):
+        get_method("nt-clarabel")
 
 
 @pytest.mark.parametrize("kw", [dict(tolerance=0.0), dict(tolerance=2.0), dict(max_iterations=0),

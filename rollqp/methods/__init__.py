@@ -23,7 +23,7 @@ _REGISTRY = {
     "qp-osqp": ("rollqp.methods.qp_osqp", "OsqpQP", None, "qp"),
     "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", None, "qp"),
     "newton": ("rollqp.methods.newton", "NewtonMethod", None, "newton"),
-    "nt-newton": ("rollqp.methods.newton", "AlternationNewton", None, "newton"),
+    "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None, "newton"),
 }
 
 QP_METHODS = tuple(k for k, v in _REGISTRY.items() if v[3] == "qp")

@@ -169,7 +169,10 @@ class NewtonMethod:
             return self._solve_normal(problem, warm, t0)
         if problem.kind == "tangential":
             return self._solve_tangential(problem, warm, t0)
-        raise InputError("problem", f"the Newton method solves normal or tangential steps, not {problem.kind!r}")
+        if problem.kind == "coupled":
+            return self._solve_coupled(problem, warm, t0)
+        raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
+                                    f"not {problem.kind!r}")
 
     # ------------------------------------------------------------ the two kinds
     def _solve_normal(self, pb, warm, t0):
@@ -354,6 +357,216 @@ class NewtonMethod:
         info = {"r": r, "backtracks": backtracks, "merit": merits[-1], "history": history, "merits": merits,
                 "steps": steps, "nonmonotone": nonmono, "shifts": shifts, "tolerance_phi": stop}
         return z, it, info
+
+    # ------------------------------------------------------------ the coupled step
+    def _solve_coupled(self, pb, warm, t0):
+        r"""GNMls on all rows of ``Φ`` (eq. 63–64, 80–90): unknowns ``z = (p̂, t̂, δ̂?, ξ̂?)``.
+
+        ``y_N = r_N ĝ`` and ``y_T = r_T ŝ`` are linear in ``z``; the friction bound is
+        ``b = μ max(0, p̂ − y_N)`` (eq. 63), so a slipping node's row depends on ``p̂`` and ``ĝ``
+        (eq. 88). Start: the previous step (warm), else one N–T sweep of the two halves.
+        """
+        sc = pb.scales
+        n = pb.n
+        S = self._coupled_system(pb)
+        N, iP, iQ = S["N"], S["iP"], S["iQ"]
+        KN, KT, kN, kT = S["KN"], S["KT"], S["kN"], S["kT"]
+        mu = pb.mu
+        Phat = pb.P / sc.force if iP is not None else None
+        Qhat = pb.Q / sc.force if iQ is not None else None
+
+        start = "warm"
+        if (warm is not None and warm.p is not None and warm.t is not None and np.shape(warm.p) == (n,)
+                and np.shape(warm.t) == (n,)):
+            p0, t0_, d0, x0 = warm.p, warm.t, warm.delta, warm.xi
+        else:  # cold: one N–T sweep of the halves (normal with t = 0, then tangential)
+            start = "cold"
+            nsol = self.solve(pb.normal_half(np.zeros(n)))
+            tsol = self.solve(pb.tangential_half(nsol.p))
+            p0, t0_, d0, x0 = nsol.p, tsol.t, nsol.delta, tsol.xi
+        z = np.zeros(N)
+        z[:n], z[n:2 * n] = p0 / sc.stress, t0_ / sc.stress
+        if iP is not None:
+            z[iP] = (d0 if d0 is not None else 0.0) / sc.displacement
+        if iQ is not None:
+            z[iQ] = (x0 if x0 is not None else 0.0) / sc.slip
+        fhat = S["fhat"]
+
+        def residual(p, t, yN, yT):
+            b = mu * np.maximum(0.0, p - yN)
+            out = np.empty(N)
+            out[:n] = np.minimum(p, yN)
+            out[n:2 * n] = t - np.clip(t - yT, -b, b)
+            if iP is not None:
+                out[iP] = fhat @ p - Phat
+            if iQ is not None:
+                out[iQ] = fhat @ t - Qhat
+            return out
+
+        stop = self.tolerance * min(1.0, S["rN"], S["rT"])
+        rho, two_sigma = self.rho, 2.0 * self.sigma
+        history, merits, steps = [], [], []
+        backtracks = nonmono = shifts = it = tightened = 0
+        p, t = z[:n], z[n:2 * n]
+        yN, yT = KN @ z + kN, KT @ z + kT
+        phi = residual(p, t, yN, yT)
+        while True:
+            nrm = float(np.max(np.abs(phi)))
+            history.append(nrm)
+            merits.append(0.5 * float(phi @ phi))
+            if nrm <= stop:
+                sol = pb.solution(p * sc.stress, t * sc.stress,
+                                  z[iP] * sc.displacement if iP is not None else None,
+                                  z[iQ] * sc.slip if iQ is not None else None)
+                if sol.residual <= self.tolerance or tightened >= 3:
+                    break
+                stop *= 0.1  # the bound μ max(0, p − r g) differs from μ p⁺ off the solution
+                tightened += 1
+                history.pop()
+                merits.pop()
+                continue
+            if it >= self.max_iterations:
+                theta = merits[-1]
+                raise SolverError(f"the coupled Newton iteration did not converge: merit θ = {theta:.3e} "
+                                  f"after {it} iterations (‖Φ‖∞ = {nrm:.3e} > {stop:.1e})",
+                                  method=self.name, status=f"merit {theta:.3e}", iterations=it, residual=nrm)
+            it += 1
+            contact, stick, slip_sign, _ = self._coupled_cases(p, t, yN, yT, mu)
+            if iP is not None and not contact.any():  # no δ̂ column: see module docstring
+                j = int(np.argmin(yN - p))
+                z[iP] += (p[j] - yN[j]) / KN[j, iP]
+                yN, yT = KN @ z + kN, KT @ z + kT
+                phi = residual(p, t, yN, yT)
+                contact, stick, slip_sign, _ = self._coupled_cases(p, t, yN, yT, mu)
+                contact[j] = True
+                shifts += 1
+            if iQ is not None and not stick.any():  # no ξ̂ column
+                b = mu * np.maximum(0.0, p - yN)
+                u = t - yT
+                excess = np.where(b > 0, np.abs(u) - b, np.inf)
+                j = int(np.argmin(excess))
+                if not np.isfinite(excess[j]):
+                    raise SolverError("no node can stick: the friction bound is zero everywhere",
+                                      method=self.name, status="degenerate", iterations=it, residual=nrm)
+                z[iQ] += np.sign(u[j]) * excess[j] / KT[j, iQ]
+                yN, yT = KN @ z + kN, KT @ z + kT
+                phi = residual(p, t, yN, yT)
+                contact, stick, slip_sign, _ = self._coupled_cases(p, t, yN, yT, mu)
+                stick[j] = True
+                slip_sign[j] = 0.0
+                shifts += 1
+            J = self._coupled_jacobian(S, contact, stick, slip_sign, mu)
+            _, _, d, fail = dgesv(J, -phi, overwrite_a=True)
+            if fail != 0 or not np.all(np.isfinite(d)):
+                raise SolverError(f"the coupled Newton matrix is singular (LAPACK info {fail})",
+                                  method=self.name, status="singular", iterations=it, residual=nrm)
+            dN, dT = KN @ d, KT @ d
+            dp, dt = d[:n], d[n:2 * n]
+            theta = merits[-1]
+            alpha = 1.0
+            while True:
+                pa = residual(p + alpha * dp, t + alpha * dt, yN + alpha * dN, yT + alpha * dT)
+                if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
+                    break
+                alpha *= rho
+                backtracks += 1
+                if alpha < ALPHA_MIN:
+                    nonmono += 1
+                    alpha = 1.0
+                    break
+            steps.append(alpha)
+            z = z + alpha * d  # eq. 79
+            p, t = z[:n], z[n:2 * n]
+            yN, yT = KN @ z + kN, KT @ z + kT
+            phi = residual(p, t, yN, yT)
+        info = {"r": (S["rN"], S["rT"]), "backtracks": backtracks, "merit": merits[-1], "history": history,
+                "merits": merits, "steps": steps, "nonmonotone": nonmono, "shifts": shifts,
+                "tolerance_phi": stop, "start": start}
+        return self._finish(sol, it, info, t0)
+
+    @staticmethod
+    def _coupled_cases(p, t, yN, yT, mu):
+        """Node cases of the coupled ``Φ`` (eq. 82–90).
+
+        Returns ``contact`` (eq. 84: row ``∂y_N``), ``stick`` (eq. 86/87: row ``∂y_T``),
+        ``slip_sign`` (eq. 88: ``σ = sgn(t̂ − y_T)``, row ``e_t − σμ(e_p − ∂y_N)``; 0 elsewhere)
+        and ``zero_bound`` (eq. 85/89/90: ``b = 0``, row ``e_t``).
+        """
+        contact = p > yN
+        b = mu * np.maximum(0.0, p - yN)
+        u = t - yT
+        zero_bound = b <= 0.0
+        stick = (np.abs(u) <= b) & ~zero_bound
+        slip_sign = np.where(stick | zero_bound, 0.0, np.sign(u))
+        return contact, stick, slip_sign, zero_bound
+
+    @staticmethod
+    def _coupled_jacobian(S, contact, stick, slip_sign, mu):
+        """The pseudo-Jacobian ``BΦ`` (eq. 80–90), Fortran-ordered for LAPACK."""
+        n = contact.size
+        J = np.array(S["J0"], order="F")  # identity rows and load rows
+        ic = np.flatnonzero(contact)
+        J[ic] = S["KN"][ic]
+        ist = np.flatnonzero(stick)
+        J[n + ist] = S["KT"][ist]
+        isl = np.flatnonzero(slip_sign)
+        if isl.size:
+            sm = (slip_sign[isl] * mu)[:, None]
+            rows = sm * S["KN"][isl]
+            rows[np.arange(isl.size), isl] -= sm[:, 0]
+            rows[np.arange(isl.size), n + isl] += 1.0
+            J[n + isl] = rows
+        return J
+
+    def _coupled_system(self, pb):
+        """Scaled, r-weighted linear parts ``y_N = K_N z + k_N``, ``y_T = K_T z + k_T``."""
+        sc = pb.scales
+        key = ("coupled", id(pb.Ann), id(pb.Att), id(pb.Ant), id(pb.Atn), id(pb.f), sc, pb.dq, self.r,
+               pb.P is None, pb.Q is None)
+        hit = self._cache.get(key)
+        if hit is None or not all(a is b for a, b in zip(hit["src"], (pb.Ann, pb.Att, pb.Ant, pb.Atn, pb.f))):
+            n = pb.n
+            m = sc.modulus / sc.length
+            dqh = pb.dq / sc.length
+            Ann, Att = pb.Ann * m, pb.Att * m
+            sN, sT = float(np.mean(np.diag(Ann))), float(np.mean(np.diag(Att)))
+            if not (sN > 0 and sT > 0):
+                raise InputError("A", "the influence matrices must have a positive mean diagonal")
+            rN = self.r if self.r is not None else 1.0 / sN
+            rT = self.r if self.r is not None else dqh / sT
+            iP = 2 * n if pb.P is not None else None
+            iQ = (2 * n + (iP is not None)) if pb.Q is not None else None
+            N = 2 * n + (iP is not None) + (iQ is not None)
+            KN = np.zeros((n, N))
+            KT = np.zeros((n, N))
+            KN[:, :n] = rN * Ann
+            KT[:, n:2 * n] = (rT / dqh) * Att
+            if pb.Ant is not None:
+                KN[:, n:2 * n] = rN * m * pb.Ant
+            if pb.Atn is not None:
+                KT[:, :n] = (rT / dqh) * m * pb.Atn
+            if iP is not None:
+                KN[:, iP] = -rN
+            if iQ is not None:
+                KT[:, iQ] = rT
+            fhat = pb.f / sc.length
+            J0 = np.zeros((N, N))
+            J0[:2 * n, :2 * n] = np.eye(2 * n)
+            if iP is not None:
+                J0[iP, :n] = fhat
+            if iQ is not None:
+                J0[iQ, n:2 * n] = fhat
+            hit = {"src": (pb.Ann, pb.Att, pb.Ant, pb.Atn, pb.f), "N": N, "iP": iP, "iQ": iQ, "KN": KN,
+                   "KT": KT, "J0": J0, "fhat": fhat, "rN": rN, "rT": rT, "dqh": dqh}
+            if len(self._cache) >= 16:
+                self._cache.clear()
+            self._cache[key] = hit
+        # the vectors change every step
+        u0 = sc.displacement
+        dqh = hit["dqh"]
+        kN = hit["rN"] * (pb.h / u0 - (pb.delta / u0 if pb.delta is not None else 0.0))
+        kT = hit["rT"] * (pb.c / u0 / dqh + (pb.xi / sc.slip if pb.xi is not None else 0.0))
+        return dict(hit, kN=kN, kT=kT)
 
     # ------------------------------------------------------------ helpers
     def _finish(self, sol, it, info, t0):

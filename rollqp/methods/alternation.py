@@ -1,0 +1,113 @@
+r"""Normal–tangential alternation (paper §6.3, the PANA process; FORMULATION.md §7).
+
+The coupled step (:class:`~rollqp.problem.CoupledStep`) is not a QP: the friction bound
+``μ p`` depends on the unknown pressure, and with ``A_nt ≠ 0`` the gap depends on the
+unknown shear. The alternation solves it as a block Gauss–Seidel iteration over its two
+halves, each an ordinary step problem that any method solves (Newton, or a convex QP):
+
+.. math::
+    p^{(m)} = \mathrm{solve}\ \text{normal}(t^{(m-1)}):\quad
+        g = h - \delta e + A_{nn} p + A_{nt} t^{(m-1)},
+
+    t^{(m)} = \mathrm{solve}\ \text{tangential}(p^{(m)}):\quad
+        |t| \le \mu p^{(m)},\ s = \xi e + (c + A_{tn} p^{(m)} + A_{tt} t)/\Delta q,
+
+until rollqp's residual of the *coupled* problem at ``(p^{(m)}, t^{(m)})`` is below the
+limit. After the tangential half only the normal rows can be violated (they saw
+``t^{(m−1)}``), so that residual measures exactly the coupling mismatch ``A_nt (t^{(m)} −
+t^{(m−1)})``. Each outer iteration warm-starts both halves from the previous one.
+
+The outer iteration is a fixed-point iteration: it converges linearly, with a rate that
+grows with ``|β|`` and ``μ`` (the paper reports about 6 outer iterations for 2β = 1, μ = 0.3;
+``benchmarks/coupled_table.py`` measures it). It is not guaranteed to converge; when it
+does not within ``max_outer`` it raises :class:`~rollqp.errors.SolverError` with the residual.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..errors import InputError, SolverError
+from .newton import NewtonMethod
+
+
+class Alternation:
+    """N–T alternation around an inner step method (paper §6.3).
+
+    Parameters
+    ----------
+    inner : method
+        Any rollqp method that solves :class:`NormalStep` and :class:`TangentialStep`
+        (``NewtonMethod``, or a QP backend).
+    max_outer : int
+        Outer iterations before :class:`SolverError`.
+    limit : float, optional
+        Residual (rollqp's, nondimensional max norm) of the coupled problem at which the
+        alternation stops. Default: the inner method's ``residual_limit`` if it has one
+        (QP backends: what their solutions are trusted to), else its ``tolerance``.
+
+    Notes
+    -----
+    Uncoupled problems are passed to ``inner`` unchanged. ``info`` of a coupled solution:
+    ``outer`` (outer iterations), ``inner_normal`` and ``inner_tangential`` (iterations of
+    the inner method summed over the halves), ``history`` (coupled residual after each
+    outer iteration).
+    """
+
+    def __init__(self, inner, max_outer: int = 200, limit: float | None = None):
+        if int(max_outer) != max_outer or max_outer < 1:
+            raise InputError("max_outer", f"must be an integer >= 1, got {max_outer!r}")
+        self.inner = inner
+        self.max_outer = int(max_outer)
+        self.limit = float(limit) if limit is not None else float(
+            getattr(inner, "residual_limit", None) or inner.tolerance)
+        self.name = getattr(inner, "name", "alternation")
+        self.operator = getattr(inner, "operator", "exact")
+        self.tolerance = inner.tolerance
+
+    def solve(self, problem, warm=None):
+        if problem.kind != "coupled":
+            return self.inner.solve(problem, warm=warm)
+        t_start = time.perf_counter()
+        n = problem.n
+        if warm is not None and warm.t is not None and np.shape(warm.t) == (n,):
+            t = np.asarray(warm.t, dtype=float)
+        else:
+            t = np.zeros(n)
+        nwarm = twarm = warm
+        it_n = it_t = 0
+        history = []
+        outer = 0
+        while True:
+            outer += 1
+            nsol = self.inner.solve(problem.normal_half(t), warm=nwarm)
+            tsol = self.inner.solve(problem.tangential_half(nsol.p), warm=twarm)
+            it_n += nsol.iterations
+            it_t += tsol.iterations
+            t = tsol.t
+            sol = problem.solution(nsol.p, t, nsol.delta, tsol.xi)
+            history.append(sol.residual)
+            if sol.residual <= self.limit:
+                break
+            if not np.isfinite(sol.residual) or outer >= self.max_outer:
+                raise SolverError(f"the N-T alternation did not converge: coupled residual {sol.residual:.3e} "
+                                  f"> {self.limit:.1e} after {outer} outer iterations",
+                                  method=self.name, status="outer limit", residual=sol.residual,
+                                  iterations=outer)
+            nwarm, twarm = nsol, tsol
+        sol.method, sol.status, sol.iterations = self.name, "solved", outer
+        sol.time = time.perf_counter() - t_start
+        sol.solver_time = nsol.solver_time + tsol.solver_time
+        sol.info.update(outer=outer, inner_normal=it_n, inner_tangential=it_t, history=history,
+                        limit=self.limit)
+        return sol
+
+
+class AlternationNewton(Alternation):
+    """``nt-newton``: the N–T alternation with Newton (GNMls) halves (paper §6.3)."""
+
+    def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
+        super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),
+                         max_outer=max_outer)
+        self.name = "nt-newton"
