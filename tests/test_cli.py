@@ -151,11 +151,14 @@ def test_builtin_name_typo_suggests(capsys):
 
 # ------------------------------------------------------------------------------- solver failure
 def test_solver_failure_exits_3_and_writes_partial(tmp_path):
-    # Clarabel's gap tolerance is floored at 1e-15; the residual limit at tolerance 1e-15 is
-    # 1e-12, below what it reaches on rolling steps (measured 4e-12 at step 2): fails early.
-    path, _ = write_scene(tmp_path, **{"solver.method": "qp-clarabel", "solver.tolerance": 1e-15})
+    # A genuine non-convergence after the starting state: the §6.1.2 ramp (Q = 0 at the start,
+    # so the braked start is trivial) with Newton allowed 3 iterations per step; the growing
+    # load needs more within a few steps (measured: step 4).
+    from rollqp.histories import Ramp
+    path, _ = write_scene(tmp_path, **{"solver.method": "newton", "solver.max_iterations": 3,
+                                       "load.tangential": Ramp(start=0.0, end=0.75, over=8 / 3)})
     proc = rollqp_cmd("run", path, "--out", "partial.npz", cwd=tmp_path)
-    one_line_error(proc, 3, "solver error", "step ", "qp-clarabel", "partial.npz")
+    one_line_error(proc, 3, "solver error", "step ", "newton", "merit", "partial.npz")
     step = int(proc.stderr.split("step ")[1].split(",")[0])
     assert step >= 1, f"fails after the starting state: step {step}"
     res = load_result(tmp_path / "partial.npz")

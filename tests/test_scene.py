@@ -431,9 +431,10 @@ def test_to_dict_fills_defaults():
 # =========================================================================== load_scene
 def test_builtin_scenes_listed():
     b = builtin_scenes()
-    assert set(b) == {"cattaneo-carter", "ramp"}, f"both built-ins listed: {sorted(b)}"
-    assert "§6.1.1" in b["cattaneo-carter"], "description cites the paper section"
-    assert "§6.1.2" in b["ramp"], "description cites the paper section"
+    expected = {"cattaneo-carter": "§6.1.1", "ramp": "§6.1.2", "goodman-bentall": "§6.2.1", "harmonic": "§6.2.2"}
+    assert set(b) == set(expected), f"the built-ins listed: {sorted(b)}"
+    for name, section in expected.items():
+        assert section in b[name], f"{name}: the description cites the paper section {section}"
 
 
 def test_builtin_contents():

@@ -611,10 +611,16 @@ class NewtonMethod:
         ``z = (p̂, δ̂)`` or ``(t̂, ξ̂)`` (without the last entry if ``δ``/``ξ`` is prescribed).
         ``cases[i]`` names the pseudo-Jacobian row chosen for node ``i``: ``"eq82"``/``"eq83"``/
         ``"eq84"`` (normal) or ``"eq85"``/``"eq86"``/``"eq87"``/``"eq88"`` (tangential).
+
+        For a :class:`~rollqp.problem.CoupledStep`, ``z = (p̂, t̂, δ̂?, ξ̂?)`` and ``cases`` is a
+        pair ``(normal, tangential)`` of per-node labels; the tangential ones add ``"eq89"``
+        (bound exactly zero, ``t̂ ≠ y_T``) and ``"eq90"`` (bound zero and ``t̂ = y_T``).
         """
         z = np.asarray(z, dtype=float)
         sc = problem.scales
         n = problem.n
+        if problem.kind == "coupled":
+            return self._coupled_residual_and_jacobian(problem, z)
         if problem.kind == "normal":
             sys_ = self._system(problem, None)
             with_load = problem.P is not None
@@ -645,3 +651,24 @@ class NewtonMethod:
         phi = np.append(ph, sys_.fhat @ x - load) if with_load else ph
         return phi, J, cases
 
+    def _coupled_residual_and_jacobian(self, pb, z):
+        S = self._coupled_system(pb)
+        n, mu, sc = pb.n, pb.mu, pb.scales
+        p, t = z[:n], z[n:2 * n]
+        yN, yT = S["KN"] @ z + S["kN"], S["KT"] @ z + S["kT"]
+        contact, stick, slip_sign, zero_bound = self._coupled_cases(p, t, yN, yT, mu)
+        J = self._coupled_jacobian(S, contact, stick, slip_sign, mu)
+        b = mu * np.maximum(0.0, p - yN)
+        phi = [np.minimum(p, yN), t - np.clip(t - yT, -b, b)]
+        if S["iP"] is not None:
+            phi.append([S["fhat"] @ p - pb.P / sc.force])
+        if S["iQ"] is not None:
+            phi.append([S["fhat"] @ t - pb.Q / sc.force])
+        u = np.abs(t - yT)
+        ncase = np.where(p < yN, "eq82", np.where(p == yN, "eq83", "eq84"))
+        exact_zero = (p - yN) == 0.0  # eq. 85 is p̂ − y_N < 0 (the bound's argument negative)
+        tcase = np.where(zero_bound & ~exact_zero, "eq85", "")
+        tcase = np.where(zero_bound & exact_zero & (u > 0), "eq89", tcase)
+        tcase = np.where(zero_bound & exact_zero & (u == 0), "eq90", tcase)
+        tcase = np.where(~zero_bound, np.where(u < b, "eq86", np.where(u == b, "eq87", "eq88")), tcase)
+        return np.concatenate(phi), np.asarray(J), (ncase, tcase)

@@ -37,6 +37,7 @@ def clarabel_tolerances(tolerance: float) -> tuple[float, float]:
 
 class ClarabelQP(QPMethod):
     name = "qp-clarabel"
+    refine = True  # interior point: complementarity stops at sqrt(gap); see active_set_refine
 
     def _settings(self):
         s = clarabel.DefaultSettings()

@@ -60,17 +60,21 @@ class OsqpQP(QPMethod):
             m.warm_start(x=x0)
         res = m.solve(raise_error=False)  # statuses are checked here, not raised by OSQP
         tries = 1
+        spent = res.info.solve_time + res.info.polish_time
+        iters = res.info.iter
         while res.info.status_polish != 1 and tries < 3:
             eps = self._eps() * 10.0 ** (-2 * tries)
             m.update_settings(eps_abs=eps, eps_rel=eps)
             res = m.solve(raise_error=False)  # statuses are checked here, not raised by OSQP
             tries += 1
+            spent += res.info.solve_time + res.info.polish_time  # every try counts
+            iters += res.info.iter
         if tries > 1:
             m.update_settings(eps_abs=self._eps(), eps_rel=self._eps())
         # A polish that still fails after the retries leaves the (tightly converged) ADMM
         # iterate: rollqp's residual check in QPMethod.solve decides whether it is enough.
         status = res.info.status
         y = res.y[0] if form.a is not None else 0.0
-        return (np.asarray(res.x), y, status, res.info.iter, res.info.solve_time + res.info.polish_time,
+        return (np.asarray(res.x), y, status, iters, spent,
                 {"solver_status": res.info.status, "status_polish": int(res.info.status_polish),
                  "tries": tries})
