@@ -44,8 +44,9 @@ class Alternation:
         Outer iterations before :class:`SolverError`.
     limit : float, optional
         Residual (rollqp's, nondimensional max norm) of the coupled problem at which the
-        alternation stops. Default: the inner method's ``residual_limit`` if it has one
-        (QP backends: what their solutions are trusted to), else its ``tolerance``.
+        alternation stops. Default: the inner method's ``tolerance``. With QP halves it also
+        stops once the residual is below their ``residual_limit`` (what their solutions are
+        trusted to) and no longer halves per outer iteration: stalled at the halves' accuracy.
 
     Notes
     -----
@@ -60,8 +61,8 @@ class Alternation:
             raise InputError("max_outer", f"must be an integer >= 1, got {max_outer!r}")
         self.inner = inner
         self.max_outer = int(max_outer)
-        self.limit = float(limit) if limit is not None else float(
-            getattr(inner, "residual_limit", None) or inner.tolerance)
+        self.limit = float(limit) if limit is not None else float(inner.tolerance)
+        self.stall_limit = max(self.limit, float(getattr(inner, "residual_limit", 0.0) or 0.0))
         self.name = getattr(inner, "name", "alternation")
         self.operator = getattr(inner, "operator", "exact")
         self.tolerance = inner.tolerance
@@ -90,6 +91,9 @@ class Alternation:
             history.append(sol.residual)
             if sol.residual <= self.limit:
                 break
+            if (len(history) > 1 and sol.residual <= self.stall_limit
+                    and sol.residual >= 0.5 * history[-2]):
+                break  # stalled at the accuracy of the halves (QP solvers)
             if not np.isfinite(sol.residual) or outer >= self.max_outer:
                 raise SolverError(f"the N-T alternation did not converge: coupled residual {sol.residual:.3e} "
                                   f"> {self.limit:.1e} after {outer} outer iterations",

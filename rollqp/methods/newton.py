@@ -446,7 +446,8 @@ class NewtonMethod:
                 excess = np.where(b > 0, np.abs(u) - b, np.inf)
                 j = int(np.argmin(excess))
                 if not np.isfinite(excess[j]):
-                    raise SolverError("no node can stick: the friction bound is zero everywhere",
+                    raise SolverError("the coupled Newton iteration reached an iterate where no node can "
+                                      f"stick (friction bound zero everywhere; merit θ = {merits[-1]:.3e})",
                                       method=self.name, status="degenerate", iterations=it, residual=nrm)
                 z[iQ] += np.sign(u[j]) * excess[j] / KT[j, iQ]
                 yN, yT = KN @ z + kN, KT @ z + kT
