@@ -191,9 +191,11 @@ def _make_method(scene: Scene, name: str):
     settings = {"tolerance": scene.solver.tolerance}
     if name not in QP_METHODS:
         settings["max_iterations"] = scene.solver.max_iterations
+    if name == "nt-newton":
+        settings["max_outer"] = scene.solver.max_iterations
     method = get_method(name, **settings)
     if scene.coupling_level == "full" and name in QP_METHODS:
-        method = Alternation(method)
+        method = Alternation(method, max_outer=scene.solver.max_iterations)
     return method
 
 

@@ -21,7 +21,8 @@ Besides the per-key ranges, a scene is checked as a whole (FORMULATION.md §1, �
 
 * the normal load stays positive over the rolled distance (no loss of contact);
 * the largest Hertz half-width, a_H·sqrt(max P/P̄), stays clear of the zone's edges by at
-  least one and a half elements: a_H·sqrt(max P/P̄) < L·(1 − 1.5/elements), L = zone·a_H;
+  least three quarters of an element: a_H·sqrt(max P/P̄) < L·(1 − 1.5/elements), L = zone·a_H
+  (the element length is 2L/elements);
 * where a tangential load is prescribed, a stick solution exists: |Q| < μP, i.e.
   |Q/(μP̄)| / (P/P̄) < 1, at every step (and at the histories' breakpoints and peaks).
 
@@ -191,7 +192,9 @@ class SolverSettings:
     tolerance : float
         Nondimensional residual tolerance, in [1e-15, 1e-2].
     max_iterations : int
-        Iteration limit per step, ``>= 1``.
+        Iteration limit per step, ``>= 1``: Newton iterations (``newton``; each half of
+        ``nt-newton``) and outer N–T iterations (``nt-newton``, and the ``qp-*`` methods on a
+        coupled scene). The QP solvers keep their own iteration limits.
     """
 
     method: str = "newton"
@@ -386,7 +389,7 @@ class Scene:
                 "discretization.zone",
                 f"the contact reaches the edge of the zone (needs zone > "
                 f"{math.sqrt(nmax) / free:.6g} for the largest normal load {nmax:.6g}·P̄ with "
-                f"{disc.elements} elements, leaving {EDGE_ELEMENTS} elements free at each end;"
+                f"{disc.elements} elements, leaving {EDGE_ELEMENTS / 2} of an element free at each end;"
                 f" got {disc.zone!r})")
         tang = load.tangential
         if tang is None:
