@@ -72,6 +72,10 @@ from ..problem import StepSolution
 ALPHA_MIN = 1e-10
 
 
+class _Stalled(Exception):
+    """The Armijo search failed from a warm start (``solve`` then restarts cold)."""
+
+
 class _System:
     """Cached, r-scaled matrices of one problem operator (per ``A``, ``f``, scales, ``Δq``, ``r``).
 
@@ -165,10 +169,16 @@ class NewtonMethod:
     def solve(self, problem, warm: StepSolution | None = None) -> StepSolution:
         """Solve a :class:`NormalStep` or :class:`TangentialStep`; raise :class:`SolverError` if short."""
         t0 = time.perf_counter()
-        if problem.kind == "normal":
-            return self._solve_normal(problem, warm, t0)
-        if problem.kind == "tangential":
-            return self._solve_tangential(problem, warm, t0)
+        if problem.kind in ("normal", "tangential"):
+            solve = self._solve_normal if problem.kind == "normal" else self._solve_tangential
+            try:
+                return solve(problem, warm, t0)
+            except _Stalled:
+                # the warm start led to a Newton fixed point that is not a solution (a wrong
+                # active set that the Newton step reproduces): restart once from the cold start
+                sol = solve(problem, None, t0)
+                sol.info["restarts"] = 1
+                return sol
         if problem.kind == "coupled":
             return self._solve_coupled(problem, warm, t0)
         raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
@@ -224,7 +234,7 @@ class NewtonMethod:
             j = int(np.argmin(y - x))
             return j, -(y[j] - x[j])
 
-        z, it, info = self._iterate(pb, sys_, z, k0, Phat, phi_nodes, mask_of, nearest)
+        z, it, info = self._iterate(pb, sys_, z, k0, Phat, phi_nodes, mask_of, nearest, start == "warm")
         p = z[:n] * sc.stress
         delta = z[n] * u0 if with_load else pb.delta
         info["start"] = start
@@ -271,14 +281,14 @@ class NewtonMethod:
                                   method=self.name, status="degenerate")
             return j, float(np.sign(u[j]) * excess[j])
 
-        z, it, info = self._iterate(pb, sys_, z, k0, Qhat, phi_nodes, mask_of, nearest)
+        z, it, info = self._iterate(pb, sys_, z, k0, Qhat, phi_nodes, mask_of, nearest, start == "warm")
         tt = z[:n] * sc.stress
         xi = z[n] * sc.slip if with_load else pb.xi
         info["start"] = start
         return self._finish(pb.solution(tt, xi), it, info, t0)
 
     # ------------------------------------------------------------ the iteration
-    def _iterate(self, pb, sys_, z, k0, load, phi_nodes, mask_of, nearest):
+    def _iterate(self, pb, sys_, z, k0, load, phi_nodes, mask_of, nearest, warm=False):
         """GNMls Steps 2–7 on ``Φ(z) = [φ(x, y); f̂ᵀx − load]`` with ``y = K z + k0``.
 
         ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z).
@@ -345,6 +355,8 @@ class NewtonMethod:
                 alpha *= rho
                 backtracks += 1
                 if alpha < ALPHA_MIN:
+                    if warm:
+                        raise _Stalled()
                     nonmono += 1
                     alpha = 1.0
                     xa, ya = x + dx, y + Kd
@@ -406,7 +418,7 @@ class NewtonMethod:
         stop = self.tolerance * min(1.0, S["rN"], S["rT"])
         rho, two_sigma = self.rho, 2.0 * self.sigma
         history, merits, steps = [], [], []
-        backtracks = nonmono = shifts = it = tightened = 0
+        backtracks = sweeps = shifts = it = tightened = 0
         p, t = z[:n], z[n:2 * n]
         yN, yT = KN @ z + kN, KT @ z + kT
         phi = residual(p, t, yN, yT)
@@ -472,18 +484,44 @@ class NewtonMethod:
                 alpha *= rho
                 backtracks += 1
                 if alpha < ALPHA_MIN:
-                    nonmono += 1
-                    alpha = 1.0
+                    alpha = 0.0
                     break
-            steps.append(alpha)
-            z = z + alpha * d  # eq. 79
+            if alpha == 0.0:
+                # Armijo failed: the direction is not a descent direction (a node on a kink
+                # where the modified row is not the directional derivative). Taking the full
+                # step anyway can cycle (measured: μ = 0.03, Goodman loading). Instead take one
+                # N–T sweep of the halves from here — each half is a monotone problem solved by
+                # its own GNMls — and resume the coupled iteration from its result.
+                sweeps += 1
+                z = self._sweep(pb, z, S)
+                steps.append(0.0)
+            else:
+                steps.append(alpha)
+                z = z + alpha * d  # eq. 79
             p, t = z[:n], z[n:2 * n]
             yN, yT = KN @ z + kN, KT @ z + kT
             phi = residual(p, t, yN, yT)
         info = {"r": (S["rN"], S["rT"]), "backtracks": backtracks, "merit": merits[-1], "history": history,
-                "merits": merits, "steps": steps, "nonmonotone": nonmono, "shifts": shifts,
+                "merits": merits, "steps": steps, "nonmonotone": sweeps, "sweeps": sweeps, "shifts": shifts,
                 "tolerance_phi": stop, "start": start}
         return self._finish(sol, it, info, t0)
+
+    def _sweep(self, pb, z, S):
+        """One N–T sweep from ``z`` (the coupled iteration's fallback); returns the new ``z``."""
+        sc, n = pb.scales, pb.n
+        iP, iQ = S["iP"], S["iQ"]
+        warm = StepSolution(p=z[:n] * sc.stress, t=z[n:2 * n] * sc.stress,
+                            delta=z[iP] * sc.displacement if iP is not None else pb.delta,
+                            xi=z[iQ] * sc.slip if iQ is not None else pb.xi)
+        nsol = self.solve(pb.normal_half(warm.t), warm=warm)
+        tsol = self.solve(pb.tangential_half(nsol.p), warm=warm)
+        out = z.copy()
+        out[:n], out[n:2 * n] = nsol.p / sc.stress, tsol.t / sc.stress
+        if iP is not None:
+            out[iP] = nsol.delta / sc.displacement
+        if iQ is not None:
+            out[iQ] = tsol.xi / sc.slip
+        return out
 
     @staticmethod
     def _coupled_cases(p, t, yN, yT, mu):
