@@ -60,7 +60,7 @@ def _progress(quiet):
 
 def cmd_run(args) -> int:
     from . import driver
-    from .plot import transient_figure
+    from .plot import plot_result
     from .report import summary
     from .scene import load_scene
     scene = load_scene(args.scene)
@@ -87,7 +87,7 @@ def cmd_run(args) -> int:
     result.save(out)
     res = result.arrays()
     if args.plot:
-        transient_figure(res, scene, args.plot)
+        plot_result(res, scene, args.plot)
     if not args.quiet:
         print(summary(res, scene, scene.solver.method, wall))
         print(f"  result        {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
