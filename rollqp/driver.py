@@ -346,10 +346,13 @@ def _march(scene, model, meth, result, progress):
     fixed = _normal_fixed(scene, model)
     state = _braked_start(scene, model, meth, result)
     if scene.load.start == "rolling":
-        if getattr(meth, "name", None) in DIRECT_STEADY:
-            state = _steady_direct(scene, model, meth, state, result)
-        else:
-            state = _steady_by_marching(scene, model, meth, state, result, fixed)
+        try:
+            if getattr(meth, "name", None) in DIRECT_STEADY:
+                state = _steady_direct(scene, model, meth, state, result)
+            else:
+                state = _steady_by_marching(scene, model, meth, state, result, fixed)
+        except SolverError as err:  # the rolling start is state 0, not step 1
+            raise (err.with_step(0) if err.step is None else err) from err
     qs = scene.q_steps
     K = qs.size - 1
     for k in range(1, K + 1):
