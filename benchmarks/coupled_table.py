@@ -267,7 +267,6 @@ def start_table(scene, res, methods):
 
 
 def bands_table(scene, res, methods):
-    q = None
     rows = []
     for name in methods:
         r = res[name]
@@ -477,7 +476,7 @@ def main(argv=None) -> int:
                                                         for m in methods}).items()}
     model = Model.build(scene, symmetric=False)
     rN, rT = default_r(scene, model)
-    print(f"### Coupled Newton against N–T alternation (paper §6.3): {label}\n")
+    print(f"### Goodman → Bentall: {label}\n")
     print(scene_line(scene) + f"; `rollqp.run(scene, method=m)`; means over the {scene.n_steps} rolling steps "
           f"(state 0, the braked start, in the next table); times are medians over {reps} run(s) of the Newton "
           f"methods and {qreps} of the QP alternations. Inner iterations: Newton iterations for `nt-newton`, "

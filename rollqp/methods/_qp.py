@@ -172,6 +172,8 @@ class QPMethod:
         if hit is not None and hit[0].shape == form.H.shape and np.array_equal(hit[0], form.H):
             return hit[1], False
         obj = build(form)
+        if len(self._cache) >= 32:  # bound memory: structures can churn (tiny pressures of ±1e-21 p0)
+            self._cache = {k: v for k, v in self._cache.items() if k[0] == "split"}
         self._cache[key] = (form.H.copy(), obj)
         return obj, True
 
