@@ -103,6 +103,18 @@ def _mat(name, M, n):
     return a
 
 
+def _set_weights(step) -> int:
+    """Validate a step's weights ``f`` (1-D, finite, all > 0), store them, return ``n``."""
+    n = np.asarray(step.f).shape[0] if np.ndim(step.f) == 1 else -1
+    if n < 1:
+        raise InputError("f", "must be a 1-D array of weights")
+    f = _vec("f", step.f, n)
+    if np.any(f <= 0):
+        raise InputError("f", "weights must all be > 0")
+    object.__setattr__(step, "f", f)
+    return n
+
+
 def _exactly_one(names, values):
     given = [n for n, v in zip(names, values) if v is not None]
     if len(given) != 1:
@@ -194,12 +206,7 @@ class NormalStep:
     kind = "normal"
 
     def __post_init__(self):
-        n = np.asarray(self.f).shape[0] if np.ndim(self.f) == 1 else -1
-        if n < 1:
-            raise InputError("f", "must be a 1-D array of weights")
-        object.__setattr__(self, "f", _vec("f", self.f, n))
-        if np.any(self.f <= 0):
-            raise InputError("f", "weights must all be > 0")
+        n = _set_weights(self)
         object.__setattr__(self, "A", _mat("A", self.A, n))
         object.__setattr__(self, "h", _vec("h", self.h, n))
         if self.offset is not None:
@@ -305,12 +312,7 @@ class TangentialStep:
     kind = "tangential"
 
     def __post_init__(self):
-        n = np.asarray(self.f).shape[0] if np.ndim(self.f) == 1 else -1
-        if n < 1:
-            raise InputError("f", "must be a 1-D array of weights")
-        object.__setattr__(self, "f", _vec("f", self.f, n))
-        if np.any(self.f <= 0):
-            raise InputError("f", "weights must all be > 0")
+        n = _set_weights(self)
         object.__setattr__(self, "A", _mat("A", self.A, n))
         object.__setattr__(self, "p", _vec("p", self.p, n))
         object.__setattr__(self, "c", _vec("c", self.c, n))
@@ -449,12 +451,7 @@ class CoupledStep:
     kind = "coupled"
 
     def __post_init__(self):
-        n = np.asarray(self.f).shape[0] if np.ndim(self.f) == 1 else -1
-        if n < 1:
-            raise InputError("f", "must be a 1-D array of weights")
-        object.__setattr__(self, "f", _vec("f", self.f, n))
-        if np.any(self.f <= 0):
-            raise InputError("f", "weights must all be > 0")
+        n = _set_weights(self)
         for name in ("Ann", "Att"):
             object.__setattr__(self, name, _mat(name, getattr(self, name), n))
         for name in ("Ant", "Atn"):
@@ -542,7 +539,7 @@ class Residuals:
     @property
     def max(self) -> float:
         """The largest residual; NaN if any is NaN (so that no limit check can pass it)."""
-        return float(np.max(np.asarray(dataclasses.astuple(self), dtype=float)))
+        return float(np.max((self.signorini, self.friction, self.load_normal, self.load_tangential)))
 
     def __or__(self, other: "Residuals") -> "Residuals":
         a = np.asarray(dataclasses.astuple(self), dtype=float)

@@ -165,9 +165,13 @@ class QPMethod:
             self._cache[key] = hit
         return hit[2]
 
+    def structure_key(self, form):
+        """What the backend's solver object depends on (default: :attr:`QPForm.structure`)."""
+        return form.structure
+
     def _solver_for(self, form, build):
         """The cached solver object for this structure and Hessian, built on first use."""
-        key = form.structure
+        key = self.structure_key(form)
         hit = self._cache.get(key)
         if hit is not None and hit[0].shape == form.H.shape and np.array_equal(hit[0], form.H):
             return hit[1], False
