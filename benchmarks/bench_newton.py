@@ -58,9 +58,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_qp import _ms, _table, machine_table  # noqa: E402
 from coupled_table import goodman_bentall_scene, source_line  # noqa: E402
 
+from rollqp import driver  # noqa: E402
 from rollqp.driver import Model  # noqa: E402
-from rollqp.methods import QP_METHODS, get_method  # noqa: E402
-from rollqp.methods.alternation import Alternation  # noqa: E402
+from rollqp.methods import QP_METHODS  # noqa: E402
 from rollqp.problem import StepSolution  # noqa: E402
 from rollqp.report import closed_form_errors  # noqa: E402
 
@@ -75,16 +75,8 @@ TARGET_RUN_C = 0.5        # s, Σ step_time of the §6.1.1 run with Newton, at m
 
 
 def make_method(name, scene):
-    """The method as ``rollqp.run`` makes it for ``scene`` (``rollqp.driver._make_method``)."""
-    settings = {"tolerance": scene.solver.tolerance}
-    if name not in QP_METHODS:
-        settings["max_iterations"] = scene.solver.max_iterations
-    if name == "nt-newton":
-        settings["max_outer"] = scene.solver.max_iterations
-    method = get_method(name, **settings)
-    if scene.coupling_level == "full" and name in QP_METHODS:
-        method = Alternation(method, max_outer=scene.solver.max_iterations)
-    return method
+    """The method exactly as ``rollqp.run`` makes it for ``scene``."""
+    return driver._make_method(scene, name)
 
 
 # ----------------------------------------------------------------------------------- steps
