@@ -199,7 +199,7 @@ def _make_method(scene: Scene, name: str):
     return method
 
 
-def run(scene, method: str | None = None, progress=None) -> Result:
+def run(scene, method: str | None = None, progress=None, observe=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -210,6 +210,9 @@ def run(scene, method: str | None = None, progress=None) -> Result:
         Overrides ``[solver].method``.
     progress : callable, optional
         Called as ``progress(k, K)`` after each rolling step.
+    observe : callable, optional
+        Called once as ``observe(model, method)`` before the march; it returns the method to
+        use (e.g. a wrapper that records step problems: :func:`rollqp.stepfile.export_step`).
 
     Raises
     ------
@@ -225,6 +228,8 @@ def run(scene, method: str | None = None, progress=None) -> Result:
         scene = scene.replace(**{"solver.method": method})
     meth = _make_method(scene, name)
     model = Model.build(scene, symmetric=getattr(meth, "operator", "exact") == "symmetrized")
+    if observe is not None:
+        meth = observe(model, meth)
     result = _new_result(scene, model, name)
     try:
         _march(scene, model, meth, result, progress)

@@ -50,12 +50,13 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 
 from .errors import InputError
 from .histories import Constant, History, parse_history
+from .methods import METHOD_NAMES
 
 __all__ = ["METHODS", "MODELS", "COUPLINGS", "STARTS", "ELEMENT_TYPES", "FORMULATION_TYPES",
            "Body", "Contact", "Load", "Discretization", "SolverSettings", "Scene",
            "load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes"]
 
-METHODS = ("newton", "nt-newton", "qp-clarabel", "qp-osqp", "qp-cvxpy")
+METHODS = METHOD_NAMES  # the method registry (rollqp/methods/__init__.py), optional backends included
 MODELS = ("halfspace", "bem")
 COUPLINGS = ("auto", "full", "goodman", "off")
 STARTS = ("braked", "rolling")

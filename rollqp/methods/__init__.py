@@ -6,7 +6,13 @@
 ``qp-cvxpy``              convex QP, cvxpy textbook formulation (OSQP underneath)
 ``newton``                generalized Newton with line search (GNMls, paper §4)
 ``nt-newton``             normal–tangential alternation of Newton halves (paper §6.3)
+``qps-daqp``, …           convex QP through qpsolvers (optional extra ``qpsolvers``:
+                          DAQP, quadprog, ProxQP, PIQP, HiGHS; :mod:`.qp_qpsolvers`)
 ========================  ==========================================================
+
+Optional backends are always registered by name; one whose package is not installed
+raises :class:`~rollqp.errors.MissingBackendError` naming the pip extra, and
+:func:`available_methods` leaves it out.
 
 A method is created once per scene with :func:`get_method` and reused for every step,
 so that solver objects are built once and only updated afterwards.
@@ -24,6 +30,9 @@ _REGISTRY = {
     "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", None, "qp"),
     "newton": ("rollqp.methods.newton", "NewtonMethod", None, "newton"),
     "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None, "newton"),
+    # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
+    **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers", "qp")
+       for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
 }
 
 QP_METHODS = tuple(k for k, v in _REGISTRY.items() if v[3] == "qp")
