@@ -3,9 +3,13 @@
     rollqp run SCENE [--out RESULT.npz] [--plot FIGURE.png] [--method METHOD] [--quiet]
     rollqp scenes
     rollqp show SCENE
+    rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
+    rollqp check-step STEP.npz SOLUTION.npz [--tol T]
+    rollqp crossval SCENE [--step K]
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first).
+``check-step`` exits 1 when the candidate fails, with one line per failed condition.
 BLAS threads are pinned to one: numpy's and scipy's wheels each bundle OpenBLAS, and two
 pools competing for 2 cores can make a dense solve 100× slower.
 """
@@ -37,6 +41,20 @@ def _parser():
     sub.add_parser("scenes", help="list the built-in scenes")
     s = sub.add_parser("show", help="print a scene's TOML with defaults filled in")
     s.add_argument("scene")
+    e = sub.add_parser("export-step", help="write one step's data and QP forms (docs/stepfiles.md)")
+    e.add_argument("scene", help="a TOML scene file or the name of a built-in scene")
+    e.add_argument("--step", type=int, required=True, help="step K: 0 = the starting state's last solve, "
+                   "K >= 1 the rolling step whose solution is state K of the result file")
+    e.add_argument("--out", help="step file (.npz); default <scene name>-step<K>.npz")
+    e.add_argument("--method", choices=METHOD_NAMES, help="method that marches to step K (default newton)")
+    c = sub.add_parser("check-step", help="check a candidate solution of an exported step")
+    c.add_argument("step_file", metavar="STEP.npz")
+    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi")
+    c.add_argument("--tol", type=float, default=None, help="pass/fail limit on each nondimensional residual "
+                   "(default 1e-6: see docs/stepfiles.md)")
+    x = sub.add_parser("crossval", help="every available method on one step, side by side")
+    x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
+    x.add_argument("--step", type=int, default=None, help="step K (default 1)")
     return p
 
 
@@ -109,6 +127,43 @@ def cmd_show(args) -> int:
     return 0
 
 
+def cmd_export_step(args) -> int:
+    from .scene import load_scene
+    from .stepfile import export_step
+    scene = load_scene(args.scene)
+    out = args.out or f"{scene.name}-step{args.step}.npz"
+    if not out.endswith(".npz"):
+        from .errors import InputError
+        raise InputError("--out", f"the step file must end in .npz, got {out!r}")
+    step = export_step(scene, args.step, method=args.method)
+    for path in step.save(out):
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_check_step(args) -> int:
+    from .stepfile import DEFAULT_TOL, StepFile, check_step, load_solution
+    step = StepFile.load(args.step_file, arg="STEP.npz")
+    sol = load_solution(args.solution, step.n, arg="SOLUTION.npz")
+    rep = check_step(step, sol, tol=DEFAULT_TOL if args.tol is None else args.tol)
+    print(rep)
+    if rep.passed:
+        return 0
+    for line in rep.diagnosis():
+        print(f"rollqp: check failed: {line}", file=sys.stderr)
+    return 1
+
+
+def cmd_crossval(args) -> int:
+    from .crossval import report
+    if args.scene.endswith(".npz"):
+        from .stepfile import StepFile
+        print(report(StepFile.load(args.scene, arg="SCENE")))
+    else:
+        print(report(args.scene, step=args.step))
+    return 0
+
+
 def main(argv=None) -> int:
     args = _parser().parse_args(argv)
     from .errors import InputError, RollqpError, SolverError
@@ -118,7 +173,8 @@ def main(argv=None) -> int:
     except ImportError:  # pragma: no cover - threadpoolctl is a dependency
         limiter = None
     try:
-        return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show}[args.command](args)
+        return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
+                "check-step": cmd_check_step, "crossval": cmd_crossval}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER

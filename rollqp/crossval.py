@@ -1,0 +1,106 @@
+"""The cross-validation report: every available method on one exported step, side by side.
+
+:func:`report` exports step ``K`` of a scene (:func:`rollqp.stepfile.export_step`, marched by
+Newton), solves that stored step with every method in :func:`rollqp.available_methods` — the
+native QP backends (Clarabel, OSQP, cvxpy), each qpsolvers backend, Newton and the N–T
+alternation — warm-started from the same previous state, and lists for each rollqp's
+residuals per condition (FORMULATION.md §5), iterations, wall time, and the largest
+difference from Newton's solution in ``p0`` (pressure) and ``μ p0`` (traction). On a coupled
+step (``A_nt ≠ 0``, §6.2.1) the QP backends run the N–T alternation (paper §6.3).
+
+Times are one solve each, on whatever machine runs the report: read them as ratios within
+one table, not as benchmarks (``benchmarks/`` has those).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import RollqpError
+from .stepfile import StepFile, export_step, solve_stored
+
+
+@dataclass
+class Row:
+    method: str
+    ok: bool
+    residuals: dict = field(default_factory=dict)
+    iterations: str = ""
+    time: float = float("nan")
+    dp: float = float("nan")
+    dt: float = float("nan")
+    states: int = 0
+    error: str = ""
+
+
+@dataclass
+class Report:
+    """A cross-validation table; ``str()`` prints it (Markdown)."""
+
+    scene: str
+    step: int
+    q: float
+    kind: str
+    rows: list
+
+    def __str__(self) -> str:
+        head = (f"scene {self.scene}, step {self.step} (q = {self.q:.6g}), {self.kind} step; "
+                "residuals nondimensional (FORMULATION.md §5), differences from newton\n\n"
+                "| method | Signorini | friction | load P | load Q | iterations | time [ms] "
+                "| max abs Δp [p0] | max abs Δt [μp0] | states ≠ |\n"
+                "|---|---|---|---|---|---|---|---|---|---|")
+        lines = [head]
+        for r in self.rows:
+            if not r.ok:
+                lines.append(f"| {r.method} | failed: {r.error} |||||||||")
+                continue
+            rs = r.residuals
+            lines.append(f"| {r.method} | {rs['signorini']:.1e} | {rs['friction']:.1e} | {rs['load_normal']:.1e} "
+                         f"| {rs['load_tangential']:.1e} | {r.iterations} | {1e3 * r.time:.1f} | {r.dp:.1e} "
+                         f"| {r.dt:.1e} | {r.states} |")
+        return "\n".join(lines)
+
+
+def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-10) -> Report:
+    """Cross-validate step ``step`` of ``scene`` (default: step 1) over ``methods`` (default: all available).
+
+    ``scene`` may also be a :class:`~rollqp.stepfile.StepFile` (then ``step`` is ignored).
+    Iterations: ``normal+tangential`` inner iterations for an uncoupled step; for a coupled
+    one ``outer (normal+tangential)`` for the alternations and Newton's own count; ``—``
+    where the solver does not report them (DAQP, HiGHS through qpsolvers).
+    """
+    from .methods import available_methods
+    from .problem import classify
+    sf = scene if isinstance(scene, StepFile) else export_step(scene, 1 if step is None else step)
+    names = list(methods) if methods is not None else available_methods()
+    if "newton" in names:
+        names.remove("newton")
+    names.insert(0, "newton")
+    sc = sf.scales
+    rows, ref, ref_state = [], None, None
+    for name in names:
+        t0 = time.perf_counter()
+        try:
+            sol = solve_stored(sf, name, tolerance=tolerance)
+        except RollqpError as err:
+            rows.append(Row(name, False, error=str(err)))
+            continue
+        wall = time.perf_counter() - t0
+        state = classify(sol.p, sol.t, sol.s, sf.mu, sc)
+        if ref is None:
+            ref, ref_state = sol, state
+        info = sol.info
+        inner = f"{info.get('inner_normal', 0)}+{info.get('inner_tangential', 0)}"
+        if not info.get("iterations_reported", True) or (name.startswith("qps-") and inner == "0+0"):
+            inner = "—"  # DAQP and HiGHS do not report iterations through qpsolvers
+        its = f"{sol.iterations} ({inner})" if "outer" in info else (inner if sf.kind == "uncoupled" else str(sol.iterations))
+        rows.append(Row(name, True, residuals=dict(signorini=sol.residuals.signorini, friction=sol.residuals.friction,
+                                                   load_normal=sol.residuals.load_normal,
+                                                   load_tangential=sol.residuals.load_tangential),
+                        iterations=its, time=wall, dp=float(np.max(np.abs(sol.p - ref.p)) / sc.stress),
+                        dt=float(np.max(np.abs(sol.t - ref.t)) / (sc.stress * (sf.mu or 1.0))),
+                        states=int(np.count_nonzero(state != ref_state))))
+    name = sf.scene.get("name", "?") if isinstance(sf.scene, dict) else "?"
+    return Report(scene=name, step=sf.step, q=sf.q, kind=sf.kind, rows=rows)
