@@ -1,0 +1,36 @@
+"""The cross-validation report (rollqp.crossval): every method on one stored step, side by side."""
+from __future__ import annotations
+
+import pytest
+
+from rollqp import cli, load_scene
+from rollqp.crossval import report
+from rollqp.methods import available_methods
+
+FAST = [m for m in ("qp-osqp", "nt-newton", "qps-daqp", "qps-quadprog") if m in available_methods()]
+
+
+@pytest.mark.parametrize("name, changes, step", [
+    ("cattaneo-carter", {"discretization.distance": 0.2}, 2),   # §6.1.1, uncoupled
+    ("goodman-bentall", {"discretization.distance": 0.05}, 1),  # §6.2.1, coupled: QP halves alternate
+])
+def test_report_lists_methods_and_agrees(name, changes, step):
+    rep = report(load_scene(name).replace(**changes), step=step, methods=FAST)
+    assert [r.method for r in rep.rows] == ["newton"] + FAST, "newton first, then the others in order"
+    for r in rep.rows:
+        assert r.ok, f"{r.method}: {r.error}"
+        assert max(r.residuals.values()) <= 1e-8, f"{r.method}: QP residual limit 1e-8"
+        # same collocation step: differences bounded by the residual limit (measured ≤ 7e-10)
+        assert r.dp <= 1e-7 and r.dt <= 1e-7, f"{r.method}: Δp {r.dp:.1e}, Δt {r.dt:.1e}"
+        assert r.states == 0, f"{r.method}: node states as Newton's"
+    text = str(rep)
+    assert "| method | Signorini |" in text and all(f"| {m} |" in text for m in FAST)
+    assert (", coupled step" in text) == (name == "goodman-bentall")
+
+
+def test_cli_crossval(capsys):
+    assert cli.main(["crossval", "cattaneo-carter", "--step", "1"]) == 0
+    out = capsys.readouterr().out
+    for m in available_methods():
+        assert f"| {m} |" in out, m
+    assert "failed" not in out, out

@@ -1,0 +1,60 @@
+"""qpsolvers backends (rollqp.methods.qp_qpsolvers): registered when installed, same answers as Newton."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rollqp import cli, driver, get_method, load_scene
+from rollqp.errors import MissingBackendError
+from rollqp.methods import available_methods
+from rollqp.methods import qp_qpsolvers as qps
+
+INSTALLED = [m for m in qps.SOLVERS if m in available_methods()]
+needs_any = pytest.mark.skipif(not INSTALLED, reason="no qpsolvers backend installed (pip install 'rollqp[qpsolvers]')")
+
+
+@pytest.fixture(scope="module")
+def short_runs():
+    scene = load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.5})
+    return scene, driver.run(scene, method="newton").arrays()
+
+
+@needs_any
+@pytest.mark.parametrize("name", INSTALLED)
+def test_backend_matches_newton_on_a_transient(short_runs, name):
+    scene, ref = short_runs
+    res = driver.run(scene, method=name).arrays()
+    # QPMethod's residual limit: 100 × tolerance 1e-10
+    assert res["residual"].max() <= 1e-8, f"{name}: residual {res['residual'].max():.2e}"
+    # both solve the same collocation problem: agree to the residual limit times the
+    # conditioning of the step (measured ≤ 1e-11 p0; 1e-8 leaves room for the interior points)
+    assert np.max(np.abs(res["pt"] - ref["pt"])) <= 1e-8 * scene.p0, name
+    assert np.max(np.abs(res["pn"] - ref["pn"])) <= 1e-8 * scene.p0, name
+    assert f'"method": "{name}"' in str(res["meta"]), "the method run is recorded"
+
+
+@needs_any
+def test_coupled_scene_runs_the_alternation():
+    scene = load_scene("goodman-bentall").replace(**{"discretization.distance": 0.05})
+    name = INSTALLED[0]
+    res = driver.run(scene, method=name).arrays()
+    ref = driver.run(scene, method="newton").arrays()
+    assert res["residual"].max() <= 1e-8
+    assert res["inner_normal"][1:].sum() > 0 or name in ("qps-daqp", "qps-highs"), "N-T inner iterations"
+    # the alternation stops at the QP residual limit 1e-8: differences of that order (measured 3e-10 p0)
+    assert np.max(np.abs(res["pt"] - ref["pt"])) <= 1e-7 * scene.p0
+
+
+def test_uninstalled_backend_is_a_clear_error(monkeypatch, capsys):
+    monkeypatch.setattr(qps, "_available", lambda solver, package: False)
+    assert "qps-daqp" not in available_methods()
+    with pytest.raises(MissingBackendError, match=r"qps-daqp.*rollqp\[qpsolvers\]"):
+        get_method("qps-daqp")
+    assert cli.main(["run", "cattaneo-carter", "--method", "qps-daqp", "--quiet", "--out", "/nonexistent/x.npz"]) == 2
+    err = capsys.readouterr().err
+    assert "qps-daqp" in err and "pip install 'rollqp[qpsolvers]'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_unknown_solver_name():
+    with pytest.raises(Exception, match="solver"):
+        qps.QpsolversQP("nosuch")
