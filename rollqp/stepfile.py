@@ -128,6 +128,9 @@ def export_step(scene, k: int, method: str | None = None) -> "StepFile":
 
 def _from_record(scene, model, k, method, problem, sol, normal, prev):
     n = model.strip.n
+    steady = (problem.Att if problem.kind == "coupled" else problem.A) is not model.Att
+    step_type = "rolling" if k > 0 else "steady" if steady else (
+        "static-shift" if scene.load.start == "braked" else "rolling")
     if problem.kind == "coupled":
         pb = problem
         ref = sol
@@ -150,7 +153,7 @@ def _from_record(scene, model, k, method, problem, sol, normal, prev):
         prev_p=np.zeros(n) if pp is None else np.asarray(pp, float), prev_t=np.asarray(pt, float),
         prev_delta=np.nan if pd is None else float(pd), prev_xi=np.nan if px is None else float(px),
         ref_p=ref.p, ref_t=ref.t, ref_delta=float(ref.delta), ref_xi=float(ref.xi), ref_method=method,
-        ref_residual=float(ref.residual), scene=scene.to_dict())
+        ref_residual=float(ref.residual), step_type=step_type, scene=scene.to_dict())
 
 
 # ------------------------------------------------------------------------------ the file
@@ -159,7 +162,8 @@ _ARRAYS_NN = ("A_nn", "A_tt", "A_nt", "A_tn")
 _SCALARS = ("step", "q", "n_steps", "mu", "dq", "a_H", "p0", "Estar", "prev_delta", "prev_xi", "ref_delta",
             "ref_xi", "ref_residual")
 _OPTIONAL = ("P", "Q", "delta", "xi")  # NaN in the file when not prescribed
-_STRINGS = ("format", "kind", "ref_method", "scene")
+_STRINGS = ("format", "kind", "step_type", "ref_method", "scene")
+STEP_TYPES = ("rolling", "static-shift", "steady")
 
 
 @dataclass
@@ -202,6 +206,7 @@ class StepFile:
     ref_xi: float
     ref_method: str
     ref_residual: float
+    step_type: str = "rolling"
     scene: dict = field(default_factory=dict)
 
     @property
@@ -264,7 +269,8 @@ class StepFile:
 
     # ---------------------------------------------------------------- I/O
     def arrays(self) -> dict:
-        out = {"format": np.asarray(FORMAT), "kind": np.asarray(self.kind), "ref_method": np.asarray(self.ref_method),
+        out = {"format": np.asarray(FORMAT), "kind": np.asarray(self.kind), "step_type": np.asarray(self.step_type),
+               "ref_method": np.asarray(self.ref_method),
                "scene": np.asarray(json.dumps(self.scene, sort_keys=True))}
         for k in _ARRAYS_N + _ARRAYS_NN:
             out[k] = np.asarray(getattr(self, k), dtype=float)
@@ -335,7 +341,14 @@ class StepFile:
         kind = str(z["kind"])
         if kind not in ("coupled", "uncoupled"):
             raise InputError(arg, f"key 'kind' must be 'coupled' or 'uncoupled', got {kind!r}")
-        step = cls(kind=kind, ref_method=str(z["ref_method"]), scene=json.loads(str(z["scene"])), **kw)
+        step_type = str(z["step_type"])
+        if step_type not in STEP_TYPES:
+            raise InputError(arg, f"key 'step_type' must be one of {', '.join(STEP_TYPES)}, got {step_type!r}")
+        try:
+            scene = json.loads(str(z["scene"]))
+        except json.JSONDecodeError as exc:
+            raise InputError(arg, f"key 'scene' must be a JSON string ({exc})") from exc
+        step = cls(kind=kind, step_type=step_type, ref_method=str(z["ref_method"]), scene=scene, **kw)
         step.problem()  # validates the data (weights > 0, loads, friction, …)
         return step
 
@@ -456,6 +469,7 @@ class CheckReport:
 
     step: int
     kind: str
+    step_type: str
     given: tuple
     tol: float
     residuals: dict
@@ -478,7 +492,7 @@ class CheckReport:
         return [f.line(self.tol) for f in self.failures]
 
     def __str__(self) -> str:
-        L = [f"step {self.step} ({self.kind}); candidate gives {', '.join(self.given)}; tolerance {self.tol:.1e}"]
+        L = [f"step {self.step} ({self.kind}, {self.step_type}); candidate gives {', '.join(self.given)}; tolerance {self.tol:.1e}"]
         if self.delta is not None:
             L.append(f"  approach δ = {self.delta:.10g}" + (" (fitted: mean gap closure at the contact nodes)"
                                                               if "delta" in self.fitted else ""))
@@ -638,7 +652,7 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
         ref = step.reference()
         ref_state = classify(ref.p, ref.t, ref.s, step.mu, sc, tol=max(tol, 1e-7))
     differs = np.flatnonzero(cand_state != ref_state)
-    return CheckReport(step=step.step, kind=step.kind, given=given, tol=tol, residuals=residuals, failures=failures,
+    return CheckReport(step=step.step, kind=step.kind, step_type=step.step_type, given=given, tol=tol, residuals=residuals, failures=failures,
                        delta=float(delta) if ("p" in sol) else None, xi=float(xi) if ("t" in sol) else None,
                        fitted=tuple(f for f in fitted if (f == "delta" and "p" in sol) or (f == "xi" and "t" in sol)),
                        comparisons=comparisons, state_differs=differs, states=(cand_state, ref_state), x=step.x,

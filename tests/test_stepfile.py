@@ -274,3 +274,14 @@ def test_cli_bad_input(similar, tmp_path, monkeypatch, capsys, args, words):
         code = exc.code
     assert code == 2, f"exit 2 for invalid input, got {code}"
     one_line(capsys.readouterr().err, "rollqp: ", *words)
+
+
+def test_step_types_and_steady_start():
+    """Step 0: the braked start's last static-shift increment, or a rolling start's steady solve."""
+    braked = export_step(load_scene("cattaneo-carter").replace(**SIMILAR), 0)
+    assert braked.step_type == "static-shift" and braked.dq == pytest.approx(braked.a_H), "shift per a_H"
+    steady = export_step(load_scene("harmonic").replace(**{"discretization.distance": 0.1}), 0)
+    assert steady.step_type == "steady" and steady.kind == "coupled"
+    rep = check_step(steady, {"p": steady.ref_p, "t": steady.ref_t}, compare_with=("newton",))
+    assert rep.passed, str(rep)
+    assert export_step(load_scene("harmonic").replace(**{"discretization.distance": 0.1}), 1).step_type == "rolling"
