@@ -62,25 +62,33 @@ class Result:
 
     def save(self, path) -> str:
         """Write the result file atomically (temporary file in the same folder, then rename)."""
-        path = os.fspath(path)
-        if not path.endswith(".npz"):
-            raise InputError("--out", f"the result file must end in .npz, got {path!r}")
-        folder = os.path.dirname(os.path.abspath(path))
-        if not os.path.isdir(folder):
-            raise InputError("--out", f"folder {folder!r} does not exist")
-        fd, tmp = tempfile.mkstemp(suffix=".npz", dir=folder, prefix=".rollqp-")
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                np.savez(fh, **self.arrays())
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual file mode
-            os.replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
-        return path
+        return save_npz(path, self.arrays(), "result file")
+
+
+def save_npz(path, arrays: dict, what: str = "result file") -> str:
+    """Write ``arrays`` to the ``.npz`` ``path`` atomically (temporary file, then rename).
+
+    A path not ending in ``.npz`` or in a missing folder is an :class:`InputError` on ``--out``.
+    """
+    path = os.fspath(path)
+    if not path.endswith(".npz"):
+        raise InputError("--out", f"the {what} must end in .npz, got {path!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise InputError("--out", f"folder {folder!r} does not exist")
+    fd, tmp = tempfile.mkstemp(suffix=".npz", dir=folder, prefix=".rollqp-")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez(fh, **arrays)
+        umask = os.umask(0)
+        os.umask(umask)
+        os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600; give the usual file mode
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+    return path
 
 
 def load_result(path) -> dict:

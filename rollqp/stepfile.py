@@ -291,14 +291,9 @@ class StepFile:
         ``load_from_file`` format, the ``q_frozen`` QPs) and ``STEP.cvxpy.py`` (rebuilds both
         halves from the ``.npz`` and solves them; writes ``STEP.cvxpy-solution.npz``).
         """
-        path = os.fspath(path)
-        if not path.endswith(".npz"):
-            raise InputError("--out", f"the step file must end in .npz, got {path!r}")
-        folder = os.path.dirname(os.path.abspath(path))
-        if not os.path.isdir(folder):
-            raise InputError("--out", f"folder {folder!r} does not exist")
+        from .result import save_npz
         arrays = self.arrays()
-        np.savez(path, **arrays)
+        path = save_npz(path, arrays, "step file")
         written = [path]
         if native:
             stem = path[:-4]
