@@ -349,9 +349,12 @@ class StepFile:
 
 
 def _read_npz(path, arg):
+    import zipfile
     path = os.fspath(path)
     if not os.path.isfile(path):
         raise InputError(arg, f"no such file: {path!r}")
+    if not zipfile.is_zipfile(path):
+        raise InputError(arg, f"{path!r} is not a .npz file (numpy's zip archive of arrays)")
     try:
         with np.load(path, allow_pickle=False) as z:
             return {k: z[k] for k in z.files}
@@ -526,8 +529,12 @@ def load_solution(path, n: int, arg: str = "SOLUTION.npz") -> dict:
 
 def validate_solution(sol: dict, n: int, arg: str = "solution") -> dict:
     unknown = sorted(set(sol) - set(SOLUTION_KEYS))
+    if "format" in sol and str(sol["format"]) == FORMAT:
+        raise InputError(arg, "this is a step file, not a solution (keys p, t, delta, xi)")
     if unknown:
-        raise InputError(arg, f"unknown key(s) {', '.join(map(repr, unknown))}; allowed: {', '.join(SOLUTION_KEYS)}")
+        more = f", … ({len(unknown)} in all)" if len(unknown) > 5 else ""
+        raise InputError(arg, f"unknown key(s) {', '.join(map(repr, unknown[:5]))}{more}; "
+                              f"allowed: {', '.join(SOLUTION_KEYS)}")
     if "p" not in sol and "t" not in sol:
         raise InputError(arg, "give the pressure 'p' and/or the traction 't'")
     out = {}

@@ -58,3 +58,15 @@ def test_uninstalled_backend_is_a_clear_error(monkeypatch, capsys):
 def test_unknown_solver_name():
     with pytest.raises(Exception, match="solver"):
         qps.QpsolversQP("nosuch")
+
+
+@needs_any
+def test_cli_run_with_a_qpsolvers_backend(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "short.toml"
+    path.write_text(load_scene("cattaneo-carter").replace(name="short", **{"discretization.distance": 0.2})
+                    .to_toml(), encoding="utf-8")
+    name = INSTALLED[0]
+    assert cli.main(["run", str(path), "--method", name, "--out", "r.npz"]) == 0
+    assert name in capsys.readouterr().out, "the summary names the method"
+    assert (tmp_path / "r.npz").is_file()

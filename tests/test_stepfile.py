@@ -254,6 +254,9 @@ def test_cli_export_and_check(tmp_path, monkeypatch, capsys):
     (["check-step", "s.npz", "wrongkey.npz"], ["SOLUTION.npz", "'pressure'"]),
     (["check-step", "s.npz", "wrongshape.npz"], ["SOLUTION.npz", "'p'", "shape"]),
     (["check-step", "good.npz", "good.npz"], ["STEP.npz", "not a rollqp step file"]),
+    (["check-step", "junk.npz", "good.npz"], ["STEP.npz", "not a .npz file"]),
+    (["check-step", "s.npz", "s.npz"], ["SOLUTION.npz", "a step file, not a solution"]),
+    (["check-step", "s.npz", "nan.npz"], ["SOLUTION.npz", "'t'", "finite"]),
     (["check-step", "s.npz", "good.npz", "--tol", "-1"], ["--tol"]),
     (["export-step", "cattaneo-carter", "--step", "100000"], ["--step", "0.."]),
     (["export-step", "cattaneo-carter", "--step", "-1"], ["--step"]),
@@ -267,6 +270,8 @@ def test_cli_bad_input(similar, tmp_path, monkeypatch, capsys, args, words):
     np.savez(tmp_path / "good.npz", p=step.ref_p)
     np.savez(tmp_path / "wrongkey.npz", pressure=step.ref_p)
     np.savez(tmp_path / "wrongshape.npz", p=step.ref_p[:-1])
+    np.savez(tmp_path / "nan.npz", t=np.full(step.n, np.nan))
+    (tmp_path / "junk.npz").write_text("not an archive", encoding="utf-8")
     capsys.readouterr()
     try:
         code = cli.main(args)
