@@ -5,7 +5,7 @@
     rollqp show SCENE
     rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
-    rollqp crossval SCENE [--step K]
+    rollqp crossval SCENE [--step K] [--methods M1,M2]
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first).
@@ -55,6 +55,7 @@ def _parser():
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
     x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
     x.add_argument("--step", type=int, default=None, help="step K (default 1)")
+    x.add_argument("--methods", help="comma-separated methods (default: every available one)")
     return p
 
 
@@ -156,11 +157,20 @@ def cmd_check_step(args) -> int:
 
 def cmd_crossval(args) -> int:
     from .crossval import report
+    from .methods import METHOD_NAMES
+    methods = None
+    if args.methods:
+        methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+        bad = [m for m in methods if m not in METHOD_NAMES]
+        if bad or not methods:
+            from .errors import InputError
+            raise InputError("--methods", f"unknown method(s) {', '.join(bad) or '(none given)'}; "
+                                          f"choose from {', '.join(METHOD_NAMES)}")
     if args.scene.endswith(".npz"):
         from .stepfile import StepFile
-        print(report(StepFile.load(args.scene, arg="SCENE")))
+        print(report(StepFile.load(args.scene, arg="SCENE"), methods=methods))
     else:
-        print(report(args.scene, step=args.step))
+        print(report(args.scene, step=args.step, methods=methods))
     return 0
 
 

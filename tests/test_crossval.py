@@ -34,3 +34,15 @@ def test_cli_crossval(capsys):
     for m in available_methods():
         assert f"| {m} |" in out, m
     assert "failed" not in out, out
+
+
+def test_cli_crossval_methods_and_step_file(tmp_path, capsys):
+    from rollqp.stepfile import export_step
+    path = tmp_path / "s.npz"
+    export_step(load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.2}), 2).save(path, native=False)
+    assert cli.main(["crossval", str(path), "--methods", "qp-osqp"]) == 0
+    out = capsys.readouterr().out
+    assert "| qp-osqp |" in out and "| newton |" in out and "| qp-clarabel |" not in out
+    assert cli.main(["crossval", str(path), "--methods", "qp-nosuch"]) == 2
+    err = capsys.readouterr().err
+    assert "--methods" in err and "qp-nosuch" in err and len(err.strip().splitlines()) == 1

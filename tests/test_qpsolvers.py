@@ -40,7 +40,8 @@ def test_coupled_scene_runs_the_alternation():
     res = driver.run(scene, method=name).arrays()
     ref = driver.run(scene, method="newton").arrays()
     assert res["residual"].max() <= 1e-8
-    assert res["inner_normal"][1:].sum() > 0 or name in ("qps-daqp", "qps-highs"), "N-T inner iterations"
+    # rolling steps are N-T outer iterations: several per step at 2β = 1, μ = 0.3 (paper §6.3: ≈ 6)
+    assert np.all(res["iterations"][1:] >= 2), f"outer iterations {res['iterations']}"
     # the alternation stops at the QP residual limit 1e-8: differences of that order (measured 3e-10 p0)
     assert np.max(np.abs(res["pt"] - ref["pt"])) <= 1e-7 * scene.p0
 

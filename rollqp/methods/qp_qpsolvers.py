@@ -7,10 +7,10 @@ Optional extra: ``pip install 'rollqp[qpsolvers]'`` installs qpsolvers and the s
 ==================  ===========  ===========================================================
 method              solver       kind, settings rollqp passes
 ==================  ===========  ===========================================================
-``qps-daqp``        DAQP         dual active set (dense); exact on its active set
+``qps-daqp``        DAQP         dual active set (dense); ``primal_tol = dual_tol = 1e-12``
 ``qps-quadprog``    quadprog     Goldfarb–Idnani dual active set (dense); no tolerances
 ``qps-proxqp``      ProxQP       proximal augmented Lagrangian (dense backend),
-                                 ``eps_abs = tolerance``, ``eps_rel = 0``
+                                 ``eps_abs = min(tolerance, 1e-9)``, ``eps_rel = 0``
 ``qps-piqp``        PIQP         proximal interior point, ``eps_abs = eps_rel =``
                                  ``eps_duality_gap_* = 1e-4·tolerance`` (floored 1e-14)
 ``qps-highs``       HiGHS        active set QP (sparse input); feasibility tolerances
