@@ -40,10 +40,10 @@ from .problem import (SEPARATION, SLIP, STICK, CoupledStep, Scales, StepSolution
 
 FORMAT = "rollqp-step/1"
 #: Default pass/fail limit of :func:`check_step` on each nondimensional residual.
-#: Six decades below the discretization error of the paper's meshes (≈1e-3 p0, docs/validation.md),
+#: Three decades below the discretization error of the paper's meshes (≈1e-3 p0, docs/validation.md),
 #: so a pass means "solves this discrete step", not "close to the physics"; two decades above the
 #: QP backends' residual limit (1e-8), and above what an interior point without refinement
-#: (the cvxpy script: ≈2e-7) or scipy's SLSQP (≈7e-8) reach on the exported QPs
+#: (the cvxpy script: 8.6e-8 to 1.6e-7) or scipy's SLSQP (1.0e-7) reach on the exported QPs
 #: (docs/stepfiles.md), so any converged solver passes.
 DEFAULT_TOL = 1e-6
 CONDITIONS = ("signorini", "friction", "load_normal", "load_tangential")
