@@ -46,3 +46,19 @@ def test_cli_crossval_methods_and_step_file(tmp_path, capsys):
     assert cli.main(["crossval", str(path), "--methods", "qp-nosuch"]) == 2
     err = capsys.readouterr().err
     assert "--methods" in err and "qp-nosuch" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("name, step, coupled", [("cattaneo-carter", 32, False), ("goodman-bentall", 64, True)])
+def test_docs_tables(name, step, coupled):
+    """The tables of docs/stepfiles.md (``rollqp crossval NAME --step K``): every method agrees."""
+    rep = report(name, step=step)
+    assert [r.method for r in rep.rows] == ["newton"] + [m for m in available_methods() if m != "newton"]
+    outer = set()
+    for r in rep.rows:
+        assert r.ok and r.states == 0, f"{r.method}: {r.error}"
+        # uncoupled: every backend solves the same collocation step (measured ≤ 1.5e-11);
+        # coupled: the alternations stop at the coupled residual 1e-10 (measured 1e-9 from Newton)
+        assert max(r.dp, r.dt) <= (1e-8 if coupled else 1e-10), r.method
+        if coupled and r.method != "newton":
+            outer.add(r.iterations.split()[0])
+    assert len(outer) <= 1, f"all alternations take the same outer iterations: {outer}"
