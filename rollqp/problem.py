@@ -592,7 +592,7 @@ def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7) -> np.nd
 def compare(a: StepSolution, b: StepSolution, mu: float | None = None, scales: Scales = Scales()) -> dict:
     """Differences between two solutions of the same step, nondimensional.
 
-    Returns max |Δp|/p0, max |Δt|/(μ p0) (or /p0 if μ is not given), |Δδ|/u0, |Δξ|/(p0/E*),
+    Returns ``max |Δp|/p0``, ``max |Δt|/(μ p0)`` (or ``/p0`` if μ is not given), ``|Δδ|/u0``, ``|Δξ|/(p0/E*)``,
     and the indices of nodes whose stick/slip/separation state differs.
     """
     out = {}
