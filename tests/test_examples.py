@@ -187,8 +187,31 @@ def test_gallery_ramp(monkeypatch, capsys, tmp_path):
     _png(fig)
 
 
+def test_one_qp_is_not_the_contact_step(monkeypatch, capsys):
+    ns = run_example("one_qp.py", [], monkeypatch)
+    capsys.readouterr()
+    slipping, control = ns["results"]["rows"]
+    clarabel = BACKENDS["clarabel"]
+    for m in (slipping, control):
+        assert m["symmetric"], "constant elements: F·A exactly symmetric, every QP here is exact"
+        assert m["newton_residual"] <= NEWTON_TOL
+        assert m["clarabel_vs_newton"] <= clarabel.accuracy, f"the two-QP answer: Clarabel vs Newton {m['clarabel_vs_newton']:.1e}"
+    # Q = 0.75 μP: half the contact slips (Cattaneo), and there the joint QP's KKT conditions
+    # give g = μ·Δq·|s| (dilatancy) — exactly, up to Clarabel's accuracy at tolerance 1e-12
+    # (measured 1.3e-12 u0) — so Signorini fails and the tractions are off by several % (measured
+    # 5.1e-3 and 2.7e-2): bounds at a fifth of the measured values, far above any solver error
+    assert slipping["slipping"] >= 0.4 * slipping["contact"], slipping
+    assert slipping["dilatancy"] <= 1e-9, f"|g − μΔq|s|| = {slipping['dilatancy']:.1e} u0 at the slipping nodes"
+    assert slipping["max_gap_slip"] >= 1e-3, "the gap opens under pressure where the joint QP slips"
+    assert slipping["joint_signorini"] >= 1e-3 and slipping["joint_dp"] >= 5e-3, slipping
+    # the control: nothing slips, and the joint QP is the contact step (cvxpy's Clarabel at 1e-12:
+    # measured 1.6e-9 p0)
+    assert control["slipping"] == 0
+    assert control["joint_dp"] <= 1e-7 and control["joint_dt"] <= 1e-7, control
+
+
 @pytest.mark.parametrize("name", ["own_arrays.py", "cattaneo_carter.py", "cattaneo.py", "carter.py", "ramp.py",
-                                  "goodman_bentall.py", "harmonic.py"])
+                                  "goodman_bentall.py", "harmonic.py", "one_qp.py"])
 def test_examples_are_documented(name):
     text = (EXAMPLES / name).read_text(encoding="utf-8")
     assert text.startswith('"""') and "Run it::" in text, f"{name} starts with a docstring saying how to run it"
