@@ -18,7 +18,9 @@ reference does not document keeps the download link.
 """
 from __future__ import annotations
 
+import importlib
 import os
+import pkgutil
 import re
 import sys
 
@@ -115,7 +117,45 @@ def drop_empty_glob(app, docname, source):
         source[0] = re.sub(r"^\*$\n", "", text, flags=re.M)
 
 
+def add_further_modules(app, docname, source):
+    """Append to the API page every public rollqp module it does not list yet.
+
+    A module added to the package is documented (and its docstrings checked by the build)
+    without editing ``api.md``; place it in the page's sections when convenient. A module
+    whose optional dependency is not installed is named instead of documented, so the build
+    does not depend on optional extras.
+    """
+    if docname != "api":
+        return
+    listed = set(re.findall(r"automodule::\s+(\S+)", source[0]))
+    documented, skipped = [], []
+    for info in pkgutil.walk_packages(rollqp.__path__, "rollqp."):
+        name = info.name
+        if name in listed or any(part.startswith("_") for part in name.split(".")):
+            continue
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            skipped.append(f"`{name}` (needs `{exc.name}`)")
+            continue
+        documented.append(name)
+    if not documented and not skipped:
+        return
+    text = ["", "## Further modules", ""]
+    if documented:
+        text += ["```{eval-rst}"]
+        for name in documented:
+            text += [f".. automodule:: {name}", "   :members:", "   :ignore-module-all:", ""]
+        text += ["```", ""]
+    if skipped:
+        text += ["Not documented in this build (optional dependency missing): " + ", ".join(skipped) + ".", ""]
+    source[0] += "\n".join(text)
+
+
 def setup(app):
     app.connect("source-read", drop_empty_glob)
+    app.connect("source-read", add_further_modules)
+    # the API page depends on the package's module list, not only on api.md: re-read it always
+    app.connect("env-get-outdated", lambda app, env, added, changed, removed: ["api"])
     app.connect("doctree-resolved", link_code_to_api)
     return {"parallel_read_safe": True}
