@@ -72,6 +72,8 @@ def figure(res, scene, path, title):
     ax[2].set(xlabel="q / a_H", ylabel="xi / xi_Carter", title="creepage after the brake is released")
     for axis in ax:
         axis.grid(alpha=0.3)
+    ax[0].legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3)
+    for axis in ax[1:]:
         axis.legend(fontsize=7)
     fig.suptitle(title)
     fig.savefig(path, dpi=110)
