@@ -114,3 +114,16 @@ def test_build_script_is_the_documented_command():
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     command = "python -m sphinx -W --keep-going -b html docs docs/_build/html"
     assert command in script and command in readme, "docs/build.sh runs the command the README shows"
+
+
+def test_every_quoted_command_names_an_existing_script_or_scene():
+    """Anywhere on the pages and in the README, not only beside figures: no stale commands."""
+    scripts = re.compile(r"python ((?:examples|benchmarks)/[A-Za-z0-9_./-]+\.py)")
+    runs = re.compile(r"rollqp run ([a-z0-9_./-]+)")       # lower case: SCENE and … are placeholders
+    for page in [*PAGES, ROOT / "README.md"]:
+        text = page.read_text(encoding="utf-8")
+        for script in scripts.findall(text):
+            assert (ROOT / script).is_file(), f"{page.name}: {script} does not exist"
+        for scene in runs.findall(text):
+            assert scene in rollqp.builtin_scenes() or (ROOT / scene).is_file(), \
+                f"{page.name}: `rollqp run {scene}`: no such built-in scene or file"
