@@ -4,6 +4,7 @@
 matrices, scales, slip operators — and is built once. :func:`run` then marches:
 
 * **starting state** (step 0):
+
   - ``start = "braked"``: the normal load is applied (Hertz for similar bodies), then the
     tangential load by static shift in ``load.start_steps`` increments (Cattaneo for
     similar bodies, §4.4): ``s = (w^k − w^{k−1})/Δ + ξ`` with ``Δ = a_H`` and ``ξ·Δ`` the

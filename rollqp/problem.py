@@ -237,6 +237,7 @@ class NormalStep:
         return self.replace(A=symmetrized(self.A, self.f))
 
     def residuals(self, p, delta) -> "Residuals":
+        """rollqp's residuals of ``(p, δ)``: ``‖min(p̂, ĝ)‖∞`` (eq. 51–52), load row (eq. 67)."""
         sc = self.scales
         g = self.gap(p, delta)
         sig = np.minimum(p / sc.stress, g / sc.displacement)
@@ -352,6 +353,7 @@ class TangentialStep:
         return self.replace(A=symmetrized(self.A, self.f))
 
     def residuals(self, t, xi) -> "Residuals":
+        """rollqp's residuals of ``(t, ξ)``: ``‖t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)‖∞`` (eq. 60), load row (eq. 67)."""
         sc = self.scales
         s = self.slip(t, xi)
         th, sh, bh = t / sc.stress, s / sc.slip, self.bound / sc.stress
@@ -507,6 +509,7 @@ class CoupledStep:
                               xi=self.xi, scales=self.scales)
 
     def residuals(self, p, t, delta, xi) -> "Residuals":
+        """rollqp's residuals of the coupled step: Signorini, friction (bound ``μp⁺``), loads (eq. 70–71)."""
         sc = self.scales
         g, s = self.gap(p, t, delta), self.slip(p, t, xi)
         sig = np.minimum(p / sc.stress, g / sc.displacement)
@@ -592,7 +595,7 @@ def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7) -> np.nd
 def compare(a: StepSolution, b: StepSolution, mu: float | None = None, scales: Scales = Scales()) -> dict:
     """Differences between two solutions of the same step, nondimensional.
 
-    Returns max |Δp|/p0, max |Δt|/(μ p0) (or /p0 if μ is not given), |Δδ|/u0, |Δξ|/(p0/E*),
+    Returns ``max |Δp|/p0``, ``max |Δt|/(μ p0)`` (or ``/p0`` if μ is not given), ``|Δδ|/u0``, ``|Δξ|/(p0/E*)``,
     and the indices of nodes whose stick/slip/separation state differs.
     """
     out = {}

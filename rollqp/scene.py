@@ -23,8 +23,8 @@ Besides the per-key ranges, a scene is checked as a whole (FORMULATION.md §1, �
 * the largest Hertz half-width, a_H·sqrt(max P/P̄), stays clear of the zone's edges by at
   least three quarters of an element: a_H·sqrt(max P/P̄) < L·(1 − 1.5/elements), L = zone·a_H
   (the element length is 2L/elements);
-* where a tangential load is prescribed, a stick solution exists: |Q| < μP, i.e.
-  |Q/(μP̄)| / (P/P̄) < 1, at every step (and at the histories' breakpoints and peaks).
+* where a tangential load is prescribed, a stick solution exists: ``|Q| < μP``, i.e.
+  ``|Q/(μP̄)| / (P/P̄) < 1``, at every step (and at the histories' breakpoints and peaks).
 
 Sign convention (FORMULATION.md §1): material moves through the contact with direction
 d = ``load.direction`` (the paper's examples: d = −1) and enters at the leading edge x = −d·L.
@@ -63,7 +63,7 @@ STARTS = ("braked", "rolling")
 ELEMENT_TYPES = ("constant", "linear", "quadratic")
 FORMULATION_TYPES = ("material", "convective-local")
 
-#: |β| above which ``coupling = "auto"`` means full coupling
+#: ``|β|`` above which ``coupling = "auto"`` means full coupling
 BETA_ZERO = 1e-12
 #: free elements required between the largest contact and each end of the zone
 EDGE_ELEMENTS = 1.5
@@ -111,7 +111,7 @@ class Contact:
     coupling : {"auto", "full", "goodman", "off"}
         Normal–tangential coupling level (§3); "auto" is "full" iff β ≠ 0, else "off".
     reference_distance : float or None
-        d_ref of the 2D half-space kernel −ln(|x − s|/d_ref), ``> 0``; None: the relative
+        d_ref of the 2D half-space kernel ``−ln(|x − s|/d_ref)``, ``> 0``; None: the relative
         radius R (see :attr:`Scene.reference_distance_value`).
     """
 
@@ -457,7 +457,7 @@ class Scene:
 
     @property
     def coupling_level(self) -> str:
-        """Coupling level used: "full", "goodman" or "off" ("auto": "full" iff |β| > 1e-12)."""
+        """Coupling level used: "full", "goodman" or "off" ("auto": "full" iff ``|β| > 1e-12``)."""
         c = self.contact.coupling
         if c == "auto":
             return "full" if abs(self.beta) > BETA_ZERO else "off"

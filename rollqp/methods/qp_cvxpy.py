@@ -1,6 +1,6 @@
 """cvxpy: the textbook formulation, for readability and as a third opinion.
 
-.. code-block:: python
+.. code-block:: text
 
     minimize    ½ xᵀ H x + qᵀ x
     subject to  aᵀ x == b,   l <= x <= u
