@@ -72,9 +72,12 @@ class Model:
         d = scene.discretization
         strip = Strip(scene.half_width, d.elements, d.element)
         t0 = time.perf_counter()
+        kw = {}
+        if scene.contact.model == "bem":  # true geometry: the rollers and their BEM meshes
+            kw = dict(A=scene.A, B=scene.B, n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1])
         infl = build_influence(scene.contact.model, strip, Estar=scene.Estar, beta=scene.beta,
                                R_A=scene.A.radius, R_B=scene.B.radius, coupling=scene.coupling_level,
-                               d_ref=scene.reference_distance_value)
+                               d_ref=scene.reference_distance_value, **kw)
         f = strip.weights
         info = dict(infl.info)
         info["asymmetry_Ann"] = asymmetry(infl.Ann, f)

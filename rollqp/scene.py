@@ -112,12 +112,17 @@ class Contact:
     reference_distance : float or None
         d_ref of the 2D half-space kernel −ln(|x − s|/d_ref), ``> 0``; None: the relative
         radius R (see :attr:`Scene.reference_distance_value`).
+    bem_outer_elements, bem_inner_elements : int or None
+        ``model = "bem"``: elements on each roller's outer circle outside the strip and on its
+        shaft, in [3, 2000]; None: the paper's 19 and 16 (docs/bem.md).
     """
 
     friction: float
     model: str = "halfspace"
     coupling: str = "auto"
     reference_distance: float | None = None
+    bem_outer_elements: int | None = None
+    bem_inner_elements: int | None = None
 
 
 @dataclass(frozen=True)
@@ -265,7 +270,10 @@ def _check_contact(c: Any) -> Contact:
     d = c.reference_distance
     if d is not None:
         d = _number("contact.reference_distance", d, "> 0 or absent (then R)", lambda x: x > 0)
-    return Contact(mu, model, coupling, d)
+    mesh = [None if getattr(c, k) is None else
+            _integer(f"contact.{k}", getattr(c, k), "in [3, 2000] or absent", lambda n: 3 <= n <= 2000)
+            for k in ("bem_outer_elements", "bem_inner_elements")]
+    return Contact(mu, model, coupling, d, *mesh)
 
 
 def _check_load(ld: Any) -> Load:
@@ -383,6 +391,7 @@ class Scene:
             raise InputError("load.normal_history",
                              f"must stay > 0 over the rolled distance [0, {q_end:.6g}] a_H, "
                              f"but its minimum is {nmin:.6g} (loss of contact is not supported)")
+        self._check_bem()
         free = 1.0 - EDGE_ELEMENTS / disc.elements
         if not math.sqrt(nmax) < disc.zone * free:
             raise InputError(
@@ -414,6 +423,26 @@ class Scene:
                              f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"
                              f" is not supported), but it reaches {ratio[i]:.6g} at q = "
                              f"{q[i]:.6g} a_H")
+
+    def _check_bem(self) -> None:
+        """``model = "bem"``: both shafts given, and the strip shorter than half a circumference."""
+        if self.contact.model != "bem":
+            return
+        for key, body in (("bodies.A", self.A), ("bodies.B", self.B)):
+            if body.shaft_radius is None:
+                raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' (the "
+                                                        f"rigid shaft's radius, in (0, {body.radius!r}))")
+            if not 2.0 * self.half_width < math.pi * body.radius:
+                raise InputError("discretization.zone",
+                                 f"the strip (2L = {2 * self.half_width:.6g}) must be shorter than half the "
+                                 f"circumference of {key} (radius {body.radius!r}) for model = 'bem'")
+
+    @property
+    def bem_mesh(self) -> tuple[int, int]:
+        """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
+        c = self.contact
+        return (19 if c.bem_outer_elements is None else c.bem_outer_elements,
+                16 if c.bem_inner_elements is None else c.bem_inner_elements)
 
     # ------------------------------------------------------------------ derived quantities
     @property
