@@ -147,6 +147,11 @@ class Load:
         d = sgn(V), the direction of the material through the contact (paper: −1).
     start_steps : int
         Quasi-static steps applying the normal load of a braked start, ``>= 1``.
+    approach : History or None
+        Prescribed approach of the shaft centres δ(q) = approach(q/a_H) (length units) instead
+        of the normal load (the normal-side analogue of ``creepage``); ``normal`` stays the
+        reference load P̄ of a_H, p0 and the zone. Meaningful with ``contact.model = "bem"``
+        (rigid shafts); on the half-space δ depends on ``reference_distance`` (docs/bem.md).
     """
 
     normal: float
@@ -156,6 +161,7 @@ class Load:
     start: str = "braked"
     direction: int = -1
     start_steps: int = 1
+    approach: History | None = None
 
 
 @dataclass(frozen=True)
@@ -294,7 +300,11 @@ def _check_load(ld: Any) -> Load:
             or direction not in (-1, 1):
         raise InputError("load.direction", f"must be -1 or +1, got {direction!r}")
     steps = _integer("load.start_steps", ld.start_steps, ">= 1", lambda n: n >= 1)
-    return Load(normal, nh, tang, creep, start, int(direction), steps)
+    approach = None if ld.approach is None else parse_history(ld.approach, "load.approach")
+    if approach is not None and nh != Constant(1.0):
+        raise InputError("load.approach", "give at most one of load.normal_history and load.approach "
+                                          "(with a prescribed approach the normal load is an unknown)")
+    return Load(normal, nh, tang, creep, start, int(direction), steps, approach)
 
 
 def _check_discretization(d: Any) -> Discretization:
@@ -577,6 +587,18 @@ class Scene:
                                               "load.tangential instead")
         return self.load.creepage(np.asarray(q, dtype=float) / self.a_H)
 
+    def prescribed_approach(self, q):
+        """Prescribed approach δ(q) = approach(q/a_H) of the shaft centres, or None if P is given.
+
+        Parameters
+        ----------
+        q : float or ndarray
+            Rolled distance, length units.
+        """
+        if self.load.approach is None:
+            return None
+        return self.load.approach(np.asarray(q, dtype=float) / self.a_H)
+
     # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
         """The full scene as a nested plain dict, defaults filled in.
@@ -797,7 +819,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     if "normal_history" in ld:
         ld["normal_history"] = parse_history(ld["normal_history"], "load.normal_history",
                                              constant_default=1.0)
-    for k in ("tangential", "creepage"):
+    for k in ("tangential", "creepage", "approach"):
         if k in ld:
             ld[k] = parse_history(ld[k], f"load.{k}")
     return Scene(name=d.get("name", default_name), description=d.get("description", ""),
