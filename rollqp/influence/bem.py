@@ -107,8 +107,10 @@ DEFAULT_OUTER, DEFAULT_INNER = 19, 16
 N_GAUSS = 10
 #: Largest number of equal parts of a near-singular element.
 MAX_PARTS = 4096
-#: Largest arc angle of a graded outer element (radians), if the element count allows it.
-MAX_ANGLE = 0.45
+#: Largest graded outer element, as a multiple of the uniform angle ``2π/n_outer`` (0.45 rad for
+#: the default 19): a compromise between grading next to the strip and the size of the far
+#: elements (docs/bem.md, "Meshes").
+MAX_ANGLE_FACTOR = 1.36
 _GX, _GW = np.polynomial.legendre.leggauss(N_GAUSS)
 _COEF = np.array([[0.0, -0.5, 0.5], [1.0, 0.0, -1.0], [0.0, 0.5, 0.5]])   # N_a = c0 + c1 ξ + c2 ξ²
 _XI_NODE = np.array([-1.0, 0.0, 1.0])
@@ -237,7 +239,7 @@ def annulus_mesh(radius: float, shaft_radius: float, strip_edges, n_outer: int =
                                                 f"the circumference of the roller (radius {R:g})")
     le = float(np.min(np.diff(edges)))
     free = 2.0 * np.pi * R - span
-    sizes = _graded_sizes(le, int(n_outer), free, MAX_ANGLE * R)
+    sizes = _graded_sizes(le, int(n_outer), free, MAX_ANGLE_FACTOR * 2.0 * np.pi * R / n_outer)
     s_edges = np.concatenate([edges, edges[-1] + np.cumsum(sizes)])
     s_edges[-1] = edges[0] + 2.0 * np.pi * R                     # the circle closes on node 0
     ne_o = s_edges.size - 1
