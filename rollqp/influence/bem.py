@@ -467,12 +467,18 @@ def contact_compliance(strip, radius, shaft_radius, E, nu, n_outer=DEFAULT_OUTER
     nodes, values = _strip_map(strip)
     ns, n = mesh.n_strip, nodes.size
     Eo = mesh.n_outer_elements
+    # local directions, b = 0 the tangent t̂ = (-n_y, n_x) (increasing s) and b = 1 the inward
+    # normal -n̂ (the push of a pressure, and a displacement that opens the gap), at the strip
+    # elements' nodes (for the loads) and at the strip nodes (for the displacements)
+    _, nrm, _ = mesh.points(np.arange(ns)[:, None], _XI_NODE[None, :])            # (ns, 3, 2)
+    dirs = np.stack([np.stack([-nrm[..., 1], nrm[..., 0]], -1), -nrm], 2)          # (ns, 3, b, comp)
     loads = np.zeros((Eo, 3, 2, 2, n))            # (element, local node, component; case b, j)
-    for b in range(2):
-        loads[:ns, :, b, b, :] = values
-    u = _solve_system(body, loads.reshape(6 * Eo, 2 * n)).reshape(-1, 2, 2, n)
+    loads[:ns] = dirs.transpose(0, 1, 3, 2)[..., None] * values[:, :, None, None, :]
+    u = _solve_system(body, loads.reshape(6 * Eo, 2 * n)).reshape(-1, 2, 2, n)[nodes]   # (i, comp, b, j)
+    n_hat = mesh.nodes[nodes] / np.linalg.norm(mesh.nodes[nodes], axis=1)[:, None]
+    node_dirs = np.stack([np.stack([-n_hat[:, 1], n_hat[:, 0]], -1), -n_hat], 1)    # (i, a, comp)
     Gmod = E / (2.0 * (1.0 + nu))
-    C = u[nodes].transpose(1, 2, 0, 3) / Gmod                       # (a, b, i, j)
+    C = np.einsum("iac,icbj->abij", node_dirs, u) / Gmod                            # (a, b, i, j)
     sizes = mesh.lengths[ns:Eo]
     info = {"assembly_seconds": body.seconds, "solve_seconds": time.perf_counter() - t1,
             "seconds": time.perf_counter() - t0, "nodes": mesh.n_nodes, "elements": mesh.n_elements,
