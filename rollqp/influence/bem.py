@@ -26,9 +26,12 @@ Discretization
   graded outer mesh; the exact arc removes that error at no cost.
 * **Meshes**: the outer boundary is the scene's strip (``[-L, L]`` mapped onto the circle by
   arc length, the strip elements *are* BEM elements, so every strip node is a BEM node) plus
-  ``n_outer`` elements (default 19, the paper's) graded geometrically away from the strip
-  (sizes ``Le·q^k``, ``k = 1 … ⌈n/2⌉`` symmetric about the point opposite the contact, ``q`` from
-  the length to cover), and the inner boundary ``n_inner`` equal elements (default 16).
+  ``n_outer`` elements (default 19, the paper's) graded geometrically away from the strip:
+  sizes ``min(Le·q^m, cap)``, ``m = 1, 2, …`` from each end of the strip towards the point
+  opposite the contact, with ``cap = MAX_ANGLE_FACTOR·2πR/n_outer`` (1.36 times the uniform
+  size) and ``q`` such that the elements close the circle. The inner boundary has
+  ``n_inner`` equal elements (default 16). Without a strip (``strip_edges=None``, the ring
+  alone) the outer elements are equal.
 * **Displacements** are continuous (global nodes); **tractions** are element-wise
   (discontinuous at element ends): they are known on the outer boundary, so a strip traction
   ``N_j`` of constant, linear or quadratic strip elements is represented exactly, and on the
@@ -59,33 +62,37 @@ Each body is computed in its own frame: centre at the origin, contact point at t
 ``(0, -R)``, arc coordinate ``s`` from it in the ``+x`` direction, so the surface point is
 ``(R sin(s/R), -R cos(s/R))``. Body A lies above the contact (centre ``(0, R_A)`` in the
 contact frame); body B's frame is rotated by 180° (centre ``(0, -R_B)``), so its arc
-coordinate is ``-s`` and the node order is reversed. Tractions and displacements are taken
-in the **Cartesian** components of the contact frame: ``y`` along the line of centres (normal)
-and ``x`` across it (tangential). Then ``P = fᵀp`` and ``Q = fᵀt`` (arc-length weights) are
-exactly the forces on the shafts, and the rigid approach ``δ`` of the shaft centres enters
-every gap as ``-δ``, as in the step problems. With ``p`` pushing A in ``+y`` and B in ``-y``
-and ``t`` on A in ``+x`` (on B in ``-x``), both bodies see the load ``(t, p)`` in their own
-frames and (``J`` reverses the node order)
+coordinate is ``-s`` and the node order is reversed. As in the paper's eq. 24, tractions and
+displacements are taken in the **local** components at each surface point: normal (``n``,
+along the inward normal ``-n̂``: the push of a pressure, and a displacement that opens the
+gap) and tangential (``t``, along the tangent ``t̂`` of increasing ``s``; ``+x`` at the
+contact point). With ``p`` pushing both bodies apart and ``t`` on A along ``+t̂`` (on B the
+opposite, which is B's own ``+t̂'``), both bodies see the load ``(t, p)`` in their own frames
+and (``J`` reverses the node order)
 
 .. math::
 
-    A_{nn} = C^A_{yy} + J C^B_{yy} J, \\quad A_{nt} = C^A_{yx} + J C^B_{yx} J, \\quad
-    A_{tn} = C^A_{xy} + J C^B_{xy} J, \\quad A_{tt} = C^A_{xx} + J C^B_{xx} J
+    A_{nn} = C^A_{nn} + J C^B_{nn} J, \quad A_{nt} = C^A_{nt} + J C^B_{nt} J, \quad
+    A_{tn} = C^A_{tn} + J C^B_{tn} J, \quad A_{tt} = C^A_{tt} + J C^B_{tt} J
 
-(eq. 26, 29) with ``C^α_{ab}[i, j]`` the displacement component ``a`` at node ``i`` due to
-the unit load case ``N_j`` in component ``b`` of body α. The gap is measured along the line
-of centres between the surface points paired by arc length (material is convected along the
-surface by arc length),
+(eq. 26, 29; ``C^α_{ab}[i, j]``: displacement component ``a`` at node ``i`` due to the unit
+load case ``N_j`` in component ``b`` of body α). Local components make a rigid rotation of a
+rim (the wind-up of a roller on a thin shaft) a constant ``u_t`` and no ``u_n``: it neither
+slips nor opens the gap, as it must. (Cartesian components would turn it into a spurious
+tangential strain ``∝ x/R``: +52 % on Carter's creepage at ``a/R = 0.3`` on the paper's 15 mm
+shaft; measured before this choice.) Nodes of A and B are paired by arc length (material is
+convected along each surface by arc length), and the undeformed gap is the separation of
+the paired points along the line of centres,
 ``h(s) = R_A(1 - cos(s/R_A)) + R_B(1 - cos(s/R_B))`` (``= s²/2R`` to leading order).
 
 Displacements are relative to the rigid shafts, so ``δ`` is the approach of the shaft
-centres and the tangential displacement is relative to the shafts' rotation-free position:
-the half-space's undetermined constant ``d_ref`` does not exist here, and a prescribed
-approach or creepage is meaningful. The contact kinematics are linearized along the line
-of centres (gap and slip as Cartesian components, friction bound ``|t| <= μp`` on them):
-exact to ``O((L/R)²)``, negligible for ``L/R < 0.01`` and a ~4 % approximation for the
-largest contacts of the geometry study (``L/R ≈ 0.4``), where the small-strain model itself is
-stretched.
+centres: the half-space's undetermined constant ``d_ref`` does not exist here, and a
+prescribed approach or creepage is meaningful. Linearized kinematics, as in the paper: the
+approach enters every gap as ``-δ`` (its normal component is ``δ cos θ``), the loads are
+``P = fᵀp``, ``Q = fᵀt`` (the shaft forces are ``∫ p cos θ ± t sin θ``), and the slip is
+``∂w/∂s`` without the curvature term ``u_n/R`` of the surface strain: all exact to
+``O(θ²)``, ``θ = L/R_α``, i.e. ``1e-4`` for ``a/R = 0.01`` and a few per cent for the largest
+contacts of the geometry study (docs/bem.md).
 """
 from __future__ import annotations
 
