@@ -5,9 +5,10 @@ built-in scene (the files in ``rollqp/scenes/``) or from a plain dict of the sam
 
     name, description
     [bodies.A] [bodies.B]   radius, E, nu, shaft_radius
-    [contact]               friction, model, coupling, reference_distance
+    [contact]               friction, model, coupling, reference_distance, bem_outer_elements,
+                            bem_inner_elements
     [load]                  normal, normal_history, tangential | creepage, start, direction,
-                            start_steps
+                            start_steps, approach
     [discretization]        elements, element, zone, step, formulation, distance
     [solver]                method, tolerance, max_iterations
 

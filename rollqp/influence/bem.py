@@ -72,8 +72,8 @@ and (``J`` reverses the node order)
 
 .. math::
 
-    A_{nn} = C^A_{nn} + J C^B_{nn} J, \quad A_{nt} = C^A_{nt} + J C^B_{nt} J, \quad
-    A_{tn} = C^A_{tn} + J C^B_{tn} J, \quad A_{tt} = C^A_{tt} + J C^B_{tt} J
+    A_{nn} = C^A_{nn} + J C^B_{nn} J, \\quad A_{nt} = C^A_{nt} + J C^B_{nt} J, \\quad
+    A_{tn} = C^A_{tn} + J C^B_{tn} J, \\quad A_{tt} = C^A_{tt} + J C^B_{tt} J
 
 (eq. 26, 29; ``C^α_{ab}[i, j]``: displacement component ``a`` at node ``i`` due to the unit
 load case ``N_j`` in component ``b`` of body α). Local components make a rigid rotation of a
