@@ -5,6 +5,7 @@ Usage::
     python benchmarks/bem_study.py                      # table + docs/figures/bem-study.png (~1 min)
     python benchmarks/bem_study.py --figure out.png
     python benchmarks/bem_study.py --grading            # the mesh-grading trade-off table only
+    python benchmarks/bem_study.py --mesh docs/figures/bem-mesh.png   # the default mesh of body A
 
 The paper's rollers (R_A = 150 mm, R_B = 300 mm, relative radius R = 100 mm, steel on steel,
 μ = 0.1) in steady rolling at Q/(μP) = 0.75 (``start = "rolling"``, Newton's direct steady
@@ -154,11 +155,45 @@ def grading_table():
                    "max|Δp|/p0", "asymmetry F·A_nn"], rows)
 
 
+def mesh_figure(path):
+    """The default BEM mesh of body A of ``cattaneo-carter``: whole roller and the strip's neighbourhood."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from rollqp.influence import bem
+    sc = rollqp.load_scene("cattaneo-carter")
+    strip = rollqp.Strip(sc.half_width, 40, "quadratic")
+    m = bem.annulus_mesh(sc.A.radius, sc.A.shaft_radius, strip.edges)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.6), constrained_layout=True)
+    for ax, zoom in zip(axes, (None, 12.0 * sc.half_width)):
+        for e in range(m.n_elements):
+            x, _, _ = m.points(e, np.linspace(-1, 1, 60))
+            ax.plot(x[:, 0], x[:, 1], color="C0" if e >= m.n_strip else "C3", lw=1.2 if e >= m.n_strip else 3,
+                    zorder=1 if e >= m.n_strip else 3)
+        ends, _, _ = m.points(np.arange(m.n_elements)[:, None], np.array([-1.0, 1.0]))
+        ax.plot(ends[m.n_strip:, :, 0].ravel(), ends[m.n_strip:, :, 1].ravel(), "k|" if zoom else "k.", ms=6, zorder=2)
+        ax.set_aspect("equal")
+        if zoom:
+            ax.set_xlim(-zoom, zoom)
+            ax.set_ylim(-sc.A.radius - 0.3 * zoom, -sc.A.radius + 0.5 * zoom)
+            ax.set_title(f"near the contact (strip: 40 QCE on ±{sc.half_width:.3g} mm, red)", fontsize=9)
+        else:
+            ax.set_title(f"body A: R = {sc.A.radius:g}, shaft {sc.A.shaft_radius:g} mm; strip (red) + "
+                         f"{m.n_outer_elements - m.n_strip} graded + {m.n_elements - m.n_outer_elements} shaft elements",
+                         fontsize=9)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--figure", default=str(Path(__file__).resolve().parents[1] / "docs/figures/bem-study.png"))
     ap.add_argument("--grading", action="store_true", help="print the mesh-grading trade-off table only")
+    ap.add_argument("--mesh", metavar="PNG", help="draw the default mesh of body A to PNG and stop")
     args = ap.parse_args(argv)
+    if args.mesh:
+        mesh_figure(args.mesh)
+        return
     if args.grading:
         print(grading_table())
         return
