@@ -268,6 +268,12 @@ def test_approach_is_determined():
 
 def test_approach_scene_input():
     sc = rollqp.load_scene("cattaneo-carter")
+    bem_sc = sc.replace(**{"contact.model": "bem", "contact.bem_outer_elements": 25,
+                           "load.approach": {"kind": "ramp", "start": 0.01, "end": 0.03, "over": 2.0}})
+    back = rollqp.scene.scene_from_toml(bem_sc.to_toml())
+    assert back == bem_sc and back.bem_mesh == (25, 16), "the new keys round-trip through TOML"
+    assert "bem_outer_elements" not in sc.to_toml() and "approach" not in sc.to_toml(), \
+        "absent optional keys stay out of a half-space scene's TOML"
     with pytest.raises(InputError) as exc:
         sc.replace(**{"load.approach": {"kind": "constant", "value": 0.03},
                       "load.normal_history": {"kind": "ramp", "start": 0.5, "end": 1.0, "over": 1.0}})

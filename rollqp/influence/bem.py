@@ -557,6 +557,10 @@ def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.
         ``"full"``, dropped with ``"off"``; its size is ``info["coupling_size"]``.
     n_outer, n_inner : int
         Elements outside the strip and on each shaft (defaults: the paper's 19 and 16).
+    **_ignored
+        The half-space builder's ``R_A``, ``R_B`` and ``d_ref`` (``build_influence`` passes the
+        same keywords to every model): the radii come from ``A`` and ``B``, and with rigid
+        shafts there is no reference distance.
 
     Returns
     -------
