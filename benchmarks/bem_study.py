@@ -179,7 +179,8 @@ def mesh_figure(path):
             ax.set_title(f"near the contact (strip: 40 QCE on ±{sc.half_width:.3g} mm, red)", fontsize=9)
         else:
             ax.set_title(f"body A: R = {sc.A.radius:g}, shaft {sc.A.shaft_radius:g} mm; strip (red) + "
-                         f"{m.n_outer_elements - m.n_strip} graded + {m.n_elements - m.n_outer_elements} shaft elements",
+                         f"{m.n_outer_elements - m.n_strip} graded + "
+                         f"{m.n_elements - m.n_outer_elements} shaft elements",
                          fontsize=9)
     fig.savefig(path, dpi=120)
     plt.close(fig)

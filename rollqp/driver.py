@@ -270,7 +270,8 @@ def _record(result, model, q, state: _State, st: _Step, *, P, shift, step_time):
     sc, mu = model.scales, model.scene.contact.friction
     s = state.tsol.s
     result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=classify(state.p, state.t, s, mu, sc),
-                  P=float(model.f @ state.p) if P is None else P, Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
+                  P=float(model.f @ state.p) if P is None else P,  # None: the approach is prescribed
+                  Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
                   iterations=st.iterations, step_time=step_time, residual=st.residual,
                   inner_normal=st.inner_normal, inner_tangential=st.inner_tangential, backtracks=st.backtracks)
 

@@ -92,7 +92,8 @@ def test_mesh_grading():
     np.testing.assert_allclose(m.lengths[:59].sum(), 2 * np.pi * 150.0, rtol=1e-12)
     np.testing.assert_allclose(m.lengths[59:].sum(), 2 * np.pi * 15.0, rtol=1e-12)
     free = m.lengths[40:59]
-    assert free[0] > strip.element_length and np.all(np.diff(free[:9]) >= -1e-12 * free.max()), "graded away from the strip"
+    assert free[0] > strip.element_length and np.all(np.diff(free[:9]) >= -1e-12 * free.max()), \
+        "graded away from the strip"
     assert free.max() <= bem.MAX_ANGLE_FACTOR * 2 * np.pi * 150.0 / 19 * (1 + 1e-12)
 
 
@@ -213,7 +214,8 @@ def test_asymmetry_and_qp_vs_newton():
     d_bem = _max_diff(_symmetrized_run(sc), newton, sc)[1]
     hs = sc.replace(**{"contact.model": "halfspace"})
     d_hs = _max_diff(_symmetrized_run(hs), driver.run(hs.replace(**{"solver.method": "newton"})), hs)[1]
-    assert 0.05 < d_bem < 0.3 and abs(d_bem / d_hs - 1) < 0.25, f"sym(FA) vs A: BEM {d_bem:.3f}, half-space {d_hs:.3f} p0"
+    assert 0.05 < d_bem < 0.3 and abs(d_bem / d_hs - 1) < 0.25, \
+        f"sym(FA) vs A: BEM {d_bem:.3f}, half-space {d_hs:.3f} p0"
 
 
 # ------------------------------------------------------------------------------ rigid reference

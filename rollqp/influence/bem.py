@@ -106,7 +106,7 @@ from ..errors import InputError
 from .halfspace import COUPLINGS, Influence, _log_moments, asymmetry, min_eigenvalue
 
 __all__ = ["AnnulusMesh", "annulus_mesh", "BEMBody", "body_matrices", "contact_compliance",
-           "bem_influence", "lame_ring", "DEFAULT_OUTER", "DEFAULT_INNER"]
+           "bem_influence", "contact_gap", "lame_ring", "DEFAULT_OUTER", "DEFAULT_INNER"]
 
 #: Default element counts outside the strip and on the shaft (the paper's, §2.3).
 DEFAULT_OUTER, DEFAULT_INNER = 19, 16
