@@ -73,9 +73,12 @@ class Model:
         d = scene.discretization
         strip = Strip(scene.half_width, d.elements, d.element)
         t0 = time.perf_counter()
+        kw = {}
+        if scene.contact.model == "bem":  # true geometry: the rollers and their BEM meshes
+            kw = dict(A=scene.A, B=scene.B, n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1])
         infl = build_influence(scene.contact.model, strip, Estar=scene.Estar, beta=scene.beta,
                                R_A=scene.A.radius, R_B=scene.B.radius, coupling=scene.coupling_level,
-                               d_ref=scene.reference_distance_value)
+                               d_ref=scene.reference_distance_value, **kw)
         f = strip.weights
         info = dict(infl.info)
         info["asymmetry_Ann"] = asymmetry(infl.Ann, f)
@@ -96,9 +99,9 @@ class Model:
         return self.strip.weights
 
     # ------------------------------------------------------------ step problems
-    def normal_step(self, P, t=None) -> NormalStep:
+    def normal_step(self, P, t=None, delta=None) -> NormalStep:
         offset = None if (self.Ant is None or t is None) else self.Ant @ t
-        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=P, offset=offset, scales=self.scales)
+        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=P, delta=delta, offset=offset, scales=self.scales)
 
     def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False) -> TangentialStep:
         Atn, Att = self.steady_operators() if steady else (self.Atn, self.Att)
@@ -112,11 +115,12 @@ class Model:
         """Full coupling (``A_nt`` present): each step is one :class:`CoupledStep`."""
         return self.Ant is not None
 
-    def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False) -> CoupledStep:
+    def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None) -> CoupledStep:
         """The coupled step (FORMULATION.md §6); ``steady``: slip ``s = ξ e + d·D_up w``."""
         Atn, Att = self.steady_operators() if steady else (self.Atn, self.Att)
         return CoupledStep(Ann=self.Ann, Att=Att, Ant=self.Ant, Atn=Atn, f=self.f, h=self.h,
-                           mu=self.scene.contact.friction, c=c, dq=dq, P=P, Q=Q, xi=xi, scales=self.scales)
+                           mu=self.scene.contact.friction, c=c, dq=dq, P=P, Q=Q, xi=xi, delta=delta,
+                           scales=self.scales)
 
     def steady_operators(self):
         """``(Δ·d·D_up·A_tn, Δ·d·D_up·A_tt)`` with ``Δ = a_H``: the steady slip operators.
@@ -272,28 +276,37 @@ def _record(result, model, q, state: _State, st: _Step, *, P, shift, step_time):
     sc, mu = model.scales, model.scene.contact.friction
     s = state.tsol.s
     result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=classify(state.p, state.t, s, mu, sc),
-                  P=P, Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
+                  P=float(model.f @ state.p) if P is None else P,  # None: the approach is prescribed
+                  Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
                   iterations=st.iterations, step_time=step_time, residual=st.residual,
                   inner_normal=st.inner_normal, inner_tangential=st.inner_tangential, backtracks=st.backtracks)
 
 
 def _loads(scene, q):
-    P = float(scene.normal_load(q))
+    """``(P, Q, ξ)`` at ``q``; ``P`` is None when the approach is prescribed (:func:`_approach`)."""
+    P = None if scene.load.approach is not None else float(scene.normal_load(q))
     if scene.load.creepage is not None:
         return P, None, float(scene.prescribed_creepage(q))
     return P, float(scene.tangential_load(q)), None
 
 
-def _step(model, meth, state: _State, st: _Step, *, P, c, dq, Q=None, xi=None, normal_fixed=False, steady=False):
+def _approach(scene, q):
+    """The prescribed approach δ(q), or None (the normal load is prescribed)."""
+    d = scene.prescribed_approach(q)
+    return None if d is None else float(d)
+
+
+def _step(model, meth, state: _State, st: _Step, *, P, c, dq, Q=None, xi=None, normal_fixed=False, steady=False,
+          delta=None):
     """One step (rolling, static shift or steady): the coupled problem, or its two halves."""
     if model.coupled:
-        sol = meth.solve(model.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady), warm=state.tsol)
+        sol = meth.solve(model.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta), warm=state.tsol)
         st.add_coupled(sol)
         return _State(sol.p, sol.t, sol, sol, model.w(sol.p, sol.t))
     nsol = state.nsol
     if not normal_fixed or nsol is None:
         # goodman/off: the normal half does not see t (A_nt = 0); offset kept for generality
-        nsol = meth.solve(model.normal_step(P, state.t), warm=state.nsol)
+        nsol = meth.solve(model.normal_step(P, state.t, delta=delta), warm=state.nsol)
         st.add(nsol, "normal")
     tsol = meth.solve(model.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady), warm=state.tsol)
     st.add(tsol, "tangential")
@@ -314,6 +327,7 @@ def _braked_start(scene, model, meth, result):
     """
     t0 = time.perf_counter()
     P, Q, _ = _loads(scene, 0.0)
+    D = _approach(scene, 0.0)   # prescribed approach: applied like the load, in start_steps parts
     Qtarget = Q if Q is not None else 0.0
     n = model.strip.n
     N = scene.load.start_steps
@@ -321,17 +335,18 @@ def _braked_start(scene, model, meth, result):
     st = _Step()
     state = _State(None, np.zeros(n), None, None, np.zeros(n))  # unloaded bodies
     shift = 0.0
+    N0 = P if D is None else D
     if model.Atn is not None:
-        loading = [(P * j / N, 0.0) for j in range(1, N + 1)]
+        loading = [(N0 * j / N, 0.0) for j in range(1, N + 1)]
     else:  # no coupling: the shear of a normal load is zero, so go straight to Q (Hertz, then Cattaneo)
-        loading = [] if Qtarget != 0.0 else [(P, 0.0)]
+        loading = [] if Qtarget != 0.0 else [(N0, 0.0)]
     if Qtarget != 0.0:
-        loading += [(P, Qtarget * j / N) for j in range(1, N + 1)]
+        loading += [(N0, Qtarget * j / N) for j in range(1, N + 1)]
     Pprev = None
     for Pj, Qj in loading:
         # the normal half is re-solved only if P changed or the shear feeds back (A_nt)
-        state = _step(model, meth, state, st, P=Pj, c=-state.w, dq=delta, Q=Qj,
-                      normal_fixed=(Pj == Pprev and model.Ant is None))
+        state = _step(model, meth, state, st, P=None if D is not None else Pj, c=-state.w, dq=delta, Q=Qj,
+                      normal_fixed=(Pj == Pprev and model.Ant is None), delta=None if D is None else Pj)
         Pprev = Pj
         shift += state.tsol.xi * delta
     model.check_inside(state.p, 0)
@@ -344,7 +359,7 @@ def _normal_fixed(scene, model) -> bool:
     if model.Ant is not None:
         return False
     qs = scene.q_steps
-    P = scene.normal_load(qs)
+    P = scene.normal_load(qs) if scene.load.approach is None else scene.prescribed_approach(qs)
     return bool(np.all(P == P[0]))
 
 
@@ -366,7 +381,7 @@ def _march(scene, model, meth, result, progress):
         P, Q, xi = _loads(scene, qs[k])
         st = _Step()
         state = _step(model, meth, state, st, P=P, c=-(model.history @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                      normal_fixed=fixed)
+                      normal_fixed=fixed, delta=_approach(scene, qs[k]))
         if not fixed:
             model.check_inside(state.p, k)
         _record(result, model, qs[k], state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
@@ -384,7 +399,7 @@ def _steady_direct(scene, model, meth, state, result):
     P, Q, xi = _loads(scene, 0.0)
     st = _Step()
     state = _step(model, meth, state, st, P=P, c=np.zeros(model.strip.n), dq=model.scales.length, Q=Q, xi=xi,
-                  steady=True)
+                  steady=True, delta=_approach(scene, 0.0))
     model.check_inside(state.p, 0)
     result.rows = {key: [] for key in result.rows}
     result.meta["rolling_start"] = "direct steady solve"
@@ -405,7 +420,7 @@ def _steady_by_marching(scene, model, meth, state, result, fixed):
     change = np.inf
     for _ in range(max_steps):
         new = _step(model, meth, state, st, P=P, c=-(model.history @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                    normal_fixed=fixed)
+                    normal_fixed=fixed, delta=_approach(scene, 0.0))
         change = np.max(np.abs(new.t - state.t)) / (max(scene.contact.friction, 1e-300) * model.scales.stress)
         if not fixed:
             change = max(change, np.max(np.abs(new.p - state.p)) / model.scales.stress)

@@ -69,7 +69,26 @@ def summary(res: dict, scene, method: str, wall: float) -> str:
                           f"median {1e3 * float(np.median(res['step_time'])):.2f} ms per step)"),
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, FORMULATION.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
+    rows += _bem_rows(res, scene)
     for name, val, what in closed_form_errors(res, scene):
         rows.append((f"error: {name}", f"{val:.4f}  {what}"))
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
+
+
+def _bem_rows(res: dict, scene) -> list[tuple[str, str]]:
+    """``model = "bem"``: assembly cost, the geometric coupling and the asymmetry of F·A (docs/bem.md)."""
+    if scene.contact.model != "bem":
+        return []
+    import json
+    meta = res.get("meta")
+    meta = json.loads(str(meta)) if not isinstance(meta, dict) else meta
+    m = meta.get("model", {})
+    cost = ("cached (same geometry built before)" if m.get("bem_cached") else
+            f"{m.get('bem_seconds', float('nan')):.3f} s assembly + condensation")
+    return [("BEM", f"{cost}, {m.get('bem_memory_bytes', 0) / 2 ** 20:.1f} MiB per body system; "
+                    f"{m.get('bem_outer_elements')} outer + {m.get('bem_inner_elements')} shaft elements"),
+            ("BEM coupling", f"geometric A_nt/A_tn {m.get('geometric_coupling')} "
+                             f"(|F A_nt|/|F A_nn| = {m.get('coupling_size', float('nan')):.2e})"),
+            ("BEM asymmetry", f"|FA - (FA)^T|/|FA| = {m.get('asymmetry_FA', float('nan')):.2e} (A_nn), "
+                              f"{m.get('asymmetry_FAtt', float('nan')):.2e} (A_tt); operator {m.get('operator')}")]

@@ -5,9 +5,10 @@ built-in scene (the files in ``rollqp/scenes/``) or from a plain dict of the sam
 
     name, description
     [bodies.A] [bodies.B]   radius, E, nu, shaft_radius
-    [contact]               friction, model, coupling, reference_distance
+    [contact]               friction, model, coupling, reference_distance, bem_outer_elements,
+                            bem_inner_elements
     [load]                  normal, normal_history, tangential | creepage, start, direction,
-                            start_steps
+                            start_steps, approach
     [discretization]        elements, element, zone, step, formulation, distance
     [solver]                method, tolerance, max_iterations
 
@@ -113,12 +114,17 @@ class Contact:
     reference_distance : float or None
         d_ref of the 2D half-space kernel ``−ln(|x − s|/d_ref)``, ``> 0``; None: the relative
         radius R (see :attr:`Scene.reference_distance_value`).
+    bem_outer_elements, bem_inner_elements : int or None
+        ``model = "bem"``: elements on each roller's outer circle outside the strip and on its
+        shaft, in [3, 2000]; None: the paper's 19 and 16 (docs/bem.md).
     """
 
     friction: float
     model: str = "halfspace"
     coupling: str = "auto"
     reference_distance: float | None = None
+    bem_outer_elements: int | None = None
+    bem_inner_elements: int | None = None
 
 
 @dataclass(frozen=True)
@@ -143,6 +149,11 @@ class Load:
         d = sgn(V), the direction of the material through the contact (paper: −1).
     start_steps : int
         Quasi-static steps applying the normal load of a braked start, ``>= 1``.
+    approach : History or None
+        Prescribed approach of the shaft centres δ(q) = approach(q/a_H) (length units) instead
+        of the normal load (the normal-side analogue of ``creepage``); ``normal`` stays the
+        reference load P̄ of a_H, p0 and the zone. Meaningful with ``contact.model = "bem"``
+        (rigid shafts); on the half-space δ depends on ``reference_distance`` (docs/bem.md).
     """
 
     normal: float
@@ -152,6 +163,7 @@ class Load:
     start: str = "braked"
     direction: int = -1
     start_steps: int = 1
+    approach: History | None = None
 
 
 @dataclass(frozen=True)
@@ -266,7 +278,10 @@ def _check_contact(c: Any) -> Contact:
     d = c.reference_distance
     if d is not None:
         d = _number("contact.reference_distance", d, "> 0 or absent (then R)", lambda x: x > 0)
-    return Contact(mu, model, coupling, d)
+    mesh = [None if getattr(c, k) is None else
+            _integer(f"contact.{k}", getattr(c, k), "in [3, 2000] or absent", lambda n: 3 <= n <= 2000)
+            for k in ("bem_outer_elements", "bem_inner_elements")]
+    return Contact(mu, model, coupling, d, *mesh)
 
 
 def _check_load(ld: Any) -> Load:
@@ -287,7 +302,11 @@ def _check_load(ld: Any) -> Load:
             or direction not in (-1, 1):
         raise InputError("load.direction", f"must be -1 or +1, got {direction!r}")
     steps = _integer("load.start_steps", ld.start_steps, ">= 1", lambda n: n >= 1)
-    return Load(normal, nh, tang, creep, start, int(direction), steps)
+    approach = None if ld.approach is None else parse_history(ld.approach, "load.approach")
+    if approach is not None and nh != Constant(1.0):
+        raise InputError("load.approach", "give at most one of load.normal_history and load.approach "
+                                          "(with a prescribed approach the normal load is an unknown)")
+    return Load(normal, nh, tang, creep, start, int(direction), steps, approach)
 
 
 def _check_discretization(d: Any) -> Discretization:
@@ -384,6 +403,7 @@ class Scene:
             raise InputError("load.normal_history",
                              f"must stay > 0 over the rolled distance [0, {q_end:.6g}] a_H, "
                              f"but its minimum is {nmin:.6g} (loss of contact is not supported)")
+        self._check_bem()
         free = 1.0 - EDGE_ELEMENTS / disc.elements
         if not math.sqrt(nmax) < disc.zone * free:
             raise InputError(
@@ -415,6 +435,26 @@ class Scene:
                              f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"
                              f" is not supported), but it reaches {ratio[i]:.6g} at q = "
                              f"{q[i]:.6g} a_H")
+
+    def _check_bem(self) -> None:
+        """``model = "bem"``: both shafts given, and the strip shorter than half a circumference."""
+        if self.contact.model != "bem":
+            return
+        for key, body in (("bodies.A", self.A), ("bodies.B", self.B)):
+            if body.shaft_radius is None:
+                raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' (the "
+                                                        f"rigid shaft's radius, in (0, {body.radius!r}))")
+            if not 2.0 * self.half_width < math.pi * body.radius:
+                raise InputError("discretization.zone",
+                                 f"the strip (2L = {2 * self.half_width:.6g}) must be shorter than half the "
+                                 f"circumference of {key} (radius {body.radius!r}) for model = 'bem'")
+
+    @property
+    def bem_mesh(self) -> tuple[int, int]:
+        """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
+        c = self.contact
+        return (19 if c.bem_outer_elements is None else c.bem_outer_elements,
+                16 if c.bem_inner_elements is None else c.bem_inner_elements)
 
     # ------------------------------------------------------------------ derived quantities
     @property
@@ -548,6 +588,18 @@ class Scene:
             raise InputError("load.creepage", "not prescribed: this scene prescribes "
                                               "load.tangential instead")
         return self.load.creepage(np.asarray(q, dtype=float) / self.a_H)
+
+    def prescribed_approach(self, q):
+        """Prescribed approach δ(q) = approach(q/a_H) of the shaft centres, or None if P is given.
+
+        Parameters
+        ----------
+        q : float or ndarray
+            Rolled distance, length units.
+        """
+        if self.load.approach is None:
+            return None
+        return self.load.approach(np.asarray(q, dtype=float) / self.a_H)
 
     # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
@@ -769,7 +821,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     if "normal_history" in ld:
         ld["normal_history"] = parse_history(ld["normal_history"], "load.normal_history",
                                              constant_default=1.0)
-    for k in ("tangential", "creepage"):
+    for k in ("tangential", "creepage", "approach"):
         if k in ld:
             ld[k] = parse_history(ld[k], f"load.{k}")
     return Scene(name=d.get("name", default_name), description=d.get("description", ""),

@@ -6,12 +6,13 @@
 from __future__ import annotations
 
 from ..errors import InputError
+from .bem import bem_influence
 from .halfspace import Influence, halfspace_influence, min_eigenvalue
 
-__all__ = ["Influence", "halfspace_influence", "min_eigenvalue", "MODELS", "build_influence"]
+__all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence"]
 
 #: Available influence models (``contact.model``).
-MODELS = {"halfspace": halfspace_influence}
+MODELS = {"halfspace": halfspace_influence, "bem": bem_influence}
 
 
 def build_influence(model: str, strip, **kw) -> Influence:
@@ -20,10 +21,8 @@ def build_influence(model: str, strip, **kw) -> Influence:
     Raises
     ------
     InputError
-        ``contact.model`` for an unknown model, or ``"bem"`` (not available yet).
+        ``contact.model`` for an unknown model.
     """
-    if model == "bem" and "bem" not in MODELS:
-        raise InputError("contact.model", "the BEM model is not available yet (issue 4); use 'halfspace'")
     try:
         builder = MODELS[model]
     except (KeyError, TypeError):
