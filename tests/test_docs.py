@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 PAGES = sorted(DOCS.glob("*.md"))
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
-COMMAND = re.compile(r"`((?:python examples/|rollqp run )[^`]+)`")
+COMMAND = re.compile(r"`((?:python (?:examples|benchmarks)/|rollqp run )[^`]+)`")
 
 
 def _figures():
@@ -80,7 +80,7 @@ def test_figure_exists(page, target):
 @pytest.mark.parametrize("page, target, beside", FIGURES, ids=[t for _, t, _ in FIGURES])
 def test_figure_has_its_command_beside_it(page, target, beside):
     commands = [shlex.split(c) for c in COMMAND.findall(beside)]
-    assert commands, f"{page}: no `python examples/…` or `rollqp run …` command beside {target}"
+    assert commands, f"{page}: no `python examples/…`, `python benchmarks/…` or `rollqp run …` command beside {target}"
     image = Path("docs") / target
     writes = []
     for argv in commands:
@@ -96,7 +96,7 @@ def test_figure_has_its_command_beside_it(page, target, beside):
             unknown = _options(argv[3:]) - _cli_options("run")
             assert not unknown, f"{page}: rollqp run does not accept {sorted(unknown)}"
         for opt, value in zip(argv, argv[1:]):
-            if opt in ("--figure", "--plot"):
+            if opt in ("--figure", "--plot", "--mesh"):
                 writes.append(Path(value) == image)
             elif opt == "--figures":
                 writes.append(Path(value) == image.parent)
