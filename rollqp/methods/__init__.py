@@ -66,9 +66,8 @@ def _load(name: str):
     try:
         return getattr(mod, cls)
     except AttributeError as exc:
-        raise InputError("solver.method", f"method {name!r} is not available in this version of rollqp "
-                         "(the coupled step and the N-T alternation arrive with issue 3); "
-                         "use newton, qp-clarabel, qp-osqp or qp-cvxpy") from exc
+        raise InputError("solver.method", f"method {name!r} is not available in this version of rollqp; "
+                         f"available: {', '.join(available_methods())}") from exc
 
 
 def get_method(name: str, **settings):
