@@ -22,8 +22,10 @@ with ``Â = A E*/a_H``, ``f̂ = f/a_H``, ``ĥ = (h + o)/u0``, ``ĉ = c/u0``, ``�
 
 Newton direction (eq. 74, 80): ``J d = −Φ`` with ``J`` the Jacobian of the linear part plus the
 pseudo-Jacobian of the ``min``/``Proj`` rows chosen node by node (eq. 82–90, the paper's
-"modified" linear choice on the kinks); ``J`` is dense, assembled from cached rows and factored
-once per iteration (LAPACK ``gesv``). Step length (eq. 75–79): ``α = ρ^m`` (``s = 1``), the first
+"modified" linear choice on the kinks). ``J`` is never formed: the identity rows (separated
+and slipping nodes) are eliminated and the rest is solved on the free nodes
+(:meth:`_System.direction`, LAPACK ``getrf``/``getrs``), reusing the last factorization
+through a small Schur complement while the active set moves by a few nodes. Step length (eq. 75–79): ``α = ρ^m`` (``s = 1``), the first
 ``m`` with ``θ(z + αd) <= (1 − 2σα) θ(z)``, ``θ = ½‖Φ‖²``. Along the search line only the
 ``min``/``Proj`` are re-evaluated: the linear parts ``r ĝ``, ``r ŝ`` move by ``α K d`` with
 ``K d`` computed once per iteration.
@@ -63,7 +65,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.linalg.lapack import dgesv
+from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
 
 from ..errors import InputError, SolverError
 from ..problem import StepSolution
@@ -79,15 +81,22 @@ class _Stalled(Exception):
 class _System:
     """Cached, r-scaled matrices of one problem operator (per ``A``, ``f``, scales, ``Δq``, ``r``).
 
-    ``K`` (``n × (n+1)``) maps ``z = (x, δ̂|ξ̂)`` to the linear part of ``y = r ĝ`` or ``r ŝ``.
-    ``J = where(mask, JK, JI)`` row by row: ``JK`` holds the contact/stick rows (``K``), ``JI``
-    the identity rows (separation/slip); both end with the load row ``[f̂ᵀ, 0]``. They are
-    stored transposed (``JKT``, ``JIT``) so that ``where`` along columns gives ``Jᵀ`` in C order,
-    i.e. ``J`` in the Fortran order LAPACK wants, without a copy. ``*_nl``: the same without
-    the load row and last column (``δ``/``ξ`` prescribed).
+    ``K`` (``n × (n+1)``) maps ``z = (x, δ̂|ξ̂)`` to the linear part of ``y = r ĝ`` or ``r ŝ``;
+    ``K_nl`` is its first ``n`` columns (``δ``/``ξ`` prescribed, no load row). The
+    pseudo-Jacobian has a ``K`` row at the contact/stick nodes (``mask``), an identity row at
+    the separated/slipping nodes, and the load row ``[f̂ᵀ, 0]`` last; :meth:`direction` solves
+    with it on the free nodes only (the reduced system) and keeps the LU factors of the last
+    few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "JKT", "JIT", "K_nl", "JKT_nl", "JIT_nl")
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "_base", "factorizations", "updates")
+
+    #: Largest change of the active set, against the factored one, solved by a Schur complement
+    #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
+    UPDATE_FRACTION = 0.125
+    UPDATE_MIN = 4
+    #: Below this many free nodes a new factorization is cheaper than the bordered solve.
+    UPDATE_MIN_SIZE = 64
 
     def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale):
         n = fhat.size
@@ -95,21 +104,153 @@ class _System:
         K = np.empty((n, n + 1))
         K[:, :n] = (r / t_scale) * Ahat
         K[:, n] = r * last_column
-        JK = np.zeros((n + 1, n + 1))
-        JK[:n] = K
-        JK[n, :n] = fhat
-        JI = np.zeros((n + 1, n + 1))
-        JI[:n, :n] = np.eye(n)
-        JI[n, :n] = fhat
-        self.K, self.JKT, self.JIT = K, np.ascontiguousarray(JK.T), np.ascontiguousarray(JI.T)
+        self.K = K
         self.K_nl = np.ascontiguousarray(K[:, :n])
-        self.JKT_nl, self.JIT_nl = np.ascontiguousarray(self.K_nl.T), np.eye(n)
+        self._base = {}  # with_load -> (mask, free, position of each node in free or -1, lu, piv)
+        self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
+        self.updates = 0  # directions solved by a Schur complement on an older factorization
 
     def matrices(self, with_load):
-        """``(K, JKT, JIT)`` with or without the load row."""
+        """``K`` with or without the load column."""
+        return self.K if with_load else self.K_nl
+
+    def jacobian(self, mask, with_load):
+        """The full pseudo-Jacobian ``J`` (for tests and diagnostics; the iteration never forms it)."""
+        n = self.fhat.size
+        K = self.matrices(with_load)
+        N = K.shape[1]
+        J = np.zeros((N, N))
+        J[:n] = np.where(mask[:n, None], K, np.eye(n, N))
         if with_load:
-            return self.K, self.JKT, self.JIT
-        return self.K_nl, self.JKT_nl, self.JIT_nl
+            J[n, :n] = self.fhat
+        return J
+
+    def _factor(self, m, with_load):
+        """LU of the reduced matrix on the free set ``m`` (below); ``None`` if singular."""
+        n = self.fhat.size
+        K = self.K
+        free = np.flatnonzero(m)
+        nf = free.size
+        M = np.empty((nf + with_load, nf + with_load), order="F")
+        M[:nf, :nf] = K[np.ix_(free, free)]
+        if with_load:
+            M[:nf, nf] = K[free, n]
+            M[nf, :nf] = self.fhat[free]
+            M[nf, nf] = 0.0
+        if M.size:
+            lu, piv, info = dgetrf(M, overwrite_a=True)
+            if info != 0 or not np.all(np.isfinite(np.diag(lu))):
+                return None
+        else:
+            lu, piv = M, np.empty(0, dtype=np.int32)
+        pos = np.full(n, -1)
+        pos[free] = np.arange(nf)
+        self.factorizations += 1
+        return m.copy(), free, pos, lu, piv
+
+    def direction(self, mask, phi, with_load):
+        r"""The Newton direction ``d``: ``J d = −Φ`` solved on the free nodes (eq. 80).
+
+        A node without a ``K`` row (``mask`` false: separated, slipping) has the identity row,
+        so ``d_i = −Φ_i`` there. Eliminating those nodes leaves, on the free set ``F``,
+
+        .. math::
+            \begin{bmatrix} K_{FF} & k_F \\ \hat f_F^T & 0 \end{bmatrix}
+            \begin{bmatrix} d_F \\ d_\lambda \end{bmatrix} =
+            -\begin{bmatrix} \Phi_F + K_{F,P} d_P \\ \Phi_\lambda + \hat f_P^T d_P \end{bmatrix}
+
+        (``k_F`` the ``δ̂``/``ξ̂`` column; without the load row and column if prescribed), whose
+        determinant is that of ``J``. Its LU factors are kept. When the free set ``F`` differs
+        from the factored one ``F₀`` by a few nodes (``R = F₀∖F`` released, ``A = F∖F₀`` added:
+        the stick/slip boundary moving by a node or two between iterations and steps), the
+        system is solved on the old factors, bordered:
+
+        .. math::
+            \begin{bmatrix} M_0 & B & E_R \\ C & D & 0 \\ E_R^T & 0 & 0 \end{bmatrix}
+            \begin{bmatrix} u \\ v \\ w \end{bmatrix} =
+            \begin{bmatrix} r_0 \\ r_A \\ -\Phi_R \end{bmatrix},
+
+        (``B``, ``C``, ``D`` the rows and columns of ``K`` for ``A``; ``E_R`` unit columns: the
+        slack ``w`` frees the old rows of ``R`` and the last block pins ``d_R``), through its
+        Schur complement of size ``|A| + |R|`` (two triangular solves per bordering column, no
+        new factorization). A larger change refactors. Returns ``None`` if singular.
+        """
+        n = self.fhat.size
+        K = self.K if with_load else self.K_nl
+        m = mask[:n]
+        base = self._base.get(with_load)
+        if base is not None:
+            m0, free0, pos0, lu, piv = base
+            released = np.flatnonzero(m0 & ~m)
+            added = np.flatnonzero(m & ~m0)
+            k = released.size + added.size
+            if k and (k > max(self.UPDATE_MIN, self.UPDATE_FRACTION * free0.size)
+                      or free0.size < self.UPDATE_MIN_SIZE):
+                base = None
+        if base is None:
+            base = self._factor(m, with_load)
+            if base is None:
+                return None
+            self._base[with_load] = base
+            m0, free0, pos0, lu, piv = base
+            released = added = np.empty(0, dtype=int)
+            k = 0
+        d = np.empty(K.shape[1])
+        pinned = np.flatnonzero(~m)
+        d[pinned] = -phi[pinned]
+        known = np.flatnonzero(~m & ~m0)  # pinned now and not in the factored set
+        if known.size:
+            e = np.zeros(K.shape[1])
+            e[known] = d[known]
+            Ke = K @ e
+        else:
+            Ke = np.zeros(n)
+        nf0 = free0.size
+        r0 = np.empty(nf0 + with_load)
+        r0[:nf0] = -phi[free0] - Ke[free0]
+        if with_load:
+            r0[nf0] = -phi[n] - self.fhat[known] @ d[known]
+        if r0.size == 0 and k == 0:
+            return d
+        u0, info = dgetrs(lu, piv, r0)
+        if info != 0:
+            return None
+        if k == 0:
+            d[free0] = u0[:nf0]
+            if with_load:
+                d[n] = u0[nf0]
+            return d
+        # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z
+        na = added.size
+        W = np.zeros((nf0 + with_load, k), order="F")
+        W[:nf0, :na] = K[np.ix_(free0, added)]
+        if with_load:
+            W[nf0, :na] = self.fhat[added]
+        W[pos0[released], na + np.arange(released.size)] = 1.0
+        Z, info = dgetrs(lu, piv, W)
+        if info != 0:
+            return None
+        Cu = np.empty((k, nf0 + with_load))
+        Cu[:na, :nf0] = K[np.ix_(added, free0)]
+        if with_load:
+            Cu[:na, nf0] = K[added, n]
+        Cu[na:] = 0.0
+        Cu[na + np.arange(released.size), pos0[released]] = 1.0
+        S = -(Cu @ Z)
+        S[:na, :na] += K[np.ix_(added, added)]
+        rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu @ u0
+        try:
+            vw = np.linalg.solve(S, rhs)
+        except np.linalg.LinAlgError:
+            return None
+        u = u0 - Z @ vw
+        d[free0] = u[:nf0]
+        d[released] = -phi[released]  # what the last block pins them to, without round-off
+        d[added] = vw[:na]
+        if with_load:
+            d[n] = u[nf0]
+        self.updates += 1
+        return d
 
 
 class NewtonMethod:
@@ -296,7 +437,7 @@ class NewtonMethod:
         n = pb.n
         r = sys_.r
         with_load = load is not None
-        K, JKT, JIT = sys_.matrices(with_load)
+        K = sys_.matrices(with_load)
         fhat = sys_.fhat
         stop = self.tolerance * min(1.0, r)
         rho, two_sigma = self.rho, 2.0 * self.sigma
@@ -337,10 +478,9 @@ class NewtonMethod:
                 m[j] = True
                 shifts += 1
             mask[:n] = m
-            JT = np.where(mask[None, :], JKT, JIT)  # Jᵀ in C order = J in Fortran order
-            _, _, d, fail = dgesv(JT.T, -phi, overwrite_a=True)  # one LU factorization + solve
-            if fail != 0 or not np.all(np.isfinite(d)):
-                raise SolverError(f"the {pb.kind} Newton matrix is singular (LAPACK info {fail})",
+            d = sys_.direction(mask, phi, with_load)  # reduced system on the free nodes
+            if d is None or not np.all(np.isfinite(d)):
+                raise SolverError(f"the {pb.kind} Newton matrix is singular",
                                   method=self.name, status="singular", iterations=it, residual=nrm)
             # Armijo (eq. 75–78), s = 1
             dx = d[:n]
@@ -665,7 +805,7 @@ class NewtonMethod:
             with_load = problem.P is not None
             k0 = sys_.r * (problem.h_total / sc.displacement - (0.0 if with_load else problem.delta / sc.displacement))
             load = problem.P / sc.force if with_load else None
-            K = sys_.matrices(with_load)[0]
+            K = sys_.matrices(with_load)
             x, y = z[:n], K @ z + k0
             ph = np.minimum(x, y)
             m = x > y
@@ -677,16 +817,15 @@ class NewtonMethod:
             b = problem.bound / sc.stress
             k0 = sys_.r * (problem.c / sc.displacement / dqh + (0.0 if with_load else problem.xi / sc.slip))
             load = problem.Q / sc.force if with_load else None
-            K = sys_.matrices(with_load)[0]
+            K = sys_.matrices(with_load)
             x, y = z[:n], K @ z + k0
             ph = x - np.clip(x - y, -b, b)
             u = np.abs(x - y)
             sep = b <= 0
             m = (u <= b) & ~sep
             cases = np.where(sep, "eq85", np.where(u < b, "eq86", np.where(u == b, "eq87", "eq88")))
-        _, JKT, JIT = sys_.matrices(with_load)
         mask = np.append(m, True) if with_load else m
-        J = np.where(mask[:, None], JKT.T, JIT.T)
+        J = sys_.jacobian(mask, with_load)
         phi = np.append(ph, sys_.fhat @ x - load) if with_load else ph
         return phi, J, cases
 
