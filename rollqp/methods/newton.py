@@ -146,7 +146,7 @@ class _System:
         pos = np.full(n, -1)
         pos[free] = np.arange(nf)
         self.factorizations += 1
-        return m.copy(), free, pos, lu, piv
+        return m.copy(), free, pos, lu, piv, {}
 
     def direction(self, mask, phi, with_load):
         r"""The Newton direction ``d``: ``J d = −Φ`` solved on the free nodes (eq. 80).
@@ -180,7 +180,7 @@ class _System:
         m = mask[:n]
         base = self._base.get(with_load)
         if base is not None:
-            m0, free0, pos0, lu, piv = base
+            m0, free0, pos0, lu, piv, cols = base
             released = np.flatnonzero(m0 & ~m)
             added = np.flatnonzero(m & ~m0)
             k = released.size + added.size
@@ -192,7 +192,7 @@ class _System:
             if base is None:
                 return None
             self._base[with_load] = base
-            m0, free0, pos0, lu, piv = base
+            m0, free0, pos0, lu, piv, cols = base
             released = added = np.empty(0, dtype=int)
             k = 0
         d = np.empty(K.shape[1])
@@ -220,25 +220,37 @@ class _System:
             if with_load:
                 d[n] = u0[nf0]
             return d
-        # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z
+        # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z.
+        # The columns of Z are kept per node (``cols``): as the set drifts away from the factored
+        # one, each step adds a node or two, and only their columns cost triangular solves.
         na = added.size
-        W = np.zeros((nf0 + with_load, k), order="F")
-        W[:nf0, :na] = K[np.ix_(free0, added)]
+        keys = [j for j in added.tolist()] + [-1 - i for i in released.tolist()]
+        missing = [c for c in keys if c not in cols]
+        if missing:
+            W = np.zeros((nf0 + with_load, len(missing)), order="F")
+            ma = np.array([c for c in missing if c >= 0], dtype=int)
+            mr = np.array([-1 - c for c in missing if c < 0], dtype=int)
+            W[:nf0, :ma.size] = K[np.ix_(free0, ma)]
+            if with_load:
+                W[nf0, :ma.size] = self.fhat[ma]
+            W[pos0[mr], ma.size + np.arange(mr.size)] = 1.0
+            Zm, info = dgetrs(lu, piv, W)
+            if info != 0:
+                return None
+            for c, j in zip([c for c in missing if c >= 0] + [c for c in missing if c < 0], range(len(missing))):
+                cols[c] = Zm[:, j]
+        Z = np.column_stack([cols[c] for c in keys])
+        S = np.empty((k, k))
+        Ca = K[np.ix_(added, free0)]
+        S[:na] = -(Ca @ Z[:nf0])
         if with_load:
-            W[nf0, :na] = self.fhat[added]
-        W[pos0[released], na + np.arange(released.size)] = 1.0
-        Z, info = dgetrs(lu, piv, W)
-        if info != 0:
-            return None
-        Cu = np.empty((k, nf0 + with_load))
-        Cu[:na, :nf0] = K[np.ix_(added, free0)]
-        if with_load:
-            Cu[:na, nf0] = K[added, n]
-        Cu[na:] = 0.0
-        Cu[na + np.arange(released.size), pos0[released]] = 1.0
-        S = -(Cu @ Z)
+            S[:na] -= np.outer(K[added, n], Z[nf0])
+        S[na:] = -Z[pos0[released]]
         S[:na, :na] += K[np.ix_(added, added)]
-        rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu @ u0
+        Cu0 = np.empty(k)
+        Cu0[:na] = Ca @ u0[:nf0] + (K[added, n] * u0[nf0] if with_load else 0.0)
+        Cu0[na:] = u0[pos0[released]]
+        rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu0
         try:
             vw = np.linalg.solve(S, rhs)
         except np.linalg.LinAlgError:
