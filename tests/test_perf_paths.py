@@ -117,3 +117,34 @@ def test_transient_same_iterates_as_full_solve(monkeypatch, element):
     mu, p0 = scene.contact.friction, scene.p0
     assert np.max(np.abs(fast["pt"] - plain["pt"])) <= TOL["transient"] * mu * p0
     assert np.max(np.abs(fast["creepage"] - plain["creepage"])) <= TOL["transient"] * abs(plain["creepage"]).max()
+
+
+@pytest.mark.parametrize("backend", ["qp-osqp", "qp-clarabel"])
+def test_qp_solver_cache_follows_the_hessian(backend):
+    """The solver object is reused while the operator is the same arrays, rebuilt for another
+    operator of the same structure, and the answers equal those of fresh method objects."""
+    from rollqp.methods import get_method
+
+    model, _ = _tangential_system(elements=20, element="constant")  # symmetric F·A: one QP per solve
+    scene = model.scene
+    nsol = NewtonMethod().solve(model.normal_step(scene.load.normal))
+    Q = 0.5 * 0.1 * scene.load.normal
+    pb1 = model.tangential_step(nsol.p, np.zeros(model.strip.n), scene.dq, Q=Q)
+    pb2 = pb1.replace(A=pb1.A + 0.5 * np.diag(np.diag(pb1.A)))  # same structure, another Hessian (not a
+    # multiple: the QP form normalizes H by its largest diagonal entry)
+    meth = get_method(backend)
+    builds = []
+    orig = meth._build
+    meth._build = lambda form: builds.append(1) or orig(form)
+    s1 = meth.solve(pb1)
+    s1b = meth.solve(pb1.replace(c=pb1.c + 1e-3 * scene.a_H * scene.p0 / scene.Estar))  # same operator: reused
+    assert len(builds) == 1
+    s2 = meth.solve(pb2)
+    assert len(builds) == 2
+    # each equals a fresh object's answer (to the backends' tolerance: 1e-10 requested, rollqp's
+    # residual limit 1e-8 in μp0 units)
+    for pb, s in ((pb1, s1), (pb2, s2)):
+        fresh = get_method(backend).solve(pb)
+        assert np.max(np.abs(s.t - fresh.t)) <= 1e-8 * 0.1 * scene.p0
+    assert not np.allclose(s1.t, s2.t)  # the operators really differ
+    assert np.max(np.abs(s1b.t - s1.t)) > 0
