@@ -620,10 +620,9 @@ class NewtonMethod:
                 stick[j] = True
                 slip_sign[j] = 0.0
                 shifts += 1
-            J = self._coupled_jacobian(S, contact, stick, slip_sign, mu)
-            _, _, d, fail = dgesv(J, -phi, overwrite_a=True)
-            if fail != 0 or not np.all(np.isfinite(d)):
-                raise SolverError(f"the coupled Newton matrix is singular (LAPACK info {fail})",
+            d = self._coupled_direction(S, contact, stick, slip_sign, mu, phi)  # reduced system
+            if d is None or not np.all(np.isfinite(d)):
+                raise SolverError("the coupled Newton matrix is singular",
                                   method=self.name, status="singular", iterations=it, residual=nrm)
             dN, dT = KN @ d, KT @ d
             dp, dt = d[:n], d[n:2 * n]
@@ -690,6 +689,46 @@ class NewtonMethod:
         stick = (np.abs(u) <= b) & ~zero_bound
         slip_sign = np.where(stick | zero_bound, 0.0, np.sign(u))
         return contact, stick, slip_sign, zero_bound
+
+    @staticmethod
+    def _coupled_direction(S, contact, stick, slip_sign, mu, phi):
+        """The coupled Newton direction, ``J d = −Φ`` on the free unknowns only (eq. 80).
+
+        The rows of :meth:`_coupled_jacobian` for ``p̂_i`` of a separated node and for ``t̂_i`` of
+        a node with a zero bound are identity rows, so ``d = −Φ`` there; the rest (contact
+        pressures, tractions under a positive bound, ``δ̂``, ``ξ̂``) is assembled directly,
+        row by row, and solved (LAPACK ``gesv``). Returns ``None`` if it is singular.
+        """
+        n = contact.size
+        KN, KT = S["KN"], S["KT"]
+        ic = np.flatnonzero(contact)
+        it_ = np.flatnonzero(stick | (slip_sign != 0))  # t rows that are not identity rows
+        loads = np.array([k for k in (S["iP"], S["iQ"]) if k is not None], dtype=int)
+        free = np.concatenate([ic, n + it_, loads])
+        pinned = np.concatenate([np.flatnonzero(~contact), n + np.flatnonzero(~stick & (slip_sign == 0))])
+        R = np.empty((free.size, S["N"]))
+        R[:ic.size] = KN[ic]
+        st = stick[it_]
+        rows = np.empty((it_.size, S["N"]))
+        rows[st] = KT[it_[st]]
+        isl = it_[~st]
+        if isl.size:
+            sm = (slip_sign[isl] * mu)[:, None]
+            sl = sm * KN[isl]
+            sl[np.arange(isl.size), isl] -= sm[:, 0]
+            sl[np.arange(isl.size), n + isl] += 1.0
+            rows[~st] = sl
+        R[ic.size:ic.size + it_.size] = rows
+        R[ic.size + it_.size:] = S["J0"][loads]
+        d = np.empty(S["N"])
+        d[pinned] = -phi[pinned]
+        rhs = -phi[free] - R[:, pinned] @ d[pinned]
+        if free.size:
+            _, _, x, fail = dgesv(np.asfortranarray(R[:, free]), rhs, overwrite_a=True, overwrite_b=True)
+            if fail != 0:
+                return None
+            d[free] = x
+        return d
 
     @staticmethod
     def _coupled_jacobian(S, contact, stick, slip_sign, mu):
