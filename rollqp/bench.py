@@ -559,27 +559,38 @@ MARKERS = {"newton": "o", "nt-newton": "s", "qp-clarabel": "^", "qp-osqp": "v", 
 FLOOR = 1e-16  # errors of exactly 0 are drawn here
 
 
+def _curves(ax, curves, xlabel, ylabel, title, legend=8):
+    """Log–log curves ``{label: [(x, y), ...]}`` on ``ax`` (work–precision style)."""
+    for label, pts in curves.items():
+        if pts:
+            x, y = zip(*pts)
+            ax.loglog(x, y, marker=MARKERS.get(label, "."), label=label)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    if legend:
+        ax.legend(fontsize=legend)
+
+
+def _save(fig, plt, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def figure_tolerance(res, path):
     plt = _plt()
     if plt is None:
         return None
     fig, axes = plt.subplots(1, len(res), figsize=(5.2 * len(res), 4.2), squeeze=False)
     for ax, (label, d) in zip(axes[0], res.items()):
-        for m, runs in d["runs"].items():
-            pts = [(r.stepping, max(r.errors.get("solver") or 0.0, FLOOR)) for r in runs
-                   if r.ok and r.errors.get("solver") is not None]
-            if pts:
-                x, y = zip(*pts)
-                ax.loglog(x, y, marker=MARKERS.get(m, "o"), label=m)
-        ax.set_xlabel("stepping time Σ step_time [s]")
-        ax.set_ylabel("max distance from reference (p0, μp0)")
-        ax.set_title(re.sub(r"`", "", label.split(" (")[0]) + "\n(one point per tolerance 1e-4 … 1e-12)", fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+        curves = {m: [(r.stepping, max(r.errors.get("solver") or 0.0, FLOOR)) for r in runs
+                      if r.ok and r.errors.get("solver") is not None] for m, runs in d["runs"].items()}
+        _curves(ax, curves, "stepping time Σ step_time [s]", "max distance from reference (p0, μp0)",
+                re.sub(r"`", "", label.split(" (")[0]) + "\n(one point per tolerance 1e-4 … 1e-12)")
+    return _save(fig, plt, path)
 
 
 def figure_discretization(res, path):
@@ -591,20 +602,9 @@ def figure_discretization(res, path):
     keys = [("cattaneo", "Cattaneo, q = 0"), ("mid", f"fine reference, q = {Q_MID:g} a_H"), ("carter", "Carter, end")]
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     for ax, (k, title) in zip(axes, keys):
-        for m, runs in per.items():
-            pts = [(r.stepping, r.errors[k]) for r in runs if r.ok and r.errors.get(k)]
-            if pts:
-                x, y = zip(*pts)
-                ax.loglog(x, y, marker=MARKERS.get(m, "o"), label=m)
-        ax.set_xlabel("stepping time Σ step_time [s]")
-        ax.set_ylabel("rms error / (μp0)")
-        ax.set_title(f"{title}\n{fam}; one point per mesh", fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+        curves = {m: [(r.stepping, r.errors[k]) for r in runs if r.ok and r.errors.get(k)] for m, runs in per.items()}
+        _curves(ax, curves, "stepping time Σ step_time [s]", "rms error / (μp0)", f"{title}\n{fam}; one point per mesh")
+    return _save(fig, plt, path)
 
 
 def figure_families(res, path):
@@ -613,21 +613,12 @@ def figure_families(res, path):
         return None
     methods = list(next(iter(res.values())))
     fig, axes = plt.subplots(1, len(methods), figsize=(4.6 * len(methods), 4.2), squeeze=False)
-    for ax, m in zip(axes[0], methods):
-        for fam, per in res.items():
-            pts = [(r.stepping, r.errors["carter"]) for r in per.get(m, []) if r.ok and r.errors.get("carter")]
-            if pts:
-                x, y = zip(*pts)
-                ax.loglog(x, y, marker=".", label=fam)
-        ax.set_title(f"{m}: Carter error vs time, by discretization family", fontsize=9)
-        ax.set_xlabel("stepping time [s]")
-        ax.set_ylabel("rms error / (μp0) at the end")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0][0].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    for i, (ax, m) in enumerate(zip(axes[0], methods)):
+        curves = {fam: [(r.stepping, r.errors["carter"]) for r in per.get(m, []) if r.ok and r.errors.get("carter")]
+                  for fam, per in res.items()}
+        _curves(ax, curves, "stepping time [s]", "rms error / (μp0) at the end",
+                f"{m}: Carter error vs time, by discretization family", legend=6 if i == 0 else 0)
+    return _save(fig, plt, path)
 
 
 def figure_scaling(per, chol, expo, path):
@@ -637,20 +628,15 @@ def figure_scaling(per, chol, expo, path):
     fig, ax = plt.subplots(figsize=(6.4, 4.6))
     ns = sorted(chol)
     ax.loglog(ns, [chol[n] * 1e3 for n in ns], "k--", label=f"cho_factor (exp. {expo.get('cho_factor', np.nan):.2f})")
-    for m, runs in per.items():
-        ok = [r for r in runs if r.ok]
-        if ok:
-            ax.loglog([r.n for r in ok], [1e3 * r.step for r in ok], marker=MARKERS.get(m, "o"),
-                      label=f"{m} (exp. {expo.get(m, np.nan):.2f})")
-    ax.set_xlabel("nodes n")
-    ax.set_ylabel("median rolling step [ms]")
-    ax.set_title("cattaneo-carter, Δq = Le/2, first rolling steps; one BLAS thread", fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    curves = {m: [(r.n, 1e3 * r.step) for r in runs if r.ok] for m, runs in per.items()}
+    for m, pts in curves.items():
+        if pts:
+            x, y = zip(*pts)
+            e = expo.get(m, np.nan)
+            ax.loglog(x, y, marker=MARKERS.get(m, "o"), label=f"{m} (exp. {e:.2f})" if np.isfinite(e) else m)
+    _curves(ax, {}, "nodes n", "median rolling step [ms]",
+            "cattaneo-carter, Δq = Le/2, first rolling steps; one BLAS thread")
+    return _save(fig, plt, path)
 
 
 # ------------------------------------------------------------------------------- docs
@@ -682,7 +668,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="discretization sweep: skip a mesh whose predicted stepping time exceeds this [s] "
                          "(default 20; 2 with --quick)")
     ap.add_argument("--step-budget", type=float, default=None,
-                    help="scaling: skip a size whose predicted step time exceeds this [s] (default 1; 0.05 with --quick)")
+                    help="scaling: skip a size whose predicted step time exceeds this [s] (default 2; 0.05 with --quick)")
     ap.add_argument("--docs", action="store_true",
                     help="write the tables into docs/performance.md and the figures into docs/figures/perf-*.png")
     ap.add_argument("--figures", default=None, help="directory for the figures (default docs/figures with --docs, "
@@ -705,7 +691,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     repeats = args.repeats or (1 if quick else 3)
     run_budget = args.run_budget or (2.0 if quick else 20.0)
-    step_budget = args.step_budget or (0.05 if quick else 1.0)
+    step_budget = args.step_budget or (0.05 if quick else 2.0)
     fig_dir = Path(args.figures) if args.figures else (FIGURES if args.docs else None)
     if fig_dir is not None:
         fig_dir.mkdir(parents=True, exist_ok=True)
