@@ -1,8 +1,8 @@
-"""Benchmarks of rollqp's QP step methods; prints the markdown tables of docs/performance.md.
+"""Benchmarks of rollqp's QP step methods; prints markdown tables (parts D and E are in docs/performance.md).
 
 Usage::
 
-    python benchmarks/bench_qp.py            # the tables of docs/performance.md (a few minutes)
+    python benchmarks/bench_qp.py            # parts A–E (a few minutes)
     python benchmarks/bench_qp.py --quick    # one repeat, fewer meshes (a smoke test)
 
 What is measured (all on the built-in scene ``cattaneo-carter``, the paper's §6.1.1: similar

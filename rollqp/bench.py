@@ -561,10 +561,14 @@ FLOOR = 1e-16  # errors of exactly 0 are drawn here
 
 def _curves(ax, curves, xlabel, ylabel, title, legend=8):
     """Log–log curves ``{label: [(x, y), ...]}`` on ``ax`` (work–precision style)."""
-    for label, pts in curves.items():
-        if pts:
+    import matplotlib
+
+    cmap = matplotlib.colormaps["tab20"]
+    for i, (label, pts) in enumerate(curves.items()):
+        if pts:  # a fixed colour per label, also when another label has no points
             x, y = zip(*pts)
-            ax.loglog(x, y, marker=MARKERS.get(label, "."), label=label)
+            color = f"C{list(MARKERS).index(label)}" if label in MARKERS else cmap(i % 20)
+            ax.loglog(x, y, marker=MARKERS.get(label, "."), label=label, color=color)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=9)
@@ -633,7 +637,8 @@ def figure_scaling(per, chol, expo, path):
         if pts:
             x, y = zip(*pts)
             e = expo.get(m, np.nan)
-            ax.loglog(x, y, marker=MARKERS.get(m, "o"), label=f"{m} (exp. {e:.2f})" if np.isfinite(e) else m)
+            ax.loglog(x, y, marker=MARKERS.get(m, "o"), color=f"C{list(MARKERS).index(m)}" if m in MARKERS else None,
+                      label=f"{m} (exp. {e:.2f})" if np.isfinite(e) else m)
     _curves(ax, {}, "nodes n", "median rolling step [ms]",
             "cattaneo-carter, Δq = Le/2, first rolling steps; one BLAS thread")
     return _save(fig, plt, path)
@@ -676,7 +681,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", default=None, help="also write the raw numbers to this JSON file")
     args = ap.parse_args(argv)
 
-    limiter = pin_threads()  # noqa: F841  (kept alive for the whole study)
     quick = args.quick
     parts = [p.strip() for p in args.parts.split(",") if p.strip()]
     bad = [p for p in parts if p not in PARTS]
@@ -689,6 +693,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.docs and quick:
         print("rollqp bench: --docs writes the full study; drop --quick", file=sys.stderr)
         return 2
+    limiter = pin_threads()  # noqa: F841  (kept alive for the whole study)
     repeats = args.repeats or (1 if quick else 3)
     run_budget = args.run_budget or (2.0 if quick else 20.0)
     step_budget = args.step_budget or (0.05 if quick else 2.0)
