@@ -235,8 +235,9 @@ def diff_to(run: Run, ref: Run, mu: float) -> float | None:
     return max(dt, dp)
 
 
-def mid_error(run: Run, ref: Run, mu: float, q_mid: float = Q_MID) -> float | None:
-    """rms over |x| <= a_H of |t − t_ref|/(μp0) at q = q_mid a_H; the fine reference interpolated."""
+def mid_error(run: Run, ref: Run, mu: float, q_mid: float = Q_MID, key: str = "pt") -> float | None:
+    """rms over |x| <= a_H of |t − t_ref|/(μp0) (``key="pn"``: |p − p_ref|/p0) at q = q_mid a_H;
+    the fine reference interpolated linearly to the run's nodes."""
     if not (run.ok and ref.ok):
         return None
     a, ra = run.arrays, ref.arrays
@@ -247,8 +248,9 @@ def mid_error(run: Run, ref: Run, mu: float, q_mid: float = Q_MID) -> float | No
         return None
     x = a["x"]
     m = np.abs(x) <= aH
-    tr = np.interp(x[m], ra["x"], ra["pt"][kr])
-    return float(np.sqrt(np.mean((a["pt"][k][m] - tr) ** 2))) / (max(mu, 1e-300) * p0)
+    tr = np.interp(x[m], ra["x"], ra[key][kr])
+    unit = p0 if key == "pn" else max(mu, 1e-300) * p0
+    return float(np.sqrt(np.mean((a[key][k][m] - tr) ** 2))) / unit
 
 
 # ------------------------------------------------------------------------------- scenes
@@ -336,6 +338,40 @@ def _nodes(element, elements):
     return 2 * elements + 1 if element == "quadratic" else elements + (element == "linear")
 
 
+def mesh_sweep(methods, meshes, make_scene, nodes, errors, repeats, run_budget, tag, log):
+    """``{method: [Run per mesh]}``: ``make_scene(E)`` by each method, coarse to fine.
+
+    A mesh is skipped when the previous one's stepping time × (steps ratio) × (n ratio)^1.5
+    predicts more than ``run_budget`` seconds, or when a coarser mesh failed or was skipped;
+    ``errors(run)`` adds the run's errors against a reference.
+    """
+    per = {}
+    for m in methods:
+        rows = []
+        prev = prev_E = None
+        for E in meshes:
+            n = nodes(E)
+            if prev is not None and not prev.ok:
+                rows.append(Run(method=m, label=str(E), n=n, skipped="a coarser mesh failed or was skipped"))
+                continue
+            if prev is not None:
+                pred = prev.stepping * (E / prev_E) * (n / prev.n) ** 1.5
+                if pred > run_budget:
+                    rows.append(Run(method=m, label=str(E), n=n,
+                                    skipped=f"predicted {pred:.0f} s > {run_budget:g} s budget"))
+                    prev = rows[-1]
+                    continue
+            r = timed_run(make_scene(E), m, str(E), repeats=repeats, budget=1.0)
+            r.errors.update(errors(r))
+            r.arrays = None
+            rows.append(r)
+            prev, prev_E = r, E
+            log(f"  {tag} {m} {E}: " + (f"{r.stepping:.3f} s, " + ", ".join(
+                f"{k} {fmt_err(v)}" for k, v in r.errors.items()) if r.ok else r.failed))
+        per[m] = rows
+    return per
+
+
 def part_discretization(methods, families, meshes, repeats, run_budget, quick, log):
     """{family label: {method: [Run per mesh]}} and the fine reference."""
     ref_elements = 160 if quick else 640
@@ -346,60 +382,71 @@ def part_discretization(methods, families, meshes, repeats, run_budget, quick, l
     if not ref.ok:
         log(f"  fine reference failed: {ref.failed}")
     out = {}
-    mu = 0.1
     for fam in families:
-        per = {}
-        for m in methods:
-            rows = []
-            prev = None
-            for E in meshes:
-                n = _nodes(fam.element, E)
-                if prev is not None and prev.ok:
-                    # predicted: steps × (time per step grows like n^1.5 at least) from the last mesh
-                    pred = prev.stepping * (E / prev_E) * (n / prev.n) ** 1.5
-                    if pred > run_budget:
-                        r = Run(method=m, label=str(E), n=n,
-                                skipped=f"predicted {pred:.0f} s > {run_budget:g} s budget")
-                        rows.append(r)
-                        continue
-                elif prev is not None and not prev.ok:
-                    rows.append(Run(method=m, label=str(E), n=n, skipped="a coarser mesh failed or was skipped"))
-                    continue
-                r = timed_run(fam.scene(E, **{"solver.max_iterations": 2000}), m, str(E), repeats=repeats,
-                              budget=1.0)
-                r.errors["mid"] = mid_error(r, ref, mu)
-                r.arrays = None
-                rows.append(r)
-                prev, prev_E = r, E
-                log(f"  {fam.label} {m} {E}: " + (f"{r.stepping:.3f} s, carter {fmt_err(r.errors.get('carter'))}"
-                                                   if r.ok else r.failed))
-            per[m] = rows
-        out[fam.label] = per
+        out[fam.label] = mesh_sweep(
+            methods, meshes, lambda E, fam=fam: fam.scene(E, **{"solver.max_iterations": 2000}),
+            lambda E, fam=fam: _nodes(fam.element, E), lambda r: {"mid": mid_error(r, ref, 0.1)},
+            repeats, run_budget, fam.label, log)
     return out, ref
 
 
-def discretization_tables(res, ref) -> str:
+def part_coupled(methods, meshes, repeats, run_budget, quick, log):
+    """The coupled scene over the mesh: {label: {method: [Run]}}, the fine reference."""
+    ref_elements = 80 if quick else 160
+    ref = timed_run(coupled_scene(**{"discretization.elements": ref_elements}), "newton", "fine reference",
+                    repeats=1)
+    log(f"  coupled fine reference: newton, {ref_elements} QCE: " + (f"{ref.stepping:.1f} s" if ref.ok else ref.failed))
+    mu = 0.3
+    dist = coupled_scene().discretization.distance
+
+    def errors(r):
+        return {"start": mid_error(r, ref, mu, 0.0), "end": mid_error(r, ref, mu, dist),
+                "end_p": mid_error(r, ref, mu, dist, key="pn")}
+
+    label = "coupled `goodman-bentall`, shortened (QCE, Δq = Le/2, 1 a_H, 10 start steps)"
+    per = mesh_sweep(methods, meshes, lambda E: coupled_scene(**{"discretization.elements": E}),
+                     lambda E: 2 * E + 1, errors, repeats, run_budget, "coupled", log)
+    return {label: per}, ref
+
+
+#: Error columns of the mesh tables: (key, header).
+CC_COLUMNS = (("cattaneo", "Cattaneo (q = 0)"), ("mid", f"fine ref. (q = {Q_MID:g} a_H)"), ("carter", "Carter (end)"))
+COUPLED_COLUMNS = (("start", "t, Goodman state (q = 0)"), ("end", "t, q = 1 a_H"), ("end_p", "p, q = 1 a_H"))
+
+
+def mesh_tables(res, columns) -> str:
     parts = []
     for fam, per in res.items():
         rows = []
+        blank = ["–"] * (len(columns) + 2)
         for m, runs in per.items():
             for r in runs:
                 if r.skipped:
-                    rows.append((f"`{m}`", r.label, r.n, "–", "–", "–", "–", "–", f"skipped: {r.skipped}"))
+                    rows.append((f"`{m}`", r.label, r.n, *blank, f"skipped: {r.skipped}"))
                 elif r.failed:
-                    rows.append((f"`{m}`", r.label, r.n or "–", "–", "–", "–", "–", "–", f"failed: {r.failed[:80]}"))
+                    rows.append((f"`{m}`", r.label, r.n or "–", *blank, f"failed: {r.failed[:80]}"))
                 else:
-                    e = r.errors
-                    rows.append((f"`{m}`", r.label, r.n, r.steps, f"{r.stepping:.3f}", fmt_err(e.get("cattaneo")),
-                                 fmt_err(e.get("mid")), fmt_err(e.get("carter")), f"{r.residual:.0e}"))
-        parts.append(f"**{fam}**\n\n" + table(
-            ["method", "elements", "nodes", "steps", "stepping [s]", "Cattaneo (q = 0)", f"fine ref. (q = {Q_MID:g} a_H)",
-             "Carter (end)", "max residual / note"], rows))
+                    rows.append((f"`{m}`", r.label, r.n, r.steps, f"{r.stepping:.3f}",
+                                 *(fmt_err(r.errors.get(k)) for k, _ in columns), f"{r.residual:.0e}"))
+        parts.append(f"**{fam}**\n\n" + table(["method", "elements", "nodes", "steps", "stepping [s]",
+                                               *(h for _, h in columns), "max residual / note"], rows))
+    return "\n\n".join(parts)
+
+
+def discretization_tables(res, ref) -> str:
     note = (f"Errors: rms over the contact of \\|t − t_closed form\\|/(μp0) (`rollqp.report.closed_form_errors`), and "
             f"rms over \\|x\\| ≤ a_H of \\|t − t_ref\\|/(μp0) at q = {Q_MID:g} a_H against the fine reference "
             f"(`newton`, {ref.n} nodes, Δq = Le/4, interpolated linearly to the coarse nodes; "
             + (f"{ref.stepping:.1f} s" if ref.ok else f"failed: {ref.failed}") + ").")
-    return note + "\n\n" + "\n\n".join(parts)
+    return note + "\n\n" + mesh_tables(res, CC_COLUMNS)
+
+
+def coupled_tables(res, ref) -> str:
+    note = ("Errors against the fine reference (`newton`, " + (f"{ref.n} nodes" if ref.ok else f"failed: {ref.failed}")
+            + ", the same scene), interpolated linearly to the coarse nodes: rms over \\|x\\| ≤ a_H of "
+              "\\|t − t_ref\\|/(μp0) in the Goodman state (q = 0, after the 10 normal-load steps) and at the end, "
+              "and of \\|p − p_ref\\|/p0 at the end.")
+    return note + "\n\n" + mesh_tables(res, COUPLED_COLUMNS)
 
 
 def equal_accuracy(res, key, levels) -> str:
@@ -597,17 +644,17 @@ def figure_tolerance(res, path):
     return _save(fig, plt, path)
 
 
-def figure_discretization(res, path):
+def figure_discretization(res, path, columns=CC_COLUMNS):
     plt = _plt()
     if plt is None:
         return None
     fam = next(iter(res))
     per = res[fam]
-    keys = [("cattaneo", "Cattaneo, q = 0"), ("mid", f"fine reference, q = {Q_MID:g} a_H"), ("carter", "Carter, end")]
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    for ax, (k, title) in zip(axes, keys):
+    fig, axes = plt.subplots(1, len(columns), figsize=(5 * len(columns), 4.2))
+    for ax, (k, title) in zip(axes, columns):
         curves = {m: [(r.stepping, r.errors[k]) for r in runs if r.ok and r.errors.get(k)] for m, runs in per.items()}
-        _curves(ax, curves, "stepping time Σ step_time [s]", "rms error / (μp0)", f"{title}\n{fam}; one point per mesh")
+        _curves(ax, curves, "stepping time Σ step_time [s]", "rms error / (μp0), p: / p0",
+                f"{title}\n{re.sub('`', '', fam)}; one point per mesh")
     return _save(fig, plt, path)
 
 
@@ -742,12 +789,17 @@ def main(argv: list[str] | None = None) -> int:
         if fam_res:
             sections["families"] = discretization_tables(fam_res, ref)
             print("## Work–precision: element types, formulations, steps\n\n" + sections["families"] + "\n", flush=True)
+        coupled_res, cref = part_coupled(methods, (10, 20) if quick else (10, 20, 40, 80), repeats, run_budget,
+                                         quick, log)
+        sections["coupled"] = coupled_tables(coupled_res, cref)
+        print("## Work–precision: discretization, coupled scene\n\n" + sections["coupled"] + "\n", flush=True)
         if fig_dir is not None:
             figs.append(figure_discretization(main_res, fig_dir / "perf-wp-discretization.png"))
+            figs.append(figure_discretization(coupled_res, fig_dir / "perf-wp-coupled.png", COUPLED_COLUMNS))
             if fam_res:
                 figs.append(figure_families({**main_res, **fam_res}, fig_dir / "perf-wp-families.png"))
         raw["discretization"] = {lb: {m: [_raw(r) for r in rs] for m, rs in per.items()}
-                                 for lb, per in {**main_res, **fam_res}.items()}
+                                 for lb, per in {**main_res, **fam_res, **coupled_res}.items()}
         log(f"discretization part: {time.perf_counter() - t0:.0f} s")
     if "scaling" in parts:
         t0 = time.perf_counter()
