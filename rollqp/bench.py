@@ -654,7 +654,7 @@ def figure_discretization(res, path, columns=CC_COLUMNS):
     for ax, (k, title) in zip(axes, columns):
         curves = {m: [(r.stepping, r.errors[k]) for r in runs if r.ok and r.errors.get(k)] for m, runs in per.items()}
         _curves(ax, curves, "stepping time Σ step_time [s]", "rms error / (μp0), p: / p0",
-                f"{title}\n{re.sub('`', '', fam)}; one point per mesh")
+                f"{title}\n{re.sub('`', '', fam.split(' (')[0])}; one point per mesh")
     return _save(fig, plt, path)
 
 
