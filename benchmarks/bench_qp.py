@@ -1,8 +1,8 @@
-"""Benchmarks of rollqp's QP step methods; prints the markdown tables of docs/performance.md.
+"""Benchmarks of rollqp's QP step methods; prints markdown tables (parts D and E are in docs/performance.md).
 
 Usage::
 
-    python benchmarks/bench_qp.py            # the tables of docs/performance.md (a few minutes)
+    python benchmarks/bench_qp.py            # parts A–E (a few minutes)
     python benchmarks/bench_qp.py --quick    # one repeat, fewer meshes (a smoke test)
 
 What is measured (all on the built-in scene ``cattaneo-carter``, the paper's §6.1.1: similar
@@ -47,7 +47,7 @@ for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS
 
 import numpy as np  # noqa: E402
 import scipy.linalg  # noqa: E402,F401  (loads scipy's BLAS before the limit is applied)
-from threadpoolctl import threadpool_info, threadpool_limits  # noqa: E402
+from threadpoolctl import threadpool_limits  # noqa: E402
 
 import rollqp  # noqa: E402  (imports clarabel, osqp, cvxpy)
 
@@ -55,13 +55,10 @@ import rollqp  # noqa: E402  (imports clarabel, osqp, cvxpy)
 _THREAD_LIMIT = threadpool_limits(limits=1)
 
 import argparse  # noqa: E402
-import re  # noqa: E402
-import datetime  # noqa: E402
-import importlib.metadata as md  # noqa: E402
-import platform  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 
+from rollqp import bench as _bench  # noqa: E402
 from rollqp import closedforms as cf  # noqa: E402
 from rollqp.driver import Model  # noqa: E402
 from rollqp.methods import QP_METHODS, get_method  # noqa: E402
@@ -75,52 +72,12 @@ COLD_EVERY = 4
 
 
 # ----------------------------------------------------------------------------------- machine
-def _cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
 def machine_table() -> str:
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        usable = os.cpu_count()
-    pkgs = ["rollqp", "numpy", "scipy", "clarabel", "osqp", "cvxpy", "threadpoolctl"]
-    versions = []
-    for p in pkgs:
-        try:
-            versions.append(f"{p} {md.version(p)}")
-        except md.PackageNotFoundError:
-            versions.append(f"{p} (not installed)")
-    pools = "; ".join(f"{d.get('internal_api')} {d.get('version') or ''} "
-                      f"({d.get('num_threads')} thread{'s' if d.get('num_threads') != 1 else ''})".replace("  ", " ")
-                      for d in threadpool_info()) or "none found"
-    rows = [("date", datetime.datetime.now().isoformat(timespec="seconds")),
-            ("platform", platform.platform()),
-            ("cpu", f"{_cpu_model()}; os.cpu_count() = {os.cpu_count()}, usable = {usable}"),
-            ("python", f"{platform.python_implementation()} {platform.python_version()}"),
-            ("packages", ", ".join(versions)),
-            ("thread pools", pools),
-            ("load average", " / ".join(f"{v:.2f}" for v in os.getloadavg()) + " (1, 5, 15 min, at start)"),
-            ("command", "python " + " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:]))]
-    return _table(["", ""], rows)
+    """The machine, packages, thread pools, load and command (``rollqp.bench.machine_table``)."""
+    return _bench.machine_table()
 
 
-# ----------------------------------------------------------------------------------- helpers
-def _table(header, rows) -> str:
-    def cell(c):
-        # a literal bar, and a literal star (E*), inside a markdown table cell
-        return re.sub(r"(?<!\*)\*(?!\*)", r"\\*", str(c).replace("|", "\\|"))
-
-    out = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    out += ["| " + " | ".join(cell(c) for c in r) + " |" for r in rows]
-    return "\n".join(out)
+_table = _bench.table
 
 
 def _ms(seconds) -> str:

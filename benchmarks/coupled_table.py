@@ -60,6 +60,7 @@ from pathlib import Path  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_qp import _ms, _table, machine_table  # noqa: E402
 
+from rollqp import bench as _bench  # noqa: E402
 from rollqp import driver  # noqa: E402
 from rollqp.driver import Model  # noqa: E402
 from rollqp.errors import SolverError  # noqa: E402
@@ -86,20 +87,8 @@ def goodman_bentall_scene():
 
 
 def source_line() -> str:
-    """The rollqp source measured: git commit and whether the package's files differ from it."""
-    import subprocess
-
-    root = Path(rollqp.__file__).resolve().parent.parent
-    try:
-        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True,
-                              timeout=10).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "rollqp"], cwd=root, capture_output=True,
-                               text=True, timeout=10).stdout.split("\n")
-    except (OSError, subprocess.SubprocessError):
-        return "rollqp source: unknown (no git)"
-    changed = [ln[3:] for ln in dirty if ln.strip()]
-    return (f"rollqp source: commit {head or 'unknown'}"
-            + (f", with uncommitted changes in {', '.join(changed)}" if changed else ", no uncommitted changes in rollqp/"))
+    """The rollqp source measured (``rollqp.bench.source_line``)."""
+    return "rollqp source: " + _bench.source_line()
 
 
 def scene_line(scene) -> str:

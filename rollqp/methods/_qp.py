@@ -86,6 +86,10 @@ class QPMethod:
             if w is not None and np.shape(w) == (problem.n,):
                 x_prev = np.asarray(w, dtype=float)
         exact = self.operator == "exact" and asym > 0
+        # what the QP Hessian is a function of: the symmetrized operator (cached by _split, so the
+        # same object every step), the weights, the scales and the kind (H is normalized by its
+        # largest diagonal entry, so Δq drops out); see _solver_for
+        self._hessian_source = (sym_problem.kind, sym_problem.A, sym_problem.f, sym_problem.scales)
         iters, solver_time, outer, change = 0, 0.0, 0, np.inf
         x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
         while True:
@@ -170,15 +174,26 @@ class QPMethod:
         return form.structure
 
     def _solver_for(self, form, build):
-        """The cached solver object for this structure and Hessian, built on first use."""
+        """The cached solver object for this structure and Hessian, built on first use.
+
+        The Hessian is recognized by its source (:attr:`_hessian_source`, set by :meth:`solve`:
+        the operator and weight arrays by identity, kind and scales), which costs nothing per
+        QP; a form from elsewhere is compared entry by entry (``O(n²)``).
+        """
         key = self.structure_key(form)
         hit = self._cache.get(key)
-        if hit is not None and hit[0].shape == form.H.shape and np.array_equal(hit[0], form.H):
-            return hit[1], False
+        src = getattr(self, "_hessian_source", None)
+        if hit is not None and hit[0].shape == form.H.shape:
+            same = (src is not None and hit[2] is not None and len(src) == len(hit[2])
+                    and all(a is b or (not isinstance(a, np.ndarray) and a == b) for a, b in zip(src, hit[2])))
+            if same or np.array_equal(hit[0], form.H):
+                if not same:
+                    self._cache[key] = (hit[0], hit[1], src)
+                return hit[1], False
         obj = build(form)
         if len(self._cache) >= 32:  # bound memory: structures can churn (tiny pressures of ±1e-21 p0)
             self._cache = {k: v for k, v in self._cache.items() if k[0] == "split"}
-        self._cache[key] = (form.H.copy(), obj)
+        self._cache[key] = (form.H.copy(), obj, src)
         return obj, True
 
     def _solve_form(self, form, x0):  # pragma: no cover - abstract
