@@ -6,6 +6,7 @@
     rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
     rollqp crossval SCENE [--step K] [--methods M1,M2]
+    rollqp bench [--quick] [--docs] [...]   (rollqp.bench: work–precision and scaling)
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first).
@@ -56,6 +57,9 @@ def _parser():
     x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
     x.add_argument("--step", type=int, default=None, help="step K (default 1)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
+    b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
+                       "(docs/performance.md; 'rollqp bench --help' for the options)")
+    b.add_argument("bench_args", nargs=argparse.REMAINDER)
     return p
 
 
@@ -174,8 +178,17 @@ def cmd_crossval(args) -> int:
     return 0
 
 
+def cmd_bench(args) -> int:
+    from .bench import main as bench_main
+    return bench_main(args.bench_args)
+
+
 def main(argv=None) -> int:
-    args = _parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["bench"]:  # the harness parses its own options (rollqp.bench.main)
+        args = argparse.Namespace(command="bench", bench_args=argv[1:])
+    else:
+        args = _parser().parse_args(argv)
     from .errors import InputError, RollqpError, SolverError
     try:
         from threadpoolctl import threadpool_limits
@@ -184,7 +197,7 @@ def main(argv=None) -> int:
         limiter = None
     try:
         return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
-                "check-step": cmd_check_step, "crossval": cmd_crossval}[args.command](args)
+                "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER

@@ -43,3 +43,10 @@ def test_write_sections(tmp_path):
 def test_bad_arguments_exit_2(capsys):
     assert bench.main(["--parts", "nonsense"]) == 2
     assert "unknown part" in capsys.readouterr().err
+
+
+def test_cli_routes_bench(capsys):
+    """``rollqp bench ...`` is the harness with its own options (rollqp.cli hands them over)."""
+    from rollqp import cli
+    assert cli.main(["bench", "--parts", "nope"]) == 2
+    assert "unknown part nope" in capsys.readouterr().err
