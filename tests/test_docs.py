@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parent.parent
 DOCS = ROOT / "docs"
 PAGES = sorted(DOCS.glob("*.md"))
 IMAGE = re.compile(r"!\[[^\]]*\]\(([^)\s]+)\)")
-COMMAND = re.compile(r"`((?:python (?:examples|benchmarks)/|rollqp run )[^`]+)`")
+COMMAND = re.compile(r"`((?:python (?:examples|benchmarks)/|rollqp run |rollqp bench )[^`]+)`")
 
 
 def _figures():
@@ -66,6 +66,13 @@ def _cli_options(subcommand):
     return set(re.findall(r"--[a-z][a-z-]*", out.getvalue()))
 
 
+def _bench_options():
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), pytest.raises(SystemExit):
+        cli.main(["bench", "--help"])
+    return set(re.findall(r"--[a-z][a-z-]*", out.getvalue()))
+
+
 def test_pages_have_figures():
     assert len(FIGURES) >= 13, f"the gallery's figures are found: {[f for _, f, _ in FIGURES]}"
 
@@ -89,6 +96,9 @@ def test_figure_has_its_command_beside_it(page, target, beside):
             assert script.is_file(), f"{page}: {argv[1]} (beside {target}) does not exist"
             unknown = _options(argv[2:]) - _script_options(script)
             assert not unknown, f"{page}: {argv[1]} does not accept {sorted(unknown)}"
+        elif argv[1] == "bench":
+            unknown = _options(argv[2:]) - _bench_options()
+            assert not unknown, f"{page}: rollqp bench does not accept {sorted(unknown)}"
         else:
             scene = argv[2]
             assert scene in rollqp.builtin_scenes() or (ROOT / scene).is_file(), \
