@@ -36,7 +36,8 @@ from .errors import InputError, SolverError
 from .influence import build_influence
 from .methods import QP_METHODS, get_method
 from .methods.alternation import Alternation
-from .problem import CoupledStep, NormalStep, Scales, TangentialStep, asymmetry, classify, symmetrized
+from .problem import (CoupledStep, NormalStep, Scales, StepSolution, TangentialStep, asymmetry, classify,
+                      symmetrized)
 from .result import Result
 from .scene import Scene, load_scene
 from .strip import Strip
@@ -193,6 +194,8 @@ def _make_method(scene: Scene, name: str):
         settings["max_iterations"] = scene.solver.max_iterations
     if name == "nt-newton":
         settings["max_outer"] = scene.solver.max_iterations
+    if name not in QP_METHODS and scene.solver.augmentation is not None:
+        settings["r"] = scene.solver.augmentation
     method = get_method(name, **settings)
     if scene.coupling_level == "full" and name in QP_METHODS:
         method = Alternation(method, max_outer=scene.solver.max_iterations)
@@ -278,8 +281,29 @@ def _loads(scene, q):
     return P, float(scene.tangential_load(q)), None
 
 
+def _unloaded(model, xi=None) -> _State:
+    """The state at ``P = 0``: out of contact, no tractions, the surfaces relaxed (``w = 0``).
+
+    Nothing is solved: the only solution of the step has ``p = t = 0``. The approach is not
+    determined (any ``δ <= min h``); it is recorded as ``min h`` (the bodies just touch, the
+    smallest gap 0). The creepage is not determined either (nothing sticks): the prescribed one,
+    else 0, and every node is reported as separated (state 0). The slip memory is lost, so the
+    next loaded step starts from unloaded surfaces. The scene requires ``Q = 0`` wherever
+    ``P = 0`` (:class:`~rollqp.scene.Scene`).
+    """
+    n = model.strip.n
+    delta = float(np.min(model.h))
+    zero = np.zeros(n)
+    nsol = StepSolution(p=zero, g=model.h - delta, delta=delta, method="unloaded", status="unloaded")
+    tsol = StepSolution(t=zero, s=zero, xi=0.0 if xi is None else float(xi), method="unloaded",
+                        status="unloaded")
+    return _State(zero, zero, nsol, tsol, zero)
+
+
 def _step(model, meth, state: _State, st: _Step, *, P, c, dq, Q=None, xi=None, normal_fixed=False, steady=False):
     """One step (rolling, static shift or steady): the coupled problem, or its two halves."""
+    if P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
+        return _unloaded(model, xi)
     if model.coupled:
         sol = meth.solve(model.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady), warm=state.tsol)
         st.add_coupled(sol)
