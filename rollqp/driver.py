@@ -300,10 +300,30 @@ def _unloaded(model, xi=None) -> _State:
     return _State(zero, zero, nsol, tsol, zero)
 
 
+def _frictionless(model, meth, state: _State, st: _Step, *, P, c, dq, xi=None, steady=False) -> _State:
+    """A step at ``μ = 0``: ``t = 0`` (the bound ``μp`` is zero at every node), the normal half alone.
+
+    The tangential problem is degenerate (every node on the kink ``|t| = μp = 0``, no node can
+    stick, so the load row ``fᵀt = Q = 0`` has no ``ξ`` column): nothing is solved for it. The
+    creepage is not determined by the contact (the surfaces slide freely); it is the prescribed
+    one, else reported as 0, and the slip follows from it and ``w`` as in any step. With
+    ``t = 0`` the coupled step reduces to its normal half too (``A_nt t = 0``).
+    """
+    zero = np.zeros(model.strip.n)
+    nsol = meth.solve(model.normal_step(P, zero), warm=state.nsol)
+    st.add(nsol, "normal")
+    xi = 0.0 if xi is None else float(xi)
+    tsol = model.tangential_step(nsol.p, c, dq, xi=xi, steady=steady).solution(zero, xi)
+    tsol.method, tsol.status = "frictionless", "frictionless"
+    return _State(nsol.p, zero, nsol, tsol, model.w(nsol.p, zero))
+
+
 def _step(model, meth, state: _State, st: _Step, *, P, c, dq, Q=None, xi=None, normal_fixed=False, steady=False):
     """One step (rolling, static shift or steady): the coupled problem, or its two halves."""
     if P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
         return _unloaded(model, xi)
+    if model.scene.contact.friction == 0.0:
+        return _frictionless(model, meth, state, st, P=P, c=c, dq=dq, xi=xi, steady=steady)
     if model.coupled:
         sol = meth.solve(model.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady), warm=state.tsol)
         st.add_coupled(sol)

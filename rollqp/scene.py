@@ -75,7 +75,7 @@ EDGE_ELEMENTS = 1.5
 CONVECTIVE_STEP_MAX = {"constant": 1.0, "linear": 1.0, "quadratic": 0.5}
 #: allowed ``solver.augmentation`` (nondimensional r): the band in which newton converged on
 #: every hard case (docs/stability.md, ``python benchmarks/hard_cases.py --only "r="``)
-AUGMENTATION_MIN, AUGMENTATION_MAX = 1e-8, 1e8
+AUGMENTATION_MIN, AUGMENTATION_MAX = 1e-6, 10.0
 
 
 # =========================================================================== parts
