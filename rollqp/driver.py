@@ -14,6 +14,13 @@ matrices, scales, slip operators — and is built once. :func:`run` then marches
 * **rolling steps** ``k = 1..K`` at ``q_k = k Δq``: the history vector
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
   ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step.
+* **contact lost** (``P(q) = 0``): an unloaded state (:func:`_unloaded`), nothing solved;
+  **frictionless** (``μ = 0``): the normal half alone, ``t = 0`` (:func:`_frictionless`);
+* **gross sliding** (only with a prescribed creepage beyond the sliding creepage; a prescribed
+  ``|Q| >= μP`` is rejected by the scene): solved, and the states where every contact node slips
+  are listed in ``meta["gross_sliding"]``;
+* **failures**: a :class:`SolverError` names the step (0: the start) and rollqp's residual;
+  ``err.partial`` keeps the completed states (the CLI writes them to the result file).
 
 Only what the scene needs is modelled: with β = 0 (or ``coupling = "off"``) and a
 constant normal load the normal QP is solved once and reused; coupling matrices are
@@ -268,7 +275,12 @@ def _versions() -> dict:
 def _record(result, model, q, state: _State, st: _Step, *, P, shift, step_time):
     sc, mu = model.scales, model.scene.contact.friction
     s = state.tsol.s
-    result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=classify(state.p, state.t, s, mu, sc),
+    nodes = classify(state.p, state.t, s, mu, sc)
+    if np.any(nodes == 2) and not np.any(nodes == 1):
+        # gross sliding (possible with a prescribed creepage, |ξ| beyond the sliding creepage):
+        # a valid solution, flagged with the indices of such states
+        result.meta.setdefault("gross_sliding", []).append(len(result))
+    result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=nodes,
                   P=P, Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
                   iterations=st.iterations, step_time=step_time, residual=st.residual,
                   inner_normal=st.inner_normal, inner_tangential=st.inner_tangential, backtracks=st.backtracks)
@@ -425,6 +437,7 @@ def _steady_direct(scene, model, meth, state, result):
                   steady=True)
     model.check_inside(state.p, 0)
     result.rows = {key: [] for key in result.rows}
+    result.meta.pop("gross_sliding", None)  # state 0 is replaced
     result.meta["rolling_start"] = "direct steady solve"
     _record(result, model, 0.0, state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
     return state
@@ -454,6 +467,7 @@ def _steady_by_marching(scene, model, meth, state, result, fixed):
         raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
                           f"(last change {change:.2e} mu p0)", method=meth.name, step=0)
     result.rows = {key: [] for key in result.rows}
+    result.meta.pop("gross_sliding", None)  # state 0 is replaced
     result.meta["rolling_start"] = "marching to steady state"
     _record(result, model, 0.0, state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
     return state

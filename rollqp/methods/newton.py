@@ -53,7 +53,14 @@ Deviations from the paper, both on degenerate iterates only:
   changes case and ``Φ`` (and ``θ``) does not change — and that node gets the contact/stick row,
   the one-sided derivative into contact/stick (counted in ``info["shifts"]``);
 * if the Armijo search fails (``α < 1e-10``; possible only on a kink, where the modified row is
-  not the directional derivative), the full step is taken (counted in ``info["nonmonotone"]``).
+  not the directional derivative), the full step is taken (counted in ``info["nonmonotone"]``);
+* if a tangential step with ``Q`` prescribed still fails (one stick node: the repair above can
+  cycle, e.g. free rolling at μ ≲ 3e-4), it is solved with ``ξ`` prescribed and ``ξ`` is searched
+  for ``fᵀt = Q`` (``_tangential_by_creepage``; counted in ``info["creepage_search"]``).
+
+Robustness (docs/stability.md): the nondimensional ``r`` may be set (``[solver] augmentation``,
+the same for both rows) within [1e-6, 10], where every hard case converges; failures are
+:class:`~rollqp.errors.SolverError` with the merit, iterations and ``‖Φ‖∞``.
 
 References: J.-S. Pang, Newton's method for B-differentiable equations, Math. Oper. Res. 15
 (1990) 311–341; González & Abascal, IJNME 53 (2002) 843–874, §4.
