@@ -435,6 +435,10 @@ class Scene:
         with np.errstate(divide="ignore", invalid="ignore"):  # P = 0 (contact lost): Q must be 0 too
             ratio = np.where(Pr > 0, Qr / np.where(Pr > 0, Pr, 1.0), np.where(Qr > 0, np.inf, 0.0))
         i = int(np.argmax(ratio))
+        if np.isinf(ratio[i]):
+            raise InputError("load.tangential",
+                             f"must be 0 where the normal load is 0 (contact lost), but Q/(mu P̄) = "
+                             f"{float(tang(q[i])):.6g} at q = {q[i]:.6g} a_H where P = 0")
         if not ratio[i] < 1.0:
             raise InputError("load.tangential",
                              f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"

@@ -141,8 +141,8 @@ class _FailingAt:
 
 @pytest.fixture
 def failing_method(monkeypatch):
-    """The driver's method fails at the 5th solve: state 0 (1 solve, similar bodies) and three
-    rolling steps complete (normal solved once, one tangential solve per step)."""
+    """The driver's method fails at its 6th solve: state 0 (a normal and a tangential solve,
+    similar bodies) and three rolling steps (P constant: one tangential solve each) complete."""
     from rollqp import driver
     make = driver._make_method
     monkeypatch.setattr(driver, "_make_method", lambda scene, name: _FailingAt(make(scene, name), 5))

@@ -320,7 +320,7 @@ def test_normal_history_must_stay_nonnegative():
     expect_error(d, "load.normal_history", ">= 0", "minimum is -0.1")
     d = with_value(base_dict(), "load.normal_history", {"kind": "table", "q": [0.0, 3.0],
                                                         "value": [1.0, 0.0]})
-    expect_error(d, "load.tangential", "must stay below 1", "q = 3")  # Q = 0.75 μP̄ at P = 0
+    expect_error(d, "load.tangential", "must be 0 where the normal load is 0", "q = 3")  # Q = 0.75 μP̄ at P = 0
     d["load"]["tangential"]["value"] = 0.0
     assert scene_from_dict(d).load.normal_history(3.0) == 0.0, "P = 0 with Q = 0: valid"
 
