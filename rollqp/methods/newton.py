@@ -244,7 +244,7 @@ class NewtonMethod:
                 raise err
             root = brentq(F, lo, hi, xtol=1e-15, rtol=1e-15, maxiter=200) if flo * fhi < 0 else (lo if flo == 0 else hi)
             at_root = self._solve_uncoupled(pb.replace(Q=None, xi=root * sc.slip), last["sol"], t0)
-        except SolverError:
+        except (SolverError, ValueError, RuntimeError):  # a ξ-prescribed solve failed, or Brent did not converge
             raise err from None
         try:
             sol = self._solve_tangential(pb, at_root, t0)
