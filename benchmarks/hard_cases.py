@@ -409,7 +409,7 @@ def _line(r, c) -> str:
         c.expected(r.method), c.expected(r.method))
     if c.closed is not None and c.expected(r.method) == "converge":
         held += f"; {c.closed_name} ≤ {c.closed_tol:.0e}"
-    outcome = r.outcome if r.converged else f"{r.outcome}: {r.message}"
+    outcome = r.outcome if r.converged else f"{r.outcome}: {r.message}".replace("|", "\\|")
     return (f"| {r.case} | {r.method} | {outcome} | {r.iterations} | {_f(r.residual)} | "
             f"{_f(r.error)} | {_f(r.closed)} | {held} | {r.seconds:.2f} | {'yes' if r.ok else 'NO'} |")
 
