@@ -15,7 +15,7 @@ tractions are compared with the case's reference — or **stops with a rollqp er
 
 References (column "reference"):
 
-* ``newton 1e-12``: ``newton`` at ``solver.tolerance = 1e-13`` on the same discretization
+* ``newton 1e-12``: ``newton`` at ``solver.tolerance = 1e-12`` on the same discretization
   (no closed form applies, or the closed form would hide the solver error under the
   discretization error). "error" is then max over states of ``|Δp|/p0`` and ``|Δt|/(μ p0)``.
 * a closed form (Carter's creepage, Cattaneo's traction, Hertz): "error" is then the
