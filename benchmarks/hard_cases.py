@@ -242,7 +242,8 @@ def cases() -> list[Case]:
                                                        "discretization.distance": 2 * 0.5 * le}),
                         methods=("newton",) + QP, fast=fast, closed=_cattaneo_error, closed_name="Cattaneo t, Hertz p",
                         closed_tol=0.1 * le, note=f"{n} QCE: braked start (Cattaneo) and 2 rolling steps; closed form "
-                        "rms bound 0.1·Le/a_H (first order, measured 0.081·Le/a_H on 10–80 QCE, docs/validation.md)"))
+                        "rms bound 0.1·Le/a_H (first order; measured 0.093–0.097·Le/a_H on these meshes, 0.081 on 40–80 QCE "
+                        "in docs/validation.md's slightly different measure)"))
     # ---------------------------------------------------------------- loss and regain of contact
     drop = {"kind": "table", "q": [0.0, 1.0, 2.0, 2.5, 3.5, 4.5], "value": [1.0, 1.0, 0.0, 0.0, 1.0, 1.0]}
     out.append(Case("contact lost and regained", "loss of contact", lambda: _similar(**{
