@@ -15,6 +15,13 @@ matrices, scales, slip operators — and is built once. :func:`run` then marches
 * **rolling steps** ``k = 1..K`` at ``q_k = k Δq``: the history vector
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
   ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step.
+* **contact lost** (``P(q) = 0``): an unloaded state (:func:`_unloaded`), nothing solved;
+  **frictionless** (``μ = 0``): the normal half alone, ``t = 0`` (:func:`_frictionless`);
+* **gross sliding** (only with a prescribed creepage beyond the sliding creepage; a prescribed
+  ``|Q| >= μP`` is rejected by the scene): solved, and the states where every contact node slips
+  are listed in ``meta["gross_sliding"]``;
+* **failures**: a :class:`SolverError` names the step (0: the start) and rollqp's residual;
+  ``err.partial`` keeps the completed states (the CLI writes them to the result file).
 
 Only what the scene needs is modelled: with β = 0 (or ``coupling = "off"``) and a
 constant normal load the normal QP is solved once and reused; coupling matrices are
@@ -37,7 +44,8 @@ from .errors import InputError, SolverError
 from .influence import build_influence
 from .methods import QP_METHODS, get_method
 from .methods.alternation import Alternation
-from .problem import CoupledStep, NormalStep, Scales, TangentialStep, asymmetry, classify, symmetrized
+from .problem import (CoupledStep, NormalStep, Scales, StepSolution, TangentialStep, asymmetry, classify,
+                      symmetrized)
 from .result import Result
 from .scene import Scene, load_scene
 from .strip import Strip
@@ -198,6 +206,8 @@ def _make_method(scene: Scene, name: str):
         settings["max_iterations"] = scene.solver.max_iterations
     if name == "nt-newton":
         settings["max_outer"] = scene.solver.max_iterations
+    if name not in QP_METHODS and scene.solver.augmentation is not None:
+        settings["r"] = scene.solver.augmentation
     method = get_method(name, **settings)
     if scene.coupling_level == "full" and name in QP_METHODS:
         method = Alternation(method, max_outer=scene.solver.max_iterations)
@@ -275,7 +285,12 @@ def _versions() -> dict:
 def _record(result, model, q, state: _State, st: _Step, *, P, shift, step_time):
     sc, mu = model.scales, model.scene.contact.friction
     s = state.tsol.s
-    result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=classify(state.p, state.t, s, mu, sc),
+    nodes = classify(state.p, state.t, s, mu, sc)
+    if np.any(nodes == 2) and not np.any(nodes == 1):
+        # gross sliding (possible with a prescribed creepage, |ξ| beyond the sliding creepage):
+        # a valid solution, flagged with the indices of such states
+        result.meta.setdefault("gross_sliding", []).append(len(result))
+    result.append(q=q, pn=state.p, pt=state.t, slip=s, gap=state.nsol.g, state=nodes,
                   P=float(model.f @ state.p) if P is None else P,  # None: the approach is prescribed
                   Q=float(model.f @ state.t), creepage=state.tsol.xi, approach=state.nsol.delta, shift=shift,
                   iterations=st.iterations, step_time=step_time, residual=st.residual,
@@ -296,9 +311,50 @@ def _approach(scene, q):
     return None if d is None else float(d)
 
 
+def _unloaded(model, xi=None) -> _State:
+    """The state at ``P = 0``: out of contact, no tractions, the surfaces relaxed (``w = 0``).
+
+    Nothing is solved: the only solution of the step has ``p = t = 0``. The approach is not
+    determined (any ``δ <= min h``); it is recorded as ``min h`` (the bodies just touch, the
+    smallest gap 0). The creepage is not determined either (nothing sticks): the prescribed one,
+    else 0, and every node is reported as separated (state 0). The slip memory is lost, so the
+    next loaded step starts from unloaded surfaces. The scene requires ``Q = 0`` wherever
+    ``P = 0`` (:class:`~rollqp.scene.Scene`).
+    """
+    n = model.strip.n
+    delta = float(np.min(model.h))
+    zero = np.zeros(n)
+    nsol = StepSolution(p=zero, g=model.h - delta, delta=delta, method="unloaded", status="unloaded")
+    tsol = StepSolution(t=zero, s=zero, xi=0.0 if xi is None else float(xi), method="unloaded",
+                        status="unloaded")
+    return _State(zero, zero, nsol, tsol, zero)
+
+
+def _frictionless(model, meth, state: _State, st: _Step, *, P, c, dq, xi=None, steady=False, delta=None) -> _State:
+    """A step at ``μ = 0``: ``t = 0`` (the bound ``μp`` is zero at every node), the normal half alone.
+
+    The tangential problem is degenerate (every node on the kink ``|t| = μp = 0``, no node can
+    stick, so the load row ``fᵀt = Q = 0`` has no ``ξ`` column): nothing is solved for it. The
+    creepage is not determined by the contact (the surfaces slide freely); it is the prescribed
+    one, else reported as 0, and the slip follows from it and ``w`` as in any step. With
+    ``t = 0`` the coupled step reduces to its normal half too (``A_nt t = 0``).
+    """
+    zero = np.zeros(model.strip.n)
+    nsol = meth.solve(model.normal_step(P, zero, delta=delta), warm=state.nsol)
+    st.add(nsol, "normal")
+    xi = 0.0 if xi is None else float(xi)
+    tsol = model.tangential_step(nsol.p, c, dq, xi=xi, steady=steady).solution(zero, xi)
+    tsol.method, tsol.status = "frictionless", "frictionless"
+    return _State(nsol.p, zero, nsol, tsol, model.w(nsol.p, zero))
+
+
 def _step(model, meth, state: _State, st: _Step, *, P, c, dq, Q=None, xi=None, normal_fixed=False, steady=False,
           delta=None):
     """One step (rolling, static shift or steady): the coupled problem, or its two halves."""
+    if P is not None and P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
+        return _unloaded(model, xi)
+    if model.scene.contact.friction == 0.0:
+        return _frictionless(model, meth, state, st, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta)
     if model.coupled:
         sol = meth.solve(model.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta), warm=state.tsol)
         st.add_coupled(sol)
@@ -402,6 +458,7 @@ def _steady_direct(scene, model, meth, state, result):
                   steady=True, delta=_approach(scene, 0.0))
     model.check_inside(state.p, 0)
     result.rows = {key: [] for key in result.rows}
+    result.meta.pop("gross_sliding", None)  # state 0 is replaced
     result.meta["rolling_start"] = "direct steady solve"
     _record(result, model, 0.0, state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
     return state
@@ -431,6 +488,7 @@ def _steady_by_marching(scene, model, meth, state, result, fixed):
         raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
                           f"(last change {change:.2e} mu p0)", method=meth.name, step=0)
     result.rows = {key: [] for key in result.rows}
+    result.meta.pop("gross_sliding", None)  # state 0 is replaced
     result.meta["rolling_start"] = "marching to steady state"
     _record(result, model, 0.0, state, st, P=P, shift=0.0, step_time=time.perf_counter() - t0)
     return state

@@ -10,7 +10,7 @@ built-in scene (the files in ``rollqp/scenes/``) or from a plain dict of the sam
     [load]                  normal, normal_history, tangential | creepage, start, direction,
                             start_steps, approach
     [discretization]        elements, element, zone, step, formulation, distance
-    [solver]                method, tolerance, max_iterations
+    [solver]                method, tolerance, max_iterations, augmentation
 
 Units are the user's, as long as they are consistent (the paper: N and mm). Loads are per unit
 axial length. Load histories are functions of the rolled distance q in units of a_H
@@ -20,10 +20,14 @@ Every invalid input is an :class:`~rollqp.errors.InputError` naming the dotted k
 (``bodies.A.nu``) and the allowed range or values; unknown keys get the closest valid name.
 Besides the per-key ranges, a scene is checked as a whole (FORMULATION.md §1, §9):
 
-* the normal load stays positive over the rolled distance (no loss of contact);
+* the normal load stays >= 0 over the rolled distance; where it is 0 the bodies are out of
+  contact (the driver records an unloaded state, :func:`rollqp.driver.run`) and Q must be 0;
 * the largest Hertz half-width, a_H·sqrt(max P/P̄), stays clear of the zone's edges by at
   least three quarters of an element: a_H·sqrt(max P/P̄) < L·(1 − 1.5/elements), L = zone·a_H
   (the element length is 2L/elements);
+* with ``formulation = "convective-local"``, Δq is at most the node spacing
+  (``discretization.step`` <= 1 for constant and linear, <= 0.5 for quadratic elements):
+  the upwind transport is unstable beyond it (docs/stability.md);
 * where a tangential load is prescribed, a stick solution exists: ``|Q| < μP``, i.e.
   ``|Q/(μP̄)| / (P/P̄) < 1``, at every step (and at the histories' breakpoints and peaks).
 
@@ -68,6 +72,12 @@ FORMULATION_TYPES = ("material", "convective-local")
 BETA_ZERO = 1e-12
 #: free elements required between the largest contact and each end of the zone
 EDGE_ELEMENTS = 1.5
+#: largest ``discretization.step`` (Δq/Le) of the convective-local formulation: the node
+#: spacing h/Le (:meth:`Scene._check_convective_step`)
+CONVECTIVE_STEP_MAX = {"constant": 1.0, "linear": 1.0, "quadratic": 0.5}
+#: allowed ``solver.augmentation`` (nondimensional r): the band in which newton converged on
+#: every hard case (docs/stability.md, ``python benchmarks/hard_cases.py --only "r="``)
+AUGMENTATION_MIN, AUGMENTATION_MAX = 1e-6, 10.0
 
 
 # =========================================================================== parts
@@ -136,7 +146,7 @@ class Load:
     normal : float
         Reference normal load P̄ per unit length, ``> 0``; defines a_H and p0.
     normal_history : History
-        P(q) = P̄·normal_history(q/a_H); must stay > 0.
+        P(q) = P̄·normal_history(q/a_H); must stay >= 0 (0: out of contact).
     tangential : History or None
         Q(q) = μ·P̄·tangential(q/a_H) on body A (Q/(μP̄), P̄ the reference load).
     creepage : History or None
@@ -208,11 +218,20 @@ class SolverSettings:
         Iteration limit per step, ``>= 1``: Newton iterations (``newton``; each half of
         ``nt-newton``) and outer N–T iterations (``nt-newton``, and the ``qp-*`` methods on a
         coupled scene). The QP solvers keep their own iteration limits.
+    augmentation : float or None
+        The Newton methods' nondimensional augmentation ``r`` of ``min(p, r g)`` and
+        ``Proj(t − r s)`` (FORMULATION.md §5), the same for the normal and the tangential rows,
+        in [:data:`AUGMENTATION_MIN`, :data:`AUGMENTATION_MAX`] (the band in which ``newton``
+        converges on every hard case, docs/stability.md). None (default): automatic,
+        ``1/mean(diag Â)`` (normal) and ``Δq̂/mean(diag Â)`` (tangential), see
+        :mod:`rollqp.methods.newton`. Ignored by the QP methods. The solution does not depend
+        on ``r``, only the Newton path does.
     """
 
     method: str = "newton"
     tolerance: float = 1e-10
     max_iterations: int = 200
+    augmentation: float | None = None
 
 
 # =========================================================================== value checks
@@ -330,7 +349,11 @@ def _check_solver(s: Any) -> SolverSettings:
         tolerance=_number("solver.tolerance", s.tolerance, "in [1e-15, 1e-2]",
                           lambda x: 1e-15 <= x <= 1e-2),
         max_iterations=_integer("solver.max_iterations", s.max_iterations, ">= 1",
-                                lambda n: n >= 1))
+                                lambda n: n >= 1),
+        augmentation=None if s.augmentation is None else _number(
+            "solver.augmentation", s.augmentation,
+            f"in [{AUGMENTATION_MIN:g}, {AUGMENTATION_MAX:g}] or absent (automatic)",
+            lambda x: AUGMENTATION_MIN <= x <= AUGMENTATION_MAX))
 
 
 # =========================================================================== scene
@@ -399,10 +422,11 @@ class Scene:
         disc, load = self.discretization, self.load
         q_end = self.q_end
         nmin, nmax = load.normal_history.extremes(q_end)
-        if not nmin > 0:
+        if not nmin >= 0:
             raise InputError("load.normal_history",
-                             f"must stay > 0 over the rolled distance [0, {q_end:.6g}] a_H, "
-                             f"but its minimum is {nmin:.6g} (loss of contact is not supported)")
+                             f"must stay >= 0 over the rolled distance [0, {q_end:.6g}] a_H (a "
+                             f"pull, P < 0, is not a contact problem), but its minimum is {nmin:.6g}")
+        self._check_convective_step()
         self._check_bem()
         free = 1.0 - EDGE_ELEMENTS / disc.elements
         if not math.sqrt(nmax) < disc.zone * free:
@@ -423,13 +447,19 @@ class Scene:
                                  f"|Q| <= mu P = 0), got values in [{tmin:.6g}, {tmax:.6g}]")
             return
         tmin, tmax = tang.extremes(q_end)
-        if max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
+        if nmin > 0 and max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
             return
         q = np.unique(np.concatenate((self.q_steps / self.a_H,
                                       load.normal_history.critical_points(q_end),
                                       tang.critical_points(q_end))))
-        ratio = np.abs(np.asarray(tang(q))) / np.asarray(load.normal_history(q))
+        Qr, Pr = np.abs(np.asarray(tang(q), dtype=float)), np.asarray(load.normal_history(q), dtype=float)
+        with np.errstate(divide="ignore", invalid="ignore"):  # P = 0 (contact lost): Q must be 0 too
+            ratio = np.where(Pr > 0, Qr / np.where(Pr > 0, Pr, 1.0), np.where(Qr > 0, np.inf, 0.0))
         i = int(np.argmax(ratio))
+        if np.isinf(ratio[i]):
+            raise InputError("load.tangential",
+                             f"must be 0 where the normal load is 0 (contact lost), but Q/(mu P̄) = "
+                             f"{float(tang(q[i])):.6g} at q = {q[i]:.6g} a_H where P = 0")
         if not ratio[i] < 1.0:
             raise InputError("load.tangential",
                              f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"
@@ -455,6 +485,27 @@ class Scene:
         c = self.contact
         return (19 if c.bem_outer_elements is None else c.bem_outer_elements,
                 16 if c.bem_inner_elements is None else c.bem_inner_elements)
+
+    def _check_convective_step(self) -> None:
+        """Convective-local slip is stable only for Δq up to the node spacing h.
+
+        Its upwind term ``d·D_up w^{k−1}`` is explicit transport of ``w`` by Δq per step: a
+        CFL condition, Δq ≤ h, with h = Le for constant and linear elements and Le/2 for
+        quadratic ones (a midnode). Beyond it the transient does not settle: measured on
+        §6.1.1 (``docs/stability.md``) the creepage oscillates by 3–17 % of Carter's from
+        step to step and ends 4–34 % off, against ≤ 1.7 % (material, same Δq) and exactly
+        the steady limit for Δq ≤ h. Rejected, naming ``discretization.step``.
+        """
+        disc = self.discretization
+        if disc.formulation != "convective-local":
+            return
+        limit = CONVECTIVE_STEP_MAX[disc.element]
+        if disc.step > limit:
+            raise InputError("discretization.step",
+                             f"must be in (0, {limit:g}] with formulation = 'convective-local' and "
+                             f"{disc.element} elements (Δq at most the node spacing: the upwind "
+                             f"transport is unstable beyond it, docs/stability.md), got {disc.step!r}; "
+                             f"use a smaller step or formulation = 'material'")
 
     # ------------------------------------------------------------------ derived quantities
     @property

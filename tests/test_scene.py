@@ -307,7 +307,8 @@ def test_tangential_and_creepage_are_exclusive():
     expect_error(d, "load.creepage", "exactly one")
 
 
-def test_normal_history_must_stay_positive():
+def test_normal_history_must_stay_nonnegative():
+    """P < 0 is rejected; P = 0 (loss of contact) is allowed with Q = 0 there (issue 5)."""
     harm = {"kind": "harmonic", "mean": 0.5, "amplitude": 0.6, "wavelength": 40.0}
     d = with_value(base_dict(), "load.normal_history", harm)
     d["load"]["tangential"]["value"] = 0.0
@@ -316,10 +317,12 @@ def test_normal_history_must_stay_positive():
     assert scene_from_dict(d).load.normal_history.extremes(6.0)[0] > 0, \
         "trough not reached: the scene is valid"
     d["discretization"]["distance"] = 31.0
-    expect_error(d, "load.normal_history", "> 0")
+    expect_error(d, "load.normal_history", ">= 0", "minimum is -0.1")
     d = with_value(base_dict(), "load.normal_history", {"kind": "table", "q": [0.0, 3.0],
                                                         "value": [1.0, 0.0]})
-    expect_error(d, "load.normal_history", "> 0", "loss of contact")
+    expect_error(d, "load.tangential", "must be 0 where the normal load is 0", "q = 3")  # Q = 0.75 μP̄ at P = 0
+    d["load"]["tangential"]["value"] = 0.0
+    assert scene_from_dict(d).load.normal_history(3.0) == 0.0, "P = 0 with Q = 0: valid"
 
 
 def test_contact_must_stay_inside_the_zone():

@@ -55,7 +55,14 @@ Deviations from the paper, both on degenerate iterates only:
   changes case and ``Φ`` (and ``θ``) does not change — and that node gets the contact/stick row,
   the one-sided derivative into contact/stick (counted in ``info["shifts"]``);
 * if the Armijo search fails (``α < 1e-10``; possible only on a kink, where the modified row is
-  not the directional derivative), the full step is taken (counted in ``info["nonmonotone"]``).
+  not the directional derivative), the full step is taken (counted in ``info["nonmonotone"]``);
+* if a tangential step with ``Q`` prescribed still fails (one stick node: the repair above can
+  cycle, e.g. free rolling at μ ≲ 3e-4), it is solved with ``ξ`` prescribed and ``ξ`` is searched
+  for ``fᵀt = Q`` (``_tangential_by_creepage``; counted in ``info["creepage_search"]``).
+
+Robustness (docs/stability.md): the nondimensional ``r`` may be set (``[solver] augmentation``,
+the same for both rows) within [1e-6, 10], where every hard case converges; failures are
+:class:`~rollqp.errors.SolverError` with the merit, iterations and ``‖Φ‖∞``.
 
 References: J.-S. Pang, Newton's method for B-differentiable equations, Math. Oper. Res. 15
 (1990) 311–341; González & Abascal, IJNME 53 (2002) 843–874, §4.
@@ -323,19 +330,85 @@ class NewtonMethod:
         """Solve a :class:`NormalStep` or :class:`TangentialStep`; raise :class:`SolverError` if short."""
         t0 = time.perf_counter()
         if problem.kind in ("normal", "tangential"):
-            solve = self._solve_normal if problem.kind == "normal" else self._solve_tangential
             try:
-                return solve(problem, warm, t0)
-            except _Stalled:
-                # the warm start led to a Newton fixed point that is not a solution (a wrong
-                # active set that the Newton step reproduces): restart once from the cold start
-                sol = solve(problem, None, t0)
-                sol.info["restarts"] = 1
-                return sol
+                return self._solve_uncoupled(problem, warm, t0)
+            except SolverError as err:
+                if problem.kind != "tangential" or problem.Q is None:
+                    raise
+                return self._tangential_by_creepage(problem, warm, t0, err)
         if problem.kind == "coupled":
             return self._solve_coupled(problem, warm, t0)
         raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
                                     f"not {problem.kind!r}")
+
+    def _solve_uncoupled(self, problem, warm, t0):
+        solve = self._solve_normal if problem.kind == "normal" else self._solve_tangential
+        try:
+            return solve(problem, warm, t0)
+        except _Stalled:
+            # the warm start led to a Newton fixed point that is not a solution (a wrong
+            # active set that the Newton step reproduces): restart once from the cold start
+            sol = solve(problem, None, t0)
+            sol.info["restarts"] = 1
+            return sol
+
+    def _tangential_by_creepage(self, pb, warm, t0, err):
+        r"""Fallback when GNMls fails on a tangential step with ``Q`` prescribed: solve for ``ξ``.
+
+        The failure this repairs: with a single stick node (free rolling at μ ≲ 3e-4) the load
+        row's only ``ξ̂`` entry is that node's, and the "nearest node onto its kink" repair (module
+        docstring) makes Newton cycle between active sets. With ``ξ`` prescribed instead the load
+        row is gone and GNMls converges (CONTACT's workaround: solve with ξ given first). The
+        load is then met by a root search on ``F(ξ̂) = f̂ᵀt̂(ξ̂) − Q̂``, continuous, piecewise
+        linear and monotone (friction opposes slip), each evaluation a ξ-prescribed solve warm
+        started from the previous one: bracketing by doubling steps from the warm ``ξ``, then
+        Brent's method. The root's traction then warm-starts the Q-prescribed GNMls (one or two
+        iterations on the right active set); if that fails too, the ξ-prescribed solution at the
+        root is kept when rollqp's residual of the original problem is within tolerance.
+        Counted in ``info["creepage_search"]`` (evaluations). Otherwise ``err`` is raised.
+        """
+        from scipy.optimize import brentq
+
+        sc = pb.scales
+        Qhat = pb.Q / sc.force
+        fhat = pb.f / sc.length
+        last = {"sol": warm, "evals": 0, "its": int(err.iterations or 0)}
+
+        def F(xh):
+            last["evals"] += 1
+            sol = self._solve_uncoupled(pb.replace(Q=None, xi=xh * sc.slip), last["sol"], t0)
+            last["sol"] = sol
+            last["its"] += sol.iterations
+            return float(fhat @ (sol.t / sc.stress)) - Qhat
+
+        try:
+            x0 = warm.xi / sc.slip if warm is not None and warm.xi is not None else 0.0
+            f0 = F(x0)
+            h = 2.0 * pb.mu * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
+            lo = hi = x0
+            flo = fhi = f0
+            for _ in range(80):  # widen both ways until F changes sign
+                if flo * fhi <= 0.0:
+                    break
+                lo, hi = lo - h, hi + h
+                flo, fhi = F(lo), F(hi)
+                h *= 2.0
+            else:
+                raise err
+            root = brentq(F, lo, hi, xtol=1e-15, rtol=1e-15, maxiter=200) if flo * fhi < 0 else (lo if flo == 0 else hi)
+            at_root = self._solve_uncoupled(pb.replace(Q=None, xi=root * sc.slip), last["sol"], t0)
+        except (SolverError, ValueError, RuntimeError):  # a ξ-prescribed solve failed, or Brent did not converge
+            raise err from None
+        try:
+            sol = self._solve_tangential(pb, at_root, t0)
+        except (SolverError, _Stalled):
+            sol = pb.solution(at_root.t, at_root.xi)
+            if not sol.residual <= self.tolerance:
+                raise err from None
+            sol = self._finish(sol, at_root.iterations, dict(at_root.info), t0)
+        sol.info["creepage_search"] = last["evals"] + 1
+        sol.iterations += last["its"] + at_root.iterations  # all Newton iterations of the step
+        return sol
 
     # ------------------------------------------------------------ the two kinds
     def _solve_normal(self, pb, warm, t0):
