@@ -226,7 +226,7 @@ def timed_run(scene, method, label="", repeats=3, budget=2.0, keep=True) -> Run:
 
 
 def diff_to(run: Run, ref: Run, mu: float) -> float | None:
-    """Largest |t − t_ref|/(μp0) and |p − p_ref|/p0 over all states (same discretization)."""
+    """Largest ``|t − t_ref|/(μp0)`` and ``|p − p_ref|/p0`` over all states (same discretization)."""
     if not (run.ok and ref.ok) or run.arrays["pt"].shape != ref.arrays["pt"].shape:
         return None
     p0 = float(ref.arrays["p0"])
@@ -236,7 +236,7 @@ def diff_to(run: Run, ref: Run, mu: float) -> float | None:
 
 
 def mid_error(run: Run, ref: Run, mu: float, q_mid: float = Q_MID, key: str = "pt") -> float | None:
-    """rms over |x| <= a_H of |t − t_ref|/(μp0) (``key="pn"``: |p − p_ref|/p0) at q = q_mid a_H;
+    """rms over ``|x| <= a_H`` of ``|t − t_ref|/(μp0)`` (``key="pn"``: ``|p − p_ref|/p0``) at q = q_mid a_H;
     the fine reference interpolated linearly to the run's nodes."""
     if not (run.ok and ref.ok):
         return None
