@@ -9,9 +9,11 @@ matrices, scales, slip operators — and is built once. :func:`run` then marches
     tangential load by static shift in ``load.start_steps`` increments (Cattaneo for
     similar bodies, §4.4): ``s = (w^k − w^{k−1})/Δ + ξ`` with ``Δ = a_H`` and ``ξ·Δ`` the
     rigid shift;
-  - ``start = "rolling"``: steady rolling at the initial loads, reached by marching the
-    transient at constant loads from the braked state until the tractions stop changing
-    (the QP methods cannot pose the non-symmetric steady problem directly).
+  - ``start = "rolling"``: steady rolling at the initial loads. ``newton`` and ``nt-newton``
+    solve the steady problem directly (slip ``s = ξ e + d·D_up w``, :meth:`Model.steady_operators`);
+    the QP methods reach it by marching the transient at constant loads from the braked state
+    until the tractions stop changing (the steady slip operator is far from symmetric, and
+    their splitting does not converge on it).
 * **rolling steps** ``k = 1..K`` at ``q_k = k Δq``: the history vector
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
   ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step.
