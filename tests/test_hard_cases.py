@@ -180,3 +180,17 @@ def test_gross_sliding_under_prescribed_creepage_is_flagged():
     assert res.meta.get("gross_sliding", [])[-1] == len(res) - 1 and len(res.meta["gross_sliding"]) >= len(res) - 1
     half = scene.replace(**{"load.creepage": {"kind": "constant", "value": -0.5 * 0.1 * scene.a_H / scene.R}})
     assert "gross_sliding" not in rollqp.run(half, method="newton").meta
+
+
+def test_newton_never_returns_a_step_above_its_tolerance():
+    """At r = 1e-8 (outside the accepted band; set past the scene's check as the hard-case
+    script does) Newton's r-scaled stopping test is met in the braked start while rollqp's own
+    residual is 3.4e-10 > 1e-10 (round-off in the r-scaled rows). That is a SolverError naming
+    the residual, not a step handed back as solved (NewtonMethod._checked)."""
+    scene = load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.5, "solver.method": "newton"})
+    with pytest.raises(SolverError, match="exceeds the tolerance") as info:
+        rollqp.run(hc._with_augmentation(scene, 1e-8))
+    assert "step 0" in str(info.value)
+    # inside the band every step is solved within the tolerance
+    res = rollqp.run(scene.replace(**{"solver.augmentation": 1e-6}))
+    assert np.max(res["residual"]) <= 1e-10

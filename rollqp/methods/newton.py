@@ -331,11 +331,12 @@ class NewtonMethod:
         t0 = time.perf_counter()
         if problem.kind in ("normal", "tangential"):
             try:
-                return self._solve_uncoupled(problem, warm, t0)
+                sol = self._solve_uncoupled(problem, warm, t0)
             except SolverError as err:
                 if problem.kind != "tangential" or problem.Q is None:
                     raise
-                return self._tangential_by_creepage(problem, warm, t0, err)
+                sol = self._tangential_by_creepage(problem, warm, t0, err)
+            return self._checked(sol)
         if problem.kind == "coupled":
             return self._solve_coupled(problem, warm, t0)
         raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
@@ -872,6 +873,21 @@ class NewtonMethod:
         return dict(hit, kN=kN, kT=kT)
 
     # ------------------------------------------------------------ helpers
+    def _checked(self, sol):
+        """Never hand back a step whose rollqp residual misses the tolerance.
+
+        The iteration stops on ``‖Φ‖∞ <= tolerance·min(1, r)``, which bounds rollqp's own
+        residual (r = 1) by ``tolerance`` in exact arithmetic. With an extreme ``r`` (measured:
+        r = 1e-8, outside the accepted band) round-off in the r-scaled rows breaks that
+        implication; the step is then a failure, not a solution.
+        """
+        if not sol.residual <= self.tolerance:
+            raise SolverError(f"the Newton iteration stopped on its scaled test but rollqp's residual {sol.residual:.3e} exceeds the "
+                              f"tolerance {self.tolerance:.1e} (augmentation r = {sol.info.get('r', float('nan')):.3g})",
+                              method=self.name, status="residual above tolerance",
+                              iterations=sol.iterations, residual=sol.residual)
+        return sol
+
     def _finish(self, sol, it, info, t0):
         sol.method, sol.status, sol.iterations = self.name, "solved", it
         sol.info.update(info)
