@@ -42,11 +42,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError, SolverError
+from .errors import InputError, RollqpError, SolverError
 from .influence import build_influence
 from .methods import QP_METHODS, get_method
 from .methods.alternation import Alternation
-from .problem import (CoupledStep, NormalStep, Scales, StepSolution, TangentialStep, asymmetry, classify,
+from .problem import (is_trusted, trust_matrix, CoupledStep, NormalStep, Scales, StepSolution, TangentialStep, asymmetry, classify,
                       symmetrized)
 from .result import Result
 from .scene import Scene, load_scene
@@ -100,7 +100,9 @@ class Model:
         info["influence_seconds"] = time.perf_counter() - t0
         info["operator"] = "symmetrized" if symmetric else "collocation"
         history = strip.history_operator(d.formulation, scene.dq, scene.load.direction)
-        return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=infl.Atn, Ant=infl.Ant, h=infl.h,
+        # finite, fixed for the scene: validated once here, read-only from now on (problem.trust_matrix)
+        Ann, Att, Atn, Ant = (None if M is None else _trusted(M) for M in (Ann, Att, infl.Atn, infl.Ant))
+        return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
                    scales=Scales(scene.a_H, scene.p0, scene.Estar), history=history, symmetric=symmetric,
                    info=info)
 
@@ -199,6 +201,15 @@ class _Step:
 
 #: Methods that solve non-symmetric step problems directly (the steady rolling start).
 DIRECT_STEADY = ("newton", "nt-newton")
+
+
+def _trusted(M: np.ndarray) -> np.ndarray:
+    """``M`` checked finite once and made read-only (:func:`rollqp.problem.trust_matrix`)."""
+    if is_trusted(M):
+        return M
+    if not np.all(np.isfinite(M)):
+        raise RollqpError(f"the influence matrices are not finite (shape {M.shape})")
+    return trust_matrix(M)
 
 
 def _make_method(scene: Scene, name: str):

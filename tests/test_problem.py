@@ -388,3 +388,21 @@ def test_tangential_multiplier_is_the_creepage(constant_problem):
     expected = -fh[upper] * (s[upper] / hp.scales.slip) / form.obj_scale
     # ν is a difference of O(ξ̂ = 4) terms; where ŝ ~ 1e-2 the cancellation leaves ~1e-13 relative
     assert np.allclose(nu[upper], expected, rtol=1e-9, atol=0), "bound multipliers equal −F̂ŝ/obj"
+
+
+def test_scene_matrices_are_checked_once_and_read_only():
+    """Model.build validates the influence matrices once and makes them read-only; step
+    problems then reuse them as they are (no O(n²) check or copy per step). A user's writeable
+    array is still checked on every construction."""
+    from rollqp.driver import Model
+    from rollqp.problem import is_trusted
+    model = Model.build(rollqp.load_scene("cattaneo-carter"), symmetric=False)
+    assert is_trusted(model.Ann) and is_trusted(model.Att)
+    with pytest.raises(ValueError):
+        model.Ann[0, 0] = 1.0  # read-only: it cannot change after the check
+    step = model.normal_step(1000.0)
+    assert step.A is model.Ann
+    bad = np.array(model.Ann)          # a writeable copy: checked again
+    bad[3, 4] = np.nan
+    with pytest.raises(InputError, match="finite"):
+        rollqp.NormalStep(A=bad, f=model.f, h=model.h, P=1000.0, scales=model.scales)
