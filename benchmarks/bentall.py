@@ -41,41 +41,25 @@ from threadpoolctl import threadpool_limits
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.errors import SolverError
-from rollqp.scene import scene_from_dict
 
-G_AL, NU_AL = 23000.0, 0.31
-G_ST, NU_ST = 82000.0, 0.28
-ALUMINIUM = {"radius": 50.0, "E": 2.0 * G_AL * (1.0 + NU_AL), "nu": NU_AL}
-STEEL = {"radius": 50.0, "E": 2.0 * G_ST * (1.0 + NU_ST), "nu": NU_ST}
-FN = 16.2019          # N/mm (CONTACT: 16201.9 N over DY = 1000 mm)
-CONTACT_XL = -0.108   # mm, CONTACT's grid: XL = -0.108, DX = 0.001, MX = 216
-CONTACT_DX = 0.001
-#: CONTACT's creepages as quoted in the issue (magnitudes), and the coupling of CONTACT's run:
-#: MAXOUT = 1 (no outer normal–tangential iteration: goodman) in cases 1–2, MAXOUT = 10 (full) in case 4.
+# CONTACT's bentall case (materials, load, grid), one copy with tests/test_bentall.py
+from rollqp._refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
+from rollqp._refcases import bentall_scene  # noqa: E402
+
 CONTACT = {1e-4: ("5.260e-4", "goodman"), 0.05: ("4.29e-4", "full")}
 
 
 # =========================================================================== helpers
 def scene(mu, elements=80, element="constant", coupling="goodman", direction=-1, zone=1.1, swap=False,
           method="newton"):
-    """Aluminium (A) on steel (B), free rolling, steady, Δq = Le."""
-    A, B = (STEEL, ALUMINIUM) if swap else (ALUMINIUM, STEEL)
-    return scene_from_dict({
-        "name": "bentall", "description": "aluminium on steel, free rolling (Bentall-Johnson)",
-        "bodies": {"A": A, "B": B},
-        "contact": {"friction": mu, "coupling": coupling},
-        "load": {"normal": FN, "tangential": {"kind": "constant", "value": 0.0}, "start": "rolling",
-                 "direction": direction},
-        "discretization": {"elements": elements, "element": element, "zone": zone, "step": 1.0,
-                           "formulation": "material", "distance": 0.0},
-        "solver": {"method": method, "tolerance": 1e-10}})
+    """Aluminium (A) on steel (B), free rolling, steady, Δq = Le (rollqp._refcases.bentall_scene)."""
+    return bentall_scene(mu, elements=elements, element=element, coupling=coupling, direction=direction,
+                         zone=zone, swap=swap, method=method)
 
 
 def contact_grid(mu, coupling, dx=CONTACT_DX, method="newton"):
-    """CONTACT's strip ±0.108 mm with elements of ``dx`` mm, d = +1 (CONTACT's CHI = 180°)."""
-    n = int(round(-2 * CONTACT_XL / dx))
-    s = scene(mu, elements=n, coupling=coupling, direction=+1, method=method)
-    return s.replace(**{"discretization.zone": -CONTACT_XL / s.a_H})
+    """CONTACT's strip ±0.108 mm with elements of ``dx`` mm, d = +1 (CHI = 180°)."""
+    return bentall_contact_grid(mu, coupling, dx=dx, method=method)
 
 
 def steady(s):

@@ -27,10 +27,8 @@ from __future__ import annotations
 
 import argparse
 import csv
-import os
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -38,40 +36,19 @@ from threadpoolctl import threadpool_limits
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.driver import Model
-from rollqp.scene import scene_from_dict
 
-ROOT = Path(__file__).resolve().parents[1]
-REFDATA = Path(os.environ.get("ROLLQP_CONTACT_REFDATA", ROOT.parent / "shared" / "refdata" / "contact"))
 
-# CONTACT's inputs (refdata README): similar materials G = 82000, ν = 0.28, R = 500 mm as two
-# cylinders of radius 1000 mm, FN' = 178.896248 N/mm (a_H = 1 mm), μ = 0.1.
-G_CONTACT, NU_CONTACT = 82000.0, 0.28
-E_CONTACT = 2.0 * G_CONTACT * (1.0 + NU_CONTACT)  # 209920
-FN_CONTACT = 178.896248
-MU_CONTACT = 0.1
-RATIO = 0.75
+# CONTACT's inputs (refdata README) and its problem as a scene: rollqp._refcases, one copy with
+# the tests.
+from rollqp._refcases import (E_CONTACT, FN_CONTACT, G_CONTACT, MU_CONTACT, NU_CONTACT,  # noqa: E402,F401
+                              RATIO_CONTACT as RATIO, REFDATA, contact_scene)
+
 QP_BACKENDS = ("qp-osqp", "qp-clarabel", "qp-cvxpy")
 #: The generalized Newton method (issue 3), run beside the QPs as a cross-check where present.
 NEWTON = ("newton",) if "newton" in rollqp.available_methods() else ()
 
 
 # =========================================================================== helpers
-def contact_scene(elements=88, ratio=RATIO, start="braked", distance=4.0, mu=MU_CONTACT,
-                  method="qp-osqp", zone=1.1, step=1.0, element="constant"):
-    """CONTACT's problem as a rollqp scene: 88 constant elements on ±1.1 a_H, Δq = DX."""
-    return scene_from_dict({
-        "name": "contact-reference",
-        "description": "CONTACT's 2D Cattaneo-Carter problem on CONTACT's grid",
-        "bodies": {"A": {"radius": 1000.0, "E": E_CONTACT, "nu": NU_CONTACT},
-                   "B": {"radius": 1000.0, "E": E_CONTACT, "nu": NU_CONTACT}},
-        "contact": {"friction": mu},
-        "load": {"normal": FN_CONTACT, "tangential": {"kind": "constant", "value": ratio},
-                 "start": start, "direction": -1},
-        "discretization": {"elements": elements, "element": element, "zone": zone, "step": step,
-                           "formulation": "material", "distance": distance},
-        "solver": {"method": method, "tolerance": 1e-10}})
-
-
 def read_csv(name):
     with open(REFDATA / name, newline="") as fh:
         return list(csv.DictReader(fh))

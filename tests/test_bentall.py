@@ -40,14 +40,9 @@ import pytest
 
 import rollqp
 from rollqp import closedforms as cf
-from rollqp.scene import scene_from_dict
-
-G_AL, NU_AL = 23000.0, 0.31   # aluminium, CONTACT's body 1
-G_ST, NU_ST = 82000.0, 0.28   # steel, CONTACT's body 2
-ALUMINIUM = {"radius": 50.0, "E": 2.0 * G_AL * (1.0 + NU_AL), "nu": NU_AL}
-STEEL = {"radius": 50.0, "E": 2.0 * G_ST * (1.0 + NU_ST), "nu": NU_ST}
-FN = 16.2019                  # N/mm: CONTACT's 16201.9 N over DY = 1000 mm
-CONTACT_XL, CONTACT_DX, CONTACT_MX = -0.108, 0.001, 216
+# CONTACT's bentall case, one copy with benchmarks/bentall.py
+from rollqp._refcases import CONTACT_DX, CONTACT_MX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid
+from rollqp._refcases import bentall_scene as _bentall_scene
 
 #: CONTACT's free-rolling creepages (magnitudes), as quoted in the issue, and their coupling.
 CONTACT_XI = {1e-4: (5.260e-4, "goodman", 1e-7), 0.05: (4.29e-4, "full", 1e-6)}  # value, coupling, last digit
@@ -55,23 +50,14 @@ CONTACT_XI = {1e-4: (5.260e-4, "goodman", 1e-7), 0.05: (4.29e-4, "full", 1e-6)} 
 
 def bentall_scene(mu, elements=80, element="constant", coupling="goodman", direction=-1, zone=1.1,
                   swap=False, method="qp-osqp", P=FN):
-    """Aluminium (A) on steel (B), free rolling, steady (rolling start), Δq = Le."""
-    A, B = (STEEL, ALUMINIUM) if swap else (ALUMINIUM, STEEL)
-    return scene_from_dict({
-        "name": "bentall", "description": "aluminium on steel, free rolling (Bentall-Johnson)",
-        "bodies": {"A": A, "B": B},
-        "contact": {"friction": mu, "coupling": coupling},
-        "load": {"normal": P, "tangential": {"kind": "constant", "value": 0.0}, "start": "rolling",
-                 "direction": direction},
-        "discretization": {"elements": elements, "element": element, "zone": zone, "step": 1.0,
-                           "formulation": "material", "distance": 0.0},
-        "solver": {"method": method, "tolerance": 1e-10}})
+    """Aluminium (A) on steel (B), free rolling, steady (rolling start), Δq = Le (rollqp._refcases)."""
+    return _bentall_scene(mu, elements=elements, element=element, coupling=coupling, direction=direction,
+                          zone=zone, swap=swap, method=method, P=P)
 
 
 def contact_scene(mu, coupling, method):
     """CONTACT's grid: 216 constant elements of 0.001 mm on ±0.108 mm, d = +1 (CHI = 180°)."""
-    s = bentall_scene(mu, elements=CONTACT_MX, coupling=coupling, direction=+1, method=method)
-    return s.replace(**{"discretization.zone": -CONTACT_XL / s.a_H})
+    return bentall_contact_grid(mu, coupling, method=method)
 
 
 def creepage(scene):

@@ -15,45 +15,30 @@ The numbers these tests keep, and the same comparison at all four steady load ra
 from __future__ import annotations
 
 import csv
-import os
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rollqp
+from rollqp import _refcases as ref  # one copy of the problem with benchmarks/validation.py
 from rollqp import closedforms as cf
-from rollqp.scene import scene_from_dict
+from rollqp._refcases import REFDATA
 
-REFDATA = Path(os.environ.get("ROLLQP_CONTACT_REFDATA",
-                              Path(__file__).resolve().parents[1].parent / "shared" / "refdata" / "contact"))
 if not REFDATA.is_dir():
     pytest.skip(f"CONTACT reference data not found at {REFDATA} (../shared/refdata/contact)",
                 allow_module_level=True)
 
 # CONTACT's inputs (refdata README): G = 82000, ν = 0.28 for both bodies, R = 500 mm
-# (1/R = 1/1000 + 1/1000), FN' = 178.896248 N/mm so that a_H = 1 mm, μ = 0.1.
-G, NU = 82000.0, 0.28
-E = 2.0 * G * (1.0 + NU)  # 209920
-FN = 178.896248
-MU = 0.1
-RATIO = 0.75
+# (1/R = 1/1000 + 1/1000), FN' = 178.896248 N/mm so that a_H = 1 mm, μ = 0.1 (rollqp._refcases).
+G, NU, E, FN, MU, RATIO = (ref.G_CONTACT, ref.NU_CONTACT, ref.E_CONTACT, ref.FN_CONTACT, ref.MU_CONTACT,
+                           ref.RATIO_CONTACT)
 N_TRANSIENT = 88  # DX = a/40 on ±1.1 a: 80 elements in contact
 N_STEADY = 220    # DX = a/100 on ±1.1 a: 200 elements in contact
 
 
 def contact_scene(elements=N_TRANSIENT, ratio=RATIO, start="braked", distance=4.0, method="qp-osqp"):
     """CONTACT's problem: piecewise-constant elements on ±1.1 a_H, Δq = one element, material form."""
-    return scene_from_dict({
-        "name": "contact-reference",
-        "description": "CONTACT's 2D Cattaneo-Carter problem on CONTACT's grid",
-        "bodies": {"A": {"radius": 1000.0, "E": E, "nu": NU}, "B": {"radius": 1000.0, "E": E, "nu": NU}},
-        "contact": {"friction": MU},
-        "load": {"normal": FN, "tangential": {"kind": "constant", "value": ratio}, "start": start,
-                 "direction": -1},
-        "discretization": {"elements": elements, "element": "constant", "zone": 1.1, "step": 1.0,
-                           "formulation": "material", "distance": distance},
-        "solver": {"method": method, "tolerance": 1e-10}})
+    return ref.contact_scene(elements=elements, ratio=ratio, start=start, distance=distance, method=method)
 
 
 def _csv(name):

@@ -1,0 +1,84 @@
+"""Reference cases shared by the tests and the benchmarks (private: not part of the API).
+
+Two problems for which CONTACT (Vollebregt & Kalker), the field's reference code, has results
+(``../shared/refdata/contact/README.md``; docs/validation.md):
+
+* :func:`contact_scene`: CONTACT's 2D Cattaneo → Carter problem of similar cylinders
+  (G = 82000, ν = 0.28, R = 500 mm as two cylinders of radius 1000 mm, FN' = 178.896248 N/mm
+  so that a_H = 1 mm, μ = 0.1), by default on CONTACT's grid: 88 constant elements on
+  ±1.1 a_H, Δq = one element, material form.
+* :func:`bentall_scene`: CONTACT's ``bentall`` case (examples/bentall.inp): R_A = R_B = 50 mm,
+  aluminium body 1 = rollqp's A (G = 23000, ν = 0.31) on steel (G = 82000, ν = 0.28),
+  FN = 16201.9 N on a DY = 1000 mm strip (16.2019 N/mm, a_H = 0.1 mm), free rolling in the
+  steady state, Δq = Le; :func:`bentall_contact_grid` puts it on CONTACT's grid (216 constant
+  elements of DX = 0.001 mm from XL = −0.108 mm, CHI = 180°, i.e. rollqp's d = +1).
+
+One copy of each, so that the tests (tests/test_contact.py, tests/test_bentall.py) and the
+benchmarks that print docs/validation.md (benchmarks/validation.py, benchmarks/bentall.py)
+always describe the same problem.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .scene import Scene, scene_from_dict
+
+#: CONTACT's result files: ``$ROLLQP_CONTACT_REFDATA`` or ``../shared/refdata/contact`` beside
+#: the checkout.
+REFDATA = Path(os.environ.get("ROLLQP_CONTACT_REFDATA",
+                              Path(__file__).resolve().parents[1].parent / "shared" / "refdata" / "contact"))
+
+# ---------------------------------------------------------------- Cattaneo → Carter (similar)
+G_CONTACT, NU_CONTACT = 82000.0, 0.28
+E_CONTACT = 2.0 * G_CONTACT * (1.0 + NU_CONTACT)  # 209920
+FN_CONTACT = 178.896248   # N/mm: a_H = 1 mm on R = 500 mm
+MU_CONTACT = 0.1
+RATIO_CONTACT = 0.75      # Q/(μP)
+
+
+def contact_scene(elements=88, ratio=RATIO_CONTACT, start="braked", distance=4.0, mu=MU_CONTACT,
+                  method="qp-osqp", zone=1.1, step=1.0, element="constant") -> Scene:
+    """CONTACT's Cattaneo → Carter problem as a rollqp scene (default: CONTACT's 88-element grid)."""
+    return scene_from_dict({
+        "name": "contact-reference",
+        "description": "CONTACT's 2D Cattaneo-Carter problem on CONTACT's grid",
+        "bodies": {"A": {"radius": 1000.0, "E": E_CONTACT, "nu": NU_CONTACT},
+                   "B": {"radius": 1000.0, "E": E_CONTACT, "nu": NU_CONTACT}},
+        "contact": {"friction": mu},
+        "load": {"normal": FN_CONTACT, "tangential": {"kind": "constant", "value": ratio},
+                 "start": start, "direction": -1},
+        "discretization": {"elements": elements, "element": element, "zone": zone, "step": step,
+                           "formulation": "material", "distance": distance},
+        "solver": {"method": method, "tolerance": 1e-10}})
+
+
+# ---------------------------------------------------------------- Bentall–Johnson (dissimilar)
+G_AL, NU_AL = 23000.0, 0.31   # aluminium, CONTACT's body 1
+G_ST, NU_ST = 82000.0, 0.28   # steel, CONTACT's body 2
+ALUMINIUM = {"radius": 50.0, "E": 2.0 * G_AL * (1.0 + NU_AL), "nu": NU_AL}
+STEEL = {"radius": 50.0, "E": 2.0 * G_ST * (1.0 + NU_ST), "nu": NU_ST}
+FN_BENTALL = 16.2019          # N/mm: CONTACT's 16201.9 N over DY = 1000 mm
+CONTACT_XL, CONTACT_DX, CONTACT_MX = -0.108, 0.001, 216   # mm: CONTACT's bentall grid
+
+
+def bentall_scene(mu, elements=80, element="constant", coupling="goodman", direction=-1, zone=1.1,
+                  swap=False, method="newton", P=FN_BENTALL) -> Scene:
+    """Aluminium (A) on steel (B), free rolling, steady (rolling start), Δq = Le."""
+    A, B = (STEEL, ALUMINIUM) if swap else (ALUMINIUM, STEEL)
+    return scene_from_dict({
+        "name": "bentall", "description": "aluminium on steel, free rolling (Bentall-Johnson)",
+        "bodies": {"A": A, "B": B},
+        "contact": {"friction": mu, "coupling": coupling},
+        "load": {"normal": P, "tangential": {"kind": "constant", "value": 0.0}, "start": "rolling",
+                 "direction": direction},
+        "discretization": {"elements": elements, "element": element, "zone": zone, "step": 1.0,
+                           "formulation": "material", "distance": 0.0},
+        "solver": {"method": method, "tolerance": 1e-10}})
+
+
+def bentall_contact_grid(mu, coupling, dx=CONTACT_DX, method="newton") -> Scene:
+    """The bentall case on CONTACT's strip ±0.108 mm with elements of ``dx`` mm, d = +1 (CHI = 180°)."""
+    n = int(round(-2 * CONTACT_XL / dx))
+    s = bentall_scene(mu, elements=n, coupling=coupling, direction=+1, method=method)
+    return s.replace(**{"discretization.zone": -CONTACT_XL / s.a_H})
