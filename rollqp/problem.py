@@ -143,16 +143,29 @@ def _exactly_one(names, values):
         raise InputError(" / ".join(names), f"give exactly one of {' or '.join(names)} (got {len(given)})")
 
 
+def split(A: np.ndarray, f: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(asymmetry, F⁻¹ sym(F A), F⁻¹ skew(F A))``: the symmetric–skew splitting of ``A``.
+
+    ``F A = sym + skew`` with ``F = diag(f)``; the QP Hessian is ``sym(F A)`` (FORMULATION.md §7)
+    and the exact-collocation QP backends iterate on the skew part. The asymmetry is
+    ``‖FA − (FA)ᵀ‖_F / ‖FA‖_F``. For an exactly symmetric ``F A`` the symmetric part is ``A``
+    itself (no copy).
+    """
+    FA = f[:, None] * A
+    skew = 0.5 * (FA - FA.T)
+    asym = float(np.linalg.norm(skew) * 2 / np.linalg.norm(FA))
+    Asym = (FA - skew) / f[:, None] if asym > 0 else A
+    return asym, Asym, skew / f[:, None]
+
+
 def symmetrized(A: np.ndarray, f: np.ndarray) -> np.ndarray:
     """``F⁻¹ sym(F A)``: the operator whose weighted form is the QP Hessian (FORMULATION.md §7)."""
-    FA = f[:, None] * A
-    return 0.5 * (FA + FA.T) / f[:, None]
+    return split(A, f)[1]
 
 
 def asymmetry(A: np.ndarray, f: np.ndarray) -> float:
     """``‖FA − (FA)ᵀ‖_F / ‖FA‖_F``."""
-    FA = f[:, None] * A
-    return float(np.linalg.norm(FA - FA.T) / np.linalg.norm(FA))
+    return split(A, f)[0]
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ import time
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..problem import StepSolution
+from ..problem import StepSolution, split
 
 
 class QPMethod:
@@ -161,11 +161,7 @@ class QPMethod:
         hit = self._cache.get(key)
         if hit is None or hit[0] is not problem.A or hit[1] is not problem.f:
             A, f = problem.A, problem.f
-            FA = f[:, None] * A
-            skew = 0.5 * (FA - FA.T)
-            asym = float(np.linalg.norm(skew) * 2 / np.linalg.norm(FA))
-            Asym = (FA - skew) / f[:, None] if asym > 0 else A
-            hit = (A, f, (asym, Asym, skew / f[:, None]))
+            hit = (A, f, split(A, f))
             self._cache[key] = hit
         return hit[2]
 
