@@ -6,7 +6,8 @@ The issue-5 scaling study (``rollqp bench --parts scaling``) times the uncoupled
 transient, where Newton works on one n-sized reduced system per half and reuses its
 factorization. The coupled step of ``goodman-bentall`` (β = 0.5, μ = 0.3) has 2n unknowns
 (p and t, minus separated nodes), couples them through the friction bound μ·max(0, p − r g),
-and refactors every iteration. This script measures what that costs: median ``step_time``
+and (from N = 200 unknowns) reuses one LU across iterations and steps through a Woodbury
+update of the rows whose node case changed. This script measures what that costs: median ``step_time``
 of the rolling steps after the start, iterations per step, and the dense floors
 ``cho_factor`` of size n and of size 2n. Same harness as rollqp.bench (BLAS pinned,
 failures recorded, sizes skipped when the previous one predicts more than the budget).

@@ -5,6 +5,10 @@
   while the active set moves by a few nodes, against ``numpy.linalg.solve`` on the full
   pseudo-Jacobian ``J`` — direction by direction, and over a whole transient (same iteration
   counts, same tractions).
+* The coupled Newton step's reused LU (rollqp.methods.newton._CoupledFactors: Woodbury updates
+  of the changed rows on the factored J) against the direct reduced solve
+  (NewtonMethod._coupled_direction): direction by direction on random case patterns, the
+  fallbacks (singular, ill-conditioned, inaccurate updates), and whole coupled runs.
 * The QP backends' solver cache keyed by a Hessian fingerprint: a changed Hessian builds a
   new solver object, the same Hessian reuses it.
 """
@@ -173,6 +177,136 @@ def test_coupled_transient_same_iterates_as_full_solve(monkeypatch):
     with monkeypatch.context() as mp:
         mp.setattr(NewtonMethod, "_coupled_direction", staticmethod(_full_coupled_direction))
         plain = rollqp.run(scene, method="newton").arrays()
+    assert np.array_equal(fast["iterations"][1:], plain["iterations"][1:])
+    assert np.array_equal(fast["backtracks"][1:], plain["backtracks"][1:])
+    mu, p0 = scene.contact.friction, scene.p0
+    assert np.max(np.abs(fast["pt"] - plain["pt"])) <= TOL["transient"] * mu * p0
+    assert np.max(np.abs(fast["pn"] - plain["pn"])) <= TOL["transient"] * p0
+
+
+# ------------------------------------------------------------------- coupled factorization reuse
+def _coupled_problem(elements=80):
+    """A coupled rolling step of goodman-bentall (161 nodes: above the direct-solve size)."""
+    scene = rollqp.load_scene("goodman-bentall").replace(**{"discretization.elements": elements})
+    model = Model.build(scene, symmetric=False)
+    n = model.strip.n
+    P = scene.load.normal
+    return model.coupled_step(P, np.zeros(n), scene.dq, Q=0.0)
+
+
+def _coupled_patterns(n, rng):
+    """Random node cases: a base pattern, small random changes of it (Woodbury updates, the
+    changes accumulating against the factored pattern), then a large change (refactor)."""
+    def random_cases(contact_frac, stick_frac):
+        contact = rng.random(n) < contact_frac
+        u = rng.random(n)
+        stick = u < stick_frac
+        slip_sign = np.where(stick, 0.0, np.where(u < stick_frac + (1 - stick_frac) / 2, 1.0, -1.0))
+        zero = ~stick & (rng.random(n) < 0.3)  # zero bound: identity t row
+        slip_sign[zero] = 0.0
+        return contact, stick, slip_sign
+
+    base = random_cases(0.6, 0.5)
+    out = [base]
+    cur = [a.copy() for a in base]
+    for k in (1, 2, 3, 4, 5):  # each flips k more nodes' cases
+        contact, stick, slip_sign = [a.copy() for a in cur]
+        for i in rng.choice(n, size=k, replace=False):
+            case = rng.integers(5)
+            contact[i] = case != 0 or not contact[i]
+            stick[i] = case == 1
+            slip_sign[i] = {2: 1.0, 3: -1.0}.get(int(case), 0.0)
+        cur = [contact, stick, slip_sign]
+        out.append(tuple(cur))
+    out.append(random_cases(0.4, 0.7))  # large change: refactor
+    out.append(base)  # and back
+    return out
+
+
+@pytest.mark.parametrize("loads", ["P,Q", "none"])
+def test_coupled_updated_direction_matches_direct(loads):
+    """Every direction of the reused/updated factorization (Woodbury on the factored J) equals
+    the direct reduced solve (NewtonMethod._coupled_direction) on random case patterns."""
+    pb = _coupled_problem()
+    if loads == "none":  # δ and ξ prescribed: no load rows
+        pb = pb.replace(P=None, Q=None, delta=0.0, xi=0.0)
+    meth = NewtonMethod()
+    S = meth._coupled_system(pb)
+    fac = newton_module._CoupledFactors(S)
+    assert S["N"] >= fac.DIRECT_BELOW  # the reuse path, not the direct fallback
+    n, mu = pb.n, pb.mu
+    rng = np.random.default_rng(7)
+    for contact, stick, slip_sign in _coupled_patterns(n, rng):
+        phi = rng.standard_normal(S["N"])
+        d, dN, dT = fac.direction(contact, stick, slip_sign, mu, phi)
+        ref = NewtonMethod._coupled_direction(S, contact, stick, slip_sign, mu, phi)
+        assert np.max(np.abs(d - ref)) <= TOL["direction"] * np.max(np.abs(ref))
+        # the returned K_N d, K_T d are those products (recomputed here in another order of
+        # summation: round-off of a 324-term dot product, ≲ 1e-13 relative)
+        assert np.allclose(dN, S["KN"] @ d, rtol=0, atol=1e-12 * np.max(np.abs(dN)))
+        assert np.allclose(dT, S["KT"] @ d, rtol=0, atol=1e-12 * np.max(np.abs(dT)))
+    assert fac.factorizations >= 2 and fac.updates >= 4 and fac.rejected == 0
+
+
+def test_coupled_update_falls_back_when_singular_or_inaccurate(monkeypatch):
+    """An update that makes J singular returns None, as the direct solve does; an update whose
+    capacitance matrix is too ill-conditioned, or whose residual is not at round-off, is
+    replaced by a new factorization — the direct path's direction, bit for bit."""
+    pb = _coupled_problem()
+    meth = NewtonMethod()
+    S = meth._coupled_system(pb)
+    n, mu = pb.n, pb.mu
+    rng = np.random.default_rng(3)
+    # contact at 4 nodes only, every node sticking: J regular
+    contact = np.zeros(n, dtype=bool)
+    contact[n // 2 - 2:n // 2 + 2] = True
+    stick = np.ones(n, dtype=bool)
+    sign = np.zeros(n)
+    fac = newton_module._CoupledFactors(S)
+    phi = rng.standard_normal(S["N"])
+    assert fac.direction(contact, stick, sign, mu, phi) is not None
+    # separating those 4 nodes (4 changed rows: an update) leaves no row with a δ̂ entry
+    none = np.zeros(n, dtype=bool)
+    assert NewtonMethod._coupled_direction(S, none, stick, sign, mu, phi) is None
+    assert fac.direction(none, stick, sign, mu, phi) is None
+    assert fac.updates == 0
+    # the checks reject every update: refactor, the direct path's direction exactly
+    for attr, value in (("MAX_CONDITION", 0.0), ("MAX_RESIDUAL", 0.0)):
+        fac = newton_module._CoupledFactors(S)
+        with monkeypatch.context() as mp:
+            mp.setattr(newton_module._CoupledFactors, attr, value)
+            patterns = _coupled_patterns(n, rng)[:3]
+            for c, s, g in patterns:
+                phi = rng.standard_normal(S["N"])
+                d = fac.direction(c, s, g, mu, phi)[0]
+                assert np.array_equal(d, NewtonMethod._coupled_direction(S, c, s, g, mu, phi))
+        assert fac.rejected == 2 and fac.updates == 0
+
+
+@pytest.mark.parametrize("scene_changes, direct_below", [
+    ({"discretization.distance": 1.0}, 0),  # goodman-bentall shortened, 81 nodes: reuse forced on
+    ({"discretization.elements": 80, "discretization.step": 0.5, "discretization.distance": 1.0,
+      "load.start_steps": 10, "contact.friction": 0.6}, None),  # 161 nodes, μ = 0.6
+], ids=["goodman-bentall", "mu-0.6"])
+def test_coupled_reuse_same_run_as_direct(monkeypatch, scene_changes, direct_below):
+    """Whole coupled runs with the factorization reused and with the direct solve every
+    iteration: the same iterations and backtracks at every rolling step, tractions equal to
+    round-off, and the reuse really taken (Woodbury updates counted)."""
+    scene = rollqp.load_scene("goodman-bentall").replace(**scene_changes)
+    made = []
+    init = newton_module._CoupledFactors.__init__
+    with monkeypatch.context() as mp:
+        mp.setattr(newton_module._CoupledFactors, "__init__", lambda self, S: init(self, S) or made.append(self))
+        if direct_below is not None:
+            mp.setattr(newton_module._CoupledFactors, "DIRECT_BELOW", direct_below)
+        fast = rollqp.run(scene, method="newton").arrays()
+    with monkeypatch.context() as mp:
+        mp.setattr(NewtonMethod, "coupled_reuse", False)
+        plain = rollqp.run(scene, method="newton").arrays()
+    roll = made[-1]  # the rolling steps' operator (the start's is another: its own Δq)
+    assert roll.updates > 10 * roll.factorizations
+    # the start (braked, many backtracks onto kinks) may take another path through a kink
+    # by round-off (see test_coupled_transient_same_iterates_as_full_solve); the rolling steps not
     assert np.array_equal(fast["iterations"][1:], plain["iterations"][1:])
     assert np.array_equal(fast["backtracks"][1:], plain["backtracks"][1:])
     mu, p0 = scene.contact.friction, scene.p0

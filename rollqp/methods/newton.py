@@ -25,7 +25,9 @@ pseudo-Jacobian of the ``min``/``Proj`` rows chosen node by node (eq. 82–90, t
 "modified" linear choice on the kinks). ``J`` is never formed: the identity rows (separated
 and slipping nodes) are eliminated and the rest is solved on the free nodes
 (:meth:`_System.direction`, LAPACK ``getrf``/``getrs``), reusing the last factorization
-through a small Schur complement while the active set moves by a few nodes. Step length (eq. 75–79): ``α = ρ^m`` (``s = 1``), the first
+through a small Schur complement while the active set moves by a few nodes; the coupled step
+reuses its LU likewise, by a Woodbury update of the rows whose node case changed
+(:class:`_CoupledFactors`). Step length (eq. 75–79): ``α = ρ^m`` (``s = 1``), the first
 ``m`` with ``θ(z + αd) <= (1 − 2σα) θ(z)``, ``θ = ½‖Φ‖²``. Along the search line only the
 ``min``/``Proj`` are re-evaluated: the linear parts ``r ĝ``, ``r ŝ`` move by ``α K d`` with
 ``K d`` computed once per iteration.
@@ -272,6 +274,214 @@ class _System:
         return d
 
 
+class _CoupledFactors:
+    r"""LU factors of one coupled pseudo-Jacobian ``J_f``, reused for nearby ones (Woodbury).
+
+    The rows of the coupled ``J`` (:meth:`NewtonMethod._coupled_jacobian`) take one of a few
+    kinds per node: the ``p̂_i`` row is ``K_N`` (contact) or ``e_i`` (separated); the ``t̂_i``
+    row is ``K_T`` (stick), ``e_{n+i} − σμ(e_i − K_N)`` (slip, ``σ = ±1``) or ``e_{n+i}`` (zero
+    bound); the load rows never change. ``J_f`` is factored on its free rows only (the reduced
+    system of :meth:`NewtonMethod._coupled_direction`, identity rows eliminated), which is a
+    factorization of the whole ``J_f``:
+
+    .. math::
+        J_f^{-1} b:\quad x_P = b_P, \qquad M x_F = b_F - R_{F,P}\, b_P .
+
+    A later ``J`` differs from ``J_f`` in the rows ``C`` of the nodes whose case changed,
+    ``J = J_f + E_C\,\Delta R`` (``E_C`` unit columns), and is solved on the old factors by the
+    Sherman–Morrison–Woodbury formula
+
+    .. math::
+        J^{-1} b = y - Z\,(I + \Delta R\, Z)^{-1} \Delta R\, y, \qquad y = J_f^{-1} b,\;
+        Z = J_f^{-1} E_C ,
+
+    whose columns ``J_f⁻¹ e_c`` are kept per row ``c`` until the next factorization (a drifting
+    case pattern costs triangular solves only for rows new to it). ``J`` is refactored when
+    ``|C|`` exceeds :attr:`UPDATE_FRACTION` of the factored size (at least :attr:`UPDATE_MIN`
+    rows), when the factored system is small (:attr:`UPDATE_MIN_SIZE`), when the capacitance
+    matrix ``I + ΔR Z`` is ill-conditioned (:attr:`MAX_CONDITION`), or when the updated
+    direction's residual ``‖J d + Φ‖`` is not at round-off; a fresh factorization gives the
+    direct path's direction exactly (same matrix, same LAPACK calls).
+    """
+
+    __slots__ = ("S", "n", "N", "kind", "mu", "free", "pinned", "posF", "posP", "lu", "piv", "Rp", "cols",
+                 "factorizations", "updates", "rejected", "scale")
+
+    #: Largest number of changed rows solved by the Woodbury update, as a fraction of the factored
+    #: (free) size, at least :attr:`UPDATE_MIN`; beyond, refactor. Measured (median rolling step of
+    #: benchmarks/coupled_scaling.py's scene, 321 / 641 nodes): 0.03 → 7.1 / 44.7 ms (refactors
+    #: nearly every step), 0.0625 → 2.07 / 12.1 ms, 0.125 → 2.34 / 13.0 ms, 0.25 → 3.5 ms,
+    #: 0.5 → 4.2 ms (321 nodes; the k × k capacitance and k new columns grow); the rolling
+    #: pattern drifts by ~30 rows (median; 90 % ≤ 50) from the factored one at 321 nodes.
+    UPDATE_FRACTION = 0.0625
+    UPDATE_MIN = 8
+    #: Below this many free unknowns a new factorization is as cheap as the update.
+    UPDATE_MIN_SIZE = 48
+    #: Below this many unknowns (``N``) every direction is solved directly
+    #: (:meth:`NewtonMethod._coupled_direction`): the bookkeeping costs more than the LU.
+    #: Measured (same scene, direct / updated): 41 nodes 0.28 / 0.44 ms, 81 nodes 0.54 /
+    #: 0.60 ms, 101 nodes 0.72 / 0.70 ms, 121 nodes 0.94 / 0.78 ms.
+    DIRECT_BELOW = 200
+    #: Largest condition number of the capacitance matrix accepted.
+    MAX_CONDITION = 1e8
+    #: Largest accepted ‖J d + Φ‖∞ / (‖Φ‖∞ + ‖J‖∞‖d‖∞) of an updated direction (round-off is ~1e-15).
+    MAX_RESIDUAL = 1e-10
+
+    def __init__(self, S):
+        self.S, self.n, self.N = S, S["KN"].shape[0], S["N"]
+        self.kind = None
+        self.mu = None
+        self.factorizations = self.updates = self.rejected = 0
+        self.scale = 1.0 + max(float(np.max(np.sum(np.abs(S["KN"]), axis=1))),
+                               float(np.max(np.sum(np.abs(S["KT"]), axis=1))))
+
+    @staticmethod
+    def kinds(S, contact, stick, slip_sign):
+        """Row kind codes (length ``N``): p rows 0 identity / 1 ``K_N``; t rows 0 identity /
+        2 ``K_T`` / 3 slip σ = +1 / 4 slip σ = −1; load rows 5."""
+        n = contact.size
+        k = np.full(S["N"], 5, dtype=np.int8)
+        k[:n] = contact
+        k[n:2 * n] = np.where(stick, 2, np.where(slip_sign > 0, 3, np.where(slip_sign < 0, 4, 0)))
+        return k
+
+    def rows(self, idx, kind):
+        """The rows ``idx`` of ``J`` with the kinds ``kind`` (dense, ``len(idx) × N``)."""
+        S, n, mu = self.S, self.n, self.mu
+        out = np.zeros((idx.size, self.N))
+        for code in np.unique(kind).tolist():
+            w = np.flatnonzero(kind == code)
+            r = idx[w]
+            if code == 0:
+                out[w, r] = 1.0
+            elif code == 1:
+                out[w] = S["KN"][r]
+            elif code == 2:
+                out[w] = S["KT"][r - n]
+            elif code == 5:
+                out[w] = S["J0"][r]
+            else:  # slip: e_t − σμ(e_p − K_N), assembled as in _coupled_direction
+                i = r - n
+                sm = (1.0 if code == 3 else -1.0) * mu
+                sl = sm * S["KN"][i]
+                sl[np.arange(i.size), i] -= sm
+                sl[np.arange(i.size), n + i] += 1.0
+                out[w] = sl
+        return out
+
+    def _factor(self, kind, mu):
+        """Factor ``J`` of the row kinds ``kind`` on its free rows; ``False`` if singular."""
+        self.mu = mu
+        free = np.flatnonzero(kind != 0)
+        pinned = np.flatnonzero(kind == 0)
+        R = self.rows(free, kind[free])
+        self.kind, self.free, self.pinned = kind, free, pinned
+        self.posF = np.full(self.N, -1)
+        self.posF[free] = np.arange(free.size)
+        self.posP = np.full(self.N, -1)
+        self.posP[pinned] = np.arange(pinned.size)
+        self.Rp = R[:, pinned]
+        self.cols = {}
+        self.lu = None
+        self.factorizations += 1
+        if free.size:
+            lu, piv, info = dgetrf(np.asfortranarray(R[:, free]), overwrite_a=True)
+            if info != 0:
+                self.kind = None
+                return False
+            self.lu, self.piv = lu, piv
+        return True
+
+    def _solve(self, b):
+        """``J_f⁻¹ b`` (``b`` of length ``N``)."""
+        x = np.empty(self.N)
+        x[self.pinned] = b[self.pinned]
+        if self.free.size:
+            rhs = b[self.free] - self.Rp @ x[self.pinned]
+            sol, info = dgetrs(self.lu, self.piv, rhs)
+            if info != 0:
+                return None
+            x[self.free] = sol
+        return x
+
+    def _columns(self, C):
+        """``Z = J_f⁻¹ E_C``, from the kept columns, computing the missing ones together."""
+        miss = [c for c in C.tolist() if c not in self.cols]
+        if miss:
+            miss = np.array(miss)
+            m = miss.size
+            X = np.zeros((self.N, m))
+            B = np.zeros((self.free.size, m), order="F")
+            inF = self.posF[miss] >= 0
+            jF, jP = np.flatnonzero(inF), np.flatnonzero(~inF)
+            B[self.posF[miss[jF]], jF] = 1.0
+            X[miss[jP], jP] = 1.0
+            if jP.size and self.free.size:
+                B[:, jP] = -self.Rp[:, self.posP[miss[jP]]]
+            if self.free.size:
+                sol, info = dgetrs(self.lu, self.piv, B)
+                if info != 0:
+                    return None
+                X[self.free] = sol
+            for j, c in enumerate(miss.tolist()):
+                self.cols[c] = X[:, j]
+        return np.column_stack([self.cols[c] for c in C.tolist()])
+
+    def direction(self, contact, stick, slip_sign, mu, phi):
+        """``(d, K_N d, K_T d)`` with ``J d = −Φ``; ``None`` if ``J`` is singular (see the class)."""
+        S = self.S
+        if self.N < self.DIRECT_BELOW:
+            d = NewtonMethod._coupled_direction(S, contact, stick, slip_sign, mu, phi)
+            return None if d is None else (d, S["KN"] @ d, S["KT"] @ d)
+        kind = self.kinds(S, contact, stick, slip_sign)
+        C = None
+        if self.kind is not None and mu == self.mu:
+            C = np.flatnonzero(kind != self.kind)
+            if C.size and (C.size > max(self.UPDATE_MIN, self.UPDATE_FRACTION * self.free.size)
+                           or self.free.size < self.UPDATE_MIN_SIZE):
+                C = None
+        if C is None or C.size == 0:
+            if C is None and not self._factor(kind, mu):
+                return None
+            d = self._solve(-phi)
+            return None if d is None else (d, S["KN"] @ d, S["KT"] @ d)
+        y = self._solve(-phi)
+        Z = self._columns(C)
+        if y is None or Z is None:
+            return None
+        dR = self.rows(C, kind[C]) - self.rows(C, self.kind[C])
+        cap = dR @ Z
+        cap[np.diag_indices_from(cap)] += 1.0
+        d = None
+        if np.all(np.isfinite(cap)) and np.linalg.cond(cap) <= self.MAX_CONDITION:
+            d = y - Z @ np.linalg.solve(cap, dR @ y)
+            dN, dT = S["KN"] @ d, S["KT"] @ d
+            if self._residual(kind, d, dN, dT, phi) <= self.MAX_RESIDUAL * (
+                    np.max(np.abs(phi)) + self.scale * np.max(np.abs(d))):
+                self.updates += 1
+                return d, dN, dT
+        self.rejected += 1  # refactor at this J: the direct path's direction
+        if not self._factor(kind, mu):
+            return None
+        d = self._solve(-phi)
+        return None if d is None else (d, S["KN"] @ d, S["KT"] @ d)
+
+    def _residual(self, kind, d, dN, dT, phi):
+        """``‖J d + Φ‖∞`` from ``K_N d`` and ``K_T d``."""
+        n, S = self.n, self.S
+        kp, kt = kind[:n], kind[n:2 * n]
+        dp, dt = d[:n], d[n:2 * n]
+        sig = np.where(kt == 3, 1.0, -1.0) * self.mu
+        Jd = np.empty(self.N)
+        Jd[:n] = np.where(kp == 1, dN, dp)
+        Jd[n:2 * n] = np.where(kt == 2, dT, np.where(kt == 0, dt, dt - sig * (dp - dN)))
+        loads = np.arange(2 * n, self.N)
+        if loads.size:
+            Jd[loads] = S["J0"][loads] @ d
+        r = Jd + phi
+        return float(np.max(np.abs(r))) if np.all(np.isfinite(r)) else np.inf
+
+
 class NewtonMethod:
     r"""GNMls for one uncoupled step (paper §4, eq. 74–90); see the module docstring.
 
@@ -303,6 +513,10 @@ class NewtonMethod:
 
     name = "newton"
     operator = "exact"  # the driver asks: the collocation operator itself, not F⁻¹ sym(F A)
+    #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
+    #: (:class:`_CoupledFactors`); ``False`` solves a new reduced system every iteration
+    #: (:meth:`_coupled_direction`, the reference the tests compare with).
+    coupled_reuse = True
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, r: float | None = None,
                  rho: float = 0.9, sigma: float = 0.1):
@@ -603,6 +817,9 @@ class NewtonMethod:
         ``y_N = r_N ĝ`` and ``y_T = r_T ŝ`` are linear in ``z``; the friction bound is
         ``b = μ max(0, p̂ − y_N)`` (eq. 63), so a slipping node's row depends on ``p̂`` and ``ĝ``
         (eq. 88). Start: the previous step (warm), else one N–T sweep of the two halves.
+        Directions: :class:`_CoupledFactors` (one LU reused across iterations and steps through
+        a Woodbury update of the rows whose node case changed), or with ``coupled_reuse``
+        false :meth:`_coupled_direction` (a new reduced system per iteration, the reference).
         """
         sc = pb.scales
         n = pb.n
@@ -629,6 +846,10 @@ class NewtonMethod:
         if iQ is not None:
             z[iQ] = (x0 if x0 is not None else 0.0) / sc.slip
         fhat = S["fhat"]
+        factors = S["factors"].get("lu")
+        if factors is None:
+            factors = S["factors"]["lu"] = _CoupledFactors(S)
+        counts = (factors.factorizations, factors.updates)
 
         def residual(p, t, yN, yT):
             b = mu * np.maximum(0.0, p - yN)
@@ -694,11 +915,16 @@ class NewtonMethod:
                 stick[j] = True
                 slip_sign[j] = 0.0
                 shifts += 1
-            d = self._coupled_direction(S, contact, stick, slip_sign, mu, phi)  # reduced system
+            if self.coupled_reuse:  # reduced system, LU reused across iterations and steps
+                out = factors.direction(contact, stick, slip_sign, mu, phi)
+                d, dN, dT = out if out is not None else (None, None, None)
+            else:  # the direct path (reference): a new reduced system every iteration
+                d = self._coupled_direction(S, contact, stick, slip_sign, mu, phi)
+                if d is not None:
+                    dN, dT = KN @ d, KT @ d
             if d is None or not np.all(np.isfinite(d)):
                 raise SolverError("the coupled Newton matrix is singular",
                                   method=self.name, status="singular", iterations=it, residual=nrm)
-            dN, dT = KN @ d, KT @ d
             dp, dt = d[:n], d[n:2 * n]
             theta = merits[-1]
             alpha = 1.0
@@ -729,6 +955,9 @@ class NewtonMethod:
         info = {"r": (S["rN"], S["rT"]), "backtracks": backtracks, "merit": merits[-1], "history": history,
                 "merits": merits, "steps": steps, "nonmonotone": sweeps, "sweeps": sweeps, "shifts": shifts,
                 "tolerance_phi": stop, "start": start}
+        if self.coupled_reuse:
+            info["factorizations"] = factors.factorizations - counts[0]
+            info["updates"] = factors.updates - counts[1]
         return self._finish(sol, it, info, t0)
 
     def _sweep(self, pb, z, S):
@@ -771,7 +1000,9 @@ class NewtonMethod:
         The rows of :meth:`_coupled_jacobian` for ``p̂_i`` of a separated node and for ``t̂_i`` of
         a node with a zero bound are identity rows, so ``d = −Φ`` there; the rest (contact
         pressures, tractions under a positive bound, ``δ̂``, ``ξ̂``) is assembled directly,
-        row by row, and solved (LAPACK ``gesv``). Returns ``None`` if it is singular.
+        row by row, and solved (LAPACK ``gesv``). Returns ``None`` if it is singular. The
+        reference path (``coupled_reuse = False``) and :class:`_CoupledFactors`' solve on small
+        systems; otherwise the iteration reuses factorizations (:class:`_CoupledFactors`).
         """
         n = contact.size
         KN, KT = S["KN"], S["KT"]
@@ -861,7 +1092,8 @@ class NewtonMethod:
             if iQ is not None:
                 J0[iQ, n:2 * n] = fhat
             hit = {"src": (pb.Ann, pb.Att, pb.Ant, pb.Atn, pb.f), "N": N, "iP": iP, "iQ": iQ, "KN": KN,
-                   "KT": KT, "J0": J0, "fhat": fhat, "rN": rN, "rT": rT, "dqh": dqh}
+                   "KT": KT, "J0": J0, "fhat": fhat, "rN": rN, "rT": rT, "dqh": dqh,
+                   "factors": {}}  # the _CoupledFactors of this operator, made by _solve_coupled
             if len(self._cache) >= 16:
                 self._cache.clear()
             self._cache[key] = hit
