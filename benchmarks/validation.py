@@ -41,7 +41,8 @@ from rollqp.driver import Model
 # CONTACT's inputs (refdata README) and its problem as a scene: rollqp._refcases, one copy with
 # the tests.
 from rollqp._refcases import (E_CONTACT, FN_CONTACT, G_CONTACT, MU_CONTACT, NU_CONTACT,  # noqa: E402,F401
-                              RATIO_CONTACT as RATIO, REFDATA, contact_scene)
+                              RATIO_CONTACT as RATIO, REFDATA, contact_scene, convergence_errors)
+from rollqp.report import rms_in_contact  # noqa: E402
 
 QP_BACKENDS = ("qp-osqp", "qp-clarabel", "qp-cvxpy")
 #: The generalized Newton method (issue 3), run beside the QPs as a cross-check where present.
@@ -58,9 +59,6 @@ def read_table(name):
     return np.genfromtxt(REFDATA / name, delimiter=",", names=True)
 
 
-def rms_in_contact(x, a, err):
-    m = np.abs(x) <= a
-    return float(np.sqrt(np.mean(err[m] ** 2)))
 
 
 def slope(n, err):
@@ -320,21 +318,6 @@ def section_contact_grid(full=False):
 
 # =========================================================================== convergence
 CONV_ELEMENTS = (10, 20, 40, 80)
-
-
-def convergence_errors(element, n, method="qp-osqp"):
-    """Errors against Hertz and Cattaneo (state 0 of a braked start) and Carter (steady)."""
-    base = rollqp.load_scene("cattaneo-carter")
-    s = base.replace(**{"discretization.elements": n, "discretization.element": element,
-                        "discretization.distance": 0.0, "solver.method": method})
-    r = rollqp.run(s).arrays()
-    x, a, p0, mu, R = r["x"], s.a_H, s.p0, s.contact.friction, s.R
-    out = {"hertz": rms_in_contact(x, a, r["pn"][0] - cf.hertz_pressure(x, a, p0)) / p0,
-           "cattaneo": rms_in_contact(x, a, r["pt"][0] - cf.cattaneo_traction(x, a, p0, mu, RATIO)) / (mu * p0)}
-    r = rollqp.run(s.replace(**{"load.start": "rolling"})).arrays()
-    out["carter"] = rms_in_contact(x, a, r["pt"][0] - cf.carter_traction(x, a, p0, mu, RATIO, -1)) / (mu * p0)
-    out["creepage"] = abs(float(r["creepage"][0]) / cf.carter_creepage(a, R, mu, RATIO) - 1)
-    return out
 
 
 def section_convergence():

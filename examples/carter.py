@@ -28,6 +28,7 @@ import numpy as np
 
 import rollqp
 from rollqp import closedforms as cf
+from rollqp.report import rms_in_contact
 from rollqp.problem import STICK
 
 #: Load ratios Q/(μP) whose tractions are drawn and checked.
@@ -36,9 +37,6 @@ RATIOS = (0.25, 0.5, 0.75, 0.95)
 CURVE = (0.05, 0.1, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.75, 0.8, 0.9, 0.95)
 
 
-def rms_in_contact(x, a, err):
-    """Root mean square of ``err`` over the nodes with |x| ≤ a (as ``rollqp run`` reports)."""
-    return float(np.sqrt(np.mean(err[np.abs(x) <= a] ** 2)))
 
 
 def steady(ratio, method="newton", elements=None):

@@ -25,15 +25,13 @@ import numpy as np
 
 import rollqp
 from rollqp import closedforms as cf
+from rollqp.report import rms_in_contact
 from rollqp.problem import STICK
 
 #: Load ratios Q/(μP) of the braked starts.
 RATIOS = (0.25, 0.5, 0.75, 0.95)
 
 
-def rms_in_contact(x, a, err):
-    """Root mean square of ``err`` over the nodes with |x| ≤ a (as ``rollqp run`` reports)."""
-    return float(np.sqrt(np.mean(err[np.abs(x) <= a] ** 2)))
 
 
 def braked_start(ratio, method="newton", elements=None):

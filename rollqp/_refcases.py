@@ -13,6 +13,9 @@ Two problems for which CONTACT (Vollebregt & Kalker), the field's reference code
   steady state, Δq = Le; :func:`bentall_contact_grid` puts it on CONTACT's grid (216 constant
   elements of DX = 0.001 mm from XL = −0.108 mm, CHI = 180°, i.e. rollqp's d = +1).
 
+:func:`convergence_errors` is the paper's §6.1.1 problem on a refined mesh against Hertz,
+Cattaneo and Carter (docs/validation.md, "Convergence").
+
 One copy of each, so that the tests (tests/test_contact.py, tests/test_bentall.py) and the
 benchmarks that print docs/validation.md (benchmarks/validation.py, benchmarks/bentall.py)
 always describe the same problem.
@@ -22,7 +25,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .scene import Scene, scene_from_dict
+from . import closedforms as cf
+from .report import rms_in_contact
+from .scene import Scene, load_scene, scene_from_dict
 
 #: CONTACT's result files: ``$ROLLQP_CONTACT_REFDATA`` or ``../shared/refdata/contact`` beside
 #: the checkout.
@@ -82,3 +87,26 @@ def bentall_contact_grid(mu, coupling, dx=CONTACT_DX, method="newton") -> Scene:
     n = int(round(-2 * CONTACT_XL / dx))
     s = bentall_scene(mu, elements=n, coupling=coupling, direction=+1, method=method)
     return s.replace(**{"discretization.zone": -CONTACT_XL / s.a_H})
+
+
+# ---------------------------------------------------------------- convergence (§6.1.1)
+def convergence_errors(element, n, method="qp-osqp") -> dict:
+    """Errors on ``n`` elements of §6.1.1 (zone ±1.25 a_H, so a_H is an element edge for every
+    ``n`` used; Δq = Le/2): Hertz and Cattaneo at q = 0 of a braked start with no rolling
+    (distance 0), Carter and its creepage in steady rolling (``start = "rolling"``); rms over
+    ``|x| <= a_H``, in p0 and μp0, and ``|ξ/ξ_Carter − 1|``."""
+    base = load_scene("cattaneo-carter")
+    s = base.replace(**{"discretization.elements": n, "discretization.element": element,
+                        "discretization.distance": 0.0, "solver.method": method})
+    from .driver import run
+    r = run(s).arrays()
+    if len(r["q"]) != 1:
+        raise AssertionError("distance 0: the starting state only")
+    x, a, p0, mu, R = r["x"], s.a_H, s.p0, s.contact.friction, s.R
+    ratio = float(r["Q"][0]) / (mu * float(r["P"][0]))  # the scene's Q/(μP), 0.75
+    out = {"hertz": rms_in_contact(x, a, r["pn"][0] - cf.hertz_pressure(x, a, p0)) / p0,
+           "cattaneo": rms_in_contact(x, a, r["pt"][0] - cf.cattaneo_traction(x, a, p0, mu, ratio)) / (mu * p0)}
+    r = run(s.replace(**{"load.start": "rolling"})).arrays()
+    out["carter"] = rms_in_contact(x, a, r["pt"][0] - cf.carter_traction(x, a, p0, mu, ratio, -1)) / (mu * p0)
+    out["creepage"] = abs(float(r["creepage"][0]) / cf.carter_creepage(a, R, mu, ratio) - 1)
+    return out

@@ -6,7 +6,9 @@ import numpy as np
 from . import closedforms as cf
 
 
-def _rms_in_contact(x, a, err):
+def rms_in_contact(x, a, err):
+    """Root mean square of ``err`` over the nodes with ``|x| <= a``: the error measure of every
+    closed-form comparison (the run summary, docs/validation.md, the tests and examples)."""
     m = np.abs(x) <= a
     return float(np.sqrt(np.mean(err[m] ** 2)))
 
@@ -28,7 +30,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     P0 = float(res["P"][0])
     a0 = cf.hertz_half_width(P0, R, scene.Estar)
     p00 = cf.hertz_peak_pressure(P0, a0)
-    out.append(("hertz", _rms_in_contact(x, a0, res["pn"][0] - cf.hertz_pressure(x, a0, p00)) / p0,
+    out.append(("hertz", rms_in_contact(x, a0, res["pn"][0] - cf.hertz_pressure(x, a0, p00)) / p0,
                 "rms(pn - Hertz)/p0 at q = 0"))
     if mu <= 0 or scene.load.tangential is None:
         return out
@@ -36,7 +38,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
         r0 = float(res["Q"][0]) / (mu * P0)
         if 0 < abs(r0) < 1:
             e = res["pt"][0] - cf.cattaneo_traction(x, a0, p00, mu, r0)
-            out.append(("cattaneo", _rms_in_contact(x, a0, e) / (mu * p0), "rms(pt - Cattaneo)/(mu p0) at q = 0"))
+            out.append(("cattaneo", rms_in_contact(x, a0, e) / (mu * p0), "rms(pt - Cattaneo)/(mu p0) at q = 0"))
     q = res["q"]
     qa = q[-1] / a
     tail = q >= q[-1] - 3 * a
@@ -46,7 +48,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
         p01 = cf.hertz_peak_pressure(P1, a1)
         r1 = float(res["Q"][-1]) / (mu * P1)
         e = res["pt"][-1] - cf.carter_traction(x, a1, p01, mu, r1, scene.load.direction)
-        out.append(("carter", _rms_in_contact(x, a1, e) / (mu * p0), f"rms(pt - Carter)/(mu p0) at q = {qa:.2f} a_H"))
+        out.append(("carter", rms_in_contact(x, a1, e) / (mu * p0), f"rms(pt - Carter)/(mu p0) at q = {qa:.2f} a_H"))
         xi = cf.carter_creepage(a1, R, mu, r1)
         if xi != 0:
             out.append(("creepage", abs(float(res["creepage"][-1]) / xi - 1),

@@ -15,13 +15,12 @@ import pytest
 
 import rollqp
 from rollqp import closedforms as cf
+from rollqp._refcases import convergence_errors
+from rollqp.report import rms_in_contact
 
 RATIO = 0.75
 
 
-def rms_in_contact(x, a, err):
-    m = np.abs(x) <= a
-    return float(np.sqrt(np.mean(err[m] ** 2)))
 
 
 def fitted_order(n, err):
@@ -108,21 +107,9 @@ QUANTITIES = ("hertz", "cattaneo", "carter", "creepage")
 
 
 def _errors(element, n):
-    """Errors on n elements (the paper's problem, zone ±1.25 a_H so a_H is an element edge for
-    every n here; Δq = Le/2): Hertz and Cattaneo at q = 0 of a braked start with no rolling
-    (distance 0), Carter and its creepage in steady rolling (start = "rolling")."""
-    base = rollqp.load_scene("cattaneo-carter")
-    s = base.replace(**{"discretization.elements": n, "discretization.element": element,
-                        "discretization.distance": 0.0, "solver.method": "qp-osqp"})
-    r = rollqp.run(s).arrays()
-    assert len(r["q"]) == 1, "distance 0: the starting state only"
-    x, a, p0, mu, R = r["x"], s.a_H, s.p0, s.contact.friction, s.R
-    out = {"hertz": rms_in_contact(x, a, r["pn"][0] - cf.hertz_pressure(x, a, p0)) / p0,
-           "cattaneo": rms_in_contact(x, a, r["pt"][0] - cf.cattaneo_traction(x, a, p0, mu, RATIO)) / (mu * p0)}
-    r = rollqp.run(s.replace(**{"load.start": "rolling"})).arrays()
-    out["carter"] = rms_in_contact(x, a, r["pt"][0] - cf.carter_traction(x, a, p0, mu, RATIO, -1)) / (mu * p0)
-    out["creepage"] = abs(float(r["creepage"][0]) / cf.carter_creepage(a, R, mu, RATIO) - 1)
-    return out
+    """Errors on n elements of §6.1.1 (rollqp._refcases.convergence_errors, one copy with
+    benchmarks/validation.py); raises if the distance-0 run stored more than the starting state."""
+    return convergence_errors(element, n)
 
 
 @pytest.mark.parametrize("element", ["constant", "linear", "quadratic"])

@@ -34,6 +34,7 @@ import pytest
 
 import rollqp
 from rollqp import closedforms as cf
+from rollqp.report import rms_in_contact
 from rollqp.driver import STEADY_TOL
 from rollqp.histories import Constant
 
@@ -56,9 +57,6 @@ SOLVER_TOL = 1e-8
 TRANSIENT_TOL = 1e-7
 
 
-def rms_in_contact(x, a, err):
-    m = np.abs(x) <= a
-    return float(np.sqrt(np.mean(err[m] ** 2)))
 
 
 def similar(**changes):
