@@ -39,20 +39,12 @@ at import, before any heavy work.
 """
 from __future__ import annotations
 
-import os
-
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-             "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")  # libraries loaded later start single-threaded too
-
 import numpy as np  # noqa: E402
-import scipy.linalg  # noqa: E402,F401  (loads scipy's BLAS before the limit is applied)
-from threadpoolctl import threadpool_limits  # noqa: E402
-
-import rollqp  # noqa: E402  (imports clarabel, osqp, cvxpy)
+import rollqp  # noqa: E402
+from rollqp.bench import pin_threads  # noqa: E402
 
 #: BLAS/OpenMP pools limited to one thread for the whole benchmark (kept alive here).
-_THREAD_LIMIT = threadpool_limits(limits=1)
+_THREAD_LIMIT = pin_threads()
 
 import argparse  # noqa: E402
 import sys  # noqa: E402

@@ -78,8 +78,20 @@ DOC = Path("docs") / "performance.md"
 
 
 # ------------------------------------------------------------------------------- machine
+#: Thread-count variables read by BLAS/OpenMP libraries when they load.
+THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
+                    "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+
 def pin_threads():
-    """Limit every BLAS/OpenMP pool to one thread for the rest of the process; the limiter."""
+    """Limit every BLAS/OpenMP pool to one thread for the rest of the process; the limiter.
+
+    The pools already loaded (numpy's and scipy's OpenBLAS, each wheel bundles its own) are
+    limited by threadpoolctl; libraries loaded later start single-threaded through the
+    environment variables (set unless the user set them). Every benchmark calls this once.
+    """
+    for var in THREAD_VARIABLES:
+        os.environ.setdefault(var, "1")
     from threadpoolctl import threadpool_limits
     import scipy.linalg  # noqa: F401  (load scipy's BLAS before the limit is applied)
     return threadpool_limits(limits=1)
