@@ -47,7 +47,7 @@ import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_qp import _ms, _table, machine_table  # noqa: E402
+from bench_qp import _ms, _run_once, _table, machine_table  # noqa: E402
 from coupled_table import goodman_bentall_scene, source_line  # noqa: E402
 
 from rollqp import driver  # noqa: E402
@@ -145,7 +145,7 @@ def measure_steps(scene, steps, methods, repeats):
 
 
 def _ratio_to_clarabel(res):
-    if "qp-clarabel" not in res:
+    if res is None or "qp-clarabel" not in res:  # part A not run, or without Clarabel
         return None
     return float(np.median([wc / wn for wc, wn in zip(res["qp-clarabel"]["walls"], res["newton"]["walls"])]))
 
@@ -204,20 +204,6 @@ def section_b(repeats, methods, stride):
                     "iterations per step", "inner normal + tangential", "backtracks per step", "max residual",
                     "max Δp/p0 / Δt/(μp0)"], rows)
     return head + "\n" + table + "\n", res
-
-
-def _run_once(name):
-    scene = rollqp.load_scene(SCENE)
-    t0, c0 = time.perf_counter(), time.process_time()
-    res = rollqp.run(scene, method=name)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    a = res.arrays()
-    errs = {n: v for n, v, _ in closed_form_errors(a, scene)}
-    st = a["step_time"]
-    return dict(wall=wall, cpu=cpu, influence=float(res.meta["model"].get("influence_seconds", np.nan)),
-                stepping=float(st.sum()), start=float(st[0]), rolling=float(st[1:].sum()),
-                median=float(np.median(st[1:])), max=float(st[1:].max()), iters=int(a["iterations"].sum()),
-                residual=float(a["residual"].max()), carter=errs.get("carter", float("nan")), K=len(st) - 1)
 
 
 def section_c(repeats, qp_repeats, backends):

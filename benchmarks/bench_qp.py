@@ -268,16 +268,20 @@ def section_step_costs(repeats, backends):
     return "\n".join(out)
 
 
-def _run_once(name):
-    scene = rollqp.load_scene(SCENE)
+def _run_once(name, scene_name=SCENE):
+    """One ``rollqp.run`` of the scene: wall and CPU time, stepping time and its parts, iterations,
+    largest residual, Carter's error (also used by bench_newton.py)."""
+    scene = rollqp.load_scene(scene_name)
     t0, c0 = time.perf_counter(), time.process_time()
     res = rollqp.run(scene, method=name)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     arr = res.arrays()
     errs = {n: v for n, v, _ in closed_form_errors(arr, scene)}
-    return dict(wall=wall, cpu=cpu, stepping=float(arr["step_time"].sum()),
-                median=float(np.median(arr["step_time"][1:])), residual=float(arr["residual"].max()),
-                iters=int(arr["iterations"].sum()), carter=errs.get("carter", float("nan")), K=len(arr["q"]) - 1)
+    st = arr["step_time"]
+    return dict(wall=wall, cpu=cpu, influence=float(res.meta["model"].get("influence_seconds", np.nan)),
+                stepping=float(st.sum()), start=float(st[0]), rolling=float(st[1:].sum()),
+                median=float(np.median(st[1:])), max=float(st[1:].max()), residual=float(arr["residual"].max()),
+                iters=int(arr["iterations"].sum()), carter=errs.get("carter", float("nan")), K=len(st) - 1)
 
 
 def section_runs(repeats, backends):
