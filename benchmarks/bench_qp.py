@@ -268,10 +268,10 @@ def section_step_costs(repeats, backends):
     return "\n".join(out)
 
 
-def _run_once(name, scene_name=SCENE):
+def _run_once(name):
     """One ``rollqp.run`` of the scene: wall and CPU time, stepping time and its parts, iterations,
     largest residual, Carter's error (also used by bench_newton.py)."""
-    scene = rollqp.load_scene(scene_name)
+    scene = rollqp.load_scene(SCENE)
     t0, c0 = time.perf_counter(), time.process_time()
     res = rollqp.run(scene, method=name)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
