@@ -42,12 +42,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError, RollqpError, SolverError
+from .errors import InputError, SolverError
 from .influence import build_influence
 from .methods import QP_METHODS, get_method
 from .methods.alternation import Alternation
-from .problem import (is_trusted, trust_matrix, CoupledStep, NormalStep, Scales, StepSolution, TangentialStep, asymmetry, classify,
-                      symmetrized)
+from .problem import (CoupledStep, NormalStep, Scales, StepSolution, TangentialStep, asymmetry, classify,
+                      symmetrized, trust_matrix)
 from .result import Result
 from .scene import Scene, load_scene
 from .strip import Strip
@@ -101,7 +101,8 @@ class Model:
         info["operator"] = "symmetrized" if symmetric else "collocation"
         history = strip.history_operator(d.formulation, scene.dq, scene.load.direction)
         # finite, fixed for the scene: validated once here, read-only from now on (problem.trust_matrix)
-        Ann, Att, Atn, Ant = (None if M is None else _trusted(M) for M in (Ann, Att, infl.Atn, infl.Ant))
+        Ann, Att, Atn, Ant = (None if M is None else trust_matrix(M, "influence")
+                              for M in (Ann, Att, infl.Atn, infl.Ant))
         return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
                    scales=Scales(scene.a_H, scene.p0, scene.Estar), history=history, symmetric=symmetric,
                    info=info)
@@ -201,15 +202,6 @@ class _Step:
 
 #: Methods that solve non-symmetric step problems directly (the steady rolling start).
 DIRECT_STEADY = ("newton", "nt-newton")
-
-
-def _trusted(M: np.ndarray) -> np.ndarray:
-    """``M`` checked finite once and made read-only (:func:`rollqp.problem.trust_matrix`)."""
-    if is_trusted(M):
-        return M
-    if not np.all(np.isfinite(M)):
-        raise RollqpError(f"the influence matrices are not finite (shape {M.shape})")
-    return trust_matrix(M)
 
 
 def _make_method(scene: Scene, name: str):

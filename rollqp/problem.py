@@ -102,8 +102,12 @@ def _vec(name, v, n):
 _CHECKED: "weakref.WeakValueDictionary[int, np.ndarray]" = weakref.WeakValueDictionary()
 
 
-def trust_matrix(a: np.ndarray) -> np.ndarray:
-    """Make ``a`` read-only and skip its finiteness check from now on (it cannot change)."""
+def trust_matrix(a: np.ndarray, name: str = "A") -> np.ndarray:
+    """Check ``a`` finite once, make it read-only, and skip the check from now on (it cannot change)."""
+    if is_trusted(a):
+        return a
+    if not np.all(np.isfinite(a)):
+        raise InputError(name, "must be finite")
     a.flags.writeable = False
     _CHECKED[id(a)] = a
     return a
