@@ -19,9 +19,10 @@ t^{(m−1)})``. Each outer iteration warm-starts both halves from the previous o
 
 The outer iteration is a fixed-point iteration: it converges linearly, with a rate that
 grows with ``|β|`` and ``μ`` (the paper reports about 6 outer iterations for 2β = 1, μ = 0.3;
-``benchmarks/coupled_table.py`` measures it). It is not guaranteed to converge: it raises :class:`~rollqp.errors.SolverError` with the residual
-when it does not within ``max_outer``, and earlier when it stalls or cycles (no 10 % gain of its
-best residual over 20 outer iterations) or diverges (``Alternation._check_progress``).
+``benchmarks/coupled_table.py`` measures it). It is not guaranteed to converge: it raises
+:class:`~rollqp.errors.SolverError` with the residual when it does not within ``max_outer``,
+and earlier when it stalls or cycles (no 10 % gain of its best residual over 20 outer
+iterations) or diverges (``Alternation._check_progress``).
 """
 from __future__ import annotations
 
@@ -95,8 +96,8 @@ class Alternation:
             if (len(history) > 1 and sol.residual <= self.stall_limit
                     and sol.residual >= 0.5 * history[-2]):
                 break  # stalled at the accuracy of the halves (QP solvers)
-            self._check_progress(history)
-            if not np.isfinite(sol.residual) or outer >= self.max_outer:
+            self._check_progress(history)  # raises on a non-finite, diverging or cycling residual
+            if outer >= self.max_outer:
                 raise SolverError(f"the N-T alternation did not converge: coupled residual {sol.residual:.3e} "
                                   f"> {self.limit:.1e} after {outer} outer iterations",
                                   method=self.name, status="outer limit", residual=sol.residual,
@@ -108,7 +109,6 @@ class Alternation:
         sol.info.update(outer=outer, inner_normal=it_n, inner_tangential=it_t, history=history,
                         limit=self.limit)
         return sol
-
 
     def _check_progress(self, history):
         """Stop early when the outer iteration cycles or diverges (it is a fixed-point iteration).
