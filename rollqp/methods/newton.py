@@ -233,12 +233,13 @@ class _System:
         # The columns of Z are kept per node (``cols``): as the set drifts away from the factored
         # one, each step adds a node or two, and only their columns cost triangular solves.
         na = added.size
-        keys = [j for j in added.tolist()] + [-1 - i for i in released.tolist()]
+        keys = added.tolist() + [-1 - i for i in released.tolist()]
         missing = [c for c in keys if c not in cols]
         if missing:
+            order = [c for c in missing if c >= 0] + [c for c in missing if c < 0]  # W's columns
             W = np.zeros((nf0 + with_load, len(missing)), order="F")
-            ma = np.array([c for c in missing if c >= 0], dtype=int)
-            mr = np.array([-1 - c for c in missing if c < 0], dtype=int)
+            ma = np.array([c for c in order if c >= 0], dtype=int)
+            mr = np.array([-1 - c for c in order if c < 0], dtype=int)
             W[:nf0, :ma.size] = K[np.ix_(free0, ma)]
             if with_load:
                 W[nf0, :ma.size] = self.fhat[ma]
@@ -246,7 +247,7 @@ class _System:
             Zm, info = dgetrs(lu, piv, W)
             if info != 0:
                 return None
-            for c, j in zip([c for c in missing if c >= 0] + [c for c in missing if c < 0], range(len(missing))):
+            for j, c in enumerate(order):
                 cols[c] = Zm[:, j]
         Z = np.column_stack([cols[c] for c in keys])
         S = np.empty((k, k))
@@ -272,6 +273,16 @@ class _System:
             d[n] = u[nf0]
         self.updates += 1
         return d
+
+
+def _slip_rows(KN, i, sm):
+    """Rows ``e_{t,i} − σμ (e_{p,i} − K_N[i])`` of the coupled pseudo-Jacobian at slipping nodes
+    ``i`` (eq. 88), with ``sm = σμ`` per node (``n`` = the number of nodes, ``KN.shape[0]``)."""
+    n = KN.shape[0]
+    rows = sm[:, None] * KN[i]
+    rows[np.arange(i.size), i] -= sm
+    rows[np.arange(i.size), n + i] += 1.0
+    return rows
 
 
 class _CoupledFactors:
@@ -360,13 +371,9 @@ class _CoupledFactors:
                 out[w] = S["KT"][r - n]
             elif code == 5:
                 out[w] = S["J0"][r]
-            else:  # slip: e_t − σμ(e_p − K_N), assembled as in _coupled_direction
+            else:  # slip, σ = +1 (3) or −1 (4)
                 i = r - n
-                sm = (1.0 if code == 3 else -1.0) * mu
-                sl = sm * S["KN"][i]
-                sl[np.arange(i.size), i] -= sm
-                sl[np.arange(i.size), n + i] += 1.0
-                out[w] = sl
+                out[w] = _slip_rows(S["KN"], i, np.full(i.size, (1.0 if code == 3 else -1.0) * mu))
         return out
 
     def _factor(self, kind, mu):
@@ -1018,11 +1025,7 @@ class NewtonMethod:
         rows[st] = KT[it_[st]]
         isl = it_[~st]
         if isl.size:
-            sm = (slip_sign[isl] * mu)[:, None]
-            sl = sm * KN[isl]
-            sl[np.arange(isl.size), isl] -= sm[:, 0]
-            sl[np.arange(isl.size), n + isl] += 1.0
-            rows[~st] = sl
+            rows[~st] = _slip_rows(KN, isl, slip_sign[isl] * mu)
         R[ic.size:ic.size + it_.size] = rows
         R[ic.size + it_.size:] = S["J0"][loads]
         d = np.empty(S["N"])
@@ -1046,11 +1049,7 @@ class NewtonMethod:
         J[n + ist] = S["KT"][ist]
         isl = np.flatnonzero(slip_sign)
         if isl.size:
-            sm = (slip_sign[isl] * mu)[:, None]
-            rows = sm * S["KN"][isl]
-            rows[np.arange(isl.size), isl] -= sm[:, 0]
-            rows[np.arange(isl.size), n + isl] += 1.0
-            J[n + isl] = rows
+            J[n + isl] = _slip_rows(S["KN"], isl, slip_sign[isl] * mu)
         return J
 
     def _coupled_system(self, pb):
