@@ -482,9 +482,10 @@ class Scene:
     @property
     def bem_mesh(self) -> tuple[int, int]:
         """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
+        from .influence.bem import DEFAULT_INNER, DEFAULT_OUTER  # one place for the paper's counts
         c = self.contact
-        return (19 if c.bem_outer_elements is None else c.bem_outer_elements,
-                16 if c.bem_inner_elements is None else c.bem_inner_elements)
+        return (DEFAULT_OUTER if c.bem_outer_elements is None else c.bem_outer_elements,
+                DEFAULT_INNER if c.bem_inner_elements is None else c.bem_inner_elements)
 
     def _check_convective_step(self) -> None:
         """Convective-local slip is stable only for Δq up to the node spacing h.
