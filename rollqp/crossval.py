@@ -93,7 +93,7 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
             ref, ref_state = sol, state
         info = sol.info
         inner = f"{info.get('inner_normal', 0)}+{info.get('inner_tangential', 0)}"
-        if not info.get("iterations_reported", True) or (name.startswith("qps-") and inner == "0+0"):
+        if not info.get("iterations_reported", True):
             inner = "—"  # DAQP and HiGHS do not report iterations through qpsolvers
         its = f"{sol.iterations} ({inner})" if "outer" in info else (inner if sf.kind == "uncoupled" else str(sol.iterations))
         rows.append(Row(name, True, residuals=dict(signorini=sol.residuals.signorini, friction=sol.residuals.friction,

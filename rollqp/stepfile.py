@@ -654,7 +654,8 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
         ref = step.reference()
         ref_state = classify(ref.p, ref.t, ref.s, step.mu, sc, tol=max(tol, 1e-7))
     differs = np.flatnonzero(cand_state != ref_state)
-    return CheckReport(step=step.step, kind=step.kind, step_type=step.step_type, given=given, tol=tol, residuals=residuals, failures=failures,
+    return CheckReport(step=step.step, kind=step.kind, step_type=step.step_type, given=given, tol=tol,
+                       residuals=residuals, failures=failures,
                        delta=float(delta) if ("p" in sol) else None, xi=float(xi) if ("t" in sol) else None,
                        fitted=tuple(f for f in fitted if (f == "delta" and "p" in sol) or (f == "xi" and "t" in sol)),
                        comparisons=comparisons, state_differs=differs, states=(cand_state, ref_state), x=step.x,

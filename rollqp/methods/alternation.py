@@ -107,7 +107,10 @@ class Alternation:
         sol.time = time.perf_counter() - t_start
         sol.solver_time = nsol.solver_time + tsol.solver_time
         sol.info.update(outer=outer, inner_normal=it_n, inner_tangential=it_t, history=history,
-                        limit=self.limit)
+                        limit=self.limit,
+                        # inner counts are meaningful only if the halves' solver reports them
+                        iterations_reported=nsol.info.get("iterations_reported", True)
+                        and tsol.info.get("iterations_reported", True))
         return sol
 
     def _check_progress(self, history):
