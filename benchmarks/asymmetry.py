@@ -18,11 +18,11 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 import rollqp
-from rollqp import driver
+from rollqp.operators import SceneOperators
 from rollqp.histories import Constant
 from rollqp.methods import get_method
 from rollqp.methods.alternation import Alternation
-from rollqp.problem import asymmetry
+from rollqp.influence.operator import asymmetry
 
 
 def similar(element, elements):
@@ -41,13 +41,7 @@ def coupled(element, elements):
 
 def run_with(scene, operator):
     """Run ``scene`` with OSQP (alternation if coupled) and the given QP operator."""
-    meth = get_method("qp-osqp", tolerance=scene.solver.tolerance, operator=operator)
-    if scene.coupling_level == "full":
-        meth = Alternation(meth)
-    model = driver.Model.build(scene, symmetric=operator == "symmetrized")
-    result = driver._new_result(scene, model, "qp-osqp")
-    driver._march(scene, model, meth, result, None)
-    return result
+    return rollqp.run(scene, method=get_method("qp-osqp", tolerance=scene.solver.tolerance, operator=operator))
 
 
 def table(make, label):
@@ -59,7 +53,7 @@ def table(make, label):
         for elements in (20, 40, 80):
             scene = make(element, elements)
             mu, p0 = scene.contact.friction, scene.p0
-            model = driver.Model.build(scene, symmetric=False)
+            model = SceneOperators.build(scene)
             asym = asymmetry(model.Ann, model.f)
             ref = rollqp.run(scene, method="newton")
             ex = run_with(scene, "exact")

@@ -43,7 +43,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_qp import _table  # noqa: E402
 
 from rollqp import closedforms as cf  # noqa: E402
-from rollqp import driver  # noqa: E402
+from rollqp import run  # noqa: E402
 
 A_OVER_R = (0.01, 0.02, 0.05, 0.1, 0.2, 0.3)
 SHAFT_RATIOS = (0.1, 0.5, 0.8)
@@ -74,12 +74,12 @@ def study():
     for ratio in SHAFT_RATIOS:
         for aR in A_OVER_R:
             hs = scene_for(aR, ratio, "halfspace")
-            mh = measures(driver.run(hs), hs)
+            mh = measures(run(hs), hs)
             bs = scene_for(aR, ratio, "bem")
-            rb = driver.run(bs)
+            rb = run(bs)
             mb = measures(rb, bs)
             bf = scene_for(aR, ratio, "bem", "full")
-            mf = measures(driver.run(bf), bf)
+            mf = measures(run(bf), bf)
             xi_carter = cf.carter_creepage(hs.a_H, hs.R, hs.contact.friction, RATIO)
             rows.append(dict(shaft=ratio, aR=aR, p=mb[0] / mh[0], a=mb[1] / mh[1], xi=mb[2] / mh[2],
                              xi_full=mf[2] / mh[2], p_full=mf[0] / mh[0],
@@ -124,7 +124,7 @@ def grading_table():
     """
     from rollqp.influence import bem
     base = rollqp.load_scene("cattaneo-carter").replace(**{"solver.method": "newton"})
-    rh = driver.run(base)
+    rh = run(base)
     strip = rollqp.Strip(base.half_width, 40, "quadratic")
     exact = cf.lame_ring_displacement(150.0, 15.0, 150.0, 1.0, base.A.E, base.A.nu)
     keep = bem.MAX_ANGLE_FACTOR
@@ -135,7 +135,7 @@ def grading_table():
             bem._CACHE.clear()
             mesh = bem.annulus_mesh(150.0, 15.0, strip.edges)
             lame = np.max(np.abs(bem.lame_ring(mesh, base.A.nu, 1.0, base.A.E) / exact - 1))
-            rb = driver.run(base.replace(**{"contact.model": "bem"}))
+            rb = run(base.replace(**{"contact.model": "bem"}))
             dt = np.max(np.abs(np.asarray(rb.rows["pt"]) - np.asarray(rh.rows["pt"]))) / (0.1 * base.p0)
             dp = np.max(np.abs(np.asarray(rb.rows["pn"]) - np.asarray(rh.rows["pn"]))) / base.p0
             free = mesh.lengths[40:mesh.n_outer_elements]

@@ -39,7 +39,7 @@ from pathlib import Path  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_qp import _table, machine_table  # noqa: E402
 
-from rollqp import driver  # noqa: E402
+from rollqp import run  # noqa: E402
 from rollqp.influence import bem  # noqa: E402
 
 
@@ -73,7 +73,7 @@ def per_step(scene, methods, repeats):
             bem._CACHE.clear()
             times = {}
             for model in ("halfspace", "bem"):
-                r = driver.run(scene.replace(**{"contact.model": model, "solver.method": m}))
+                r = run(scene.replace(**{"contact.model": model, "solver.method": m}))
                 times[model] = float(np.median(np.asarray(r.rows["step_time"])[1:]))
                 med[model].append(times[model])
             ratios.append(times["bem"] / times["halfspace"])

@@ -50,9 +50,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_qp import _ms, _run_once, _table, machine_table  # noqa: E402
 from coupled_table import goodman_bentall_scene, source_line  # noqa: E402
 
-from rollqp import driver  # noqa: E402
-from rollqp.driver import Model  # noqa: E402
-from rollqp.methods import QP_METHODS  # noqa: E402
+from rollqp.methods import QP_METHODS, scene_method  # noqa: E402
+from rollqp.operators import SceneOperators  # noqa: E402
 from rollqp.problem import StepSolution  # noqa: E402
 from rollqp.report import closed_form_errors  # noqa: E402
 
@@ -68,7 +67,7 @@ TARGET_RUN_C = 0.5        # s, Σ step_time of the §6.1.1 run with Newton, at m
 
 def make_method(name, scene):
     """The method exactly as ``rollqp.run`` makes it for ``scene``."""
-    return driver._make_method(scene, name)
+    return scene_method(scene.replace(**{"solver.method": name}).solver, coupled=scene.coupling_level == "full")
 
 
 # ----------------------------------------------------------------------------------- steps
@@ -85,13 +84,13 @@ def reference_steps(scene, window, stride=1):
     """Step problems of the window built from a ``newton`` run's states, as the driver builds them."""
     res = rollqp.run(scene, method="newton")
     a = res.arrays()
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene)
     q = scene.q_steps / scene.a_H
     ks = np.flatnonzero((q > window[0] + 1e-12) & (q <= window[1] + 1e-12))[::stride]
     steps = []
     for k in ks:
         p, t = a["pn"][k - 1], a["pt"][k - 1]
-        c = -(model.history @ model.w(p, t))
+        c = -(model.history() @ model.w(p, t))
         P, Q = float(scene.normal_load(scene.q_steps[k])), float(scene.tangential_load(scene.q_steps[k]))
         prob = (model.coupled_step(P, c, scene.dq, Q=Q) if model.coupled
                 else model.tangential_step(p, c, scene.dq, Q=Q))

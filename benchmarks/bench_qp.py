@@ -12,7 +12,7 @@ A. **Per-step cost** of a tangential step in the middle of the transient (rolled
    0.5 < q/a_H <= 1.5, where the stick zone is moving) for each QP backend, on 40 quadratic
    elements (81 nodes, the paper's mesh) and on 80 constant elements (80 nodes, exactly
    symmetric F·A: one QP per step). The step is marched here with the public
-   :class:`rollqp.driver.Model` (braked start, then rolling steps, as ``rollqp.run`` does),
+   :class:`rollqp.SceneOperators` (braked start, then rolling steps, as ``rollqp.run`` does),
    and each step's :class:`~rollqp.problem.StepSolution` gives rollqp's wall time
    (``time``), the external solver's own time (``solver_time``) and the number of QPs of the
    symmetric–skew splitting (``info["qp_solves"]``). The backend's native calls are timed
@@ -52,7 +52,7 @@ import time  # noqa: E402
 
 from rollqp import bench as _bench  # noqa: E402
 from rollqp import closedforms as cf  # noqa: E402
-from rollqp.driver import Model  # noqa: E402
+from rollqp.operators import SceneOperators  # noqa: E402
 from rollqp.methods import QP_METHODS, get_method  # noqa: E402
 from rollqp.report import closed_form_errors  # noqa: E402
 
@@ -92,9 +92,9 @@ class Probe:
         self.iterates = []
         solve_form, build = method._solve_form, method._build
 
-        def timed_solve_form(form, x0):
+        def timed_solve_form(form, x0, source=None):
             t0 = time.perf_counter()
-            out = solve_form(form, x0)
+            out = solve_form(form, x0, source)
             self.backend += time.perf_counter() - t0
             self.iterates.append(np.array(out[0], dtype=float))
             self.qps += 1
@@ -115,7 +115,7 @@ def new_method(name, scene, **kw):
 
 
 def march(scene, model, method, k_stop, on_step=None):
-    """Braked start and rolling steps 1..k_stop, as ``rollqp.driver.run`` does.
+    """Braked start and rolling steps 1..k_stop, as ``rollqp.run`` does.
 
     Restricted to what the benchmark needs: β = 0 (or coupling off) and constant loads, so
     the normal step is solved once and each rolling step is one tangential step problem.
@@ -144,7 +144,7 @@ def march(scene, model, method, k_stop, on_step=None):
         w = model.w(p, tsol.t)
     for k in range(1, k_stop + 1):
         t0, c0 = time.perf_counter(), time.process_time()
-        c = -(model.history @ w)
+        c = -(model.history() @ w)
         prob = model.tangential_step(p, c, scene.dq, Q=Q)
         warm = tsol
         tsol = method.solve(prob, warm=warm)
@@ -164,7 +164,7 @@ def window_steps(scene):
 def step_costs(scene, name, symmetric=False, operator="exact", cold=True):
     """Median per-step numbers of the tangential steps in the window, one march (module docstring)."""
     k0, k1 = window_steps(scene)
-    model = Model.build(scene, symmetric=symmetric)
+    model = SceneOperators.build(scene, symmetrized=symmetric)
     meth = new_method(name, scene, operator=operator)
     probe = Probe(meth)
     rows, keep = [], []
@@ -221,7 +221,7 @@ def clarabel_setup_in_solve_time(scene, samples=21):
     the solver object (``DefaultInfo::finalize``, "includes setup"), so on every re-solve of a
     reused object it exceeds the solve's own wall time by that set-up time.
     """
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene)
     form = model.normal_step(float(scene.normal_load(0.0))).qp_form()
     solver = new_method("qp-clarabel", scene)._build(form)
     diffs = []
@@ -295,7 +295,7 @@ def section_runs(repeats, backends):
     scene = rollqp.load_scene(SCENE)
     probe_backend = "qp-osqp" if "qp-osqp" in backends else backends[0]
     qps = []
-    march(scene, Model.build(scene, symmetric=False), new_method(probe_backend, scene), scene.n_steps,
+    march(scene, SceneOperators.build(scene), new_method(probe_backend, scene), scene.n_steps,
           lambda k, prob, warm, sol, times: qps.append((scene.q_steps[k] / scene.a_H, sol.info["qp_solves"])))
     qps = np.array(qps)
     bands = [(0.0, 0.5), (0.5, 1.5), (1.5, 3.0), (3.0, scene.q_steps[-1] / scene.a_H)]
@@ -321,7 +321,7 @@ def section_splitting(repeats, backends):
         for op in ("exact", "symmetrized"):
             sym = op == "symmetrized"
             c = costs[(name, op)]
-            model = Model.build(scene, symmetric=sym)
+            model = SceneOperators.build(scene, symmetrized=sym)
             sol = new_method(name, scene, operator=op).solve(model.normal_step(float(scene.normal_load(0.0))))
             x = model.strip.x
             err = (sol.p - cf.hertz_pressure(x, a, p0)) / p0
@@ -360,7 +360,7 @@ def section_contraction(meshes):
     for element in ("quadratic", "linear", "constant"):
         for ne in meshes:
             scene = base.replace(**{"discretization.element": element, "discretization.elements": ne})
-            model = Model.build(scene, symmetric=False)
+            model = SceneOperators.build(scene)
             A, f = model.Ann, model.f
             FA = f[:, None] * A
             H, S = 0.5 * (FA + FA.T), 0.5 * (FA - FA.T)
@@ -374,7 +374,7 @@ def section_contraction(meshes):
             probe = Probe(meth)
             sol = meth.solve(model.normal_step(P))
             gm, worst = _observed_contraction(probe.iterates)
-            sym_model = Model.build(scene, symmetric=True)
+            sym_model = SceneOperators.build(scene, symmetrized=True)
             sym = new_method("qp-osqp", scene, operator="symmetrized").solve(sym_model.normal_step(P))
             rows.append((element, ne, model.strip.n, f"{np.linalg.norm(A - A.T) / np.linalg.norm(A):.3f}",
                          f"{np.linalg.norm(FA - FA.T) / np.linalg.norm(FA):.2e}", f"{inner:.2f}", f"{rho:.4f}",
@@ -405,7 +405,7 @@ def section_contraction(meshes):
 def section_multipliers(backends):
     """The equality multipliers as δ and ξ: the gap closes and the slip vanishes where they should."""
     scene = rollqp.load_scene(SCENE)
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene)
     sc = model.scales
     k_probe = window_steps(scene)[1]
     rows = []

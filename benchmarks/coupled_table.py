@@ -27,7 +27,7 @@ iterations for the QP alternations), ``backtracks`` (Armijo reductions), ``step_
 The braked start (state 0: 40 normal-load increments) is reported separately.
 
 Then, to explain the differences from the paper's numbers, variants are run through the
-driver's own march (``rollqp.driver._march``, with method objects the registry does not
+march (``rollqp.march``, with method objects the registry does not
 name): the N–T stopping limit, the halves started cold instead of from the previous outer
 iteration, and the augmentation r of the coupled Newton method.
 
@@ -53,8 +53,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_qp import _ms, _table, machine_table  # noqa: E402
 
 from rollqp import bench as _bench  # noqa: E402
-from rollqp import driver  # noqa: E402
-from rollqp.driver import Model  # noqa: E402
+import rollqp  # noqa: E402
+from rollqp.march import new_result  # noqa: E402
+from rollqp.operators import SceneOperators  # noqa: E402
 from rollqp.errors import SolverError  # noqa: E402
 from rollqp.methods.alternation import Alternation  # noqa: E402
 from rollqp.methods.newton import NewtonMethod  # noqa: E402
@@ -141,12 +142,13 @@ class _Recorder:
 
 
 def run_variant(scene, model, method, label):
-    """The driver's march (``rollqp.driver._march``) with a method object the registry does not name."""
+    """``rollqp.march`` with a method object the registry does not name."""
     rec = _Recorder(method)
-    res = driver._new_result(scene, model, label)
+    res = new_result(scene, model, label)
     t0, c0 = time.perf_counter(), time.process_time()
     try:
-        driver._march(scene, model, method, res, None)
+        for r in rollqp.march(scene, method=method):
+            res.add(r)
     except SolverError as err:
         return dict(failed=f"step {len(res)}: {err}", wall=time.perf_counter() - t0, cpu=time.process_time() - c0)
     return _summary(res.arrays(), scene, time.perf_counter() - t0, time.process_time() - c0,
@@ -270,7 +272,7 @@ def bands_table(scene, res, methods):
 
 def variants(scene, repeats):
     """Explanatory variants (module docstring); ``{label: combined run}`` in table order."""
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene)
     tol, its = scene.solver.tolerance, scene.solver.max_iterations
 
     class ColdHalves:
@@ -278,6 +280,10 @@ def variants(scene, repeats):
 
         def __init__(self, inner):
             self.inner, self.tolerance, self.name = inner, inner.tolerance, "cold halves"
+            self.solves, self.operator = inner.solves, inner.operator
+
+        def setup(self, operators):
+            self.inner.setup(operators)
 
         def solve(self, problem, warm=None):
             return self.inner.solve(problem, warm=None)
@@ -327,7 +333,7 @@ def variants_table(scene, var, ref, model):
 def accounting(scene, model, repeats):
     """Where the rolling steps' time goes, coupled Newton against N–T with Newton halves.
 
-    One march each through the driver (``rollqp.driver._march``) with the method's ``solve``
+    One march each (``rollqp.march``) with the method's ``solve``
     (and, for N–T, the inner Newton method's ``solve``) wrapped on the instance to sum their wall
     time over the rolling steps; medians over ``repeats`` marches.
     """
@@ -336,7 +342,7 @@ def accounting(scene, model, repeats):
     def one(kind):
         inner = NewtonMethod(tolerance=tol, max_iterations=its)
         meth = inner if kind == "coupled" else Alternation(inner, max_outer=its)
-        res = driver._new_result(scene, model, kind)
+        res = new_result(scene, model, kind)
         acc = dict(solve=0.0, halves=0.0, half_calls=0, half_its=0, its=0)
         outer_solve, inner_solve = meth.solve, inner.solve
 
@@ -362,7 +368,8 @@ def accounting(scene, model, repeats):
         else:
             inner.solve = timed_inner
             meth.solve = timed_outer
-        driver._march(scene, model, meth, res, None)
+        for r in rollqp.march(scene, method=meth):
+            res.add(r)
         acc["step"] = float(res.arrays()["step_time"][1:].sum())
         return acc
 
@@ -455,7 +462,7 @@ def main(argv=None) -> int:
     jobs = {m: (lambda m=m: run_public(scene, m)) for m in methods}
     res = {m: combine(v) for m, v in interleaved(jobs, {m: (qreps if m.startswith("qp-") else reps)
                                                         for m in methods}).items()}
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene)
     rN, rT = default_r(scene, model)
     print(f"### Goodman → Bentall: {label}\n")
     print(scene_line(scene) + f"; `rollqp.run(scene, method=m)`; means over the {scene.n_steps} rolling steps "

@@ -35,7 +35,7 @@ from threadpoolctl import threadpool_limits
 
 import rollqp
 from rollqp import closedforms as cf
-from rollqp.driver import Model
+from rollqp.operators import SceneOperators
 
 
 # CONTACT's inputs (refdata README) and its problem as a scene: rollqp._refcases, one copy with
@@ -347,8 +347,8 @@ def section_splitting():
     rows = []
     for el in ("linear", "quadratic"):
         for n in CONV_ELEMENTS:
-            m = Model.build(base.replace(**{"discretization.elements": n, "discretization.element": el}),
-                            symmetric=False)
+            m = SceneOperators.build(base.replace(**{"discretization.elements": n, "discretization.element": el}),
+                            symmetrized=False)
             FA = m.f[:, None] * m.Att
             H, S = 0.5 * (FA + FA.T), 0.5 * (FA - FA.T)
             w, V = np.linalg.eigh(H)

@@ -30,7 +30,7 @@ import cvxpy as cp
 import numpy as np
 
 import rollqp
-from rollqp.driver import Model
+from rollqp.operators import SceneOperators
 
 #: Clarabel's tolerances for the joint QP (cvxpy's defaults are 1e-8: never trust them for a comparison).
 TOL = 1e-12
@@ -40,7 +40,7 @@ def model(elements=80):
     scene = rollqp.load_scene("cattaneo-carter").replace(**{
         "discretization.element": "constant", "discretization.elements": elements,
         "discretization.distance": 0.0})
-    return scene, Model.build(scene, symmetric=False)
+    return scene, SceneOperators.build(scene)
 
 
 def two_qps(m, P, Q, dq, method):
@@ -54,7 +54,7 @@ def joint_qp(m, mu, P, Q, dq):
     """One QP over (p̂, t̂) on {p̂ >= 0, |t̂| <= μp̂}; returns p̂, t̂, δ̂ and Δq̂·ξ̂ (its multipliers)."""
     sc = m.scales
     u0, fh, dqh = sc.displacement, m.f / sc.length, dq / sc.length
-    Ah = m.Ann * sc.modulus / sc.length
+    Ah = m.Ann.dense() * (sc.modulus / sc.length)
     H = fh[:, None] * Ah                      # F̂Â: exactly symmetric for constant elements (tested)
     p, t = cp.Variable(fh.size), cp.Variable(fh.size)
     # E = ½p̂ᵀF̂Âp̂ + (F̂ĥ)ᵀp̂ + ½t̂ᵀF̂Ât̂ (c = 0: unloaded bodies before the shift; β = 0)
@@ -77,7 +77,7 @@ def measure(ratio, elements=80):
     gh = m.h / sc.displacement - dh + Ah @ ph          # ĝ of the joint QP
     sh = dqxi / dqh + (Ah @ th) / dqh                  # ŝ of the joint QP
     contact = ph > 1e-6
-    FA = m.f[:, None] * m.Ann
+    FA = m.f[:, None] * m.Ann.dense()
     slipping = contact & (np.abs(sh) > 1e-6)
     return {
         "ratio": ratio,

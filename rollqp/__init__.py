@@ -6,8 +6,9 @@ holds the other to account (González & Abascal 2002; see ``docs/``).
 
 Public API
 ----------
-load_scene, builtin_scenes, Scene        scenes (SPEC.md)
-run, Model                               the transient driver
+load_scene, builtin_scenes, Scene        scenes (docs/scenes.md)
+march, run, StepRecord                   the transient: a stream of step records, or a Result
+SceneOperators                           what a scene's transient needs, built once
 Result, load_result                      result files
 Strip                                    strip discretization
 halfspace_influence, Influence           influence matrices
@@ -28,7 +29,8 @@ from .problem import (NormalStep, Residuals, Scales, StepSolution, TangentialSte
 from .result import Result, load_result
 from .scene import Scene, builtin_scenes, load_scene
 from .strip import Strip
-from .driver import Model, run
+from .operators import SceneOperators
+from .march import StepRecord, march, run
 
 
 def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> StepSolution:
@@ -41,7 +43,7 @@ def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> S
     return get_method(method, **settings).solve(problem, warm=warm)
 
 
-__all__ = ["load_scene", "builtin_scenes", "Scene", "run", "Model", "Result", "load_result", "Strip",
+__all__ = ["load_scene", "builtin_scenes", "Scene", "march", "run", "StepRecord", "SceneOperators", "Result", "load_result", "Strip",
            "halfspace_influence", "Influence", "NormalStep", "TangentialStep", "Scales", "StepSolution",
            "Residuals", "classify", "compare", "solve_step", "get_method", "available_methods",
            "closedforms", "InputError", "SolverError", "RollqpError", "MissingBackendError"]

@@ -98,7 +98,7 @@ def convergence_errors(element, n, method="qp-osqp") -> dict:
     base = load_scene("cattaneo-carter")
     s = base.replace(**{"discretization.elements": n, "discretization.element": element,
                         "discretization.distance": 0.0, "solver.method": method})
-    from .driver import run
+    from .march import run
     r = run(s).arrays()
     if len(r["q"]) != 1:
         raise AssertionError("distance 0: the starting state only")

@@ -200,7 +200,7 @@ def _short(exc) -> str:
 def timed_run(scene, method, label="", repeats=3, budget=2.0, keep=True) -> Run:
     """Run ``scene`` with ``method`` up to ``repeats`` times (stopping once ``budget`` seconds
     are spent, at least once); medians of the times. Never raises: failures are recorded."""
-    from .driver import run as drive
+    from .march import run as drive
 
     out = Run(method=method, label=label)
     stepping, steps, walls = [], [], []

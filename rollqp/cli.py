@@ -82,7 +82,7 @@ def _progress(quiet):
 
 
 def cmd_run(args) -> int:
-    from . import driver
+    from .march import run
     from .plot import plot_result
     from .report import summary
     from .scene import load_scene
@@ -96,7 +96,7 @@ def cmd_run(args) -> int:
     cb, close = _progress(args.quiet)
     t0 = time.perf_counter()
     try:
-        result = driver.run(scene, progress=cb)
+        result = run(scene, progress=cb)
     except Exception as err:
         partial = getattr(err, "partial", None)
         if partial is not None and len(partial):

@@ -35,12 +35,12 @@ The residuals (:class:`Residuals`) are the max-norms of
 from __future__ import annotations
 
 import dataclasses
-import weakref
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .errors import InputError
+from .influence.operator import Operator, as_operator, asymmetry, split  # noqa: F401 - re-exported
 
 # Node states in result files (SPEC.md): 0 separation, 1 stick, 2 slip.
 SEPARATION, STICK, SLIP = 0, 1, 2
@@ -95,40 +95,6 @@ def _vec(name, v, n):
     return a
 
 
-#: Read-only matrices already validated (by identity). A scene's influence matrices are built
-#: once and made read-only (:meth:`rollqp.driver.Model.build`); every step problem and every
-#: half of an N–T alternation reuses them, so their O(n²) finiteness check is done once, not
-#: per step (at 2561 nodes it cost ~5 ms a step).
-_CHECKED: "weakref.WeakValueDictionary[int, np.ndarray]" = weakref.WeakValueDictionary()
-
-
-def trust_matrix(a: np.ndarray, name: str = "A") -> np.ndarray:
-    """Check ``a`` finite once, make it read-only, and skip the check from now on (it cannot change)."""
-    if is_trusted(a):
-        return a
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite")
-    a.flags.writeable = False
-    _CHECKED[id(a)] = a
-    return a
-
-
-def is_trusted(M) -> bool:
-    """``M`` was validated by :func:`trust_matrix` and is still read-only."""
-    return isinstance(M, np.ndarray) and not M.flags.writeable and _CHECKED.get(id(M)) is M
-
-
-def _mat(name, M, n):
-    if is_trusted(M) and M.shape == (n, n):
-        return M
-    a = np.asarray(M, dtype=float)
-    if a.shape != (n, n):
-        raise InputError(name, f"must have shape ({n}, {n}), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite")
-    return a
-
-
 def _set_weights(step) -> int:
     """Validate a step's weights ``f`` (1-D, finite, all > 0), store them, return ``n``."""
     n = np.asarray(step.f).shape[0] if np.ndim(step.f) == 1 else -1
@@ -147,29 +113,18 @@ def _exactly_one(names, values):
         raise InputError(" / ".join(names), f"give exactly one of {' or '.join(names)} (got {len(given)})")
 
 
-def split(A: np.ndarray, f: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
-    """``(asymmetry, F⁻¹ sym(F A), F⁻¹ skew(F A))``: the symmetric–skew splitting of ``A``.
+def friction_residual(t, s, bound):
+    """``t − Proj_[−b, b](t − s)`` (eq. 60): zero iff ``|t| <= b`` and ``t`` opposes the slip ``s``.
 
-    ``F A = sym + skew`` with ``F = diag(f)``; the QP Hessian is ``sym(F A)`` (FORMULATION.md §7)
-    and the exact-collocation QP backends iterate on the skew part. The asymmetry is
-    ``‖FA − (FA)ᵀ‖_F / ‖FA‖_F``. For an exactly symmetric ``F A`` the symmetric part is ``A``
-    itself (no copy).
+    The one expression of the friction law's projection residual: rollqp's residuals use it with
+    nondimensional ``t̂, ŝ, b̂``; the Newton method with ``r ŝ`` in place of ``ŝ`` (eq. 56, 63).
     """
-    FA = f[:, None] * A
-    skew = 0.5 * (FA - FA.T)
-    asym = float(np.linalg.norm(skew) * 2 / np.linalg.norm(FA))
-    Asym = (FA - skew) / f[:, None] if asym > 0 else A
-    return asym, Asym, skew / f[:, None]
+    return t - np.clip(t - s, -bound, bound)
 
 
-def symmetrized(A: np.ndarray, f: np.ndarray) -> np.ndarray:
-    """``F⁻¹ sym(F A)``: the operator whose weighted form is the QP Hessian (FORMULATION.md §7)."""
-    return split(A, f)[1]
-
-
-def asymmetry(A: np.ndarray, f: np.ndarray) -> float:
-    """``‖FA − (FA)ᵀ‖_F / ‖FA‖_F``."""
-    return split(A, f)[0]
+def symmetrized(A, f: np.ndarray) -> Operator:
+    """``F⁻¹ sym(F A)``: the operator whose weighted form is the QP Hessian (docs/formulation.md §7)."""
+    return as_operator(A).split(f).sym
 
 
 @dataclass(frozen=True)
@@ -246,7 +201,7 @@ class NormalStep:
 
     def __post_init__(self):
         n = _set_weights(self)
-        object.__setattr__(self, "A", _mat("A", self.A, n))
+        object.__setattr__(self, "A", as_operator(self.A, "A", n))
         object.__setattr__(self, "h", _vec("h", self.h, n))
         if self.offset is not None:
             object.__setattr__(self, "offset", _vec("offset", self.offset, n))
@@ -275,6 +230,18 @@ class NormalStep:
         """The same problem with ``A`` replaced by ``F⁻¹ sym(F A)`` (what a QP solves)."""
         return self.replace(A=symmetrized(self.A, self.f))
 
+    def traction(self, sol: "StepSolution"):
+        """The unknown traction of this problem in a solution: the pressure ``p``."""
+        return sol.p
+
+    def shifted(self, extra: np.ndarray) -> "NormalStep":
+        """The same problem with ``extra`` (displacement units) added to the gap: ``o + extra``."""
+        return self.replace(offset=extra if self.offset is None else self.offset + extra)
+
+    def evaluate(self, sol: "StepSolution") -> "StepSolution":
+        """``sol``'s pressure and approach re-evaluated on this problem (rollqp's residuals)."""
+        return self.solution(sol.p, sol.delta)
+
     def residuals(self, p, delta) -> "Residuals":
         """rollqp's residuals of ``(p, δ)``: ``‖min(p̂, ĝ)‖∞`` (eq. 51–52), load row (eq. 67)."""
         sc = self.scales
@@ -290,7 +257,7 @@ class NormalStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        Ah = self.A * sc.modulus / sc.length
+        Ah = self.A.dense() * (sc.modulus / sc.length)
         FA = fh[:, None] * Ah
         H = 0.5 * (FA + FA.T)
         q = fh * self.h_total / sc.displacement
@@ -353,7 +320,7 @@ class TangentialStep:
 
     def __post_init__(self):
         n = _set_weights(self)
-        object.__setattr__(self, "A", _mat("A", self.A, n))
+        object.__setattr__(self, "A", as_operator(self.A, "A", n))
         object.__setattr__(self, "p", _vec("p", self.p, n))
         object.__setattr__(self, "c", _vec("c", self.c, n))
         if not (np.isfinite(self.mu) and self.mu >= 0):
@@ -391,12 +358,24 @@ class TangentialStep:
         """The same problem with ``A`` replaced by ``F⁻¹ sym(F A)`` (what a QP solves)."""
         return self.replace(A=symmetrized(self.A, self.f))
 
+    def traction(self, sol: "StepSolution"):
+        """The unknown traction of this problem in a solution: the shear ``t``."""
+        return sol.t
+
+    def shifted(self, extra: np.ndarray) -> "TangentialStep":
+        """The same problem with ``extra`` (displacement units) added to the history: ``c + extra``."""
+        return self.replace(c=self.c + extra)
+
+    def evaluate(self, sol: "StepSolution") -> "StepSolution":
+        """``sol``'s traction and creepage re-evaluated on this problem (rollqp's residuals)."""
+        return self.solution(sol.t, sol.xi)
+
     def residuals(self, t, xi) -> "Residuals":
         """rollqp's residuals of ``(t, ξ)``: ``‖t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)‖∞`` (eq. 60), load row (eq. 67)."""
         sc = self.scales
         s = self.slip(t, xi)
         th, sh, bh = t / sc.stress, s / sc.slip, self.bound / sc.stress
-        fr = th - np.clip(th - sh, -bh, bh)
+        fr = friction_residual(th, sh, bh)
         load = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
         return Residuals(friction=float(np.max(np.abs(fr))), load_tangential=abs(float(load)))
 
@@ -408,7 +387,7 @@ class TangentialStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        Ah = self.A * sc.modulus / sc.length
+        Ah = self.A.dense() * (sc.modulus / sc.length)
         dqh = self.dq / sc.length
         FA = fh[:, None] * Ah / dqh
         H = 0.5 * (FA + FA.T)
@@ -471,7 +450,7 @@ class CoupledStep:
     Notes
     -----
     ``Atn`` and ``Att`` are the *slip* operators: for transient steps the influence matrices
-    themselves; for steady rolling (``s = ξ e + d·D_up w``) the driver passes
+    themselves; for steady rolling (``s = ξ e + d·D_up w``) rollqp.march passes
     ``Δ·d·D_up·A_tn`` and ``Δ·d·D_up·A_tt`` with ``dq = Δ`` and ``c = 0``.
     """
 
@@ -494,10 +473,10 @@ class CoupledStep:
     def __post_init__(self):
         n = _set_weights(self)
         for name in ("Ann", "Att"):
-            object.__setattr__(self, name, _mat(name, getattr(self, name), n))
+            object.__setattr__(self, name, as_operator(getattr(self, name), name, n))
         for name in ("Ant", "Atn"):
             if getattr(self, name) is not None:
-                object.__setattr__(self, name, _mat(name, getattr(self, name), n))
+                object.__setattr__(self, name, as_operator(getattr(self, name), name, n))
         object.__setattr__(self, "h", _vec("h", self.h, n))
         object.__setattr__(self, "c", _vec("c", self.c, n))
         if not (np.isfinite(self.mu) and self.mu >= 0):
@@ -554,7 +533,7 @@ class CoupledStep:
         sig = np.minimum(p / sc.stress, g / sc.displacement)
         th, sh = t / sc.stress, s / sc.slip
         bh = self.mu * np.maximum(p, 0.0) / sc.stress
-        fr = th - np.clip(th - sh, -bh, bh)
+        fr = friction_residual(th, sh, bh)
         ln = 0.0 if self.P is None else (self.f @ p - self.P) / sc.force
         lt = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
         return Residuals(signorini=float(np.max(np.abs(sig))), friction=float(np.max(np.abs(fr))),

@@ -39,6 +39,23 @@ class Result:
         for k, v in vals.items():
             self.rows[k].append(np.array(v, copy=True))
 
+    def add(self, rec) -> None:
+        """Append the state of a :class:`~rollqp.march.StepRecord` (``rec.k`` must be ``len(self)``)."""
+        if rec.k != len(self):
+            raise ValueError(f"record {rec.k} appended as state {len(self)}")
+        st, c, tsol = rec.state, rec.counters, rec.state.tsol
+        if rec.gross_sliding:  # possible with a prescribed creepage beyond the sliding creepage
+            self.meta.setdefault("gross_sliding", []).append(rec.k)
+        if rec.k == 0 and rec.phase == "steady":
+            self.meta["rolling_start"] = "direct steady solve"
+        elif rec.k == 0 and rec.phase == "rolling":
+            self.meta["rolling_start"] = "marching to steady state"
+        self.append(q=rec.q, pn=st.p, pt=st.t, slip=tsol.s, gap=st.nsol.g, state=rec.nodes, P=rec.P,
+                    Q=rec.Q,
+                    creepage=tsol.xi, approach=st.nsol.delta, shift=rec.shift, iterations=c.iterations,
+                    step_time=rec.step_time, residual=c.residual, inner_normal=c.inner_normal,
+                    inner_tangential=c.inner_tangential, backtracks=c.backtracks)
+
     def __len__(self):
         return len(self.rows["q"])
 

@@ -21,7 +21,7 @@ Every invalid input is an :class:`~rollqp.errors.InputError` naming the dotted k
 Besides the per-key ranges, a scene is checked as a whole (FORMULATION.md §1, §9):
 
 * the normal load stays >= 0 over the rolled distance; where it is 0 the bodies are out of
-  contact (the driver records an unloaded state, :func:`rollqp.driver.run`) and Q must be 0;
+  contact (the driver records an unloaded state, :func:`rollqp.run`) and Q must be 0;
 * the largest Hertz half-width, a_H·sqrt(max P/P̄), stays clear of the zone's edges by at
   least three quarters of an element: a_H·sqrt(max P/P̄) < L·(1 − 1.5/elements), L = zone·a_H
   (the element length is 2L/elements);
@@ -55,7 +55,7 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 
 from .errors import InputError
 from .histories import Constant, History, parse_history
-from .methods import METHOD_NAMES
+from .methods import METHOD_NAMES, check_name
 
 __all__ = ["METHODS", "MODELS", "COUPLINGS", "STARTS", "ELEMENT_TYPES", "FORMULATION_TYPES",
            "Body", "Contact", "Load", "Discretization", "SolverSettings", "Scene",
@@ -214,10 +214,12 @@ class SolverSettings:
         One of :data:`METHODS`.
     tolerance : float
         Nondimensional residual tolerance, in [1e-15, 1e-2].
-    max_iterations : int
+    max_iterations : int or None
         Iteration limit per step, ``>= 1``: Newton iterations (``newton``; each half of
-        ``nt-newton``) and outer N–T iterations (``nt-newton``, and the ``qp-*`` methods on a
-        coupled scene). The QP solvers keep their own iteration limits.
+        ``nt-newton``), outer N–T iterations (``nt-newton``, and the QP methods on a coupled
+        scene), and the QP solver's own iterations per QP (the ``qp-*`` and ``qps-*`` methods).
+        None (default): each method's own limit (Newton 200, N–T 200 outer iterations, the QP
+        solvers' defaults).
     augmentation : float or None
         The Newton methods' nondimensional augmentation ``r`` of ``min(p, r g)`` and
         ``Proj(t − r s)`` (FORMULATION.md §5), the same for the normal and the tangential rows,
@@ -230,7 +232,7 @@ class SolverSettings:
 
     method: str = "newton"
     tolerance: float = 1e-10
-    max_iterations: int = 200
+    max_iterations: int | None = None
     augmentation: float | None = None
 
 
@@ -345,11 +347,11 @@ def _check_solver(s: Any) -> SolverSettings:
     if not isinstance(s, SolverSettings):
         raise InputError("solver", f"must be a SolverSettings, got {s!r}")
     return SolverSettings(
-        method=_choice("solver.method", s.method, METHODS),
+        method=check_name(s.method, "solver.method"),
         tolerance=_number("solver.tolerance", s.tolerance, "in [1e-15, 1e-2]",
                           lambda x: 1e-15 <= x <= 1e-2),
-        max_iterations=_integer("solver.max_iterations", s.max_iterations, ">= 1",
-                                lambda n: n >= 1),
+        max_iterations=None if s.max_iterations is None else _integer(
+            "solver.max_iterations", s.max_iterations, ">= 1 or absent (each method's default)", lambda n: n >= 1),
         augmentation=None if s.augmentation is None else _number(
             "solver.augmentation", s.augmentation,
             f"in [{AUGMENTATION_MIN:g}, {AUGMENTATION_MAX:g}] or absent (automatic)",

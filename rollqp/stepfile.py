@@ -27,7 +27,6 @@ pressure. ``kind = "coupled"``: ``A_nt ≠ 0``, a quasi-variational inequality, 
 """
 from __future__ import annotations
 
-import dataclasses
 import json
 import os
 from dataclasses import dataclass, field
@@ -35,8 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError, SolverError
-from .problem import (SEPARATION, SLIP, STICK, CoupledStep, Scales, StepSolution, classify,
-                      symmetrized)
+from .problem import SEPARATION, SLIP, STICK, CoupledStep, Scales, StepSolution, classify, friction_residual
 
 FORMAT = "rollqp-step/1"
 #: Default pass/fail limit of :func:`check_step` on each nondimensional residual.
@@ -55,42 +53,6 @@ _STATE = {SEPARATION: "separation", STICK: "stick", SLIP: "slip"}
 SOLUTION_KEYS = ("p", "t", "delta", "xi")
 
 
-class _Stop(Exception):
-    """Raised from the progress callback once step K is recorded."""
-
-
-class _Recorder:
-    """Wraps the scene's method; keeps the last two step records (one per tangential/coupled solve)."""
-
-    def __init__(self, inner, model, target):
-        self.inner, self.model, self.target = inner, model, target
-        self.normal = None  # (problem, solution) of the last normal solve
-        self.state = (None, np.zeros(model.strip.n), None, None)  # (p, t, delta, xi) before the next solve
-        self.records = []
-        self.snapshot = None
-
-    def __getattr__(self, attr):
-        return getattr(self.inner, attr)
-
-    def solve(self, problem, warm=None):
-        sol = self.inner.solve(problem, warm=warm)
-        if problem.kind == "normal":
-            self.normal = (problem, sol)
-            return sol
-        prev = self.state
-        if problem.kind == "coupled":
-            self.state = (sol.p, sol.t, sol.delta, sol.xi)
-        else:
-            self.state = (problem.p, sol.t, self.normal[1].delta, sol.xi)
-        self.records = (self.records + [(problem, sol, self.normal, prev)])[-2:]
-        return sol
-
-    def progress(self, k, K):
-        if k == max(self.target, 1):
-            self.snapshot = self.records[-1] if self.target == k else self.records[-2]
-            raise _Stop
-
-
 def export_step(scene, k: int, method: str | None = None) -> "StepFile":
     """March ``scene`` to step ``k`` with ``method`` (default Newton) and return its :class:`StepFile`.
 
@@ -104,56 +66,51 @@ def export_step(scene, k: int, method: str | None = None) -> "StepFile":
         Method that marches the scene to step ``k`` (default ``"newton"``, whatever the
         scene's ``[solver].method``); its solution of step ``k`` is stored as ``ref_*``.
     """
-    from . import driver
+    from .march import march, prepare
     from .scene import Scene, load_scene
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene "
                                    f"{scene.name!r}, got {k!r}")
     method = method or "newton"
-    box = {}
-
-    def observe(model, meth):
-        box["rec"] = _Recorder(meth, model, int(k))
-        return box["rec"]
-
-    try:
-        driver.run(scene, method=method, observe=observe, progress=lambda i, n: box["rec"].progress(i, n))
-    except _Stop:
-        pass
-    rec = box["rec"]
-    snap = rec.snapshot or rec.records[-1]
-    return _from_record(scene, rec.model, int(k), method, *snap)
+    prepared = prepare(scene, method)
+    for rec in march(scene, prepared=prepared):
+        if rec.k == k:
+            break
+    if rec.problem is None:
+        raise InputError("--step", f"step {k} of scene {scene.name!r} is out of contact (P = 0): nothing is solved there")
+    return _from_record(prepared[0], prepared[2], int(k), method, rec)
 
 
-def _from_record(scene, model, k, method, problem, sol, normal, prev):
-    n = model.strip.n
-    steady = (problem.Att if problem.kind == "coupled" else problem.A) is not model.Att
-    step_type = "rolling" if k > 0 else "steady" if steady else (
-        "static-shift" if scene.load.start == "braked" else "rolling")
+def _from_record(scene, ops, k, method, rec):
+    n = ops.n
+    problem, sol = rec.problem, rec.solution
     if problem.kind == "coupled":
         pb = problem
         ref = sol
     else:  # uncoupled: the normal half in effect and this tangential half, as one CoupledStep
-        npb, nsol = normal
-        Atn = model.Atn if problem.A is model.Att else model.steady_operators()[0]
+        npb, nsol = rec.normal
+        Atn = ops.steady()[0] if rec.phase == "steady" else ops.Atn
         c = problem.c if Atn is None else problem.c - Atn @ problem.p
         pb = CoupledStep(Ann=npb.A, Att=problem.A, Ant=None, Atn=Atn, f=problem.f, h=npb.h_total, mu=problem.mu,
                          c=c, dq=problem.dq, P=npb.P, delta=npb.delta, Q=problem.Q, xi=problem.xi,
                          scales=problem.scales)
         ref = pb.solution(nsol.p, sol.t, nsol.delta, sol.xi)
     zero = np.zeros((n, n))
-    pp, pt, pd, px = prev
+    prev = rec.previous
+    pd = None if prev.nsol is None else prev.nsol.delta
+    px = None if prev.tsol is None else prev.tsol.xi
+    dense = lambda M: zero if M is None else np.asarray(M)  # noqa: E731
     return StepFile(
         step=k, q=float(scene.q_steps[k]), n_steps=scene.n_steps, kind="coupled" if pb.Ant is not None else "uncoupled",
-        x=model.strip.x.copy(), f=pb.f, h=pb.h, mu=pb.mu, dq=pb.dq, c=pb.c, A_nn=pb.Ann, A_tt=pb.Att,
-        A_nt=pb.Ant if pb.Ant is not None else zero, A_tn=pb.Atn if pb.Atn is not None else zero,
+        x=ops.strip.x.copy(), f=pb.f, h=pb.h, mu=pb.mu, dq=pb.dq, c=pb.c, A_nn=dense(pb.Ann), A_tt=dense(pb.Att),
+        A_nt=dense(pb.Ant), A_tn=dense(pb.Atn),
         P=pb.P, Q=pb.Q, delta=pb.delta, xi=pb.xi, a_H=pb.scales.length, p0=pb.scales.stress,
         Estar=pb.scales.modulus,
-        prev_p=np.zeros(n) if pp is None else np.asarray(pp, float), prev_t=np.asarray(pt, float),
+        prev_p=np.zeros(n) if prev.p is None else np.asarray(prev.p, float), prev_t=np.asarray(prev.t, float),
         prev_delta=np.nan if pd is None else float(pd), prev_xi=np.nan if px is None else float(px),
         ref_p=ref.p, ref_t=ref.t, ref_delta=float(ref.delta), ref_xi=float(ref.xi), ref_method=method,
-        ref_residual=float(ref.residual), step_type=step_type, scene=scene.to_dict())
+        ref_residual=float(ref.residual), step_type=rec.phase, scene=scene.to_dict())
 
 
 # ------------------------------------------------------------------------------ the file
@@ -254,7 +211,7 @@ class StepFile:
             hp = pb.normal_half(self.ref_t) if half == "normal" else pb.tangential_half(self.ref_p)
             form = hp.symmetrized().qp_form()
             den = form.obj_scale * (1.0 if half == "normal" else hp.dq / sc.length)
-            M = fh[:, None] * hp.A * (sc.modulus / sc.length) / den
+            M = fh[:, None] * hp.A.dense() * (sc.modulus / sc.length) / den
             skew = 0.5 * (M - M.T)
             other = self.A_nt if half == "normal" else self.A_tn
             coupling = fh[:, None] * other * (sc.stress / sc.displacement) / den
@@ -380,17 +337,14 @@ def clarabel_json(arrays: dict, half: str) -> dict:
     (:func:`~rollqp.methods.qp_clarabel.clarabel_tolerances` for tolerance 1e-10).
     """
     import scipy.sparse as sp
-    from .methods.qp_clarabel import clarabel_tolerances
+
+    from .methods.qp_clarabel import clarabel_rows, clarabel_settings
+    from .problem import QPForm
     g = lambda k: arrays[f"{half}_qp_{k}"]  # noqa: E731
-    H, q, lb, ub, Aeq, beq = g("P"), g("q_frozen"), g("lb"), g("ub"), g("A"), g("b")
-    n = q.size
-    fixed = lb == ub
-    up = np.flatnonzero(np.isfinite(ub) & ~fixed)
-    lo = np.flatnonzero(np.isfinite(lb) & ~fixed)
-    fx = np.flatnonzero(fixed)
-    I = np.eye(n)
-    A = np.vstack([Aeq, I[fx], I[up], -I[lo]])
-    b = np.concatenate([beq, lb[fx], ub[up], -lb[lo]])
+    Aeq, beq = g("A"), g("b")
+    form = QPForm(H=g("P"), q=g("q_frozen"), lower=g("lb"), upper=g("ub"), a=Aeq[0] if Aeq.shape[0] else None,
+                  b=float(beq[0]) if Aeq.shape[0] else None, obj_scale=1.0, eq_scale=1.0, kind=half)
+    A, b, cones = clarabel_rows(form)
 
     def csc(M):
         M = sp.csc_matrix(M)
@@ -398,31 +352,26 @@ def clarabel_json(arrays: dict, half: str) -> dict:
         return {"m": int(M.shape[0]), "n": int(M.shape[1]), "colptr": M.indptr.tolist(),
                 "rowval": M.indices.tolist(), "nzval": M.data.tolist()}
 
-    gap, feas = clarabel_tolerances(1e-10)
-    return {"P": csc(sp.triu(H)), "q": q.tolist(), "A": csc(A), "b": b.tolist(),
-            "cones": [{"ZeroConeT": int(Aeq.shape[0] + fx.size)}, {"NonnegativeConeT": int(up.size + lo.size)}],
-            "settings": {"verbose": False, "presolve_enable": False, "tol_gap_abs": gap, "tol_gap_rel": gap,
-                         "tol_feas": feas, "tol_ktratio": min(1e-6, gap), "iterative_refinement_reltol": 1e-14,
-                         "iterative_refinement_abstol": 1e-14}}
+    settings = clarabel_settings(1e-10)
+    settings.pop("iterative_refinement_max_iter")
+    return {"P": csc(sp.triu(form.H)), "q": form.q.tolist(), "A": csc(A), "b": b.tolist(),
+            "cones": [{name: int(m)} for name, m in cones], "settings": settings}
 
 
 # ------------------------------------------------------------------------------ solving stored steps
 def solve_stored(step: StepFile, method: str, tolerance: float = 1e-10) -> StepSolution:
     """Solve a stored step with any rollqp method, warm-started from the previous state.
 
-    Uncoupled steps: the normal half, then the tangential half at its pressure (as the driver
+    Uncoupled steps: the normal half, then the tangential half at its pressure (as the march
     does). Coupled steps: Newton on the coupled problem; ``nt-newton`` and the QP backends by
     the N–T alternation (paper §6.3). ``info`` holds ``iterations_normal`` and
     ``iterations_tangential`` (inner iterations) besides the method's own.
     """
-    from .methods import QP_METHODS, get_method
-    from .methods.alternation import Alternation
+    from .methods import compose, get_method
     pb = step.problem()
-    meth = get_method(method, tolerance=tolerance)
+    meth = compose(get_method(method, tolerance=tolerance), pb.Ant is not None)
     warm = step.previous() if np.any(step.prev_p) else None  # none before the first load increment
     if pb.Ant is not None:
-        if method in QP_METHODS:
-            meth = Alternation(meth, max_outer=200)
         sol = meth.solve(pb, warm=warm)
         sol.info.setdefault("inner_normal", 0)
         sol.info.setdefault("inner_tangential", 0)
@@ -621,7 +570,7 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
             reasons = ["negative pressure" if ph[i] < -tol else "penetration (g < 0)" if gh[i] < -tol
                        else "pressure with the gap open" for i in nodes]
         elif c == "friction":
-            r = th - np.clip(th - sh, -bh, bh)
+            r = friction_residual(th, sh, bh)
             nodes = np.flatnonzero(np.abs(r) > tol)
             reasons = ["|t| above the bound mu p" if abs(th[i]) > bh[i] + tol
                        else "slips below the bound (should stick)" if abs(th[i]) < bh[i] - tol

@@ -209,3 +209,27 @@ def builtin_scene():
         scene = rollqp.load_scene(name)
         return scene.replace(**changes) if changes else scene
     return load
+
+
+# ------------------------------------------------------------------------------- method wrappers
+class Delegate:
+    """A step method that delegates to ``inner`` (the :class:`rollqp.methods.base.Method` protocol);
+    subclasses override :meth:`solve` to spy on or to break the inner method. Passed to
+    :func:`rollqp.run` as the method object, it is composed and set up like any method."""
+
+    def __init__(self, inner):
+        self.inner = inner
+        self.name, self.operator, self.tolerance = inner.name, inner.operator, inner.tolerance
+        self.solves = inner.solves
+
+    def setup(self, operators):
+        self.inner.setup(operators)
+
+    def solve(self, problem, warm=None):
+        return self.inner.solve(problem, warm=warm)
+
+
+def scene_method_of(scene, name=None):
+    """The method ``name`` (default the scene's) built from ``scene``'s solver settings, not composed."""
+    from rollqp.methods import method_class
+    return method_class(name or scene.solver.method).from_settings(scene.solver)

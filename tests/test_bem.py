@@ -15,7 +15,6 @@ import pytest
 
 import rollqp
 from rollqp import closedforms as cf
-from rollqp import driver
 from rollqp.errors import InputError
 from rollqp.influence import bem
 from rollqp.influence.bem import annulus_mesh, bem_influence, contact_compliance, lame_ring
@@ -162,7 +161,7 @@ def test_hertz_small_contact(element):
 
 def _runs(**changes):
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"solver.method": "newton", **changes})
-    return sc, driver.run(sc), driver.run(sc.replace(**{"contact.model": "bem"}))
+    return sc, rollqp.run(sc), rollqp.run(sc.replace(**{"contact.model": "bem"}))
 
 
 def test_transient_matches_halfspace():
@@ -185,11 +184,7 @@ def _symmetrized_run(sc):
     OSQP, not Clarabel: Clarabel stops at a residual of 1.9e-7 (above its 1e-8 limit) at step 58
     of the BEM run.
     """
-    meth = get_method("qp-osqp", tolerance=sc.solver.tolerance, operator="symmetrized")
-    model = driver.Model.build(sc, symmetric=True)
-    res = driver._new_result(sc, model, "qp-osqp")
-    driver._march(sc, model, meth, res, None)
-    return res
+    return rollqp.run(sc, method=get_method("qp-osqp", tolerance=sc.solver.tolerance, operator="symmetrized"))
 
 
 def _max_diff(r1, r2, sc):
@@ -201,19 +196,19 @@ def _max_diff(r1, r2, sc):
 def test_asymmetry_and_qp_vs_newton():
     """F·A of the BEM is symmetric to discretization error; QP (exact and sym(F A)) vs Newton."""
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "discretization.distance": 3.0})
-    newton = driver.run(sc.replace(**{"solver.method": "newton"}))
+    newton = rollqp.run(sc.replace(**{"solver.method": "newton"}))
     info = newton.meta["model"]
     # measured 9.5e-4 (A_nn) and 1.6e-4 (A_tt); the half-space's QCE: 1.1e-3 (FORMULATION.md §7)
     assert 0 < info["asymmetry_FA"] < 5e-3 and 0 < info["asymmetry_FAtt"] < 5e-3
     # the default QP operator solves the collocation problem (symmetric-skew splitting): the same
     # solution to the backends' accuracy (conftest BACKENDS: 5e-9 each; measured 9e-11)
-    qp = driver.run(sc.replace(**{"solver.method": "qp-osqp"}))
+    qp = rollqp.run(sc.replace(**{"solver.method": "qp-osqp"}))
     assert max(_max_diff(qp, newton, sc)) < 1e-8
     # the QP on sym(F A) alone solves a different problem: on QCE a checkerboard of ~0.13 p0 on
     # the half-space already (docs/formulation.md §8); measured 0.142 (BEM) against 0.131 (half-space)
     d_bem = _max_diff(_symmetrized_run(sc), newton, sc)[1]
     hs = sc.replace(**{"contact.model": "halfspace"})
-    d_hs = _max_diff(_symmetrized_run(hs), driver.run(hs.replace(**{"solver.method": "newton"})), hs)[1]
+    d_hs = _max_diff(_symmetrized_run(hs), rollqp.run(hs.replace(**{"solver.method": "newton"})), hs)[1]
     assert 0.05 < d_bem < 0.3 and abs(d_bem / d_hs - 1) < 0.25, \
         f"sym(FA) vs A: BEM {d_bem:.3f}, half-space {d_hs:.3f} p0"
 
@@ -223,9 +218,9 @@ def test_prescribed_approach_scene():
     """δ from a P-prescribed BEM run, prescribed back: the load is P again, at every step."""
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "solver.method": "newton",
                                                         "discretization.distance": 2.0})
-    r = driver.run(sc)
+    r = rollqp.run(sc)
     delta = float(r.rows["approach"][0])
-    r2 = driver.run(sc.replace(**{"load.approach": {"kind": "constant", "value": delta}}))
+    r2 = rollqp.run(sc.replace(**{"load.approach": {"kind": "constant", "value": delta}}))
     P = np.asarray(r2.rows["P"])
     # solver tolerance 1e-10 on nondimensional residuals (measured 1e-16)
     np.testing.assert_allclose(P, sc.load.normal, rtol=1e-8)
@@ -238,9 +233,9 @@ def test_prescribed_approach_coupled():
     """Full coupling (goodman-bentall on the BEM): δ prescribed by Newton and by QP N–T alternation."""
     sc = rollqp.load_scene("goodman-bentall").replace(**{"solver.method": "newton", "contact.model": "bem",
                                                         "discretization.distance": 1.0})
-    r = driver.run(sc)
+    r = rollqp.run(sc)
     delta = float(r.rows["approach"][-1])
-    runs = [driver.run(sc.replace(**{"load.approach": {"kind": "constant", "value": delta}, "solver.method": m}))
+    runs = [rollqp.run(sc.replace(**{"load.approach": {"kind": "constant", "value": delta}, "solver.method": m}))
             for m in ("newton", "qp-osqp")]
     for r2 in runs:
         P = np.asarray(r2.rows["P"])
@@ -305,8 +300,8 @@ def test_cache_and_summary(tmp_path):
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "solver.method": "newton",
                                                         "discretization.distance": 0.5,
                                                         "bodies.A.shaft_radius": 20.0})
-    r1 = driver.run(sc)
-    r2 = driver.run(sc)
+    r1 = rollqp.run(sc)
+    r2 = rollqp.run(sc)
     assert not r1.meta["model"]["bem_cached"] and r2.meta["model"]["bem_cached"]
     np.testing.assert_array_equal(np.asarray(r1.rows["pn"]), np.asarray(r2.rows["pn"]))
     text = summary(r1.arrays(), sc, "newton", 1.0)
@@ -351,4 +346,4 @@ def test_halfspace_scene_never_builds_bem(monkeypatch):
         raise AssertionError("BEM built for a half-space scene")
     monkeypatch.setattr(bem, "contact_compliance", boom)
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"solver.method": "newton", "discretization.distance": 0.5})
-    driver.run(sc)
+    rollqp.run(sc)

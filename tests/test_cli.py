@@ -14,7 +14,8 @@ import numpy as np
 import pytest
 
 import rollqp
-from rollqp import cli, driver, load_result, load_scene
+from rollqp import cli, load_result, load_scene
+from conftest import Delegate
 from rollqp.scene import builtin_scenes, scene_from_toml
 
 SPEC_KEYS = {"x", "q", "pn", "pt", "slip", "gap", "state", "P", "Q", "creepage", "approach", "iterations",
@@ -168,21 +169,19 @@ def test_solver_failure_exits_3_and_writes_partial(tmp_path):
 
 def test_injected_failure_exits_3_and_writes_partial(tmp_path, capsys, monkeypatch):
     path, scene = write_scene(tmp_path)
-    real = driver.get_method
+    real = rollqp.methods.scene_method
 
-    def failing(name, **kw):
-        method = real(name, **kw)
-        solve, calls = method.solve, []
+    class Failing(Delegate):
+        calls = 0
 
-        def solve_or_fail(problem, warm=None):
+        def solve(self, problem, warm=None):
             if problem.kind == "tangential":
-                calls.append(1)
-                if len(calls) == 4:                        # tangential solve 4 = rolling step 3
-                    raise rollqp.SolverError("injected", method=name, status="test")
-            return solve(problem, warm=warm)
-        method.solve = solve_or_fail
-        return method
-    monkeypatch.setattr(driver, "get_method", failing)
+                self.calls += 1
+                if self.calls == 4:                        # tangential solve 4 = rolling step 3
+                    raise rollqp.SolverError("injected", method=self.name, status="test")
+            return self.inner.solve(problem, warm=warm)
+
+    monkeypatch.setattr(rollqp.methods, "scene_method", lambda settings, coupled=False: Failing(real(settings, coupled)))
     out = tmp_path / "p.npz"
     assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 3, "exit 3 on a solver failure"
     err = capsys.readouterr().err

@@ -12,13 +12,14 @@ import numpy as np
 import pytest
 
 import rollqp
-from rollqp.driver import Model
+from rollqp.operators import SceneOperators
 from rollqp.errors import InputError, SolverError
 from rollqp.histories import Constant
 from rollqp.methods import get_method
 from rollqp.methods.alternation import Alternation, AlternationNewton
 from rollqp.methods.newton import NewtonMethod
 from rollqp.problem import CoupledStep, Scales
+from conftest import Delegate, scene_method_of
 
 MU = 0.3
 
@@ -46,12 +47,12 @@ def dissimilar(element="constant", elements=40, **changes):
 
 def _rolling_step(scene, Qratio=0.3):
     """A coupled rolling step after a coupled static loading (the braked start in one step)."""
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene, symmetrized=False)
     P = scene.load.normal
     n = model.strip.n
     static = model.coupled_step(P, np.zeros(n), model.scales.length, Q=0.0)
     s0 = NewtonMethod().solve(static)
-    c = -(model.history @ model.w(s0.p, s0.t))
+    c = -(model.history() @ model.w(s0.p, s0.t))
     step = model.coupled_step(P, c, scene.dq, Q=Qratio * MU * P)
     return model, static, s0, step
 
@@ -250,19 +251,13 @@ def test_alternation_gives_up_clearly(case):
 def _kinds(monkeypatch, scene, method):
     """Run ``scene`` and return the set of step-problem kinds the method was asked to solve."""
     seen = set()
-    real = rollqp.driver.get_method
 
-    def spy(name, **kw):
-        m = real(name, **kw)
-        solve = m.solve
-
-        def wrapped(problem, warm=None):
+    class Spy(Delegate):
+        def solve(self, problem, warm=None):
             seen.add(problem.kind)
-            return solve(problem, warm=warm)
-        m.solve = wrapped
-        return m
-    monkeypatch.setattr(rollqp.driver, "get_method", spy)
-    r = rollqp.run(scene, method=method)
+            return self.inner.solve(problem, warm=warm)
+
+    r = rollqp.run(scene, method=Spy(scene_method_of(scene, method)))
     return seen, r
 
 
@@ -287,9 +282,9 @@ def test_full_coupling_uses_the_coupled_step(monkeypatch):
 
 def test_model_builds_only_what_the_level_needs():
     for level, (tn, nt) in {"off": (False, False), "goodman": (True, False), "full": (True, True)}.items():
-        m = Model.build(dissimilar(**{"contact.coupling": level}), symmetric=False)
+        m = SceneOperators.build(dissimilar(**{"contact.coupling": level}), symmetrized=False)
         assert (m.Atn is not None, m.Ant is not None) == (tn, nt), level
-    m = Model.build(rollqp.load_scene("cattaneo-carter"), symmetric=False)
+    m = SceneOperators.build(rollqp.load_scene("cattaneo-carter"), symmetrized=False)
     assert m.Atn is None and m.Ant is None, "similar bodies: auto → off, no coupling matrices"
 
 

@@ -1,4 +1,4 @@
-"""The transient driver (rollqp.driver; paper §4.1, §4.4; FORMULATION.md §9) on the built-in scenes.
+"""The transient (rollqp.march; paper §4.1, §4.4; FORMULATION.md §9) on the built-in scenes.
 
 Tier 1 (closed forms, discretization error of the paper's 40 QCE, Δq = Le/2): Cattaneo at
 the braked start, Carter after rolling, from a braked start, a ramp or a rolling start.
@@ -19,7 +19,9 @@ import numpy as np
 import pytest
 
 import rollqp
-from rollqp import SolverError, closedforms as cf, driver, load_result
+from rollqp import SolverError, closedforms as cf, load_result
+from rollqp.operators import SceneOperators
+from conftest import Delegate
 from rollqp.result import Result
 
 METHOD = "qp-osqp"
@@ -142,15 +144,13 @@ def test_reversed_load_flips_traction_and_creepage(short):
 
 
 # ------------------------------------------------------------------------------- solves
-class Counting:
+class Counting(Delegate):
     """A method that counts its normal and tangential solves, and can fail at one of them."""
 
     def __init__(self, inner, fail_at_tangential=None):
-        self.inner, self.fail_at = inner, fail_at_tangential
+        super().__init__(inner)
+        self.fail_at = fail_at_tangential
         self.counts = {"normal": 0, "tangential": 0}
-
-    def __getattr__(self, name):
-        return getattr(self.inner, name)
 
     def solve(self, problem, warm=None):
         self.counts[problem.kind] += 1
@@ -161,17 +161,18 @@ class Counting:
 
 @pytest.fixture
 def counting(monkeypatch):
-    """Patch the driver to use a :class:`Counting` method; returns the created instances."""
+    """Make scenes run with a :class:`Counting` method; returns the created instances."""
+    import rollqp.methods
     made = []
 
     def install(fail_at_tangential=None):
-        real = driver.get_method
+        real = rollqp.methods.scene_method
 
-        def make(name, **kw):
-            m = Counting(real(name, **kw), fail_at_tangential)
+        def make(settings, coupled=False):
+            m = Counting(real(settings, coupled), fail_at_tangential)
             made.append(m)
             return m
-        monkeypatch.setattr(driver, "get_method", make)
+        monkeypatch.setattr(rollqp.methods, "scene_method", make)
         return made
     return install
 
@@ -199,7 +200,7 @@ def test_varying_normal_load_solved_every_step(builtin_scene, counting):
     expected = scene.normal_load(res["q"])
     # recorded from the same history evaluation: round-off only
     assert np.allclose(res["P"], expected, rtol=1e-12), "P(q) recorded as prescribed"
-    f = driver.Model.build(scene, symmetric=False).f
+    f = SceneOperators.build(scene).f
     assert np.allclose(res["pn"] @ f, res["P"], rtol=1e-8), "fᵀp = P(q) at every state (solver tolerance)"
 
 
@@ -311,14 +312,14 @@ def test_result_file_has_default_permissions(tmp_path):
         "a result file is created with the same permissions as any other file (umask)"
 
 
-@pytest.mark.xfail(strict=True, raises=AssertionError,
-                   reason="library bug: driver._make_method passes only the tolerance to QP methods, so "
-                          "the scene's solver.max_iterations is silently ignored")
 def test_scene_iteration_limit_reaches_qp_methods(builtin_scene):
+    """``solver.max_iterations`` is the QP solver's own limit per QP (methods.base: from_settings):
+    one interior-point iteration cannot solve the braked start's QPs, so the start fails, naming
+    the step and the method; without the key Clarabel keeps its own limit and solves it."""
     scene = builtin_scene("cattaneo-carter", **{"discretization.distance": 0.0, "solver.max_iterations": 1,
                                                  "solver.method": "qp-clarabel"})
-    try:
-        res = rollqp.run(scene).arrays()
-    except SolverError:
-        return
-    raise AssertionError(f"solver.max_iterations = 1 was ignored: step 0 took {res['iterations'][0]} iterations")
+    with pytest.raises(SolverError) as info:
+        rollqp.run(scene)
+    assert info.value.step == 0 and info.value.method == "qp-clarabel", str(info.value)
+    res = rollqp.run(scene.replace(**{"solver.max_iterations": None})).arrays()
+    assert res["iterations"][0] > 1 and res["residual"][0] <= 1e-8

@@ -35,6 +35,7 @@ import rollqp
 from rollqp import cli
 from rollqp.errors import InputError, SolverError
 from rollqp.scene import load_scene
+from conftest import Delegate
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import hard_cases as hc  # noqa: E402
@@ -125,12 +126,12 @@ def test_unloaded_states_are_zero_and_finite():
 
 
 # =========================================================================== failures keep steps
-class _FailingAt:
+class _FailingAt(Delegate):
     """A method that delegates to ``inner`` and fails at its ``fail_at``-th solve (0-based)."""
 
     def __init__(self, inner, fail_at):
-        self.inner, self.fail_at, self.calls = inner, fail_at, 0
-        self.name, self.operator, self.tolerance = inner.name, inner.operator, inner.tolerance
+        super().__init__(inner)
+        self.fail_at, self.calls = fail_at, 0
 
     def solve(self, problem, warm=None):
         self.calls += 1
@@ -141,11 +142,12 @@ class _FailingAt:
 
 @pytest.fixture
 def failing_method(monkeypatch):
-    """The driver's method fails at its 6th solve: state 0 (a normal and a tangential solve,
+    """The scene's method fails at its 6th solve: state 0 (a normal and a tangential solve,
     similar bodies) and three rolling steps (P constant: one tangential solve each) complete."""
-    from rollqp import driver
-    make = driver._make_method
-    monkeypatch.setattr(driver, "_make_method", lambda scene, name: _FailingAt(make(scene, name), 5))
+    import rollqp.methods
+    make = rollqp.methods.scene_method
+    monkeypatch.setattr(rollqp.methods, "scene_method",
+                        lambda settings, coupled=False: _FailingAt(make(settings, coupled), 5))
 
 
 def test_driver_failure_names_the_step_and_keeps_completed_states(failing_method):

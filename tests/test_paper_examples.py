@@ -130,7 +130,7 @@ def test_goodman_starting_state(goodman_bentall):
     assert abs(stick[1] + stick[2]) <= 1e-9 and stick[2] > 0, f"stick zone centred on x = 0: {stick}"
     # friction opposes the relative displacement the pressure alone produces (A_tn p)
     p, t, state = res["pn"][0], res["pt"][0], res["state"][0]
-    model = rollqp.Model.build(scene, symmetric=False)
+    model = rollqp.SceneOperators.build(scene, symmetrized=False)
     wp = model.Atn @ p
     slip = state == 2
     assert np.all(np.sign(t[slip]) == -np.sign(wp[slip])), "t opposes A_tn p in the slip zones"

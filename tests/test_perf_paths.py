@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import rollqp
-from rollqp.driver import Model
+from rollqp.operators import SceneOperators
 from rollqp.methods import newton as newton_module
 from rollqp.methods.newton import NewtonMethod
 
@@ -38,7 +38,7 @@ TOL = {
 def _tangential_system(elements=80, element="quadratic"):
     scene = rollqp.load_scene("cattaneo-carter").replace(
         **{"discretization.elements": elements, "discretization.element": element})
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene, symmetrized=False)
     nsol = NewtonMethod().solve(model.normal_step(scene.load.normal))
     pb = model.tangential_step(nsol.p, np.zeros(model.strip.n), scene.dq, Q=0.5 * 0.1 * scene.load.normal)
     meth = NewtonMethod()
@@ -188,7 +188,7 @@ def test_coupled_transient_same_iterates_as_full_solve(monkeypatch):
 def _coupled_problem(elements=80):
     """A coupled rolling step of goodman-bentall (161 nodes: above the direct-solve size)."""
     scene = rollqp.load_scene("goodman-bentall").replace(**{"discretization.elements": elements})
-    model = Model.build(scene, symmetric=False)
+    model = SceneOperators.build(scene, symmetrized=False)
     n = model.strip.n
     P = scene.load.normal
     return model.coupled_step(P, np.zeros(n), scene.dq, Q=0.0)

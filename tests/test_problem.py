@@ -391,18 +391,24 @@ def test_tangential_multiplier_is_the_creepage(constant_problem):
 
 
 def test_scene_matrices_are_checked_once_and_read_only():
-    """Model.build validates the influence matrices once and makes them read-only; step
-    problems then reuse them as they are (no O(n²) check or copy per step). A user's writeable
-    array is still checked on every construction."""
-    from rollqp.driver import Model
-    from rollqp.problem import is_trusted
-    model = Model.build(rollqp.load_scene("cattaneo-carter"), symmetric=False)
-    assert is_trusted(model.Ann) and is_trusted(model.Att)
+    """SceneOperators.build validates the influence matrices once, as read-only Operators; step
+    problems then reuse them as they are (no O(n²) check or copy per step), and so do the
+    splittings derived from them (kept in the operator's memo). A user's writeable array is
+    copied and checked on every construction, so changing it afterwards changes no problem."""
+    from rollqp.influence.operator import Operator
+    from rollqp.operators import SceneOperators
+    model = SceneOperators.build(rollqp.load_scene("cattaneo-carter"), symmetrized=False)
+    assert isinstance(model.Ann, Operator) and isinstance(model.Att, Operator)
     with pytest.raises(ValueError):
-        model.Ann[0, 0] = 1.0  # read-only: it cannot change after the check
+        model.Ann.dense()[0, 0] = 1.0  # read-only: it cannot change after the check
     step = model.normal_step(1000.0)
     assert step.A is model.Ann
+    assert step.A.split(step.f) is model.normal_step(900.0).A.split(model.f), "one splitting per scene"
     bad = np.array(model.Ann)          # a writeable copy: checked again
     bad[3, 4] = np.nan
     with pytest.raises(InputError, match="finite"):
         rollqp.NormalStep(A=bad, f=model.f, h=model.h, P=1000.0, scales=model.scales)
+    mine = np.array(model.Ann)
+    prob = rollqp.NormalStep(A=mine, f=model.f, h=model.h, P=1000.0, scales=model.scales)
+    mine[0, 0] = 1e9                   # the user's array changes; the problem does not
+    assert np.asarray(prob.A)[0, 0] == model.Ann.dense()[0, 0]

@@ -196,13 +196,9 @@ def test_warm_start_reuses_the_solver(backend, constant_problem):
         return build(form)
     method._build = counting_build
     first = method.solve(constant_problem.normal())
-    size = len(method._cache)
-    objects = {k: v[1] for k, v in method._cache.items() if k[0] != "split"}
     assert builds == ["normal"], f"first solve builds one solver: {builds}"
     second = method.solve(constant_problem.normal(P=1.2 * P), warm=first)
     assert builds == ["normal"], f"same structure and Hessian: no rebuild ({builds})"
-    assert len(method._cache) == size, f"cache grew from {size} to {len(method._cache)}"
-    assert all(method._cache[k][1] is v for k, v in objects.items()), "the same solver objects"
     assert second.residual <= backend.residual, f"the updated solve is accurate: {second.residuals}"
     load = abs(constant_problem.f @ second.p - 1.2 * P) / constant_problem.scales.force
     assert load <= backend.residual, f"and solves the new load (residual limit): {load:.1e}"

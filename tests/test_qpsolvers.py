@@ -4,7 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rollqp import cli, driver, get_method, load_scene
+import rollqp
+from rollqp import cli, get_method, load_scene
 from rollqp.errors import MissingBackendError
 from rollqp.methods import available_methods
 from rollqp.methods import qp_qpsolvers as qps
@@ -16,14 +17,14 @@ needs_any = pytest.mark.skipif(not INSTALLED, reason="no qpsolvers backend insta
 @pytest.fixture(scope="module")
 def short_runs():
     scene = load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.5})
-    return scene, driver.run(scene, method="newton").arrays()
+    return scene, rollqp.run(scene, method="newton").arrays()
 
 
 @needs_any
 @pytest.mark.parametrize("name", INSTALLED)
 def test_backend_matches_newton_on_a_transient(short_runs, name):
     scene, ref = short_runs
-    res = driver.run(scene, method=name).arrays()
+    res = rollqp.run(scene, method=name).arrays()
     # QPMethod's residual limit: 100 × tolerance 1e-10
     assert res["residual"].max() <= 1e-8, f"{name}: residual {res['residual'].max():.2e}"
     # both solve the same collocation problem: agree to the residual limit times the
@@ -37,8 +38,8 @@ def test_backend_matches_newton_on_a_transient(short_runs, name):
 def test_coupled_scene_runs_the_alternation():
     scene = load_scene("goodman-bentall").replace(**{"discretization.distance": 0.05})
     name = INSTALLED[0]
-    res = driver.run(scene, method=name).arrays()
-    ref = driver.run(scene, method="newton").arrays()
+    res = rollqp.run(scene, method=name).arrays()
+    ref = rollqp.run(scene, method="newton").arrays()
     assert res["residual"].max() <= 1e-8
     # rolling steps are N-T outer iterations: several per step at 2β = 1, μ = 0.3 (paper §6.3: ≈ 6)
     assert np.all(res["iterations"][1:] >= 2), f"outer iterations {res['iterations']}"
@@ -57,8 +58,8 @@ def test_uninstalled_backend_is_a_clear_error(monkeypatch, capsys):
 
 
 def test_unknown_solver_name():
-    with pytest.raises(Exception, match="solver"):
-        qps.QpsolversQP("nosuch")
+    with pytest.raises(rollqp.InputError, match="solver.method: must be one of .*qps-daqp"):
+        get_method("qps-nosuch")
 
 
 @needs_any

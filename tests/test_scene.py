@@ -423,7 +423,7 @@ def test_to_dict_fills_defaults():
     d = base_dict()
     del d["solver"]
     out = scene_from_dict(d).to_dict()
-    assert out["solver"] == {"method": "newton", "tolerance": 1e-10, "max_iterations": 200}, \
+    assert out["solver"] == {"method": "newton", "tolerance": 1e-10}, \
         "solver defaults filled"
     assert out["load"]["normal_history"] == {"kind": "constant", "value": 1.0}, \
         "history written with its value"

@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rollqp import cli, driver, load_scene
+import rollqp
+from rollqp import cli, load_scene
 from rollqp.problem import SLIP, STICK, classify
 from rollqp.stepfile import DEFAULT_TOL, StepFile, check_step, export_step, solve_stored
 
@@ -41,7 +42,7 @@ def coupled(tmp_path_factory):
 @pytest.mark.parametrize("K", [0, 3])
 def test_step_numbering_matches_result_file(similar, K):
     scene = similar[0]
-    res = driver.run(scene, method="newton").arrays()
+    res = rollqp.run(scene, method="newton").arrays()
     step = export_step(scene, K)
     # the same deterministic Newton march: equal to round-off (1e-12 p0)
     assert np.max(np.abs(step.ref_p - res["pn"][K])) <= 1e-12 * step.p0, "p of step K is state K"

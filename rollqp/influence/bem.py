@@ -103,7 +103,8 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import InputError
-from .halfspace import COUPLINGS, Influence, _log_moments, asymmetry, min_eigenvalue
+from .halfspace import COUPLINGS, Influence, _log_moments, min_eigenvalue
+from .operator import asymmetry
 
 __all__ = ["AnnulusMesh", "annulus_mesh", "BEMBody", "body_matrices", "contact_compliance",
            "bem_influence", "contact_gap", "lame_ring", "DEFAULT_OUTER", "DEFAULT_INNER"]
@@ -595,7 +596,7 @@ def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.
             "bem_cached": bool(infoA["cached"] and infoB["cached"]),
             "bem_memory_bytes": max(infoA["memory_bytes"], infoB["memory_bytes"]),
             "bem_grading_ratio": [infoA["grading_ratio"], infoB["grading_ratio"]],
-            "asymmetry_FA": asymmetry(f, Ann), "asymmetry_FAtt": asymmetry(f, Att),
+            "asymmetry_FA": asymmetry(Ann, f), "asymmetry_FAtt": asymmetry(Att, f),
             "min_eig_rel": min_eigenvalue(f, Ann),
             "coupling_size": float(np.linalg.norm(f[:, None] * Ant) / np.linalg.norm(FAnn)),
             "reciprocity_defect": float(np.linalg.norm(f[:, None] * Atn - (f[:, None] * Ant).T)

@@ -83,6 +83,7 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import InputError
+from .operator import asymmetry
 
 __all__ = [
     "Influence",
@@ -92,7 +93,6 @@ __all__ = [
     "undeformed_gap",
     "min_eigenvalue",
     "minimum_reference_distance",
-    "asymmetry",
 ]
 
 COUPLINGS = ("auto", "full", "goodman", "off")
@@ -337,13 +337,6 @@ def _weights(F) -> np.ndarray:
     return np.diag(F).copy() if F.ndim == 2 else F
 
 
-def asymmetry(F, A) -> float:
-    """``‖FA - (FA)ᵀ‖_F / ‖FA‖_F`` with ``F = diag(f)`` (``F`` the weights or the matrix)."""
-    FA = _weights(F)[:, None] * np.asarray(A, dtype=float)
-    norm = np.linalg.norm(FA)
-    return float(np.linalg.norm(FA - FA.T) / norm) if norm > 0 else 0.0
-
-
 def min_eigenvalue(F, A) -> float:
     """Smallest eigenvalue of ``sym(F A)`` relative to the largest in magnitude.
 
@@ -531,7 +524,7 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
         "d_ref": d_ref, "d_ref_min": d_min, "d_ref_min_continuous": 0.5 * L,
         "coupling": coupling, "beta": beta, "kappa": 2.0 * beta, "Estar": Estar,
         "R": R, "R_A": float(R_A), "R_B": float(R_B),
-        "asymmetry_FA": asymmetry(f, K),
+        "asymmetry_FA": asymmetry(K, f),
         "asymmetry_A": float(np.linalg.norm(K - K.T) / np.linalg.norm(K)),
         "min_eig_rel": lam,
         "gauss_points": GAUSS_POINTS, "far_field": FAR_FIELD,

@@ -1,4 +1,4 @@
-"""Registry of step methods: one module per method (STYLE.md).
+"""Registry of step methods: one module per method (the protocol: :mod:`rollqp.methods.base`).
 
 ========================  ==========================================================
 ``qp-clarabel``           convex QP, Clarabel native (interior point)
@@ -12,31 +12,37 @@
 
 Optional backends are always registered by name; one whose package is not installed
 raises :class:`~rollqp.errors.MissingBackendError` naming the pip extra, and
-:func:`available_methods` leaves it out.
+:func:`available_methods` leaves it out. Modules are imported on first use.
 
-A method is created once per scene with :func:`get_method` and reused for every step,
-so that solver objects are built once and only updated afterwards.
+:func:`get_method` makes one method from its name and settings; :func:`scene_method` makes the
+method a scene runs with, composed from what the named method declares it solves
+(:attr:`~rollqp.methods.base.Method.solves`): on a coupled scene a method that does not solve
+coupled steps runs inside the N–T alternation. This module is the only place where method
+names are looked at.
 """
 from __future__ import annotations
 
 import importlib
 
 from ..errors import InputError, MissingBackendError
+from .base import KINDS, Method, check_kind, check_options  # noqa: F401 - the protocol, re-exported
 
-# name -> (module, class, pip extra that provides it or None, what it solves)
+# name -> (module, class, pip extra that provides it or None)
 _REGISTRY = {
-    "qp-clarabel": ("rollqp.methods.qp_clarabel", "ClarabelQP", None, "qp"),
-    "qp-osqp": ("rollqp.methods.qp_osqp", "OsqpQP", None, "qp"),
-    "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", None, "qp"),
-    "newton": ("rollqp.methods.newton", "NewtonMethod", None, "newton"),
-    "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None, "newton"),
+    "qp-clarabel": ("rollqp.methods.qp_clarabel", "ClarabelQP", None),
+    "qp-osqp": ("rollqp.methods.qp_osqp", "OsqpQP", None),
+    "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"),
+    "newton": ("rollqp.methods.newton", "NewtonMethod", None),
+    "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
-    **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers", "qp")
+    **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers")
        for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
 }
 
-QP_METHODS = tuple(k for k, v in _REGISTRY.items() if v[3] == "qp")
 METHOD_NAMES = tuple(_REGISTRY)
+#: The methods that pose convex QPs (each half of a step one QP; coupled steps by the N–T
+#: alternation): for listings and benchmarks. What a method can do is its ``solves``.
+QP_METHODS = tuple(k for k in _REGISTRY if k.startswith(("qp-", "qps-")))
 
 
 def available_methods() -> list[str]:
@@ -44,32 +50,79 @@ def available_methods() -> list[str]:
     out = []
     for name in _REGISTRY:
         try:
-            _load(name)
-        except (MissingBackendError, InputError, AttributeError):
+            method_class(name)
+        except (MissingBackendError, InputError):
             continue
         out.append(name)
     return out
 
 
-def _load(name: str):
-    if name not in _REGISTRY:
-        raise InputError("solver.method", f"unknown method {name!r}; choose one of {', '.join(_REGISTRY)}")
-    module, cls, extra, _ = _REGISTRY[name]
+def check_name(name, key: str = "solver.method") -> str:
+    """``name`` if it is a registered method, else an :class:`InputError` on ``key`` listing them."""
+    if not isinstance(name, str) or name not in _REGISTRY:
+        import difflib
+        close = difflib.get_close_matches(name, list(_REGISTRY), n=1) if isinstance(name, str) else []
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise InputError(key, f"must be one of {', '.join(map(repr, _REGISTRY))}, got {name!r}{hint}")
+    return name
+
+
+def method_class(name: str) -> type:
+    """The class of method ``name``, importing its module on first use.
+
+    Raises
+    ------
+    InputError
+        ``solver.method`` for an unknown name.
+    MissingBackendError
+        The method's package is not installed (the message names the pip extra).
+    """
+    check_name(name)
+    module, cls, extra = _REGISTRY[name]
     try:
         mod = importlib.import_module(module)
     except ModuleNotFoundError as exc:
-        if exc.name == module:
-            raise InputError("solver.method", f"method {name!r} is not available in this version of rollqp; "
-                             f"available: {', '.join(QP_METHODS)}") from exc
         hint = f" (pip install 'rollqp[{extra}]')" if extra else ""
         raise MissingBackendError(f"method {name!r} needs the package {exc.name!r}{hint}") from exc
+    return getattr(mod, cls)
+
+
+def get_method(name: str, **settings) -> Method:
+    """A fresh instance of method ``name`` with ``settings`` (tolerance, max_iterations, …).
+
+    An unknown setting is an :class:`InputError` naming it.
+    """
+    cls = method_class(name)
     try:
-        return getattr(mod, cls)
-    except AttributeError as exc:
-        raise InputError("solver.method", f"method {name!r} is not available in this version of rollqp; "
-                         f"available: {', '.join(available_methods())}") from exc
+        return cls(**settings)
+    except TypeError as exc:  # a keyword the constructor does not take
+        raise InputError(name, f"invalid settings {sorted(settings)}: {exc}") from None
 
 
-def get_method(name: str, **settings):
-    """A fresh instance of method ``name`` with ``settings`` (tolerance, max_iterations, …)."""
-    return _load(name)(**settings)
+def scene_method(settings, coupled: bool = False, **options) -> Method:
+    """The method a scene runs with: ``settings.method`` built from the scene's solver settings.
+
+    Parameters
+    ----------
+    settings : rollqp.scene.SolverSettings
+        ``method``, ``tolerance``, ``max_iterations``, ``augmentation``.
+    coupled : bool
+        The scene's steps are coupled (full coupling): a method that does not declare
+        ``"coupled"`` is wrapped in the N–T alternation (paper §6.3), with
+        ``settings.max_iterations`` outer iterations.
+    **options
+        Method-specific settings (an unknown one is an :class:`InputError`).
+    """
+    method = method_class(settings.method).from_settings(settings, **options)
+    return compose(method, coupled, max_outer=settings.max_iterations)
+
+
+def compose(method: Method, coupled: bool, max_outer: int | None = None) -> Method:
+    """``method``, or the N–T alternation around it when ``coupled`` and it does not solve coupled steps."""
+    if coupled and "coupled" not in method.solves:
+        if not {"normal", "tangential"} <= method.solves:
+            raise InputError("solver.method", f"method {method.name!r} solves neither coupled steps nor both "
+                                              "halves of them")
+        from .alternation import Alternation
+        return Alternation(method, max_outer=max_outer)
+    return method

@@ -1,4 +1,4 @@
-"""Shared machinery of the QP backends (FORMULATION.md §7).
+"""Shared machinery of the QP backends (docs/formulation.md §6–8).
 
 Each backend translates a :class:`~rollqp.problem.QPForm` into its solver's native form
 once per *structure* (problem kind, size, which bounds are finite, load or multiplier
@@ -14,11 +14,12 @@ import time
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..problem import StepSolution, split
+from ..problem import StepSolution
+from .base import check_kind, check_options
 
 
 class QPMethod:
-    """Base class: one instance per scene, holding one solver object per problem structure.
+    """Base class of the QP backends: built once per scene, one solver object per problem structure.
 
     Parameters
     ----------
@@ -30,13 +31,16 @@ class QPMethod:
         ``max(100·tolerance, 1e-12)``: the solvers' stopping tests are on their scaled
         KKT conditions, which bound rollqp's residuals up to the conditioning of the
         scaling (measured factor below 100 on the paper's meshes).
-    max_iterations : int
-        Solver iteration limit.
+    max_iterations : int, optional
+        The solver's own iteration limit per QP (None: the backend's default).
     operator : {"exact", "symmetrized"}
         ``"exact"`` (default): solve the collocation problem itself by symmetric–skew
         splitting (below). ``"symmetrized"``: one QP with ``F⁻¹ sym(F A)`` in place of
         ``A``; the solution then belongs to that other discrete problem, and its residuals
         are computed on it.
+    **options
+        Native settings of the backend's solver (:attr:`native_options`); an unknown one is
+        an :class:`~rollqp.errors.InputError` naming it.
 
     Notes
     -----
@@ -52,14 +56,26 @@ class QPMethod:
     (``docs/validation.md``). The single symmetrized QP is *not* a small perturbation:
     on 40 quadratic elements it puts a vertex/midnode checkerboard of 13 % of p0 on the
     Hertz pressure, because ``S`` feeds the log kernel's weakest mode.
+
+    One solver object is kept per constraint structure (:meth:`structure_key`) with the Hessian
+    it was built for, recognized by its source (the symmetrized operator, the weights and the
+    scales: the Hessian is normalized by its largest diagonal entry, so ``Δq`` drops out);
+    :meth:`setup` drops them at the start of a scene. The splitting itself is the operator's own (:meth:`Operator.split
+    <rollqp.influence.operator.Operator.split>`), computed once per scene.
     """
 
     name = "qp"
+    solves = frozenset({"normal", "tangential"})
     extra = None  # pip extra that installs the backend, if optional
     #: Active-set refinement of the solver's answer (:func:`active_set_refine`); on for the
     #: interior-point backends, whose complementarity stops at ``sqrt(gap tolerance)``.
     refine = False
     max_splitting = 60
+    #: Native solver settings a backend accepts as ``**options`` (see each backend).
+    native_options: tuple = ()
+    #: Solver objects kept before the oldest are dropped: structures can churn (tiny pressures
+    #: of ±1e-21 p0 at separated nodes change the finite-bound pattern).
+    MAX_SOLVERS = 32
 
     def __init__(self, tolerance: float = 1e-10, residual_limit: float | None = None,
                  max_iterations: int | None = None, operator: str = "exact", **options):
@@ -67,53 +83,60 @@ class QPMethod:
             raise InputError("solver.tolerance", f"must be in (0, 1), got {tolerance!r}")
         if operator not in ("exact", "symmetrized"):
             raise InputError("operator", f"must be 'exact' or 'symmetrized', got {operator!r}")
+        if max_iterations is not None and (int(max_iterations) != max_iterations or max_iterations < 1):
+            raise InputError("solver.max_iterations", f"must be an integer >= 1, got {max_iterations!r}")
+        check_options(self.name, options, self.native_options)
         self.tolerance = float(tolerance)
         self.residual_limit = float(residual_limit) if residual_limit is not None else max(100 * tolerance, 1e-12)
         self.max_iterations = max_iterations
         self.operator = operator
         self.options = options
-        self._cache = {}
+        self._solvers = {}
+
+    @classmethod
+    def from_settings(cls, settings, **options) -> "QPMethod":
+        """From a scene's solver settings: ``tolerance``, and ``max_iterations`` as the solver's
+        iteration limit per QP (absent: the backend's own); ``augmentation`` is Newton's only."""
+        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations, **options)
+
+    def setup(self, operators) -> None:
+        """A new scene: drop the solver objects of the previous one (they are rebuilt on first use)."""
+        self._solvers = {}
 
     # --------------------------------------------------------------- public
     def solve(self, problem, warm: StepSolution | None = None) -> StepSolution:
         """Solve a normal or tangential step; raise :class:`SolverError` short of solved."""
+        check_kind(self, problem)
         t0 = time.perf_counter()
-        asym, Asym, Skew = self._split(problem)
-        sym_problem = problem.replace(A=Asym) if asym > 0 else problem
+        sp = problem.A.split(problem.f)
+        sym_problem = problem.replace(A=sp.sym) if sp.asymmetry > 0 else problem
         x_prev = None
         if warm is not None:
-            w = warm.p if problem.kind == "normal" else warm.t
+            w = problem.traction(warm)
             if w is not None and np.shape(w) == (problem.n,):
                 x_prev = np.asarray(w, dtype=float)
-        exact = self.operator == "exact" and asym > 0
-        # what the QP Hessian is a function of: the symmetrized operator (cached by _split, so the
-        # same object every step), the weights, the scales and the kind (H is normalized by its
-        # largest diagonal entry, so Δq drops out); see _solver_for
-        self._hessian_source = (sym_problem.kind, sym_problem.A, sym_problem.f, sym_problem.scales)
+        exact = self.operator == "exact" and sp.asymmetry > 0
+        # what the QP Hessian is a function of (the solver objects are kept per source, _solver_for)
+        source = (sym_problem.A, sym_problem.f.tobytes(), sym_problem.scales)
         iters, solver_time, outer, change = 0, 0.0, 0, np.inf
         x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
         while True:
             outer += 1
-            prob = sym_problem
-            if exact:
-                extra = Skew @ x_phys  # F⁻¹ S x_{k−1}, in displacement units
-                prob = (sym_problem.replace(offset=extra if sym_problem.offset is None else sym_problem.offset + extra)
-                        if problem.kind == "normal" else sym_problem.replace(c=sym_problem.c + extra))
+            prob = sym_problem.shifted(sp.skew @ x_phys) if exact else sym_problem  # F⁻¹ S x_{k−1}
             form = prob.qp_form()
             x0 = None if x_prev is None else x_prev / problem.scales.stress
-            x, y, status, it, st, info = self._solve_form(form, x0)
+            x, y, status, it, st, info = self._solve_form(form, x0, source)
             iters += int(it)
             solver_time += float(st)
             if status == "solved" and self.refine:
                 x, y = self._refined(prob, form, x, y, info)
+            sol = prob.solution_from_qp(form, x, y)
             if status != "solved":
-                sol = prob.solution_from_qp(form, x, y)
                 raise SolverError(f"the {problem.kind} QP was not solved", method=self.name, status=status,
                                   residual=sol.residual, iterations=iters)
-            sol = prob.solution_from_qp(form, x, y)
-            x_new = sol.p if problem.kind == "normal" else sol.t
             if not exact:
                 break
+            x_new = problem.traction(sol)
             last, change = change, float(np.max(np.abs(x_new - x_phys))) / problem.scales.stress
             x_phys = x_prev = x_new
             if change <= self.tolerance or (change >= 0.5 * last and change <= self.residual_limit):
@@ -121,13 +144,13 @@ class QPMethod:
             if outer >= self.max_splitting:
                 raise SolverError("the symmetric-skew splitting did not converge", method=self.name,
                                   status=f"change {change:.2e} after {outer} QPs", iterations=iters,
-                                  residual=self._evaluate(problem, sol).residual)
-        final = self._evaluate(problem if exact or asym == 0 else sym_problem, sol)
+                                  residual=problem.evaluate(sol).residual)
+        final = (problem if exact or sp.asymmetry == 0 else sym_problem).evaluate(sol)
         final.method, final.status, final.iterations = self.name, "solved", iters
         final.solver_time = solver_time
         final.time = time.perf_counter() - t0
         final.info.update(info)
-        final.info.update(asymmetry=asym, operator="exact" if (exact or asym == 0) else "symmetrized",
+        final.info.update(asymmetry=sp.asymmetry, operator="exact" if (exact or sp.asymmetry == 0) else "symmetrized",
                           qp_solves=outer)
         if not final.residual <= self.residual_limit:
             raise SolverError(f"the {problem.kind} QP solution's residual is above {self.residual_limit:.1e}",
@@ -148,51 +171,34 @@ class QPMethod:
                 return cand
         return x, y
 
-    @staticmethod
-    def _evaluate(problem, sol):
-        """Re-evaluate a QP solution on ``problem`` (rollqp's residuals, not the solver's)."""
-        if problem.kind == "normal":
-            return problem.solution(sol.p, sol.delta)
-        return problem.solution(sol.t, sol.xi)
-
-    def _split(self, problem):
-        """``(asymmetry, F⁻¹ sym(FA), F⁻¹ skew(FA))`` of the problem's operator, cached per matrix."""
-        key = ("split", id(problem.A), id(problem.f))
-        hit = self._cache.get(key)
-        if hit is None or hit[0] is not problem.A or hit[1] is not problem.f:
-            A, f = problem.A, problem.f
-            hit = (A, f, split(A, f))
-            self._cache[key] = hit
-        return hit[2]
-
     def structure_key(self, form):
-        """What the backend's solver object depends on (default: :attr:`QPForm.structure`)."""
+        """What the backend's solver object depends on besides the Hessian (default: :attr:`QPForm.structure`)."""
         return form.structure
 
-    def _solver_for(self, form, build):
-        """The cached solver object for this structure and Hessian, built on first use.
+    def _solver_for(self, form, source, build):
+        """``(solver object, fresh)`` for this constraint structure and Hessian, built on first use.
 
-        The Hessian is recognized by its source (:attr:`_hessian_source`, set by :meth:`solve`:
-        the operator and weight arrays by identity, kind and scales), which costs nothing per
-        QP; a form from elsewhere is compared entry by entry (``O(n²)``).
+        One solver object is kept per structure (:meth:`structure_key`) with the Hessian it was
+        built for. ``source`` is what the Hessian is a function of — the (symmetrized) operator,
+        the weights and the scales; the same source costs nothing to recognize, another one (a
+        user's new problem on the same matrix) is compared entry by entry (``O(n²)``).
         """
         key = self.structure_key(form)
-        hit = self._cache.get(key)
-        src = getattr(self, "_hessian_source", None)
-        if hit is not None and hit[0].shape == form.H.shape:
-            same = (src is not None and hit[2] is not None and len(src) == len(hit[2])
-                    and all(a is b or (not isinstance(a, np.ndarray) and a == b) for a, b in zip(src, hit[2])))
-            if same or np.array_equal(hit[0], form.H):
+        hit = self._solvers.get(key)
+        if hit is not None and hit[2].shape == form.H.shape:
+            src, obj, H = hit
+            same = src is not None and source is not None and src[0] is source[0] and src[1:] == source[1:]
+            if same or np.array_equal(H, form.H):
                 if not same:
-                    self._cache[key] = (hit[0], hit[1], src)
-                return hit[1], False
+                    self._solvers[key] = (source, obj, H)
+                return obj, False
         obj = build(form)
-        if len(self._cache) >= 32:  # bound memory: structures can churn (tiny pressures of ±1e-21 p0)
-            self._cache = {k: v for k, v in self._cache.items() if k[0] == "split"}
-        self._cache[key] = (form.H.copy(), obj, src)
+        if len(self._solvers) >= self.MAX_SOLVERS:
+            self._solvers.pop(next(iter(self._solvers)))
+        self._solvers[key] = (source, obj, form.H.copy())
         return obj, True
 
-    def _solve_form(self, form, x0):  # pragma: no cover - abstract
+    def _solve_form(self, form, x0, source=None):  # pragma: no cover - abstract
         """Return ``(x, y, status, iterations, solver_time, info)``; status 'solved' or the solver's."""
         raise NotImplementedError
 

@@ -31,6 +31,7 @@ import time
 import numpy as np
 
 from ..errors import InputError, SolverError
+from .base import check_options
 from .newton import NewtonMethod
 
 
@@ -59,15 +60,23 @@ class Alternation:
     """
 
     def __init__(self, inner, max_outer: int = 200, limit: float | None = None):
+        if max_outer is None:
+            max_outer = 200
         if int(max_outer) != max_outer or max_outer < 1:
             raise InputError("max_outer", f"must be an integer >= 1, got {max_outer!r}")
         self.inner = inner
+        # coupled steps by alternation; the steady (non-symmetric) problem only if the halves pose it
+        self.solves = frozenset({"coupled"}) | inner.solves
         self.max_outer = int(max_outer)
         self.limit = float(limit) if limit is not None else float(inner.tolerance)
         self.stall_limit = max(self.limit, float(getattr(inner, "residual_limit", 0.0) or 0.0))
         self.name = getattr(inner, "name", "alternation")
         self.operator = getattr(inner, "operator", "exact")
         self.tolerance = inner.tolerance
+
+    def setup(self, operators) -> None:
+        """A new scene: the inner method's set-up."""
+        self.inner.setup(operators)
 
     def solve(self, problem, warm=None):
         if problem.kind != "coupled":
@@ -150,7 +159,17 @@ DIVERGE_FACTOR = 1e6
 class AlternationNewton(Alternation):
     """``nt-newton``: the N–T alternation with Newton (GNMls) halves (paper §6.3)."""
 
+    name = "nt-newton"
+
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
         super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),
                          max_outer=max_outer)
         self.name = "nt-newton"
+
+    @classmethod
+    def from_settings(cls, settings, **options) -> "AlternationNewton":
+        """From a scene's solver settings: ``max_iterations`` bounds both the Newton iterations of each
+        half and the outer iterations; ``augmentation`` is the halves' ``r``."""
+        check_options(cls.name, options, ("rho", "sigma"))
+        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations,
+                   max_outer=settings.max_iterations, r=settings.augmentation, **options)

@@ -78,6 +78,7 @@ from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
 
 from ..errors import InputError, SolverError
 from ..problem import StepSolution
+from .base import check_options
 
 #: Smallest Armijo step tried before the full step is taken anyway (see module docstring).
 ALPHA_MIN = 1e-10
@@ -519,7 +520,8 @@ class NewtonMethod:
     """
 
     name = "newton"
-    operator = "exact"  # the driver asks: the collocation operator itself, not F⁻¹ sym(F A)
+    solves = frozenset({"normal", "tangential", "coupled", "steady"})
+    operator = "exact"  # the collocation operator itself, not F⁻¹ sym(F A)
     #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
     #: (:class:`_CoupledFactors`); ``False`` solves a new reduced system every iteration
     #: (:meth:`_coupled_direction`, the reference the tests compare with).
@@ -544,6 +546,18 @@ class NewtonMethod:
         self.r = None if r is None else float(r)
         self.rho = float(rho)
         self.sigma = float(sigma)
+        self._cache = {}
+
+    @classmethod
+    def from_settings(cls, settings, **options) -> "NewtonMethod":
+        """From a scene's solver settings: ``tolerance``, ``max_iterations`` (Newton iterations per
+        step, default 200) and ``augmentation`` (``r``, default automatic)."""
+        check_options(cls.name, options, ("rho", "sigma"))
+        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations,
+                   r=settings.augmentation, **options)
+
+    def setup(self, operators) -> None:
+        """A new scene: drop the scaled systems and factorizations of the previous one."""
         self._cache = {}
 
     # ------------------------------------------------------------------ public
@@ -1062,7 +1076,7 @@ class NewtonMethod:
             n = pb.n
             m = sc.modulus / sc.length
             dqh = pb.dq / sc.length
-            Ann, Att = pb.Ann * m, pb.Att * m
+            Ann, Att = pb.Ann.dense() * m, pb.Att.dense() * m
             sN, sT = float(np.mean(np.diag(Ann))), float(np.mean(np.diag(Att)))
             if not (sN > 0 and sT > 0):
                 raise InputError("A", "the influence matrices must have a positive mean diagonal")
@@ -1076,9 +1090,9 @@ class NewtonMethod:
             KN[:, :n] = rN * Ann
             KT[:, n:2 * n] = (rT / dqh) * Att
             if pb.Ant is not None:
-                KN[:, n:2 * n] = rN * m * pb.Ant
+                KN[:, n:2 * n] = rN * m * pb.Ant.dense()
             if pb.Atn is not None:
-                KT[:, :n] = (rT / dqh) * m * pb.Atn
+                KT[:, :n] = (rT / dqh) * m * pb.Atn.dense()
             if iP is not None:
                 KN[:, iP] = -rN
             if iQ is not None:
@@ -1137,7 +1151,7 @@ class NewtonMethod:
         hit = self._cache.get(key)
         if hit is not None and hit.A is pb.A and hit.f is pb.f:
             return hit
-        Ahat = pb.A * (sc.modulus / sc.length)
+        Ahat = pb.A.dense() * (sc.modulus / sc.length)
         fhat = pb.f / sc.length
         scale = float(np.mean(np.diag(Ahat)))
         if not scale > 0:

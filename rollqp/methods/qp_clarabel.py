@@ -37,56 +37,67 @@ def clarabel_tolerances(tolerance: float) -> tuple[float, float]:
     return t, t
 
 
+def clarabel_rows(form):
+    """Clarabel's constraint rows ``A x + s = b``, ``s`` in the cones, for a :class:`~rollqp.problem.QPForm`.
+
+    The zero cone holds the load row (if any) and the nodes without a friction bound
+    (``lower == upper``: equalities, not two opposite bounds, :func:`~rollqp.methods._qp.constraint_rows`);
+    the nonnegative cone ``x <= upper`` (finite) and ``−x <= −lower`` (finite).
+
+    Returns
+    -------
+    A : scipy.sparse.csc_matrix
+    b : ndarray
+    cones : tuple of (str, int)
+        ``("ZeroConeT", m0)``, ``("NonnegativeConeT", m1)``.
+    """
+    n, up, lo, fx = constraint_rows(form)
+    I = sp.identity(n, format="csr")
+    blocks = [sp.csr_matrix(form.a[None, :])] if form.a is not None else []
+    blocks += [I[fx], I[up], -I[lo]]
+    b = [[form.b]] if form.a is not None else []
+    b += [form.lower[fx], form.upper[up], -form.lower[lo]]
+    b = np.concatenate([np.atleast_1d(np.asarray(v, dtype=float)) for v in b])
+    cones = (("ZeroConeT", int(form.a is not None) + fx.size), ("NonnegativeConeT", up.size + lo.size))
+    return sp.vstack(blocks, format="csc"), b, cones
+
+
+def clarabel_settings(tolerance: float) -> dict:
+    """rollqp's Clarabel settings for a requested residual (never the defaults: module docstring)."""
+    gap, feas = clarabel_tolerances(tolerance)
+    return dict(verbose=False, presolve_enable=False, tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=feas,
+                tol_ktratio=min(1e-6, gap), iterative_refinement_reltol=1e-14,
+                iterative_refinement_abstol=1e-14, iterative_refinement_max_iter=20)
+
+
 class ClarabelQP(QPMethod):
+    """Clarabel on the QPs of a step; ``**options`` are ``clarabel.DefaultSettings`` attributes."""
+
     name = "qp-clarabel"
     refine = True  # interior point: complementarity stops at sqrt(gap); see active_set_refine
+    native_options = tuple(a for a in dir(clarabel.DefaultSettings()) if not a.startswith("_"))
 
     def _settings(self):
         s = clarabel.DefaultSettings()
-        s.verbose = False
-        s.presolve_enable = False
-        gap, feas = clarabel_tolerances(self.tolerance)
-        s.tol_gap_abs = gap
-        s.tol_gap_rel = gap
-        s.tol_feas = feas
-        s.tol_ktratio = min(1e-6, gap)
-        s.iterative_refinement_reltol = 1e-14
-        s.iterative_refinement_abstol = 1e-14
-        s.iterative_refinement_max_iter = 20
-        s.max_iter = int(self.max_iterations or 200)
-        for k, v in self.options.items():
+        values = clarabel_settings(self.tolerance)
+        values["max_iter"] = int(self.max_iterations or 200)
+        values.update(self.options)
+        for k, v in values.items():
             setattr(s, k, v)
         return s
 
-    def _rhs(self, form):
-        n, up, lo, fx = constraint_rows(form)
-        parts = []
-        if form.a is not None:
-            parts.append([form.b])
-        parts += [form.lower[fx], form.upper[up], -form.lower[lo]]
-        return np.concatenate([np.atleast_1d(np.asarray(p, dtype=float)) for p in parts])
-
     def _build(self, form):
-        n, up, lo, fx = constraint_rows(form)
-        blocks = []
-        I = sp.identity(n, format="csr")
-        if form.a is not None:
-            blocks.append(sp.csr_matrix(form.a[None, :]))
-        blocks += [I[fx], I[up], -I[lo]]
-        cones = []
-        if form.a is not None or fx.size:
-            cones.append(clarabel.ZeroConeT(int(form.a is not None) + fx.size))
-        cones.append(clarabel.NonnegativeConeT(up.size + lo.size))
-        A = sp.vstack(blocks, format="csc")
+        A, b, cones = clarabel_rows(form)
+        cones = [getattr(clarabel, name)(m) for name, m in cones if m or name == "NonnegativeConeT"]
         P = sp.triu(sp.csc_matrix(form.H), format="csc")
-        return clarabel.DefaultSolver(P, form.q, A, self._rhs(form), cones, self._settings())
+        return clarabel.DefaultSolver(P, form.q, A, b, cones, self._settings())
 
-    def _solve_form(self, form, x0):
+    def _solve_form(self, form, x0, source=None):
         t0 = time.perf_counter()
-        solver, fresh = self._solver_for(form, self._build)
+        solver, fresh = self._solver_for(form, source, self._build)
         setup = time.perf_counter() - t0 if fresh else 0.0
         if not fresh:
-            solver.update(q=form.q, b=self._rhs(form))
+            solver.update(q=form.q, b=clarabel_rows(form)[1])
         t1 = time.perf_counter()
         sol = solver.solve()
         solve_wall = time.perf_counter() - t1

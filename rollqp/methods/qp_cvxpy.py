@@ -16,6 +16,8 @@ import cvxpy as cp
 import numpy as np
 
 from ._qp import QPMethod, constraint_rows
+from .qp_clarabel import ClarabelQP, clarabel_settings
+from .qp_osqp import OsqpQP
 
 try:
     import osqp as _osqp
@@ -25,16 +27,22 @@ except ImportError:  # pragma: no cover - osqp is a core dependency
 
 
 class CvxpyQP(QPMethod):
+    """cvxpy on the QPs of a step; ``solver`` is ``"OSQP"`` (default) or ``"CLARABEL"``, and
+    ``**options`` are that solver's settings (cvxpy passes them on)."""
+
     name = "qp-cvxpy"
     # OSQP's own polish fails inside cvxpy on most of these QPs (the status_polish check
     # retries), and Clarabel stops at sqrt(gap): refine on the found active set (_qp.py).
     refine = True
+    native_options = tuple(sorted(set(OsqpQP.native_options) | set(ClarabelQP.native_options)))
 
-    def __init__(self, tolerance=1e-10, residual_limit=None, max_iterations=None, solver="OSQP", **options):
-        super().__init__(tolerance, residual_limit, max_iterations, **options)
+    def __init__(self, tolerance=1e-10, residual_limit=None, max_iterations=None, operator="exact",
+                 solver="OSQP", **options):
         if solver not in ("OSQP", "CLARABEL"):
             from ..errors import InputError
             raise InputError("solver", f"cvxpy backend solver must be 'OSQP' or 'CLARABEL', got {solver!r}")
+        self.native_options = OsqpQP.native_options if solver == "OSQP" else ClarabelQP.native_options
+        super().__init__(tolerance, residual_limit, max_iterations, operator, **options)
         self.solver = solver
 
     def _build(self, form):
@@ -70,16 +78,15 @@ class CvxpyQP(QPMethod):
             kw = dict(**{_POLISH_KEY: True}, polish_refine_iter=20, eps_abs=eps, eps_rel=eps, delta=1e-10,
                       max_iter=int(self.max_iterations or 200000), warm_start=True)
         else:
-            from .qp_clarabel import clarabel_tolerances
-            gap, feas = clarabel_tolerances(self.tolerance)
-            kw = dict(tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=feas, tol_ktratio=min(1e-6, gap),
-                      iterative_refinement_reltol=1e-14, iterative_refinement_abstol=1e-14,
-                      max_iter=int(self.max_iterations or 200))
+            kw = clarabel_settings(self.tolerance)
+            for k in ("verbose", "presolve_enable", "iterative_refinement_max_iter"):
+                kw.pop(k)  # as before: cvxpy's own defaults for these
+            kw["max_iter"] = int(self.max_iterations or 200)
         kw.update(self.options)
         return kw
 
-    def _solve_form(self, form, x0):
-        (prob, x, params, cons), _ = self._solver_for(form, self._build)
+    def _solve_form(self, form, x0, source=None):
+        (prob, x, params, cons), _ = self._solver_for(form, source, self._build)
         params["q"].value = form.q
         if "b" in params:
             params["b"].value = float(form.b)

@@ -18,7 +18,10 @@ from ._qp import QPMethod, constraint_rows
 
 
 class OsqpQP(QPMethod):
+    """OSQP on the QPs of a step; ``**options`` are OSQP settings (``osqp`` ``setup`` keywords)."""
+
     name = "qp-osqp"
+    native_options = tuple(a for a in dir(osqp.ext_builtin.OSQPSettings()) if not a.startswith("_"))
 
     def _settings(self, eps):
         s = dict(verbose=False, polishing=True, polish_refine_iter=20, eps_abs=eps, eps_rel=eps,
@@ -58,8 +61,8 @@ class OsqpQP(QPMethod):
         # ADMM tolerance: polishing supplies the final digits; start loose, retry tighter.
         return max(self.tolerance, 1e-7)
 
-    def _solve_form(self, form, x0):
-        m, fresh = self._solver_for(form, self._build)
+    def _solve_form(self, form, x0, source=None):
+        m, fresh = self._solver_for(form, source, self._build)
         if not fresh:
             l, u = self._bounds(form)
             m.update(q=form.q, l=l, u=u)

@@ -43,8 +43,23 @@ import time
 
 import numpy as np
 
-from ..errors import InputError, MissingBackendError
+from ..errors import MissingBackendError
 from ._qp import QPMethod, constraint_rows
+
+#: Native settings rollqp lets through to each solver (qpsolvers passes keywords on unchecked,
+#: so rollqp checks them: an unknown setting is an error, not silently ignored).
+NATIVE_OPTIONS = {
+    "daqp": ("primal_tol", "dual_tol", "zero_tol", "pivot_tol", "progress_tol", "cycle_tol", "iter_limit",
+             "fval_bound", "eps_prox", "eta_prox", "rho_soft", "rel_subopt", "abs_subopt"),
+    "quadprog": (),
+    "proxqp": ("backend", "eps_abs", "eps_rel", "max_iter", "verbose", "rho", "mu_eq", "mu_in",
+               "check_duality_gap", "eps_duality_gap_abs", "eps_duality_gap_rel", "compute_timings"),
+    "piqp": ("backend", "eps_abs", "eps_rel", "eps_duality_gap_abs", "eps_duality_gap_rel", "max_iter", "verbose",
+             "rho_init", "delta_init", "reg_lower_limit", "max_factor_retires", "preconditioner_scale_cost",
+             "preconditioner_iter", "tau", "compute_timings"),
+    "highs": ("primal_feasibility_tolerance", "dual_feasibility_tolerance", "qp_regularization_value",
+              "time_limit", "output_flag", "log_to_console"),
+}
 
 #: rollqp method name -> (qpsolvers solver name, package that provides it, refine)
 SOLVERS = {
@@ -99,27 +114,21 @@ def _iterations(extras) -> int:
 
 
 class QpsolversQP(QPMethod):
-    """A QP backend through qpsolvers; ``solver`` is qpsolvers' name of the solver.
+    """A QP backend through qpsolvers; subclasses (:func:`backend`) fix the solver.
 
     Parameters
     ----------
-    solver : str
-        One of the solvers in :data:`SOLVERS` (``"daqp"``, ``"quadprog"``, …).
     tolerance, residual_limit, max_iterations, operator
         As :class:`~rollqp.methods._qp.QPMethod`.
     **options
-        Passed to the solver through qpsolvers, over rollqp's settings.
+        The solver's settings (:data:`NATIVE_OPTIONS`), passed through qpsolvers over rollqp's.
     """
 
-    def __init__(self, solver: str, tolerance: float = 1e-10, residual_limit=None, max_iterations=None,
+    solver = ""  # qpsolvers' name of the solver, set by each subclass
+
+    def __init__(self, tolerance: float = 1e-10, residual_limit=None, max_iterations=None,
                  operator: str = "exact", **options):
-        names = {v[0]: k for k, v in SOLVERS.items()}
-        if solver not in names:
-            raise InputError("solver", f"qpsolvers backend must be one of {', '.join(names)}, got {solver!r}")
         super().__init__(tolerance, residual_limit, max_iterations, operator, **options)
-        self.solver = solver
-        self.name = names[solver]
-        self.refine = SOLVERS[self.name][2]
         import qpsolvers
         self._qpsolvers = qpsolvers
 
@@ -143,7 +152,7 @@ class QpsolversQP(QPMethod):
         return self._qpsolvers.Problem(P, form.q, G, h if h.size else None,
                                        A, np.asarray(b, dtype=float) if A_rows else None)
 
-    def _solve_form(self, form, x0):
+    def _solve_form(self, form, x0, source=None):
         problem = self._problem(form)
         kwargs = _settings(self.solver, self.tolerance, self.max_iterations)
         kwargs.update(self.options)
@@ -173,8 +182,17 @@ def _available(solver: str, package: str) -> bool:
     return solver in qpsolvers.available_solvers
 
 
+@functools.lru_cache(maxsize=None)
+def backend(name: str) -> type:
+    """The method class of the qpsolvers backend ``name`` (``"qps-daqp"``, …)."""
+    solver, _, refine = SOLVERS[name]
+    return type(f"Qps{solver.capitalize()}", (QpsolversQP,),
+                {"name": name, "solver": solver, "refine": refine, "native_options": NATIVE_OPTIONS[solver],
+                 "__doc__": f"``{name}``: {solver} through qpsolvers (:class:`QpsolversQP`)."})
+
+
 def __getattr__(attr):
-    """``qps_<solver>``: the factory of that backend, if qpsolvers and the solver are installed."""
+    """``qps_<solver>``: the class of that backend, if qpsolvers and the solver are installed."""
     name = attr.replace("_", "-")
     if name not in SOLVERS:
         raise AttributeError(attr)
@@ -182,4 +200,4 @@ def __getattr__(attr):
     if not _available(solver, package):
         raise MissingBackendError(f"method {name!r} needs the solver package {package!r} "
                                   f"(pip install 'rollqp[qpsolvers]')")
-    return functools.partial(QpsolversQP, solver)
+    return backend(name)

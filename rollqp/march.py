@@ -1,0 +1,492 @@
+"""The transient: integration over the rolled distance as a stream of step records (paper §4.1, §4.4).
+
+:func:`march` yields one :class:`StepRecord` per state of the result file; :func:`run`
+collects them into a :class:`~rollqp.result.Result`. Anything that observes or extends the
+transient — the step files (:mod:`rollqp.stepfile`), the cross-validation report, the
+benchmarks, post-processing — consumes the records; it needs no private call. The phases
+(docs/formulation.md §9):
+
+* **starting state** (record ``k = 0``):
+
+  - ``start = "braked"`` (phase ``"static-shift"``): the normal load is applied (Hertz for
+    similar bodies), then the tangential load by static shift in ``load.start_steps``
+    increments (Cattaneo for similar bodies, §4.4): ``s = (w^k − w^{k−1})/Δ + ξ`` with
+    ``Δ = a_H`` and ``ξ·Δ`` the rigid shift;
+  - ``start = "rolling"``: steady rolling at the initial loads. A method that declares
+    ``"steady"`` (:attr:`Method.solves <rollqp.methods.base.Method.solves>`) solves the
+    steady problem directly (phase ``"steady"``; slip ``s = ξ e + d·D_up w``,
+    :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`); the others
+    (the QP backends: the steady operator is far from symmetric and their splitting does not
+    converge on it) reach it by marching the transient at constant loads from the braked
+    state until the tractions stop changing (phase ``"rolling"``).
+* **rolling steps** ``k = 1..K`` at ``q_k = k Δq`` (phase ``"rolling"``): the history vector
+  ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
+  ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step.
+* **contact lost** (``P(q) = 0``): an unloaded state (:func:`_unloaded`), nothing solved;
+  **frictionless** (``μ = 0``): the normal half alone, ``t = 0`` (:func:`_frictionless`);
+* **gross sliding** (only with a prescribed creepage beyond the sliding creepage; a prescribed
+  ``|Q| >= μP`` is rejected by the scene): solved, and marked in the record (``gross_sliding``);
+* **failures**: a :class:`~rollqp.errors.SolverError` names the step (0: the start) and
+  rollqp's residual; :func:`run` attaches the completed states as ``err.partial``.
+
+Only what the scene needs is modelled: with no shear feedback (``A_nt`` absent) and a constant
+normal load the normal half is solved once and reused; coupling operators exist only for the
+coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Iterator
+
+import numpy as np
+
+from .errors import InputError, SolverError
+from .operators import SceneOperators
+from .problem import StepSolution, classify
+from .result import Result
+from .scene import Scene, load_scene
+
+__all__ = ["State", "StepRecord", "march", "run", "prepare"]
+
+#: Rolling start by marching: stop when max|Δt| per step is below this fraction of μp0
+#: (a hundred times above the QP solvers' step-to-step noise of ~1e-10, and far below
+#: the discretization error of ~1e-3) …
+STEADY_TOL = 1e-8
+#: … or after this many a_H of rolling (Carter's transient dies out within ~3 a_H).
+STEADY_MAX_DISTANCE = 40.0
+
+
+@dataclass(frozen=True)
+class State:
+    """An accepted state: tractions, the relative displacement ``w``, and the solutions behind it.
+
+    ``nsol`` is the normal half's solution (``normal`` its problem) and ``tsol`` the tangential
+    one; for a coupled step both are the one coupled :class:`~rollqp.problem.StepSolution`.
+    They are the warm starts of the next step.
+    """
+
+    p: np.ndarray
+    t: np.ndarray
+    w: np.ndarray
+    nsol: StepSolution | None = None
+    tsol: StepSolution | None = None
+    normal: object = None
+
+
+@dataclass
+class Counters:
+    """What the solves of one state report to the result file."""
+
+    iterations: int = 0
+    residual: float = 0.0
+    inner_normal: int = 0
+    inner_tangential: int = 0
+    backtracks: int = 0
+
+    def add(self, sol, half=None):
+        """Count a solution of a normal or tangential half (two-QP path)."""
+        self.iterations += sol.iterations
+        if half == "normal":
+            self.inner_normal += sol.iterations
+        elif half == "tangential":
+            self.inner_tangential += sol.iterations
+        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.residual = max(self.residual, sol.residual)
+
+    def add_coupled(self, sol):
+        """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
+        self.iterations += sol.iterations
+        self.inner_normal += int(sol.info.get("inner_normal", 0))
+        self.inner_tangential += int(sol.info.get("inner_tangential", 0))
+        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.residual = max(self.residual, sol.residual)
+
+
+@dataclass
+class StepRecord:
+    """One state of the transient and the last solve that produced it.
+
+    Attributes
+    ----------
+    k : int
+        Index of the state in the result file (0: the starting state).
+    phase : {"static-shift", "steady", "rolling"}
+        How the last solve posed the slip: static shift (braked start), the steady-rolling
+        problem (direct rolling start), or a rolling step.
+    q : float
+        Rolled distance (length units).
+    P : float
+        Normal load (prescribed, or ``fᵀp`` when the approach is prescribed).
+    Q : float
+        Tangential load ``fᵀt`` on body A.
+    state : State
+        The state after the step.
+    previous : State
+        The state the last solve started from.
+    problem : NormalStep, TangentialStep or CoupledStep or None
+        The last tangential or coupled problem solved (``None``: nothing was solved, contact lost).
+    solution : StepSolution or None
+        Its solution.
+    counters : Counters
+    shift : float
+        Rigid static shift of a braked start (zero for rolling states).
+    step_time : float
+        Wall seconds of the state (every solve behind it).
+    nodes : ndarray of int8
+        0 separation, 1 stick, 2 slip.
+    gross_sliding : bool
+        Every contact node slips (possible only with a prescribed creepage).
+    """
+
+    k: int
+    phase: str
+    q: float
+    P: float
+    Q: float
+    state: State
+    previous: State
+    problem: object
+    solution: StepSolution | None
+    counters: Counters
+    shift: float
+    step_time: float
+    nodes: np.ndarray = field(repr=False, default=None)
+    gross_sliding: bool = False
+
+    @property
+    def normal(self):
+        """``(NormalStep, StepSolution)`` of the normal half in effect, or ``None`` (coupled step, no contact)."""
+        st = self.state
+        return None if st.normal is None else (st.normal, st.nsol)
+
+
+class _March:
+    """The march of one scene with one method: the step logic, one small method per phase."""
+
+    def __init__(self, scene: Scene, ops: SceneOperators, method):
+        self.scene, self.ops, self.method = scene, ops, method
+        self.fixed = self._normal_fixed()
+
+    # ------------------------------------------------------------ loads
+    def loads(self, q):
+        """``(P, Q, ξ)`` at ``q``; ``P`` is None when the approach is prescribed (:meth:`approach`)."""
+        sc = self.scene
+        P = None if sc.load.approach is not None else float(sc.normal_load(q))
+        if sc.load.creepage is not None:
+            return P, None, float(sc.prescribed_creepage(q))
+        return P, float(sc.tangential_load(q)), None
+
+    def approach(self, q):
+        """The prescribed approach δ(q), or None (the normal load is prescribed)."""
+        d = self.scene.prescribed_approach(q)
+        return None if d is None else float(d)
+
+    def _normal_fixed(self) -> bool:
+        """The normal step cannot change: no shear feedback (A_nt absent) and constant P."""
+        if self.ops.Ant is not None:
+            return False
+        qs = self.scene.q_steps
+        sc = self.scene
+        P = sc.normal_load(qs) if sc.load.approach is None else sc.prescribed_approach(qs)
+        return bool(np.all(P == P[0]))
+
+    # ------------------------------------------------------------ one step
+    def step(self, state: State, cnt: Counters, *, P, c, dq, Q=None, xi=None, normal_fixed=False,
+             steady=False, delta=None):
+        """One step (rolling, static shift or steady): ``(new state, problem, solution)``."""
+        ops, meth = self.ops, self.method
+        if P is not None and P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
+            return _unloaded(ops, xi), None, None
+        if ops.mu == 0.0:
+            return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta)
+        if ops.coupled:
+            pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta)
+            sol = meth.solve(pb, warm=state.tsol)
+            cnt.add_coupled(sol)
+            return State(sol.p, sol.t, ops.w(sol.p, sol.t), sol, sol, None), pb, sol
+        nsol, npb = state.nsol, state.normal
+        if not normal_fixed or nsol is None:
+            # goodman/off: the normal half does not see t (A_nt = 0); offset kept for generality
+            npb = ops.normal_step(P, state.t, delta=delta)
+            nsol = meth.solve(npb, warm=state.nsol)
+            cnt.add(nsol, "normal")
+        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady)
+        tsol = meth.solve(pb, warm=state.tsol)
+        cnt.add(tsol, "tangential")
+        return State(nsol.p, tsol.t, ops.w(nsol.p, tsol.t), nsol, tsol, npb), pb, tsol
+
+    def _frictionless(self, state, cnt, *, P, c, dq, xi=None, steady=False, delta=None):
+        """A step at ``μ = 0``: ``t = 0`` (the bound ``μp`` is zero at every node), the normal half alone.
+
+        The tangential problem is degenerate (every node on the kink ``|t| = μp = 0``, no node can
+        stick, so the load row ``fᵀt = Q = 0`` has no ``ξ`` column): nothing is solved for it. The
+        creepage is not determined by the contact (the surfaces slide freely); it is the prescribed
+        one, else reported as 0, and the slip follows from it and ``w`` as in any step. With
+        ``t = 0`` the coupled step reduces to its normal half too (``A_nt t = 0``).
+        """
+        ops = self.ops
+        zero = np.zeros(ops.n)
+        npb = ops.normal_step(P, zero, delta=delta)
+        nsol = self.method.solve(npb, warm=state.nsol)
+        cnt.add(nsol, "normal")
+        xi = 0.0 if xi is None else float(xi)
+        pb = ops.tangential_step(nsol.p, c, dq, xi=xi, steady=steady)
+        tsol = pb.solution(zero, xi)
+        tsol.method, tsol.status = "frictionless", "frictionless"
+        return State(nsol.p, zero, ops.w(nsol.p, zero), nsol, tsol, npb), pb, tsol
+
+    def record(self, k, phase, q, state, previous, problem, sol, cnt, *, P, shift, t0) -> StepRecord:
+        ops = self.ops
+        tsol = state.tsol
+        nodes = classify(state.p, state.t, tsol.s, ops.mu, ops.scales)
+        gross = bool(np.any(nodes == 2) and not np.any(nodes == 1))
+        return StepRecord(k=k, phase=phase, q=float(q), P=float(ops.f @ state.p) if P is None else P,
+                          Q=float(ops.f @ state.t), state=state, previous=previous, problem=problem, solution=sol, counters=cnt,
+                          shift=shift, step_time=time.perf_counter() - t0, nodes=nodes, gross_sliding=gross)
+
+    # ------------------------------------------------------------ the phases
+    def braked_start(self):
+        """Step 0 of a braked start (§2.2, §4.4; docs/formulation.md §9), by static shift.
+
+        1. The normal load in ``load.start_steps`` quasi-static increments at ``Q = 0``. With
+           coupling (β ≠ 0, ``goodman`` or ``full``) the pressure displaces the surfaces
+           tangentially and friction resists: the Goodman-type starting state. Without coupling
+           the shear stays zero and the normal load is applied at once (path independent).
+        2. The tangential load in ``load.start_steps`` increments (Cattaneo for similar bodies).
+
+        Static-shift slip: ``s = ξ + (w^j − w^{j−1})/Δ`` with ``Δ = a_H`` and ``ξ·Δ`` the rigid
+        shift increment, accumulated in the record's ``shift``.
+        """
+        scene, ops = self.scene, self.ops
+        t0 = time.perf_counter()
+        P, Q, _ = self.loads(0.0)
+        D = self.approach(0.0)  # prescribed approach: applied like the load, in start_steps parts
+        Qtarget = Q if Q is not None else 0.0
+        n = ops.n
+        N = scene.load.start_steps
+        delta = ops.scales.length
+        cnt = Counters()
+        state = previous = State(None, np.zeros(n), np.zeros(n))  # unloaded bodies
+        problem = sol = None
+        shift = 0.0
+        N0 = P if D is None else D
+        if ops.Atn is not None:
+            loading = [(N0 * j / N, 0.0) for j in range(1, N + 1)]
+        else:  # no coupling: the shear of a normal load is zero, so go straight to Q (Hertz, then Cattaneo)
+            loading = [] if Qtarget != 0.0 else [(N0, 0.0)]
+        if Qtarget != 0.0:
+            loading += [(N0, Qtarget * j / N) for j in range(1, N + 1)]
+        Pprev = None
+        for Pj, Qj in loading:
+            # the normal half is re-solved only if P changed or the shear feeds back (A_nt)
+            previous = state
+            state, problem, sol = self.step(state, cnt, P=None if D is not None else Pj, c=-state.w, dq=delta,
+                                            Q=Qj, normal_fixed=(Pj == Pprev and ops.Ant is None),
+                                            delta=None if D is None else Pj)
+            Pprev = Pj
+            shift += state.tsol.xi * delta
+        ops.check_inside(state.p, 0)
+        return self.record(0, "static-shift", 0.0, state, previous, problem, sol, cnt, P=P, shift=shift, t0=t0)
+
+    def steady_direct(self, start: StepRecord) -> StepRecord:
+        """Rolling start: the steady rolling problem ``s = ξ e + d·D_up w`` solved directly.
+
+        Not symmetric (``D_up A`` is not), so only methods that declare ``"steady"`` pose it;
+        warm-started from the braked state.
+        """
+        t0 = time.perf_counter()
+        P, Q, xi = self.loads(0.0)
+        cnt = Counters()
+        state, problem, sol = self.step(start.state, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
+                                        Q=Q, xi=xi, steady=True, delta=self.approach(0.0))
+        self.ops.check_inside(state.p, 0)
+        return self.record(0, "steady", 0.0, state, start.state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+
+    def steady_by_marching(self, start: StepRecord) -> StepRecord:
+        """Rolling start: roll at the initial loads until the tractions stop changing.
+
+        For methods that cannot pose the non-symmetric steady problem (``STEADY_TOL``,
+        ``STEADY_MAX_DISTANCE``).
+        """
+        scene, ops = self.scene, self.ops
+        t0 = time.perf_counter()
+        P, Q, xi = self.loads(0.0)
+        cnt = Counters()
+        M = ops.history()
+        max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
+        change = np.inf
+        state = start.state
+        for _ in range(max_steps):
+            previous = state
+            state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
+                                            normal_fixed=self.fixed, delta=self.approach(0.0))
+            change = np.max(np.abs(state.t - previous.t)) / (max(ops.mu, 1e-300) * ops.scales.stress)
+            if not self.fixed:
+                change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
+            if change < STEADY_TOL:
+                break
+        else:
+            raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
+                              f"(last change {change:.2e} mu p0)", method=self.method.name, step=0)
+        return self.record(0, "rolling", 0.0, state, previous, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+
+    def rolling(self, k: int, q: float, state: State, M) -> StepRecord:
+        """Rolling step ``k`` at ``q``."""
+        scene = self.scene
+        t0 = time.perf_counter()
+        P, Q, xi = self.loads(q)
+        cnt = Counters()
+        new, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
+                                      normal_fixed=self.fixed, delta=self.approach(q))
+        if not self.fixed:
+            self.ops.check_inside(new.p, k)
+        return self.record(k, "rolling", q, new, state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+
+
+def prepare(scene, method=None):
+    """``(scene, method, operators)``: the scene validated, its method composed and set up on its operators.
+
+    Parameters
+    ----------
+    scene : Scene, str or path
+        A scene object, a TOML path, or a built-in name.
+    method : str or Method, optional
+        A method name (overrides ``[solver].method``) or a method object (used as it is, composed
+        with the N–T alternation if the scene is coupled and it does not solve coupled steps).
+    """
+    from .methods import compose, scene_method
+    scene = scene if isinstance(scene, Scene) else load_scene(scene)
+    if isinstance(method, str) and method != scene.solver.method:
+        scene = scene.replace(**{"solver.method": method})
+    coupled = scene.coupling_level == "full"
+    if method is None or isinstance(method, str):
+        meth = scene_method(scene.solver, coupled=coupled)
+    else:
+        meth = compose(method, coupled, max_outer=scene.solver.max_iterations)
+    ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")
+    meth.setup(ops)
+    return scene, meth, ops
+
+
+def march(scene, method=None, *, prepared=None) -> Iterator[StepRecord]:
+    """The transient of ``scene`` as a stream of :class:`StepRecord` (module docstring).
+
+    Parameters
+    ----------
+    scene : Scene, str or path
+        A scene object, a TOML path, or a built-in name.
+    method : str or Method, optional
+        A method name (overrides ``[solver].method``) or a method object (:func:`prepare`).
+    prepared : tuple, optional
+        ``(scene, method, operators)`` from :func:`prepare` (to look at the operators first).
+
+    Yields
+    ------
+    StepRecord
+        ``k = 0`` (the starting state), then the rolling steps ``k = 1..K``.
+
+    Raises
+    ------
+    SolverError
+        A step failed; ``err.step`` names it (0: the start).
+    InputError
+        The scene cannot be run with this method, or the contact leaves the zone.
+    """
+    scene, meth, ops = prepared if prepared is not None else prepare(scene, method)
+    m = _March(scene, ops, meth)
+    try:
+        start = m.braked_start()
+        if scene.load.start == "rolling":
+            start = m.steady_direct(start) if "steady" in meth.solves else m.steady_by_marching(start)
+    except SolverError as err:  # the start is state 0
+        raise (err.with_step(0) if err.step is None else err) from err
+    yield start
+    M = ops.history()
+    qs = scene.q_steps
+    state = start.state
+    for k in range(1, qs.size):
+        try:
+            rec = m.rolling(k, float(qs[k]), state, M)
+        except SolverError as err:
+            raise (err.with_step(k) if err.step is None else err) from err
+        state = rec.state
+        yield rec
+
+
+def run(scene, method=None, progress=None) -> Result:
+    """Run a scene's transient and return its :class:`~rollqp.result.Result`.
+
+    Parameters
+    ----------
+    scene : Scene, str or path
+        A scene object, a TOML path, or a built-in name.
+    method : str or Method, optional
+        Overrides ``[solver].method`` (:func:`prepare`).
+    progress : callable, optional
+        Called as ``progress(k, K)`` after each rolling step.
+
+    Raises
+    ------
+    SolverError
+        A step failed; ``err.partial`` holds the :class:`Result` of the completed steps and
+        ``err.step`` the failing step.
+    InputError
+        The scene cannot be run with this method, or the contact leaves the zone
+        (``err.partial`` as above).
+    """
+    scene, meth, ops = prepared = prepare(scene, method)
+    result = new_result(scene, ops, meth.name)
+    K = scene.n_steps
+    try:
+        for rec in march(scene, prepared=prepared):
+            result.add(rec)
+            if progress is not None and rec.k > 0:
+                progress(rec.k, K)
+    except (SolverError, InputError) as err:
+        err.partial = result
+        raise
+    return result
+
+
+def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
+    """An empty :class:`Result` with the scene's scalars and metadata."""
+    import rollqp
+    meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info),
+            "versions": _versions(), "rollqp": rollqp.__version__,
+            "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
+            "step_problem": "coupled" if ops.coupled else "normal + tangential",
+            "slip_note": "step 0 of a braked start: static-shift slip per a_H of shift"}
+    scalars = {"a_H": scene.a_H, "p0": scene.p0, "R": scene.R, "Estar": scene.Estar, "beta": scene.beta,
+               "leading_edge": scene.leading_edge}
+    return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta)
+
+
+def _versions() -> dict:
+    import importlib.metadata as md
+    out = {}
+    for pkg in ("numpy", "scipy", "clarabel", "osqp", "cvxpy"):
+        try:
+            out[pkg] = md.version(pkg)
+        except md.PackageNotFoundError:
+            out[pkg] = None
+    return out
+
+
+def _unloaded(ops: SceneOperators, xi=None) -> State:
+    """The state at ``P = 0``: out of contact, no tractions, the surfaces relaxed (``w = 0``).
+
+    Nothing is solved: the only solution of the step has ``p = t = 0``. The approach is not
+    determined (any ``δ <= min h``); it is recorded as ``min h`` (the bodies just touch, the
+    smallest gap 0). The creepage is not determined either (nothing sticks): the prescribed one,
+    else 0, and every node is reported as separated (state 0). The slip memory is lost, so the
+    next loaded step starts from unloaded surfaces. The scene requires ``Q = 0`` wherever
+    ``P = 0`` (:class:`~rollqp.scene.Scene`).
+    """
+    n = ops.n
+    delta = float(np.min(ops.h))
+    zero = np.zeros(n)
+    nsol = StepSolution(p=zero, g=ops.h - delta, delta=delta, method="unloaded", status="unloaded")
+    tsol = StepSolution(t=zero, s=zero, xi=0.0 if xi is None else float(xi), method="unloaded",
+                        status="unloaded")
+    return State(zero, zero, zero, nsol, tsol, None)

@@ -1,0 +1,170 @@
+"""What a scene's transient needs that cannot change during it, built once: :class:`SceneOperators`.
+
+The strip (docs/formulation.md §2), the influence operators (§3) as read-only
+:class:`~rollqp.influence.operator.Operator`\\ s validated once, the undeformed gap, the scales of
+the nondimensional form (§5), the history operators of the slip (§4) and the steady-rolling slip
+operators (§9). Methods receive it once per scene (:meth:`Method.setup
+<rollqp.methods.base.Method.setup>`); :func:`rollqp.march` asks it for each step's problem.
+
+Only what the scene needs is built: coupling operators for the coupling level asked for, the
+steady operators only for a direct steady rolling start, each history operator on first use.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError
+from .influence import build_influence
+from .influence.operator import Operator, asymmetry
+from .problem import CoupledStep, NormalStep, Scales, TangentialStep
+from .strip import Strip
+
+__all__ = ["SceneOperators"]
+
+
+@dataclass
+class SceneOperators:
+    """The fixed part of a scene's transient (module docstring); build with :meth:`build`.
+
+    Attributes
+    ----------
+    scene : Scene
+    strip : Strip
+    Ann, Att : Operator
+        Normal and tangential influence (eq. 25, 28); ``F⁻¹ sym(F A)`` of them when
+        ``symmetrized``.
+    Atn, Ant : Operator or None
+        Coupling (``None``: absent at the scene's coupling level, docs/formulation.md §3).
+    h : ndarray
+        Undeformed gap at the nodes (eq. 10).
+    scales : Scales
+        ``a_H``, ``p0``, ``E*`` of the reference load.
+    symmetrized : bool
+        The QP operator ``F⁻¹ sym(F A)`` replaces ``A`` for the whole transient (history
+        vectors included), so that every step's residual refers to one discrete model.
+    info : dict
+        The influence model's data and diagnostics, the measured asymmetries of ``F·A``,
+        ``influence_seconds``, ``operator``.
+    """
+
+    scene: object
+    strip: Strip
+    Ann: Operator
+    Att: Operator
+    Atn: Operator | None
+    Ant: Operator | None
+    h: np.ndarray
+    scales: Scales
+    symmetrized: bool = False
+    info: dict = field(default_factory=dict)
+    _memo: dict = field(default_factory=dict, repr=False)
+
+    @classmethod
+    def build(cls, scene, symmetrized: bool = False) -> "SceneOperators":
+        """Discretize ``scene``; ``symmetrized`` selects the QP operator ``F⁻¹ sym(F A)``."""
+        d = scene.discretization
+        strip = Strip(scene.half_width, d.elements, d.element)
+        t0 = time.perf_counter()
+        kw = {}
+        if scene.contact.model == "bem":  # true geometry: the rollers and their BEM meshes
+            kw = dict(A=scene.A, B=scene.B, n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1])
+        infl = build_influence(scene.contact.model, strip, Estar=scene.Estar, beta=scene.beta,
+                               R_A=scene.A.radius, R_B=scene.B.radius, coupling=scene.coupling_level,
+                               d_ref=scene.reference_distance_value, **kw)
+        f = strip.weights
+        info = dict(infl.info)
+        info["asymmetry_Ann"] = asymmetry(infl.Ann, f)
+        info["asymmetry_Att"] = asymmetry(infl.Att, f)
+        Ann = Operator(infl.Ann, "influence")
+        same = infl.Att is infl.Ann or np.array_equal(infl.Att, infl.Ann)
+        Att = Ann if same else Operator(infl.Att, "influence")
+        if symmetrized:
+            Ann = Ann.split(f).sym
+            Att = Ann if same else Att.split(f).sym
+        info["influence_seconds"] = time.perf_counter() - t0
+        info["operator"] = "symmetrized" if symmetrized else "collocation"
+        Atn, Ant = (None if M is None else Operator(M, "influence") for M in (infl.Atn, infl.Ant))
+        return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
+                   scales=Scales(scene.a_H, scene.p0, scene.Estar), symmetrized=symmetrized, info=info)
+
+    @property
+    def f(self) -> np.ndarray:
+        """Integration weights ``f_j = ∫ N_j`` (eq. 65–67)."""
+        return self.strip.weights
+
+    @property
+    def n(self) -> int:
+        return self.strip.n
+
+    @property
+    def coupled(self) -> bool:
+        """Full coupling (``A_nt`` present): each step is one :class:`CoupledStep`."""
+        return self.Ant is not None
+
+    @property
+    def mu(self) -> float:
+        return self.scene.contact.friction
+
+    # ------------------------------------------------------------ slip operators
+    def history(self, formulation: str | None = None, dq: float | None = None,
+                direction: int | None = None) -> np.ndarray:
+        """``M`` with the history vector ``c^{k−1} = −M w^{k−1}`` (eq. 37, 48), built once per argument set.
+
+        The defaults are the scene's own: ``discretization.formulation``, ``Δq`` and ``load.direction``.
+        """
+        sc = self.scene
+        formulation = sc.discretization.formulation if formulation is None else formulation
+        dq = sc.dq if dq is None else dq
+        direction = sc.load.direction if direction is None else direction
+        key = ("history", formulation, float(dq), int(direction))
+        if key not in self._memo:
+            self._memo[key] = self.strip.history_operator(formulation, dq, direction)
+        return self._memo[key]
+
+    def steady(self) -> tuple[Operator | None, Operator]:
+        """``(Δ·d·D_up·A_tn, Δ·d·D_up·A_tt)`` with ``Δ = a_H``: the steady slip operators, built once.
+
+        With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt t)/dq``
+        is then the steady-rolling slip ``ξ e + d·D_up w`` (docs/formulation.md §4, §9).
+        """
+        if "steady" not in self._memo:
+            T = self.scales.length * self.strip.steady_operator(self.scene.load.direction)
+            Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")
+            self._memo["steady"] = (Atn, Operator(T @ self.Att.dense(), "steady A_tt"))
+        return self._memo["steady"]
+
+    # ------------------------------------------------------------ step problems
+    def normal_step(self, P, t=None, delta=None) -> NormalStep:
+        """The normal step (eq. 53): load ``P`` (or approach ``delta``), shear ``t`` fixed."""
+        offset = None if (self.Ant is None or t is None) else self.Ant @ t
+        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=P, delta=delta, offset=offset, scales=self.scales)
+
+    def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False) -> TangentialStep:
+        """The tangential step (eq. 61/62) at the pressure ``p``; ``steady``: the steady slip operators."""
+        Atn, Att = self.steady() if steady else (self.Atn, self.Att)
+        if Atn is not None:
+            c = c + Atn @ p
+        return TangentialStep(A=Att, f=self.f, p=p, mu=self.mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales)
+
+    def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None) -> CoupledStep:
+        """The coupled step (docs/formulation.md §10); ``steady``: slip ``s = ξ e + d·D_up w``."""
+        Atn, Att = self.steady() if steady else (self.Atn, self.Att)
+        return CoupledStep(Ann=self.Ann, Att=Att, Ant=self.Ant, Atn=Atn, f=self.f, h=self.h, mu=self.mu,
+                           c=c, dq=dq, P=P, Q=Q, xi=xi, delta=delta, scales=self.scales)
+
+    def w(self, p, t) -> np.ndarray:
+        """Relative tangential displacement ``w = A_tn p + A_tt t`` (eq. 28)."""
+        out = self.Att @ t
+        return out if self.Atn is None else out + self.Atn @ p
+
+    def check_inside(self, p, step: int):
+        """The contact must not reach the ends of the potential contact zone (docs/formulation.md §1)."""
+        ends = (p[0], p[-1])
+        if max(ends) > 1e-8 * self.scales.stress:
+            raise InputError("discretization.zone",
+                             f"the contact reaches the edge of the zone at step {step} "
+                             f"(p/p0 = {max(ends) / self.scales.stress:.2e} at an end node): increase zone "
+                             f"(now {self.scene.discretization.zone})")
