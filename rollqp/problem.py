@@ -257,7 +257,7 @@ class NormalStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        Ah = self.A.dense() * (sc.modulus / sc.length)
+        Ah = self.A.dense() * sc.modulus / sc.length
         FA = fh[:, None] * Ah
         H = 0.5 * (FA + FA.T)
         q = fh * self.h_total / sc.displacement
@@ -387,7 +387,7 @@ class TangentialStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        Ah = self.A.dense() * (sc.modulus / sc.length)
+        Ah = self.A.dense() * sc.modulus / sc.length
         dqh = self.dq / sc.length
         FA = fh[:, None] * Ah / dqh
         H = 0.5 * (FA + FA.T)
