@@ -440,7 +440,7 @@ def run(scene, method=None, progress=None) -> Result:
     K = scene.n_steps
     try:
         for rec in march(scene, prepared=prepared):
-            result.add(rec)
+            result.add(rec, ops)
             if progress is not None and rec.k > 0:
                 progress(rec.k, K)
     except (SolverError, InputError) as err:
@@ -450,8 +450,9 @@ def run(scene, method=None, progress=None) -> Result:
 
 
 def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
-    """An empty :class:`Result` with the scene's scalars and metadata."""
+    """An empty :class:`Result` with the scene's scalars, metadata and the computed fields it needs."""
     import rollqp
+    from .fields import fields_for
     meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info),
             "versions": _versions(), "rollqp": rollqp.__version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
@@ -459,7 +460,7 @@ def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
             "slip_note": "step 0 of a braked start: static-shift slip per a_H of shift"}
     scalars = {"a_H": scene.a_H, "p0": scene.p0, "R": scene.R, "Estar": scene.Estar, "beta": scene.beta,
                "leading_edge": scene.leading_edge}
-    return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta)
+    return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta, extra=fields_for(scene))
 
 
 def _versions() -> dict:

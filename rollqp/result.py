@@ -1,4 +1,4 @@
-"""The result file (SPEC.md): one ``.npz`` without pickled objects, written atomically."""
+"""The result file (docs/results.md): one ``.npz`` without pickled objects, written atomically."""
 from __future__ import annotations
 
 import json
@@ -9,38 +9,45 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError
+from .fields import FIELDS, dtype_of
 
+#: The core per-state and per-step fields, read off each record (:mod:`rollqp.fields` documents them).
 _PER_STATE = ("pn", "pt", "slip", "gap", "state")
 _PER_STEP = ("q", "P", "Q", "creepage", "approach", "shift", "iterations", "step_time", "residual",
              "inner_normal", "inner_tangential", "backtracks")
-_COUNTS = ("iterations", "inner_normal", "inner_tangential", "backtracks")
 
 
 @dataclass
 class Result:
     """States of a transient: index 0 is the starting state, 1..K the rolling steps.
 
-    Arrays follow SPEC.md's result file; ``shift`` (rigid static shift of the braked
-    start, zero for rolling states) and ``scalars`` (``a_H``, ``p0``, ``R``, ``Estar``,
-    ``beta``, ``leading_edge``) are kept beside them. ``meta`` is JSON-able.
+    The arrays are the result file's (docs/results.md; every key is a :class:`rollqp.fields.Field`):
+    the core fields read off each :class:`~rollqp.march.StepRecord` (:meth:`add`), the computed
+    fields the scene needs (``extra``: :func:`rollqp.fields.fields_for`), and ``scalars``
+    (``a_H``, ``p0``, ``R``, ``Estar``, ``beta``, ``leading_edge``). ``meta`` is JSON-able.
     """
 
     x: np.ndarray
     scalars: dict
     meta: dict
-    rows: dict = field(default_factory=lambda: {k: [] for k in _PER_STATE + _PER_STEP})
+    extra: list = field(default_factory=list)
+    rows: dict = field(default_factory=dict)
 
-    def append(self, *, q, pn, pt, slip, gap, state, P, Q, creepage, approach, shift=0.0,
-               iterations=0, step_time=0.0, residual=0.0, inner_normal=0, inner_tangential=0, backtracks=0):
-        vals = dict(q=q, pn=pn, pt=pt, slip=slip, gap=gap, state=state, P=P, Q=Q, creepage=creepage,
-                    approach=approach, shift=shift, iterations=iterations, step_time=step_time,
-                    residual=residual, inner_normal=inner_normal, inner_tangential=inner_tangential,
-                    backtracks=backtracks)
-        for k, v in vals.items():
-            self.rows[k].append(np.array(v, copy=True))
+    def __post_init__(self):
+        for k in _PER_STATE + _PER_STEP + tuple(f.name for f in self.extra):
+            self.rows.setdefault(k, [])
 
-    def add(self, rec) -> None:
-        """Append the state of a :class:`~rollqp.march.StepRecord` (``rec.k`` must be ``len(self)``)."""
+    def append(self, **values):
+        """Append one state: every core field (and every ``extra`` one) by name."""
+        missing = [k for k in self.rows if k not in values]
+        if missing:
+            raise TypeError(f"Result.append: missing field(s) {', '.join(missing)}")
+        for k in self.rows:
+            self.rows[k].append(np.array(values[k], copy=True))
+
+    def add(self, rec, operators=None) -> None:
+        """Append the state of a :class:`~rollqp.march.StepRecord` (``rec.k`` must be ``len(self)``);
+        the ``extra`` fields are computed from the record and the scene's ``operators``."""
         if rec.k != len(self):
             raise ValueError(f"record {rec.k} appended as state {len(self)}")
         st, c, tsol = rec.state, rec.counters, rec.state.tsol
@@ -50,25 +57,25 @@ class Result:
             self.meta["rolling_start"] = "direct steady solve"
         elif rec.k == 0 and rec.phase == "rolling":
             self.meta["rolling_start"] = "marching to steady state"
-        self.append(q=rec.q, pn=st.p, pt=st.t, slip=tsol.s, gap=st.nsol.g, state=rec.nodes, P=rec.P,
-                    Q=rec.Q,
-                    creepage=tsol.xi, approach=st.nsol.delta, shift=rec.shift, iterations=c.iterations,
-                    step_time=rec.step_time, residual=c.residual, inner_normal=c.inner_normal,
-                    inner_tangential=c.inner_tangential, backtracks=c.backtracks)
+        values = dict(q=rec.q, pn=st.p, pt=st.t, slip=tsol.s, gap=st.nsol.g, state=rec.nodes, P=rec.P, Q=rec.Q,
+                      creepage=tsol.xi, approach=st.nsol.delta, shift=rec.shift, iterations=c.iterations,
+                      step_time=rec.step_time, residual=c.residual, inner_normal=c.inner_normal,
+                      inner_tangential=c.inner_tangential, backtracks=c.backtracks)
+        for f in self.extra:
+            values[f.name] = f.compute(rec, operators)
+        self.append(**values)
 
     def __len__(self):
         return len(self.rows["q"])
 
     def arrays(self) -> dict:
-        """All arrays of the result file, keyed as in SPEC.md."""
+        """All arrays of the result file, keyed as in docs/results.md."""
         n = self.x.size
         out = {"x": np.asarray(self.x, dtype=float)}
-        for k in _PER_STATE:
-            dtype = np.int8 if k == "state" else float
-            out[k] = np.asarray(self.rows[k], dtype=dtype).reshape(len(self), n)
-        for k in _PER_STEP:
-            dtype = np.int64 if k in _COUNTS else float
-            out[k] = np.asarray(self.rows[k], dtype=dtype).reshape(len(self))
+        for k, v in self.rows.items():
+            per_state = k in _PER_STATE or (k in FIELDS and FIELDS[k].shape == "state")
+            shape = (len(self), n) if per_state else (len(self),)
+            out[k] = np.asarray(v, dtype=dtype_of(k)).reshape(shape)
         for k, v in self.scalars.items():
             out[k] = np.asarray(v)
         out["meta"] = np.asarray(json.dumps(self.meta, sort_keys=True, default=_json_default))
