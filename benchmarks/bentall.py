@@ -43,8 +43,8 @@ from rollqp import closedforms as cf
 from rollqp.errors import SolverError
 
 # CONTACT's bentall case (materials, load, grid), one copy with tests/test_bentall.py
-from rollqp._refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
-from rollqp._refcases import bentall_scene  # noqa: E402
+from rollqp.refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
+from rollqp.refcases import bentall_scene  # noqa: E402
 
 CONTACT = {1e-4: ("5.260e-4", "goodman"), 0.05: ("4.29e-4", "full")}
 
@@ -52,7 +52,7 @@ CONTACT = {1e-4: ("5.260e-4", "goodman"), 0.05: ("4.29e-4", "full")}
 # =========================================================================== helpers
 def scene(mu, elements=80, element="constant", coupling="goodman", direction=-1, zone=1.1, swap=False,
           method="newton"):
-    """Aluminium (A) on steel (B), free rolling, steady, Δq = Le (rollqp._refcases.bentall_scene)."""
+    """Aluminium (A) on steel (B), free rolling, steady, Δq = Le (rollqp.refcases.bentall_scene)."""
     return bentall_scene(mu, elements=elements, element=element, coupling=coupling, direction=direction,
                          zone=zone, swap=swap, method=method)
 

@@ -72,8 +72,8 @@ def measure(scene, res):
 
 def figure(runs, curve, path):
     """Tractions against Carter's, and the creep curve against Carter's law."""
-    from rollqp.plot import _plt
-    plt = _plt()
+    from rollqp.plot import pyplot
+    plt = pyplot()
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.4), constrained_layout=True)
     scene = runs[0][0]
     d = scene.load.direction

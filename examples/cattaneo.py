@@ -63,8 +63,8 @@ def measure(scene, res):
 
 def figure(runs, path):
     """Pressure against Hertz, tractions against Cattaneo, stick zones against c/a = √(1 − r)."""
-    from rollqp.plot import _plt
-    plt = _plt()
+    from rollqp.plot import pyplot
+    plt = pyplot()
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
     scene, res, _ = runs[0]
     a, p0, mu = float(res["a_H"]), float(res["p0"]), scene.contact.friction

@@ -42,8 +42,8 @@ def transient(res, scene):
 
 def figure(res, scene, path, title):
     """Tractions (with Cattaneo and Carter), slip and creepage over the transient."""
-    from rollqp.plot import _plt
-    plt = _plt()
+    from rollqp.plot import pyplot
+    plt = pyplot()
     x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
     mu, d = scene.contact.friction, scene.load.direction
     ratio = float(res["Q"][-1]) / (mu * float(res["P"][-1]))

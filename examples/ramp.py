@@ -79,8 +79,8 @@ def measure(ramp, ramp_scene, ref, ref_scene, other):
 
 def figure(ramp, ramp_scene, ref, other, path, title):
     """Tractions of the ramp (paper Fig. 5) and the creepage of both histories."""
-    from rollqp.plot import _plt
-    plt = _plt()
+    from rollqp.plot import pyplot
+    plt = pyplot()
     x, a, p0, R = ramp["x"], float(ramp["a_H"]), float(ramp["p0"]), float(ramp["R"])
     mu, d = ramp_scene.contact.friction, ramp_scene.load.direction
     q = ramp["q"] / a

@@ -31,7 +31,8 @@ from .errors import MissingBackendError
 from .scene import BETA_ZERO
 
 
-def _plt():
+def pyplot():
+    """``matplotlib.pyplot`` with the non-interactive Agg backend; a one-line error naming the extra if absent."""
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -50,7 +51,7 @@ def snapshot_indices(q, a, wanted=(0.0, 0.25, 0.5, 1.0, 2.0)):
 
 def transient_figure(res: dict, scene, path: str, title: str | None = None) -> str:
     """Save a three-panel figure: t/(μp0), slip, and creepage against q."""
-    plt = _plt()
+    plt = pyplot()
     x, a, p0 = res["x"], float(res["a_H"]), float(res["p0"])
     mu = scene.contact.friction or 1.0
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
@@ -237,7 +238,7 @@ def draw_snapshots(axes, res, scene=None, at=None, n: int = 5) -> list[int]:
     list of int
         The state indices drawn.
     """
-    plt = _plt()
+    plt = pyplot()
     res = _arrays(res)
     info = _Info(res, scene)
     a, p0, mu = info.a, info.p0, info.mu_scale
@@ -289,7 +290,7 @@ def draw_snapshots(axes, res, scene=None, at=None, n: int = 5) -> list[int]:
 
 def draw_zone_map(ax, res, scene=None):
     """Draw the node states of every stored state over (q/a_H, x/a_H), Hertz edges overlaid."""
-    _plt()
+    pyplot()
     from matplotlib.colors import BoundaryNorm, ListedColormap
     from matplotlib.patches import Patch
     res = _arrays(res)
@@ -378,7 +379,7 @@ def snapshot_figure(res, scene=None, path=None, at=None, n: int = 5, title: str 
         steady state (:func:`settled_q`), ``n − 1`` evenly spaced over the transient and the
         last one.
     """
-    plt = _plt()
+    plt = pyplot()
     res = _arrays(res)
     fig, ax = plt.subplots(2, 2, figsize=(13, 8.4), constrained_layout=True)
     draw_snapshots(ax.ravel(), res, scene, at=at, n=n)
@@ -388,7 +389,7 @@ def snapshot_figure(res, scene=None, path=None, at=None, n: int = 5, title: str 
 
 def zone_map_figure(res, scene=None, path=None, title: str | None = None):
     """Node states over (q/a_H, x/a_H), and the creepage and loads against q/a_H."""
-    plt = _plt()
+    plt = pyplot()
     res = _arrays(res)
     fig, ax = plt.subplots(2, 1, figsize=(11, 7.6), sharex=True, constrained_layout=True,
                            gridspec_kw={"height_ratios": [2.2, 1]})
@@ -401,7 +402,7 @@ def zone_map_figure(res, scene=None, path=None, title: str | None = None):
 
 def dissimilar_figure(res, scene=None, path=None, at=None, n: int = 5, title: str | None = None):
     """One page: the four snapshot panels, the zone map and the creepage/load history."""
-    plt = _plt()
+    plt = pyplot()
     res = _arrays(res)
     fig = plt.figure(figsize=(16, 10.5), constrained_layout=True)
     gs = fig.add_gridspec(3, 3, height_ratios=[1, 1, 1])
@@ -439,7 +440,7 @@ def comparison_figure(results: dict, scene=None, path=None, at=None, n: int = 4,
     at, n :
         States to draw (:func:`select_states`, from the first result's q).
     """
-    plt = _plt()
+    plt = pyplot()
     items = [(k, _arrays(v)) for k, v in results.items()]
     first = items[0][1]
     info = _Info(first, scene)

@@ -527,6 +527,30 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
     t = sol.get("t", step.ref_t)
     given = tuple(k for k in SOLUTION_KEYS if k in sol)
     notes, fitted = [], []
+    delta, xi = _fitted_multipliers(step, pb, sol, p, t, tol, notes, fitted)
+    s = pb.slip(p, t, xi)
+    res = pb.residuals(p, t, delta, xi)
+    checked = []
+    if "p" in sol:
+        checked += ["signorini", "load_normal"] if pb.P is not None else ["signorini"]
+    if "t" in sol:
+        checked += ["friction", "load_tangential"] if pb.Q is not None else ["friction"]
+    residuals = {c: getattr(res, c) for c in checked}
+    failures = [_failure(c, residuals[c], step, pb, p, t, delta, xi, tol) for c in checked if residuals[c] > tol]
+    cand_state = classify(p, t, s, step.mu, sc, tol=max(tol, 1e-7))
+    comparisons, ref_state = _compare(step, sol, p, t, tol, compare_with, notes)
+    differs = np.flatnonzero(cand_state != ref_state)
+    return CheckReport(step=step.step, kind=step.kind, step_type=step.step_type, given=given, tol=tol,
+                       residuals=residuals, failures=failures,
+                       delta=float(delta) if ("p" in sol) else None, xi=float(xi) if ("t" in sol) else None,
+                       fitted=tuple(f for f in fitted if (f == "delta" and "p" in sol) or (f == "xi" and "t" in sol)),
+                       comparisons=comparisons, state_differs=differs, states=(cand_state, ref_state), x=step.x,
+                       notes=notes)
+
+
+def _fitted_multipliers(step, pb, sol, p, t, tol, notes, fitted):
+    """``(δ, ξ)``: prescribed, the candidate's, or fitted (:func:`check_step`); notes and fits appended."""
+    sc = step.scales
     ph = p / sc.stress
     delta = pb.delta if pb.delta is not None else sol.get("delta")
     if "delta" in sol and pb.delta is not None:
@@ -539,8 +563,8 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
     xi = pb.xi if pb.xi is not None else sol.get("xi")
     if "xi" in sol and pb.xi is not None:
         notes.append("the step prescribes ξ; the candidate's ξ is ignored")
-    bh = step.mu * np.maximum(p, 0.0) / sc.stress
     if xi is None:
+        bh = step.mu * np.maximum(p, 0.0) / sc.stress
         w = (pb.c + pb.Att @ t + (0.0 if pb.Atn is None else pb.Atn @ p)) / pb.dq
         stick = (bh - np.abs(t) / sc.stress > tol) & (ph > tol)
         if stick.any():
@@ -549,42 +573,41 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
         else:
             xi = step.ref_xi
             notes.append("no stick node to fit ξ on: rollqp's ξ used")
-    g, s = pb.gap(p, t, delta), pb.slip(p, t, xi)
-    gh, th, sh = g / sc.displacement, t / sc.stress, s / sc.slip
-    res = pb.residuals(p, t, delta, xi)
-    checked = []
-    if "p" in sol:
-        checked += ["signorini", "load_normal"] if pb.P is not None else ["signorini"]
-    if "t" in sol:
-        checked += ["friction", "load_tangential"] if pb.Q is not None else ["friction"]
-    residuals = {c: getattr(res, c) for c in checked}
-    failures = []
-    for c in checked:
-        v = residuals[c]
-        if v <= tol:
-            continue
-        nodes, reasons, detail = np.array([], dtype=int), [], ""
-        if c == "signorini":
-            r = np.minimum(ph, gh)
-            nodes = np.flatnonzero(np.abs(r) > tol)
-            reasons = ["negative pressure" if ph[i] < -tol else "penetration (g < 0)" if gh[i] < -tol
-                       else "pressure with the gap open" for i in nodes]
-        elif c == "friction":
-            r = friction_residual(th, sh, bh)
-            nodes = np.flatnonzero(np.abs(r) > tol)
-            reasons = ["|t| above the bound mu p" if abs(th[i]) > bh[i] + tol
-                       else "slips below the bound (should stick)" if abs(th[i]) < bh[i] - tol
-                       else "slip not opposed by t" for i in nodes]
-        else:
-            load = "P" if c == "load_normal" else "Q"
-            got = float(step.f @ (p if c == "load_normal" else t))
-            detail = f"f'{'p' if load == 'P' else 't'} = {got:.8g}, {load} = {getattr(pb, load):.8g}"
-        if nodes.size:  # worst first
-            order = np.argsort(-np.abs(r[nodes]), kind="stable")
-            nodes, reasons = nodes[order], [reasons[j] for j in order]
-        failures.append(Failure(c, v, nodes, reasons, step.x[nodes], detail))
+    return delta, xi
+
+
+def _failure(c, value, step, pb, p, t, delta, xi, tol) -> Failure:
+    """The :class:`Failure` of condition ``c``: the violating nodes, worst first, with why."""
+    sc = step.scales
+    nodes, reasons, detail = np.array([], dtype=int), [], ""
+    if c == "signorini":
+        ph, gh = p / sc.stress, pb.gap(p, t, delta) / sc.displacement
+        r = np.minimum(ph, gh)
+        nodes = np.flatnonzero(np.abs(r) > tol)
+        reasons = ["negative pressure" if ph[i] < -tol else "penetration (g < 0)" if gh[i] < -tol
+                   else "pressure with the gap open" for i in nodes]
+    elif c == "friction":
+        th, sh = t / sc.stress, pb.slip(p, t, xi) / sc.slip
+        bh = step.mu * np.maximum(p, 0.0) / sc.stress
+        r = friction_residual(th, sh, bh)
+        nodes = np.flatnonzero(np.abs(r) > tol)
+        reasons = ["|t| above the bound mu p" if abs(th[i]) > bh[i] + tol
+                   else "slips below the bound (should stick)" if abs(th[i]) < bh[i] - tol
+                   else "slip not opposed by t" for i in nodes]
+    else:
+        load = "P" if c == "load_normal" else "Q"
+        got = float(step.f @ (p if c == "load_normal" else t))
+        detail = f"f'{'p' if load == 'P' else 't'} = {got:.8g}, {load} = {getattr(pb, load):.8g}"
+    if nodes.size:  # worst first
+        order = np.argsort(-np.abs(r[nodes]), kind="stable")
+        nodes, reasons = nodes[order], [reasons[j] for j in order]
+    return Failure(c, value, nodes, reasons, step.x[nodes], detail)
+
+
+def _compare(step, sol, p, t, tol, compare_with, notes):
+    """``(comparisons, reference node states)``: the candidate against rollqp's methods on the step."""
+    sc = step.scales
     comparisons, ref_state = {}, None
-    cand_state = classify(p, t, s, step.mu, sc, tol=max(tol, 1e-7))
     for name in compare_with:
         try:
             other = solve_stored(step, name)
@@ -602,13 +625,7 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
     if ref_state is None:
         ref = step.reference()
         ref_state = classify(ref.p, ref.t, ref.s, step.mu, sc, tol=max(tol, 1e-7))
-    differs = np.flatnonzero(cand_state != ref_state)
-    return CheckReport(step=step.step, kind=step.kind, step_type=step.step_type, given=given, tol=tol,
-                       residuals=residuals, failures=failures,
-                       delta=float(delta) if ("p" in sol) else None, xi=float(xi) if ("t" in sol) else None,
-                       fitted=tuple(f for f in fitted if (f == "delta" and "p" in sol) or (f == "xi" and "t" in sol)),
-                       comparisons=comparisons, state_differs=differs, states=(cand_state, ref_state), x=step.x,
-                       notes=notes)
+    return comparisons, ref_state
 
 
 # ------------------------------------------------------------------------------ the cvxpy script

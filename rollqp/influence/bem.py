@@ -14,7 +14,7 @@ that is not a contact-node displacement (eq. 24) gives the body's contact compli
 ``S^α``: column ``j`` is the displacement of the strip nodes due to a unit nodal traction of
 shape ``N_j`` (the strip's own shape function). Both bodies are combined into the matrices of
 :class:`~rollqp.influence.halfspace.Influence` (eq. 25–30) in the project's sign convention
-(FORMULATION.md §1, §3).
+(docs/formulation.md §1, §3).
 
 Discretization
 --------------
@@ -513,21 +513,28 @@ def lame_ring(mesh: AnnulusMesh, nu: float, pressure: float = 1.0, E: float = 1.
 
 
 # ---------------------------------------------------------------------------------- the influence
-_CACHE: dict = {}
-_CACHE_SIZE = 8
+#: The contact compliances of the last :data:`GEOMETRY_MEMO_SIZE` roller geometries, keyed by the
+#: geometry itself (strip half-width, elements and element type; radius, shaft radius, E, ν; the
+#: outer and inner element counts): the roller's BEM assembly and condensation (``O(N³)``, seconds)
+#: depend on nothing else, so two scenes on the same rollers — a study over loads, friction or the
+#: method, the two bodies of a symmetric pair — assemble each roller once per process. Read-only
+#: arrays; ``info["cached"]`` says whether a scene's bodies came from here.
+GEOMETRY_MEMO: dict = {}
+GEOMETRY_MEMO_SIZE = 8
 
 
-def _cached_compliance(strip, radius, shaft, E, nu, n_outer, n_inner):
+def body_compliance(strip, radius, shaft, E, nu, n_outer, n_inner):
+    """``(S, info)`` of one roller (:func:`contact_compliance`), through the geometry memo :data:`GEOMETRY_MEMO`."""
     key = (float(strip.half_width), int(strip.n_elements), strip.element, float(radius), float(shaft),
            float(E), float(nu), int(n_outer), int(n_inner))
-    if key in _CACHE:
-        C, info = _CACHE[key]
+    if key in GEOMETRY_MEMO:
+        C, info = GEOMETRY_MEMO[key]
         return C, dict(info, cached=True)
     C, info = contact_compliance(strip, radius, shaft, E, nu, n_outer, n_inner)
     C.setflags(write=False)
-    if len(_CACHE) >= _CACHE_SIZE:
-        _CACHE.pop(next(iter(_CACHE)))
-    _CACHE[key] = (C, info)
+    if len(GEOMETRY_MEMO) >= GEOMETRY_MEMO_SIZE:
+        GEOMETRY_MEMO.pop(next(iter(GEOMETRY_MEMO)))
+    GEOMETRY_MEMO[key] = (C, info)
     return C, dict(info, cached=False)
 
 
@@ -579,8 +586,8 @@ def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.
             raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' "
                                                     "(the inner radius of the roller, in (0, radius))")
     t0 = time.perf_counter()
-    CA, infoA = _cached_compliance(strip, A.radius, A.shaft_radius, A.E, A.nu, n_outer, n_inner)
-    CB, infoB = _cached_compliance(strip, B.radius, B.shaft_radius, B.E, B.nu, n_outer, n_inner)
+    CA, infoA = body_compliance(strip, A.radius, A.shaft_radius, A.E, A.nu, n_outer, n_inner)
+    CB, infoB = body_compliance(strip, B.radius, B.shaft_radius, B.E, B.nu, n_outer, n_inner)
     J = np.arange(strip.n)[::-1]
     comb = lambda a, b: CA[a, b] + CB[a, b][np.ix_(J, J)]  # noqa: E731
     Ann, Att, Ant, Atn = comb(1, 1), comb(0, 0), comb(1, 0), comb(0, 1)

@@ -447,6 +447,35 @@ class Influence:
         return int(self.h.size)
 
 
+def _coupling(strip, f, beta, Estar, coupling):
+    """``(A_tn, A_nt or None, reciprocity defect)``: ``∓(β/E*) S`` (eq. 26, 29); ``A_nt`` with full coupling only.
+
+    Reciprocity ``F A_tn = (F A_nt)ᵀ`` holds iff ``F S`` is antisymmetric; its defect is
+    ``‖FS + (FS)ᵀ‖/‖FS‖``.
+    """
+    S = sgn_kernel_matrix(strip)
+    FS = f[:, None] * S
+    nFS = np.linalg.norm(FS)
+    defect = float(np.linalg.norm(FS + FS.T) / nFS) if nFS > 0 else 0.0
+    return (-beta / Estar) * S, ((beta / Estar) * S if coupling == "full" else None), defect
+
+
+def _check_definite(f, K, d_ref, L):
+    """``(λ_min/max|λ|, d_min)`` of ``sym(F K)``; an :class:`InputError` on ``contact.reference_distance``
+    if it is not positive definite, with the smallest admissible ``d_ref`` (:func:`_threshold`)."""
+    lam = min_eigenvalue(f, K)
+    d_min = _threshold(f, K, d_ref)
+    if not lam > 0:
+        hint = (f"the smallest admissible value for this mesh is {d_min:.6g}"
+                if np.isfinite(d_min) else "no admissible value could be determined")
+        raise InputError(
+            "contact.reference_distance",
+            f"d_ref = {d_ref:.6g} makes the normal influence matrix indefinite "
+            f"(relative min eigenvalue {lam:.3e}); it must exceed L/2 = {L / 2:.6g} "
+            f"(continuous bound), {hint}; the default is the relative radius R")
+    return lam, d_min
+
+
 def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: float = np.inf,
                         coupling: str = "off", d_ref: float | None = None) -> Influence:
     """Half-space influence of two cylinders (eq. 25–30; FORMULATION.md §3).
@@ -505,17 +534,7 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
     L = 0.5 * float(np.asarray(strip.edges)[-1] - np.asarray(strip.edges)[0])
 
     K = log_kernel_matrix(strip, d_ref)
-    lam = min_eigenvalue(f, K)
-    if not lam > 0:
-        d_min = _threshold(f, K, d_ref)
-        hint = (f"the smallest admissible value for this mesh is {d_min:.6g}"
-                if np.isfinite(d_min) else "no admissible value could be determined")
-        raise InputError(
-            "contact.reference_distance",
-            f"d_ref = {d_ref:.6g} makes the normal influence matrix indefinite "
-            f"(relative min eigenvalue {lam:.3e}); it must exceed L/2 = {L / 2:.6g} "
-            f"(continuous bound), {hint}; the default is the relative radius R")
-    d_min = _threshold(f, K, d_ref)
+    lam, d_min = _check_definite(f, K, d_ref, L)
 
     Ann = (2.0 / (np.pi * Estar)) * K
     Att = Ann.copy()
@@ -530,14 +549,7 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
         "gauss_points": GAUSS_POINTS, "far_field": FAR_FIELD,
     }
     if coupling in ("full", "goodman"):
-        S = sgn_kernel_matrix(strip)
-        FS = f[:, None] * S
-        nFS = np.linalg.norm(FS)
-        # Reciprocity F A_tn = (F A_nt)ᵀ  <=>  F S antisymmetric.
-        info["reciprocity_defect"] = float(np.linalg.norm(FS + FS.T) / nFS) if nFS > 0 else 0.0
-        Atn = (-beta / Estar) * S
-        if coupling == "full":
-            Ant = (beta / Estar) * S
+        Atn, Ant, info["reciprocity_defect"] = _coupling(strip, f, beta, Estar, coupling)
     for M in (Ann, Att, Ant, Atn, h):
         if M is not None:
             M.setflags(write=False)

@@ -1,4 +1,4 @@
-"""Reference cases shared by the tests and the benchmarks (private: not part of the API).
+"""Reference cases of CONTACT (Vollebregt & Kalker) and the paper's §6.1.1 convergence problem, as scenes.
 
 Two problems for which CONTACT (Vollebregt & Kalker), the field's reference code, has results
 (``../shared/refdata/contact/README.md``; docs/validation.md):
