@@ -91,6 +91,7 @@ __all__ = [
     "log_kernel_matrix",
     "sgn_kernel_matrix",
     "undeformed_gap",
+    "element_offsets",
     "min_eigenvalue",
     "minimum_reference_distance",
 ]
@@ -169,7 +170,7 @@ def _snap(value: float) -> float:
     return float(np.round(value * 2.0 ** 20) / 2.0 ** 20)
 
 
-def _offsets(strip, lattice: bool | None = None):
+def element_offsets(strip, lattice: bool | None = None):
     """Reference offsets ``ξ[i, e] = (x_i - c_e) / hl_e`` as ``(values, index, hl)``.
 
     ``values[index]`` is the (n, n_elements) offset matrix. On a uniform lattice (nodes
@@ -211,7 +212,7 @@ def _assemble(strip, moments, offsets) -> np.ndarray:
     """``M[i, j] = Σ_e hl_e ∫_{-1}^{1} N_a(ξ) k(ξ, ξ_ie) dξ`` over the ``(e, a)`` with node ``j``.
 
     ``moments(values)`` returns the reference moments ``∫ ξ^m k dξ`` (m = 0, 1, 2);
-    ``offsets`` is the result of :func:`_offsets`.
+    ``offsets`` is the result of :func:`element_offsets`.
     """
     values, index, hl = offsets
     coef = np.asarray(strip.coefficients, dtype=float)          # (nen, 3)
@@ -232,7 +233,7 @@ def _check_positive(value, key, what):
     return value
 
 
-def log_kernel_matrix(strip, d_ref: float) -> np.ndarray:
+def log_kernel_matrix(strip, d_ref: float, lattice: bool | None = None) -> np.ndarray:
     """Collocation matrix of the 2D log kernel (the shape of ``A_nn``, eq. 25–26).
 
     .. math::
@@ -248,6 +249,9 @@ def log_kernel_matrix(strip, d_ref: float) -> np.ndarray:
         Nodes ``x``, ``edges``, ``connectivity``, reference ``coefficients``, ``weights``.
     d_ref : float
         Reference distance of the logarithm (> 0, same length unit as ``x``).
+    lattice : bool, optional
+        The assembly path (:func:`element_offsets`): ``None`` detects a uniform lattice and
+        evaluates each distinct offset once, ``False`` forces the general path.
 
     Returns
     -------
@@ -262,11 +266,7 @@ def log_kernel_matrix(strip, d_ref: float) -> np.ndarray:
     so ``K(d') = K(d) + ln(d'/d) e fᵀ``.
     """
     d_ref = _check_positive(d_ref, "contact.reference_distance", "the reference distance")
-    return _log_kernel(strip, d_ref)
-
-
-def _log_kernel(strip, d_ref, lattice=None):
-    offsets = _offsets(strip, lattice)
+    offsets = element_offsets(strip, lattice)
     K = -_assemble(strip, _log_moments, offsets)
     hl = offsets[2]
     coef = np.asarray(strip.coefficients, dtype=float)
@@ -277,7 +277,7 @@ def _log_kernel(strip, d_ref, lattice=None):
     return K + shift[None, :]
 
 
-def sgn_kernel_matrix(strip) -> np.ndarray:
+def sgn_kernel_matrix(strip, lattice: bool | None = None) -> np.ndarray:
     """Collocation matrix of the sign kernel (the shape of ``A_nt``, ``A_tn``; eq. 26, 29).
 
     .. math::
@@ -289,6 +289,8 @@ def sgn_kernel_matrix(strip) -> np.ndarray:
     Parameters
     ----------
     strip : rollqp.strip.Strip
+    lattice : bool, optional
+        The assembly path, as for :func:`log_kernel_matrix`.
 
     Returns
     -------
@@ -296,11 +298,7 @@ def sgn_kernel_matrix(strip) -> np.ndarray:
         ``Σ_j S[i, j] = (x_i + L) - (L - x_i) = 2 x_i``; ``F S`` is antisymmetric up to the
         discretization error, exactly for constant elements on a uniform grid.
     """
-    return _sgn_kernel(strip)
-
-
-def _sgn_kernel(strip, lattice=None):
-    return _assemble(strip, _sgn_moments, _offsets(strip, lattice))
+    return _assemble(strip, _sgn_moments, element_offsets(strip, lattice))
 
 
 def undeformed_gap(x, R_A: float, R_B: float = np.inf) -> np.ndarray:
@@ -390,7 +388,7 @@ def minimum_reference_distance(strip) -> float:
     """
     L = 0.5 * float(np.asarray(strip.edges)[-1] - np.asarray(strip.edges)[0])
     d0 = 4.0 * L
-    return _threshold(np.asarray(strip.weights, dtype=float), _log_kernel(strip, d0), d0)
+    return _threshold(np.asarray(strip.weights, dtype=float), log_kernel_matrix(strip, d0), d0)
 
 
 # ---------------------------------------------------------------------------------------------
