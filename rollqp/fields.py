@@ -98,7 +98,8 @@ FIELDS: dict[str, Field] = {f.name: f for f in (
     Field("R", "scalar", LENGTH, "relative radius, 1/R = 1/R_A + 1/R_B", contract=True),
     Field("Estar", "scalar", STRESS, "contact modulus E*, 1/E* = (1-nu_A^2)/E_A + (1-nu_B^2)/E_B", contract=True),
     Field("beta", "scalar", "1", "Dundurs' parameter beta (the paper's constant is 2 beta)", contract=True),
-    Field("leading_edge", "scalar", "1", "+1 or -1: the sign of x where material enters", contract=True),
+    Field("leading_edge", "scalar", "1", "+1 or -1: the sign of x where material enters", dtype="int64",
+          contract=True),
 )}
 
 

@@ -115,11 +115,43 @@ def save_npz(path, arrays: dict, what: str = "result file") -> str:
     return path
 
 
-def load_result(path) -> dict:
-    """Read a result file into a dict of arrays (``meta`` decoded from JSON)."""
-    with np.load(path, allow_pickle=False) as z:
-        out = {k: z[k] for k in z.files}
-    out["meta"] = json.loads(str(out["meta"]))
+def load_result(path, arg: str = "RESULT.npz") -> dict:
+    """Read a result file into a dict of arrays (``meta`` decoded from JSON), every key checked.
+
+    The file is read without trusting it (:func:`rollqp.npzfile.read_npz`); each key that
+    :mod:`rollqp.fields` documents must have its shape (``(K+1, n)``, ``(K+1,)``, ``(n,)`` or
+    ``()``) and hold real numbers; other keys are kept as they are.
+
+    Raises
+    ------
+    InputError
+        ``arg``: a missing or corrupt file, a file that is not a result file, a bad key.
+    """
+    from .npzfile import read_npz, real_array, text_value
+    z = read_npz(path, arg)
+    for key in ("x", "q", "meta"):
+        if key not in z:
+            raise InputError(arg, f"{os.fspath(path)!r} is not a rollqp result file (no key {key!r})")
+    n, K1 = np.shape(z["x"])[0] if np.ndim(z["x"]) == 1 else -1, np.shape(z["q"])[0] if np.ndim(z["q"]) == 1 else -1
+    if n < 1 or K1 < 1:
+        raise InputError(arg, f"keys 'x' and 'q' must be non-empty 1-D arrays, got shapes {np.shape(z['x'])}, "
+                              f"{np.shape(z['q'])}")
+    shapes = {"state": (K1, n), "step": (K1,), "node": (n,), "scalar": ()}
+    out = {}
+    for key, value in z.items():
+        f = FIELDS.get(key)
+        if f is None or key == "meta":
+            out[key] = value
+            continue
+        finite = key not in ("approach", "creepage", "residual")  # NaN where undetermined
+        real_array(z, key, shapes[f.shape], arg, finite=finite)  # checks kind, shape, finiteness
+        out[key] = value
+    try:
+        out["meta"] = json.loads(text_value(z, "meta", arg))
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise InputError(arg, f"key 'meta' must be a JSON string ({type(exc).__name__})") from exc
+    if not isinstance(out["meta"], dict):
+        raise InputError(arg, "key 'meta' must be a JSON object")
     return out
 
 

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError, SolverError
+from .npzfile import read_npz, real_array, real_scalar, text_value
 from .problem import SEPARATION, SLIP, STICK, CoupledStep, Scales, StepSolution, classify, friction_residual
 
 FORMAT = "rollqp-step/1"
@@ -51,6 +52,8 @@ _LABEL = {"signorini": "Signorini (p >= 0, g >= 0, p·g = 0; eq. 51-52)",
           "load_tangential": "tangential load f't = Q (eq. 67)"}
 _STATE = {SEPARATION: "separation", STICK: "stick", SLIP: "slip"}
 SOLUTION_KEYS = ("p", "t", "delta", "xi")
+#: Largest step file read (nodes): its four n × n matrices stay below 13 GB.
+MAX_NODES = 20001
 
 
 def export_step(scene, k: int, method: str | None = None) -> "StepFile":
@@ -268,64 +271,57 @@ class StepFile:
 
     @classmethod
     def load(cls, path, arg: str = "STEP.npz") -> "StepFile":
-        """Read a step file; a missing file, a foreign ``.npz`` or a bad key is an :class:`InputError`."""
-        z = _read_npz(path, arg)
-        if "format" not in z or str(z["format"]) != FORMAT:
+        """Read a step file, every key checked (kind, shape, finiteness); its stored QP forms must
+        agree with its data. A missing, corrupt or foreign file or a bad key is an :class:`InputError`."""
+        z = read_npz(path, arg)
+        if "format" not in z or np.asarray(z["format"]).dtype.kind not in "US" or str(z["format"]) != FORMAT:
             raise InputError(arg, f"{os.fspath(path)!r} is not a rollqp step file (key 'format' must be {FORMAT!r})")
         missing = [k for k in _ARRAYS_N + _ARRAYS_NN + _SCALARS + _OPTIONAL + _STRINGS if k not in z]
         if missing:
             raise InputError(arg, f"missing key(s) {', '.join(missing)} in {os.fspath(path)!r}")
-        n = np.asarray(z["f"]).shape[0] if np.ndim(z["f"]) == 1 else 0
-        kw = {}
-        for k in _ARRAYS_N:
-            kw[k] = _array(z, k, (n,), arg)
-        for k in _ARRAYS_NN:
-            kw[k] = _array(z, k, (n, n), arg)
-        for k in _SCALARS + _OPTIONAL:
-            v = np.asarray(z[k])
-            if v.shape != ():
-                raise InputError(arg, f"key {k!r} must be a scalar, got shape {v.shape}")
-            kw[k] = float(v)
+        f = np.asarray(z["f"])
+        n = f.shape[0] if f.ndim == 1 else 0
+        if not 1 <= n <= MAX_NODES:
+            raise InputError(arg, f"key 'f' must be a 1-D array of 1 to {MAX_NODES} weights, got shape {f.shape}")
+        kw = {k: real_array(z, k, (n,), arg) for k in _ARRAYS_N}
+        kw.update({k: real_array(z, k, (n, n), arg) for k in _ARRAYS_NN})
+        kw.update({k: real_scalar(z, k, arg, finite=k not in ("prev_delta", "prev_xi")) for k in _SCALARS})
         for k in _OPTIONAL:
-            kw[k] = None if not np.isfinite(kw[k]) else kw[k]
+            v = real_scalar(z, k, arg, finite=False)
+            if np.isinf(v):
+                raise InputError(arg, f"key {k!r} must be finite, or NaN when not prescribed; got {v!r}")
+            kw[k] = None if np.isnan(v) else v
         for k in ("step", "n_steps"):
+            if kw[k] != int(kw[k]) or not 0 <= kw[k] <= 1e9:
+                raise InputError(arg, f"key {k!r} must be a whole number >= 0, got {kw[k]!r}")
             kw[k] = int(kw[k])
-        kind = str(z["kind"])
-        if kind not in ("coupled", "uncoupled"):
-            raise InputError(arg, f"key 'kind' must be 'coupled' or 'uncoupled', got {kind!r}")
-        step_type = str(z["step_type"])
-        if step_type not in STEP_TYPES:
-            raise InputError(arg, f"key 'step_type' must be one of {', '.join(STEP_TYPES)}, got {step_type!r}")
+        kind = text_value(z, "kind", arg, ("coupled", "uncoupled"))
+        step_type = text_value(z, "step_type", arg, STEP_TYPES)
         try:
-            scene = json.loads(str(z["scene"]))
-        except json.JSONDecodeError as exc:
-            raise InputError(arg, f"key 'scene' must be a JSON string ({exc})") from exc
-        step = cls(kind=kind, step_type=step_type, ref_method=str(z["ref_method"]), scene=scene, **kw)
+            scene = json.loads(text_value(z, "scene", arg))
+        except (json.JSONDecodeError, RecursionError) as exc:
+            raise InputError(arg, f"key 'scene' must be a JSON string ({type(exc).__name__})") from exc
+        step = cls(kind=kind, step_type=step_type, ref_method=text_value(z, "ref_method", arg)[:100], scene=scene, **kw)
         step.problem()  # validates the data (weights > 0, loads, friction, …)
+        step.check_forms(z, arg)
         return step
 
+    def check_forms(self, z: dict, arg: str = "STEP.npz") -> None:
+        """The stored QP forms (``normal_qp_*``, ``tangential_qp_*`` in ``z``) are those of this step's data.
 
-def _read_npz(path, arg):
-    import zipfile
-    path = os.fspath(path)
-    if not os.path.isfile(path):
-        raise InputError(arg, f"no such file: {path!r}")
-    if not zipfile.is_zipfile(path):
-        raise InputError(arg, f"{path!r} is not a .npz file (numpy's zip archive of arrays)")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
-    except (ValueError, OSError, EOFError) as exc:
-        raise InputError(arg, f"{path!r} is not a readable .npz without pickles ({exc})") from exc
-
-
-def _array(z, k, shape, arg):
-    v = np.asarray(z[k], dtype=float)
-    if v.shape != shape:
-        raise InputError(arg, f"key {k!r} must have shape {shape}, got {v.shape}")
-    if not np.all(np.isfinite(v)):
-        raise InputError(arg, f"key {k!r} must be finite")
-    return v
+        Recomputed from the same data they agree up to the round-off of another BLAS (1e-10 of
+        the largest entry); anything else is a corrupt or edited file, an :class:`InputError`.
+        """
+        for half, form in self.qp_forms().items():
+            for key, value in form.items():
+                name = f"{half}_qp_{key}"
+                value = np.asarray(value, dtype=float)
+                stored = real_array(z, name, value.shape, arg, finite=False)
+                fin = np.isfinite(value)
+                scale = max(1.0, float(np.max(np.abs(value[fin]), initial=0.0)))
+                if (not np.array_equal(fin, np.isfinite(stored)) or not np.array_equal(value[~fin], stored[~fin])
+                        or np.any(np.abs(value[fin] - stored[fin]) > 1e-10 * scale)):
+                    raise InputError(arg, f"key {name!r} does not match the step's own data (a corrupt or edited file)")
 
 
 def clarabel_json(arrays: dict, half: str) -> dict:
@@ -472,13 +468,13 @@ class CheckReport:
 
 def load_solution(path, n: int, arg: str = "SOLUTION.npz") -> dict:
     """Read a candidate solution: keys ``p``, ``t`` ((n,), scene units), ``delta``, ``xi`` (scalars)."""
-    z = _read_npz(path, arg)
+    z = read_npz(path, arg)
     return validate_solution(z, n, arg)
 
 
 def validate_solution(sol: dict, n: int, arg: str = "solution") -> dict:
     unknown = sorted(set(sol) - set(SOLUTION_KEYS))
-    if "format" in sol and str(sol["format"]) == FORMAT:
+    if "format" in sol and np.asarray(sol["format"]).dtype.kind in "US" and str(sol["format"]) == FORMAT:
         raise InputError(arg, "this is a step file, not a solution (keys p, t, delta, xi)")
     if unknown:
         more = f", … ({len(unknown)} in all)" if len(unknown) > 5 else ""
@@ -486,16 +482,8 @@ def validate_solution(sol: dict, n: int, arg: str = "solution") -> dict:
                               f"allowed: {', '.join(SOLUTION_KEYS)}")
     if "p" not in sol and "t" not in sol:
         raise InputError(arg, "give the pressure 'p' and/or the traction 't'")
-    out = {}
-    for k in ("p", "t"):
-        if k in sol:
-            out[k] = _array(sol, k, (n,), arg)
-    for k in ("delta", "xi"):
-        if k in sol:
-            v = np.asarray(sol[k], dtype=float)
-            if v.size != 1 or not np.isfinite(v).all():
-                raise InputError(arg, f"key {k!r} must be one finite number, got shape {v.shape}")
-            out[k] = float(v.reshape(()))
+    out = {k: real_array(sol, k, (n,), arg) for k in ("p", "t") if k in sol}
+    out.update({k: real_scalar(sol, k, arg) for k in ("delta", "xi") if k in sol})
     return out
 
 
