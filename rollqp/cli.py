@@ -22,6 +22,8 @@ import sys
 import time
 
 EXIT_INPUT, EXIT_SOLVER = 2, 3
+#: Interrupted by Ctrl-C (SIGINT) or SIGTERM: the shell's 128 + signal number.
+EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 
 
 class _Parser(argparse.ArgumentParser):
@@ -34,8 +36,12 @@ def _parser():
     p = _Parser(prog="rollqp", description="2D transient rolling contact: convex QP steps and generalized Newton.")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     r = sub.add_parser("run", help="run a scene and write its result file")
-    r.add_argument("scene", help="a TOML scene file or the name of a built-in scene")
-    r.add_argument("--out", help="result file (.npz); default: <scene name>.npz in the current folder")
+    r.add_argument("scene", nargs="?", help="a TOML scene file or the name of a built-in scene "
+                   "(with --resume: optional, the scene stored in the result file)")
+    r.add_argument("--out", help="result file (.npz); default: <scene name>.npz in the current folder "
+                   "(with --resume: the resumed file)")
+    r.add_argument("--resume", metavar="RESULT.npz", help="continue an interrupted or failed run from its "
+                   "result file")
     r.add_argument("--plot", help="draw tractions, slip and creepage to this PNG file")
     r.add_argument("--method", choices=METHOD_NAMES, help="overrides [solver].method")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
@@ -63,51 +69,149 @@ def _parser():
     return p
 
 
+#: Seconds between progress lines when stderr is not a terminal (a log file, a batch job).
+LOG_EVERY = 5.0
+
+
 def _progress(quiet):
-    """A progress callback: a tqdm bar that appears only after 2 s, on a terminal."""
-    if quiet or not sys.stderr.isatty():
+    """A progress callback and its closer: a tqdm bar on a terminal (after 2 s, if tqdm is
+    installed), a line every :data:`LOG_EVERY` seconds otherwise (logs and batch jobs)."""
+    if quiet:
         return None, lambda: None
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover - tqdm is a dependency
-        return None, lambda: None
-    bar = {}
+    if sys.stderr.isatty():
+        try:
+            from tqdm import tqdm
+        except ImportError:
+            tqdm = None
+        if tqdm is not None:
+            bar = {}
 
-    def cb(k, K):
-        if "b" not in bar:
-            bar["b"] = tqdm(total=K, delay=2.0, unit="step", leave=False, file=sys.stderr)
-        bar["b"].update(1)
+            def cb(k, K):
+                if "b" not in bar:
+                    bar["b"] = tqdm(total=K, delay=2.0, unit="step", leave=False, file=sys.stderr)
+                bar["b"].update(1)
 
-    return cb, lambda: bar.get("b") and bar["b"].close()
+            return cb, lambda: bar.get("b") and bar["b"].close()
+    t0 = time.perf_counter()
+    last = [t0]
+
+    def line(k, K):
+        now = time.perf_counter()
+        if now - last[0] >= LOG_EVERY or k == K and now - t0 >= LOG_EVERY:
+            last[0] = now
+            print(f"rollqp: step {k}/{K} ({100.0 * k / max(K, 1):.0f} %), {now - t0:.1f} s", file=sys.stderr,
+                  flush=True)
+
+    return line, lambda: None
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, handled as Ctrl-C: the completed states are written before rollqp exits."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
+def default_output(name: str, suffix: str = ".npz") -> str:
+    """``<name><suffix>`` in the current folder, the scene name reduced to a safe file name.
+
+    A scene's name never steers the path: every character outside ``[A-Za-z0-9._-]`` becomes
+    ``_`` and leading dots are dropped (``"../x"`` → ``"_x"``), so the default output stays in
+    the working folder.
+    """
+    import re
+    safe = re.sub(r"[^A-Za-z0-9._-]", "_", name).lstrip(".")[:100] or "result"
+    return safe + suffix
+
+
+def _check_plot(path):
+    """Check ``--plot`` before the run: a known image format and a writable folder."""
+    if path is None:
+        return
+    from .errors import InputError
+    from .plot import pyplot
+    ext = os.path.splitext(path)[1].lstrip(".").lower()
+    formats = pyplot().figure().canvas.get_supported_filetypes()
+    pyplot().close("all")
+    if ext not in formats:
+        raise InputError("--plot", f"unknown figure format {ext or '(none)'!r}; use one of "
+                                   f"{', '.join(sorted(formats))}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
+        raise InputError("--plot", f"cannot write in folder {folder!r}")
+
+
+def _run_scene(args):
+    """``(scene, resume arrays or None, out)`` of ``rollqp run``'s arguments, checked before any work."""
+    from .errors import InputError
+    from .result import check_output, load_result
+    from .scene import load_scene, scene_from_dict
+    resume = None
+    if args.resume:
+        resume = load_result(args.resume, "--resume")
+        try:
+            scene = scene_from_dict(resume["meta"]["scene"], source=args.resume)
+        except (KeyError, TypeError) as exc:
+            raise InputError("--resume", "the result file holds no scene (meta['scene'])") from exc
+        if args.scene is not None and load_scene(args.scene).to_dict() != scene.to_dict():
+            raise InputError("--resume", f"the result file was computed for another scene than {args.scene!r}")
+        if args.method and args.method != scene.solver.method:
+            raise InputError("--method", f"the run was made with {scene.solver.method!r}; resume it with that method")
+    elif args.scene is None:
+        raise InputError("SCENE", "give a scene file or a built-in scene (or --resume RESULT.npz)")
+    else:
+        scene = load_scene(args.scene)
+        if args.method:
+            scene = scene.replace(**{"solver.method": args.method})
+    out = check_output(args.out or args.resume or default_output(scene.name))
+    _check_plot(args.plot)
+    return scene, resume, out
+
+
+def _save_partial(err, out, what):
+    """Write the completed states of a failed or interrupted run; the one-line message says where."""
+    partial = getattr(err, "partial", None)
+    if partial is None or not len(partial):
+        return f"{what}; nothing was completed"
+    partial.meta["failed" if what != "interrupted" else "interrupted"] = str(err) or what
+    partial.save(out)
+    return f"{what} — the {len(partial)} completed states are in {out} (continue: rollqp run --resume {out})"
 
 
 def cmd_run(args) -> int:
+    import signal
+
     from .march import run
     from .plot import plot_result
     from .report import summary
-    from .scene import load_scene
-    scene = load_scene(args.scene)
-    if args.method:
-        scene = scene.replace(**{"solver.method": args.method})
-    out = args.out or f"{scene.name}.npz"
-    if not out.endswith(".npz"):
-        from .errors import InputError
-        raise InputError("--out", f"the result file must end in .npz, got {out!r}")
+    from .result import OutputLock
+    scene, resume, out = _run_scene(args)
+    if resume is not None and len(resume["q"]) == scene.n_steps + 1:
+        print(f"rollqp: {args.resume} is complete ({scene.n_steps} rolling steps): nothing to resume",
+              file=sys.stderr)
+        return 0
     cb, close = _progress(args.quiet)
     t0 = time.perf_counter()
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
-        result = run(scene, progress=cb)
-    except Exception as err:
-        partial = getattr(err, "partial", None)
-        if partial is not None and len(partial):
-            partial.meta["failed"] = str(err)
-            partial.save(out)
-            err.args = (f"{err} — the {len(partial)} completed states are in {out}",)
-        raise
+        with OutputLock(out):
+            try:
+                result = run(scene, progress=cb, resume=resume)
+            except KeyboardInterrupt as err:
+                close()
+                print(f"rollqp: {_save_partial(err, out, 'interrupted')}", file=sys.stderr)
+                return EXIT_TERMINATED if isinstance(err, Terminated) else EXIT_INTERRUPTED
+            except Exception as err:
+                if getattr(err, "partial", None) is not None:
+                    err.args = (_save_partial(err, out, str(err)),)
+                raise
+            finally:
+                close()
+            wall = time.perf_counter() - t0
+            result.save(out)
     finally:
-        close()
-    wall = time.perf_counter() - t0
-    result.save(out)
+        signal.signal(signal.SIGTERM, previous)
     res = result.arrays()
     if args.plot:
         plot_result(res, scene, args.plot)
@@ -135,11 +239,9 @@ def cmd_show(args) -> int:
 def cmd_export_step(args) -> int:
     from .scene import load_scene
     from .stepfile import export_step
+    from .result import check_output
     scene = load_scene(args.scene)
-    out = args.out or f"{scene.name}-step{args.step}.npz"
-    if not out.endswith(".npz"):
-        from .errors import InputError
-        raise InputError("--out", f"the step file must end in .npz, got {out!r}")
+    out = check_output(args.out or default_output(scene.name, f"-step{args.step}.npz"), "step file")
     step = export_step(scene, args.step, method=args.method)
     for path in step.save(out):
         print(f"wrote {path}")

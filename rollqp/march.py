@@ -369,7 +369,7 @@ def prepare(scene, method=None):
     return scene, meth, ops
 
 
-def march(scene, method=None, *, prepared=None) -> Iterator[StepRecord]:
+def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRecord]:
     """The transient of ``scene`` as a stream of :class:`StepRecord` (module docstring).
 
     Parameters
@@ -380,6 +380,9 @@ def march(scene, method=None, *, prepared=None) -> Iterator[StepRecord]:
         A method name (overrides ``[solver].method``) or a method object (:func:`prepare`).
     prepared : tuple, optional
         ``(scene, method, operators)`` from :func:`prepare` (to look at the operators first).
+    resume : dict, optional
+        The arrays of a result file of this scene (:func:`~rollqp.result.load_result`): the march
+        continues after its last state (:func:`resumed_state`) and yields only the steps after it.
 
     Yields
     ------
@@ -395,17 +398,20 @@ def march(scene, method=None, *, prepared=None) -> Iterator[StepRecord]:
     """
     scene, meth, ops = prepared if prepared is not None else prepare(scene, method)
     m = _March(scene, ops, meth)
-    try:
-        start = m.braked_start()
-        if scene.load.start == "rolling":
-            start = m.steady_direct(start) if "steady" in meth.solves else m.steady_by_marching(start)
-    except SolverError as err:  # the start is state 0
-        raise (err.with_step(0) if err.step is None else err) from err
-    yield start
+    if resume is not None:
+        state, first = resumed_state(scene, ops, resume), len(resume["q"])
+    else:
+        try:
+            start = m.braked_start()
+            if scene.load.start == "rolling":
+                start = m.steady_direct(start) if "steady" in meth.solves else m.steady_by_marching(start)
+        except SolverError as err:  # the start is state 0
+            raise (err.with_step(0) if err.step is None else err) from err
+        yield start
+        state, first = start.state, 1
     M = ops.history()
     qs = scene.q_steps
-    state = start.state
-    for k in range(1, qs.size):
+    for k in range(first, qs.size):
         try:
             rec = m.rolling(k, float(qs[k]), state, M)
         except SolverError as err:
@@ -414,7 +420,35 @@ def march(scene, method=None, *, prepared=None) -> Iterator[StepRecord]:
         yield rec
 
 
-def run(scene, method=None, progress=None) -> Result:
+def resumed_state(scene, ops: SceneOperators, arrays: dict) -> State:
+    """The last state of a result file of ``scene``, as the march continues from it.
+
+    Tractions, approach and creepage are the stored ones (float64, as the march keeps them);
+    ``w`` is recomputed from the tractions (eq. 28). The continuation equals an uninterrupted
+    run to round-off: the warm starts are the same numbers, but what a method built during the
+    first part (Newton's reused factorizations, a QP solver's internal state) is built anew.
+
+    Raises
+    ------
+    InputError
+        ``--resume``: the file belongs to another scene (other nodes or rolled distances).
+    """
+    x, q = np.asarray(arrays["x"]), np.asarray(arrays["q"])
+    qs = scene.q_steps
+    if x.shape != (ops.n,) or not np.allclose(x, ops.strip.x, rtol=0, atol=1e-12 * scene.half_width):
+        raise InputError("--resume", f"the result file's {x.size} nodes are not this scene's {ops.n}: another scene")
+    if q.size > qs.size or not np.allclose(q, qs[:q.size], rtol=1e-12, atol=1e-15 * scene.a_H):
+        raise InputError("--resume", f"the result file's rolled distances are not this scene's "
+                                     f"(it has {q.size} states, the scene {qs.size}): another scene")
+    p, t = np.array(arrays["pn"][-1], dtype=float), np.array(arrays["pt"][-1], dtype=float)
+    nsol = StepSolution(p=p, g=np.array(arrays["gap"][-1], dtype=float), delta=float(arrays["approach"][-1]),
+                        method="resumed", status="resumed")
+    tsol = StepSolution(t=t, s=np.array(arrays["slip"][-1], dtype=float), xi=float(arrays["creepage"][-1]),
+                        method="resumed", status="resumed")
+    return State(p, t, ops.w(p, t), nsol, tsol, None)
+
+
+def run(scene, method=None, progress=None, resume=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -425,6 +459,10 @@ def run(scene, method=None, progress=None) -> Result:
         Overrides ``[solver].method`` (:func:`prepare`).
     progress : callable, optional
         Called as ``progress(k, K)`` after each rolling step.
+    resume : dict, optional
+        The arrays of an earlier, incomplete result file of this scene
+        (:func:`~rollqp.result.load_result`): its states are kept and the run continues after
+        the last one (:func:`resumed_state`); ``meta["resumed_from"]`` records where.
 
     Raises
     ------
@@ -434,16 +472,21 @@ def run(scene, method=None, progress=None) -> Result:
     InputError
         The scene cannot be run with this method, or the contact leaves the zone
         (``err.partial`` as above).
+    KeyboardInterrupt
+        Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
     scene, meth, ops = prepared = prepare(scene, method)
     result = new_result(scene, ops, meth.name)
+    if resume is not None:
+        result.extend(resume)
+        result.meta["resumed_from"] = len(result) - 1
     K = scene.n_steps
     try:
-        for rec in march(scene, prepared=prepared):
+        for rec in march(scene, prepared=prepared, resume=resume):
             result.add(rec, ops)
             if progress is not None and rec.k > 0:
                 progress(rec.k, K)
-    except (SolverError, InputError) as err:
+    except (SolverError, InputError, KeyboardInterrupt) as err:
         err.partial = result
         raise
     return result

@@ -45,6 +45,20 @@ class Result:
         for k in self.rows:
             self.rows[k].append(np.array(values[k], copy=True))
 
+    def extend(self, arrays: dict) -> None:
+        """Append every state of a result file's ``arrays`` (an earlier part of the same run);
+        its ``gross_sliding`` and ``rolling_start`` notes are kept."""
+        meta = arrays.get("meta", {})
+        for k in ("gross_sliding", "rolling_start"):
+            if k in meta:
+                self.meta[k] = meta[k]
+        missing = [k for k in self.rows if k not in arrays]
+        if missing:
+            raise InputError("--resume", f"the result file lacks {', '.join(missing)}: not written by this "
+                                         "version of rollqp for this scene")
+        for i in range(len(arrays["q"])):
+            self.append(**{k: arrays[k][i] for k in self.rows})
+
     def add(self, rec, operators=None) -> None:
         """Append the state of a :class:`~rollqp.march.StepRecord` (``rec.k`` must be ``len(self)``);
         the ``extra`` fields are computed from the record and the scene's ``operators``."""
@@ -89,10 +103,76 @@ class Result:
         return save_npz(path, self.arrays(), "result file")
 
 
+#: Temporary files of an atomic write: ``.rollqp-<pid>-<random>.npz`` beside the target, so
+#: that one left behind by a killed process (SIGKILL during the write) is recognized and removed
+#: by the next write into the same folder (:func:`remove_stale_temporaries`).
+TEMP_PREFIX = ".rollqp-"
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (on this machine)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder) -> list[str]:
+    """Delete the temporary files of writes whose process no longer runs; return their names."""
+    removed = []
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return removed
+    for name in names:
+        if not (name.startswith(TEMP_PREFIX) and name.endswith(".npz")):
+            continue
+        pid = name[len(TEMP_PREFIX):].split("-", 1)[0]
+        if pid.isdigit() and not _alive(int(pid)):
+            try:
+                os.unlink(os.path.join(folder, name))
+                removed.append(name)
+            except OSError:
+                pass
+    return removed
+
+
+def check_output(path, what: str = "result file", key: str = "--out") -> str:
+    """``path`` as a string if a ``.npz`` can be written there: checked before any work.
+
+    Raises
+    ------
+    InputError
+        ``key``: not ending in ``.npz``, a missing or unwritable folder, or a folder in its place.
+    """
+    path = os.fspath(path)
+    if not path.endswith(".npz"):
+        raise InputError(key, f"the {what} must end in .npz, got {path!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise InputError(key, f"folder {folder!r} does not exist")
+    if os.path.isdir(path):
+        raise InputError(key, f"{path!r} is a folder, not a file")
+    try:
+        fd, probe = tempfile.mkstemp(suffix=".npz", dir=folder, prefix=f"{TEMP_PREFIX}{os.getpid()}-")
+    except OSError as exc:
+        raise InputError(key, f"cannot write in folder {folder!r} ({exc.strerror or exc})") from None
+    os.close(fd)
+    os.unlink(probe)
+    return path
+
+
 def save_npz(path, arrays: dict, what: str = "result file") -> str:
     """Write ``arrays`` to the ``.npz`` ``path`` atomically (temporary file, then rename).
 
     A path not ending in ``.npz`` or in a missing folder is an :class:`InputError` on ``--out``.
+    Temporary files left in the folder by killed writers are removed first
+    (:func:`remove_stale_temporaries`); an interrupted write removes its own.
     """
     path = os.fspath(path)
     if not path.endswith(".npz"):
@@ -100,7 +180,8 @@ def save_npz(path, arrays: dict, what: str = "result file") -> str:
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise InputError("--out", f"folder {folder!r} does not exist")
-    fd, tmp = tempfile.mkstemp(suffix=".npz", dir=folder, prefix=".rollqp-")
+    remove_stale_temporaries(folder)
+    fd, tmp = tempfile.mkstemp(suffix=".npz", dir=folder, prefix=f"{TEMP_PREFIX}{os.getpid()}-")
     try:
         with os.fdopen(fd, "wb") as fh:
             np.savez(fh, **arrays)
@@ -113,6 +194,57 @@ def save_npz(path, arrays: dict, what: str = "result file") -> str:
             os.unlink(tmp)
         raise
     return path
+
+
+class OutputLock:
+    """Exclusive right to write one result file for the length of a run (``with OutputLock(path):``).
+
+    A lock file ``PATH.lock`` holding the writer's process id, created atomically (``O_EXCL``).
+    A second run writing the same ``--out`` while the first is alive is refused at once, before
+    any work (:class:`InputError` naming ``--out`` and the other process), instead of racing it
+    (the last rename would win). A lock left by a process that no longer runs is taken over.
+    """
+
+    def __init__(self, path, key: str = "--out"):
+        self.lock = os.fspath(path) + ".lock"
+        self.key = key
+        self.held = False
+
+    def __enter__(self) -> "OutputLock":
+        for _ in range(2):
+            try:
+                fd = os.open(self.lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                owner = self._owner()
+                if owner is not None and _alive(owner):
+                    raise InputError(self.key, f"another rollqp process (pid {owner}) is writing "
+                                               f"{self.lock[:-5]!r}; wait for it or choose another --out") from None
+                try:
+                    os.unlink(self.lock)  # stale: its process is gone
+                except FileNotFoundError:
+                    pass
+                continue
+            with os.fdopen(fd, "w") as fh:
+                fh.write(str(os.getpid()))
+            self.held = True
+            return self
+        raise InputError(self.key, f"cannot lock {self.lock!r}")
+
+    def _owner(self):
+        try:
+            with open(self.lock, encoding="ascii") as fh:
+                text = fh.read(32).strip()
+        except (OSError, UnicodeDecodeError):
+            return None
+        return int(text) if text.isdigit() else None
+
+    def __exit__(self, *exc) -> None:
+        if self.held:
+            try:
+                os.unlink(self.lock)
+            except FileNotFoundError:
+                pass
+            self.held = False
 
 
 def load_result(path, arg: str = "RESULT.npz") -> dict:

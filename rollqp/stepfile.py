@@ -264,8 +264,7 @@ class StepFile:
                 written.append(name)
             name = f"{stem}.cvxpy.py"
             with open(name, "w", encoding="utf-8") as fh:
-                fh.write(CVXPY_SCRIPT.replace("@STEPFILE_STEM@", os.path.basename(stem))
-                         .replace("@STEPFILE@", os.path.basename(path)))
+                fh.write(cvxpy_script(os.path.basename(path)))
             written.append(name)
         return written
 
@@ -617,6 +616,21 @@ def _compare(step, sol, p, t, tol, compare_with, notes):
 
 
 # ------------------------------------------------------------------------------ the cvxpy script
+def cvxpy_script(step_name: str) -> str:
+    """The cvxpy script for the step file ``step_name`` (a file name, no folder).
+
+    The name is data, never code: it enters the script as a Python string literal
+    (``repr``), and in the docstring only with its characters outside ``[A-Za-z0-9._-]``
+    replaced, so no file name can end the docstring or the literal and inject code.
+    """
+    import re
+    shown = re.sub(r"[^A-Za-z0-9._-]", "_", step_name)
+    return (CVXPY_SCRIPT.replace("@STEPFILE_LITERAL@", repr(step_name))
+            .replace("@STEPFILE_STEM@", shown[:-4] if shown.endswith(".npz") else shown)
+            .replace("@STEPFILE@", shown))
+
+
+
 CVXPY_SCRIPT = r'''"""Rebuild and solve the step in @STEPFILE@ with cvxpy (written by rollqp export-step).
 
 Self-contained: needs numpy and cvxpy only. Each half of the step is the variational
@@ -636,7 +650,7 @@ import cvxpy as cp
 import numpy as np
 
 here = os.path.dirname(os.path.abspath(__file__))
-path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, "@STEPFILE@")
+path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, @STEPFILE_LITERAL@)
 z = dict(np.load(path, allow_pickle=False))
 TOL = 1e-11  # change of x (p/p0, t/p0) per sweep at which the iteration stops
 

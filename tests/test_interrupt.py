@@ -1,0 +1,129 @@
+"""Nothing lost: a real signal to a real ``rollqp run`` writes the completed states, and
+``--resume`` continues from them to the uninterrupted result; concurrent writers to one
+``--out`` are refused; temporary files of killed writes are cleaned up."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import rollqp
+from rollqp.errors import InputError
+from rollqp.result import OutputLock, TEMP_PREFIX, load_result, save_npz
+
+#: 641 nodes, 3072 newton steps: about 6 s here, long enough to be interrupted mid-run.
+LONG = {"discretization.elements": 320, "discretization.distance": 12.0, "solver.method": "newton"}
+
+
+def _cli(*args, cwd):
+    return subprocess.Popen([sys.executable, "-m", "rollqp.cli", *args], cwd=cwd, stderr=subprocess.PIPE,
+                            stdout=subprocess.PIPE, text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+
+
+def _interrupt_mid_run(tmp_path, sig):
+    """Start the long run, send ``sig`` a second after it holds its output lock; ``(code, stderr)``."""
+    proc = _cli("run", "scene.toml", "--out", "r.npz", "--quiet", cwd=tmp_path)
+    lock = tmp_path / "r.npz.lock"
+    deadline = time.monotonic() + 60
+    while not lock.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(1.0)
+    proc.send_signal(sig)
+    _, err = proc.communicate(timeout=120)
+    return proc.returncode, err
+
+
+@pytest.fixture(scope="module")
+def long_scene(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("long")
+    scene = rollqp.load_scene("cattaneo-carter").replace(**LONG)
+    (folder / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
+    full = rollqp.run(scene).arrays()
+    return scene, full
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
+def test_signal_writes_completed_states_and_resume_reproduces(long_scene, tmp_path, sig, code):
+    scene, full = long_scene
+    (tmp_path / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
+    got, err = _interrupt_mid_run(tmp_path, sig)
+    assert got == code and err.count("\n") == 1 and "interrupted" in err and "--resume r.npz" in err, (got, err)
+    part = load_result(tmp_path / "r.npz")
+    K0 = part["q"].size
+    assert 1 < K0 < scene.n_steps + 1, f"interrupted mid-run: {K0} of {scene.n_steps + 1} states"
+    assert part["meta"]["interrupted"], "the file says it was interrupted"
+    assert not (tmp_path / "r.npz.lock").exists(), "the lock is released"
+    # the completed states are the uninterrupted run's, bit for bit (same computation)
+    assert np.array_equal(part["pt"], full["pt"][:K0]) and np.array_equal(part["pn"], full["pn"][:K0])
+    proc = _cli("run", "--resume", "r.npz", "--quiet", cwd=tmp_path)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0, err
+    res = load_result(tmp_path / "r.npz")
+    assert res["meta"]["resumed_from"] == K0 - 1 and "interrupted" not in res["meta"]
+    p0, mu = scene.p0, scene.contact.friction
+    # Equal to round-off, not bit for bit: the resumed march rebuilds Newton's reused LU
+    # factorizations, whose directions differ from the reused ones at round-off; the steps stop
+    # at the same tolerance (1e-10), so the tractions agree far below it (measured 2.4e-11 μp0).
+    assert np.max(np.abs(res["pt"] - full["pt"])) <= 1e-10 * mu * p0
+    assert np.max(np.abs(res["pn"] - full["pn"])) <= 1e-10 * p0
+    assert np.array_equal(res["state"], full["state"]), "the same stick/slip zones at every state"
+
+
+def test_second_writer_to_the_same_output_is_refused(tmp_path):
+    out = tmp_path / "r.npz"
+    with OutputLock(out):
+        with pytest.raises(InputError, match=r"--out: another rollqp process \(pid \d+\) is writing"):
+            with OutputLock(out):
+                pass
+        proc = _cli("run", "cattaneo-carter", "--out", str(out), "--quiet", cwd=tmp_path)
+        _, err = proc.communicate(timeout=60)
+        assert proc.returncode == 2 and "another rollqp process" in err and err.count("\n") == 1, err
+    with OutputLock(out):  # released: taken again
+        pass
+
+
+def test_stale_lock_and_temporary_files_are_cleaned_up(tmp_path):
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True,
+                          text=True).stdout.strip()               # a pid that no longer runs
+    (tmp_path / "r.npz.lock").write_text(dead)
+    stale = tmp_path / f"{TEMP_PREFIX}{dead}-abc.npz"              # left by a killed write
+    stale.write_bytes(b"partial")
+    mine = tmp_path / f"{TEMP_PREFIX}{os.getpid()}-live.npz"      # a live process's: kept
+    mine.write_bytes(b"in flight")
+    with OutputLock(tmp_path / "r.npz"):
+        save_npz(tmp_path / "r.npz", {"x": np.zeros(2)})
+    assert not stale.exists() and mine.exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([mine.name, "r.npz"])
+
+
+def test_default_output_stays_in_the_working_folder(tmp_path):
+    scene = rollqp.load_scene("cattaneo-carter").replace(**{"name": "../../escape", "discretization.distance": 0.0})
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
+    proc = _cli("run", "scene.toml", "--quiet", cwd=tmp_path / "sub")
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 0, err
+    written = [p.name for p in (tmp_path / "sub").iterdir() if p.suffix == ".npz"]
+    assert written == ["_.._escape.npz"], f"'/' and leading dots replaced: {written}"
+    assert not list(tmp_path.glob("*.npz")) and not (tmp_path.parent / "escape.npz").exists()
+    meta = json.loads(str(np.load(tmp_path / "sub" / written[0])["meta"]))
+    assert meta["scene"]["name"] == "../../escape"
+
+
+def test_bad_plot_and_output_fail_before_the_run(tmp_path, capsys):
+    """``--plot`` with an unknown format and ``--out`` in a missing folder are found before any
+    work (no figure library traceback after a long run)."""
+    from rollqp import cli
+    assert cli.main(["run", "cattaneo-carter", "--plot", str(tmp_path / "f.xyz"), "--out",
+                     str(tmp_path / "r.npz")]) == 2
+    err = capsys.readouterr().err
+    assert "--plot: unknown figure format 'xyz'" in err and err.count("\n") == 1, err
+    assert cli.main(["run", "cattaneo-carter", "--out", str(tmp_path / "missing" / "r.npz")]) == 2
+    assert "does not exist" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir()), "nothing was run or written"
