@@ -69,7 +69,8 @@ def _parser():
     return p
 
 
-#: Seconds between progress lines when stderr is not a terminal (a log file, a batch job).
+#: Seconds between progress lines when stderr is not a terminal (a log file, a batch job);
+#: ``$ROLLQP_PROGRESS_SECONDS`` overrides it.
 LOG_EVERY = 5.0
 
 
@@ -94,10 +95,14 @@ def _progress(quiet):
             return cb, lambda: bar.get("b") and bar["b"].close()
     t0 = time.perf_counter()
     last = [t0]
+    try:
+        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
+    except ValueError:
+        every = LOG_EVERY
 
     def line(k, K):
         now = time.perf_counter()
-        if now - last[0] >= LOG_EVERY or k == K and now - t0 >= LOG_EVERY:
+        if now - last[0] >= every or k == K and now - t0 >= every:
             last[0] = now
             print(f"rollqp: step {k}/{K} ({100.0 * k / max(K, 1):.0f} %), {now - t0:.1f} s", file=sys.stderr,
                   flush=True)
@@ -164,6 +169,8 @@ def _run_scene(args):
         scene = load_scene(args.scene)
         if args.method:
             scene = scene.replace(**{"solver.method": args.method})
+    from .methods import method_class
+    method_class(scene.solver.method)  # installed? (a missing backend names its pip extra)
     out = check_output(args.out or args.resume or default_output(scene.name))
     _check_plot(args.plot)
     return scene, resume, out
