@@ -19,7 +19,7 @@ Sections (``--only`` names):
 * ``convergence``       log–log slopes of the errors against Hertz, Cattaneo, Carter, creepage;
 * ``splitting``         the symmetric–skew splitting's contraction factor ρ (rollqp.methods._qp).
 
-Reference data: ``../shared/refdata/contact`` beside the repository (or ``$ROLLQP_CONTACT_REFDATA``);
+Reference data: ``tests/data/contact`` in the repository (or ``$ROLLQP_CONTACT_REFDATA``);
 see its README for CONTACT's conventions. CONTACT's FX < 0 with cksi > 0; rollqp's Q > 0 gives
 ξ < 0 and t ≥ 0 with the same magnitudes, so |ξ| is compared with cksi and pt with −px.
 """

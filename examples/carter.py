@@ -4,7 +4,7 @@ The rollers of the paper's §6.1 (built-in scene ``cattaneo-carter``: steel on s
 40 quadratic elements on ±1.25 a_H, material moving in −x so that it enters at x = +a) roll
 steadily under a tangential load Q. The steady state is solved directly
 (``load.start = "rolling"``, rolled distance 0: with ``newton`` the steady problem
-s = ξ + d·∂w/∂x is one nonsmooth system, FORMULATION.md §4) and held against Carter's closed
+s = ξ + d·∂w/∂x is one nonsmooth system, docs/formulation.md §2) and held against Carter's closed
 forms (``rollqp.closedforms``):
 
 * traction: a stick zone of half-width c = a√(1 − Q/(μP)) touching the leading edge, where

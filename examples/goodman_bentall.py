@@ -12,7 +12,7 @@ freely (Q = 0) for 6 a_H. Run twice, as the paper does:
 
 Both end in Bentall's steady free rolling; the creepage is held against Bentall & Johnson's
 μ → 0 value |ξ| = 0.457·κ·a/R (``rollqp.closedforms.bentall_johnson_creepage``; for finite μ
-the magnitude is smaller, and its sign is d·sgn(κ), FORMULATION.md §1, §11).
+the magnitude is smaller, and its sign is d·sgn(κ), docs/formulation.md §1, §12).
 
 Run it::
 

@@ -9,7 +9,7 @@ the first block only plain numpy arrays are used.
 The problem: the paper's steel rollers (R_A = 150 mm, R_B = 300 mm, E = 210 GPa, ν = 0.3,
 P = 1000 N/mm, μ = 0.1), pressed together (normal step), then shifted without rolling until
 Q = 0.6 μP (one tangential static-shift step: Cattaneo's problem). Sign convention
-(FORMULATION.md §1): p ≥ 0 in compression, t on body A in +x, g ≥ 0 the gap,
+(docs/formulation.md §1): p ≥ 0 in compression, t on body A in +x, g ≥ 0 the gap,
 s = ξ + (c + A t)/Δq the slip of A relative to B.
 
 Run it::

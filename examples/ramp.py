@@ -11,7 +11,7 @@ scenes and measures
   state of §6.1.1 (``cattaneo-carter``);
 * what the creepage means *during* the ramp. With P and Q prescribed, the 2D half-space
   displacements carry an arbitrary rigid constant (the reference distance d_ref of the log
-  kernel, FORMULATION.md §3): changing d_ref → d' adds c·Q, c = (2/(πE*))·ln(d'/d), to the
+  kernel, docs/formulation.md §3): changing d_ref → d' adds c·Q, c = (2/(πE*))·ln(d'/d), to the
   rigid tangential displacement, which a growing Q turns into an extra rigid slip that the
   creepage absorbs, Δξ = −c·dQ/dq. The tractions do not change. The example runs the ramp
   again with d_ref = 10 R and checks both statements; so, while the load changes, the 2D

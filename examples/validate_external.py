@@ -6,7 +6,7 @@ The workflow of ``docs/stepfiles.md`` in one script:
    step K and write the step file (what ``rollqp export-step cattaneo-carter --step K`` does);
 2. solve both halves of the step from the ``.npz`` alone with ``scipy.optimize.minimize``
    (SLSQP), the collocation operator's skew part moved to the linear term at the previous
-   iterate (the splitting of FORMULATION.md §7), the friction bound from the pressure found;
+   iterate (the splitting of docs/formulation.md §8), the friction bound from the pressure found;
 3. ``check_step``: rollqp's residuals of that candidate, its differences from rollqp's Newton
    and QP solutions, and the nodes whose stick/slip/separation state differs.
 

@@ -4,7 +4,7 @@
 Newton), solves that stored step with every method in :func:`rollqp.available_methods` — the
 native QP backends (Clarabel, OSQP, cvxpy), each qpsolvers backend, Newton and the N–T
 alternation — warm-started from the same previous state, and lists for each rollqp's
-residuals per condition (FORMULATION.md §5), iterations, wall time, and the largest
+residuals per condition (docs/formulation.md §5), iterations, wall time, and the largest
 difference from Newton's solution in ``p0`` (pressure) and ``μ p0`` (traction). On a coupled
 step (``A_nt ≠ 0``, §6.2.1) the QP backends run the N–T alternation (paper §6.3).
 
@@ -47,7 +47,7 @@ class Report:
 
     def __str__(self) -> str:
         head = (f"scene {self.scene}, step {self.step} (q = {self.q:.6g}), {self.kind} step; "
-                "residuals nondimensional (FORMULATION.md §5), differences from newton\n\n"
+                "residuals nondimensional (docs/formulation.md §5), differences from newton\n\n"
                 "| method | Signorini | friction | load P | load Q | iterations | time [ms] "
                 "| max abs Δp [p0] | max abs Δt [μp0] | states ≠ |\n"
                 "|---|---|---|---|---|---|---|---|---|---|")

@@ -1,4 +1,4 @@
-r"""Step problems and their solutions (FORMULATION.md §5–7; paper eq. 49–71).
+r"""Step problems and their solutions (docs/formulation.md §4–6; paper eq. 49–71).
 
 A *step problem* is the data of one discrete step — influence matrices, weights, gap,
 friction bound, loads, history vector — and nothing about how it is solved. A
@@ -6,7 +6,7 @@ friction bound, loads, history vector — and nothing about how it is solved. A
 here, by rollqp, independently of any solver's self-reported accuracy (the split of
 ``qpsolvers.Problem`` / ``qpsolvers.Solution``).
 
-Sign convention (the project's, FORMULATION.md §1): ``p >= 0`` is the pressure, ``t`` the
+Sign convention (the project's, docs/formulation.md §1): ``p >= 0`` is the pressure, ``t`` the
 tangential traction on body A in +x, ``g >= 0`` the deformed gap, ``s`` the slip of A
 relative to B per unit rolled distance, ``δ`` the rigid approach, ``ξ`` the creepage.
 
@@ -66,7 +66,7 @@ class Scales:
 
     @classmethod
     def hertz(cls, P: float, R: float, Estar: float) -> "Scales":
-        """Hertz half-width ``a`` and peak pressure ``p0`` for load ``P`` (FORMULATION.md §11)."""
+        """Hertz half-width ``a`` and peak pressure ``p0`` for load ``P`` (docs/formulation.md §12)."""
         a = np.sqrt(4.0 * P * R / (np.pi * Estar))
         return cls(length=float(a), stress=float(2.0 * P / (np.pi * a)), modulus=float(Estar))
 
@@ -172,7 +172,7 @@ class QPForm:
 # ---------------------------------------------------------------------------- problems
 @dataclass(frozen=True)
 class NormalStep:
-    """The normal (Signorini) step problem (paper eq. 53, 67; FORMULATION.md §6).
+    """The normal (Signorini) step problem (paper eq. 53, 67; docs/formulation.md §4).
 
     Parameters
     ----------
@@ -286,7 +286,7 @@ class NormalStep:
 
 @dataclass(frozen=True)
 class TangentialStep:
-    """The tangential (friction) step problem (paper eq. 61/62, 67; FORMULATION.md §6).
+    """The tangential (friction) step problem (paper eq. 61/62, 67; docs/formulation.md §4).
 
     Parameters
     ----------
@@ -418,7 +418,7 @@ class TangentialStep:
 
 @dataclass(frozen=True)
 class CoupledStep:
-    r"""The coupled step (paper eq. 63–64, 67; FORMULATION.md §6): all rows of ``Φ``.
+    r"""The coupled step (paper eq. 63–64, 67; docs/formulation.md §4): all rows of ``Φ``.
 
     .. math::
         g = h - \delta e + A_{nn} p + A_{nt} t, \qquad
@@ -438,7 +438,7 @@ class CoupledStep:
         Normal and tangential influence (eq. 25, 28).
     Ant, Atn : (n, n) arrays or None
         Coupling: gap change per unit shear, tangential displacement per unit pressure
-        (``None``: zero; ``Ant = None`` is the Goodman level of FORMULATION.md §3).
+        (``None``: zero; ``Ant = None`` is the Goodman level of docs/formulation.md §10).
     f, h, mu : weights, undeformed gap, coefficient of friction.
     c : (n,) array
         History vector (eq. 37, 48): ``Δq·s = Δq ξ e + c + A_tn p + A_tt t``.

@@ -1,7 +1,7 @@
 """Reference cases of CONTACT (Vollebregt & Kalker) and the paper's §6.1.1 convergence problem, as scenes.
 
 Two problems for which CONTACT (Vollebregt & Kalker), the field's reference code, has results
-(``../shared/refdata/contact/README.md``; docs/validation.md):
+(``tests/data/contact/README.md`` in the source repository; docs/validation.md):
 
 * :func:`contact_scene`: CONTACT's 2D Cattaneo → Carter problem of similar cylinders
   (G = 82000, ν = 0.28, R = 500 mm as two cylinders of radius 1000 mm, FN' = 178.896248 N/mm
@@ -29,10 +29,11 @@ from . import closedforms as cf
 from .report import rms_in_contact
 from .scene import Scene, load_scene, scene_from_dict
 
-#: CONTACT's result files: ``$ROLLQP_CONTACT_REFDATA`` or ``../shared/refdata/contact`` beside
-#: the checkout.
+#: CONTACT's result files, shipped with the source repository in ``tests/data/contact`` (numbers
+#: computed with CONTACT, Apache-2.0; README and LICENSE there); ``$ROLLQP_CONTACT_REFDATA``
+#: points elsewhere.
 REFDATA = Path(os.environ.get("ROLLQP_CONTACT_REFDATA",
-                              Path(__file__).resolve().parents[1].parent / "shared" / "refdata" / "contact"))
+                              Path(__file__).resolve().parents[1] / "tests" / "data" / "contact"))
 
 # ---------------------------------------------------------------- Cattaneo → Carter (similar)
 G_CONTACT, NU_CONTACT = 82000.0, 0.28

@@ -1,4 +1,4 @@
-"""Errors against the closed forms (FORMULATION.md §11) and the run summary table."""
+"""Errors against the closed forms (docs/formulation.md §12) and the run summary table."""
 from __future__ import annotations
 
 import numpy as np
@@ -69,7 +69,7 @@ def summary(res: dict, scene, method: str, wall: float) -> str:
             ("iterations", f"{int(res['iterations'].sum())} in all, median {np.median(res['iterations'][1:] if K else res['iterations']):.0f} per step"),
             ("wall time", f"{wall:.3f} s ({float(res['step_time'].sum()):.3f} s stepping, "
                           f"median {1e3 * float(np.median(res['step_time'])):.2f} ms per step)"),
-            ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, FORMULATION.md §5)"),
+            ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _bem_rows(res, scene)
     for name, val, what in closed_form_errors(res, scene):

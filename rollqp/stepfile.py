@@ -2,11 +2,11 @@ r"""Step files: one step of a scene, exported for any solver, and a checker for 
 
 :func:`export_step` marches a scene to step ``K`` and returns a :class:`StepFile`: the step's
 data (influence matrices, weights, gap, friction, loads, history vector, scales), the state
-before it, rollqp's solution, and the convex QP form of each half (FORMULATION.md §7) in the
+before it, rollqp's solution, and the convex QP form of each half (docs/formulation.md §6) in the
 arrays a generic QP solver takes. :meth:`StepFile.save` writes it as a ``.npz`` without
 pickles, with solver-native files beside it (Clarabel's JSON, a cvxpy script); the keys are
 documented in ``docs/stepfiles.md``. :func:`check_step` evaluates a candidate solution with
-rollqp's own residuals (FORMULATION.md §5; paper eq. 51–60, 67), compares it with rollqp's
+rollqp's own residuals (docs/formulation.md §5; paper eq. 51–60, 67), compares it with rollqp's
 Newton and QP solutions, and says which condition fails at which nodes.
 
 **Step numbering** follows the result file's ``q`` index (SPEC.md): step ``K >= 1`` is the
@@ -14,7 +14,7 @@ rolling step whose solution is state ``K`` (``q = K Δq``), solved from state ``
 ``0`` is the starting state's last solve (the last static-shift increment of a braked start,
 or the steady-rolling solve / last marching step of a rolling start).
 
-**The step problem** is always stored in the coupled form of FORMULATION.md §6 (paper
+**The step problem** is always stored in the coupled form of docs/formulation.md §4 (paper
 eq. 63–64)::
 
     g = h − δ e + A_nn p + A_nt t,          s = ξ e + (c + A_tn p + A_tt t)/Δq,
@@ -441,7 +441,7 @@ class CheckReport:
         if self.xi is not None:
             L.append(f"  creepage ξ = {self.xi:.10g}" + (" (fitted: zero mean slip at the stick nodes)"
                                                           if "xi" in self.fitted else ""))
-        L.append("  rollqp residuals (nondimensional, FORMULATION.md §5):")
+        L.append("  rollqp residuals (nondimensional, docs/formulation.md §5):")
         for c in CONDITIONS:
             if c in self.residuals:
                 v = self.residuals[c]
@@ -635,7 +635,7 @@ CVXPY_SCRIPT = r'''"""Rebuild and solve the step in @STEPFILE@ with cvxpy (writt
 
 Self-contained: needs numpy and cvxpy only. Each half of the step is the variational
 inequality with operator P + skew (the collocation step; P the symmetric part of the scaled
-F·A, FORMULATION.md §7), solved as a sequence of convex QPs with Hessian P and the skew part
+F·A, docs/formulation.md §8), solved as a sequence of convex QPs with Hessian P and the skew part
 moved to the linear term at the previous iterate (q_k = q + skew x_{k-1}); the two halves
 alternate (paper §6.3), the other half entering through `coupling` (zero for an uncoupled
 step) and the friction bound mu·max(p, 0). Each sweep is one QP per half, from zero. The result is written to the .npz that `rollqp check-step` reads:

@@ -1,4 +1,4 @@
-"""Discretization of the contact strip (paper §3.1, eq. 31–48; FORMULATION.md §2, §4).
+"""Discretization of the contact strip (paper §3.1, eq. 31–48; docs/formulation.md §2).
 
 The potential contact zone ``[-L, L]`` is divided into ``n_elements`` equal elements of
 length ``Le``. Tractions are interpolated with element shape functions ``N_j``:
@@ -19,7 +19,7 @@ the element centres, which makes the material shift by one element (CONTACT's
 end node's value; only the leading-edge node ever looks there, and it must be out of
 contact (the paper's treatment of its last equation, eq. 35).
 
-Sign convention (FORMULATION.md §1): material moves through the contact with direction
+Sign convention (docs/formulation.md §1): material moves through the contact with direction
 ``d = sgn(V)``; it enters at the leading edge ``x = -d·L``.
 """
 from __future__ import annotations
@@ -197,7 +197,7 @@ class Strip:
         """``M`` such that the history vector is ``c^{k-1} = -M w^{k-1}``.
 
         With it the slip of every transient form is ``s = ξ e + (c + w^k)/Δq``
-        (eq. 36–37, 47–48; FORMULATION.md §4):
+        (eq. 36–37, 47–48; docs/formulation.md §2):
 
         * ``"material"``: ``M = R`` (eq. 37);
         * ``"convective-local"``: ``M = I - Δq·d·D_up`` (eq. 48);
@@ -213,7 +213,7 @@ class Strip:
         raise InputError("formulation", f"must be one of material, convective-local, static; got {formulation!r}")
 
     def steady_operator(self, direction: int) -> np.ndarray:
-        """``d·D_up``: the steady-rolling slip is ``s = ξ e + d·D_up w`` (FORMULATION.md §4)."""
+        """``d·D_up``: the steady-rolling slip is ``s = ξ e + d·D_up w`` (docs/formulation.md §9)."""
         return _direction(direction) * self.upwind_difference(direction)
 
 

@@ -13,7 +13,7 @@ Problems
 The paper's steel rollers (§6.1.1: R_A = 150 mm, R_B = 300 mm, E = 210 GPa, ν = 0.3,
 P = 1000 N/mm, μ = 0.1) on a strip of ±1.25 a_H, built with :class:`rollqp.Strip` and
 :func:`rollqp.halfspace_influence`, with Hertz scales. Piecewise-constant elements on this
-uniform grid give an exactly symmetric ``F·A`` (FORMULATION.md §7), so a QP solves the
+uniform grid give an exactly symmetric ``F·A`` (docs/formulation.md §7), so a QP solves the
 collocation problem itself; quadratic elements (the paper's QCE) do not.
 """
 from __future__ import annotations

@@ -101,7 +101,7 @@ def test_mesh_grading():
 def test_small_contact_matches_halfspace_signs(a):
     """Dissimilar rollers, a/R <= 0.01: BEM A = half-space A + rigid (affine) terms, on smooth loads.
 
-    The shafts fix the rigid constant the half-space leaves open (FORMULATION.md §3), and the
+    The shafts fix the rigid constant the half-space leaves open (docs/formulation.md §3), and the
     finite roller tilts the surface (a term linear in x): both are removed before comparing.
     """
     A, B = STEEL_A, ALU_B
@@ -198,7 +198,7 @@ def test_asymmetry_and_qp_vs_newton():
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "discretization.distance": 3.0})
     newton = rollqp.run(sc.replace(**{"solver.method": "newton"}))
     info = newton.meta["model"]
-    # measured 9.5e-4 (A_nn) and 1.6e-4 (A_tt); the half-space's QCE: 1.1e-3 (FORMULATION.md §7)
+    # measured 9.5e-4 (A_nn) and 1.6e-4 (A_tt); the half-space's QCE: 1.1e-3 (docs/formulation.md §7)
     assert 0 < info["asymmetry_FA"] < 5e-3 and 0 < info["asymmetry_FAtt"] < 5e-3
     # the default QP operator solves the collocation problem (symmetric-skew splitting): the same
     # solution to the backends' accuracy (conftest BACKENDS: 5e-9 each; measured 9e-11)

@@ -2,7 +2,7 @@
 
 Free rolling (Q = 0) of aluminium on steel, steady state (``load.start = "rolling"``). As μ → 0
 the creepage tends to Bentall–Johnson's |ξ| = 0.457·κ·a/R (``closedforms.bentall_johnson_creepage``,
-κ = 2β), with ``sgn ξ = d·sgn κ`` in the project's convention (FORMULATION.md §1, §3; derivation in
+κ = 2β), with ``sgn ξ = d·sgn κ`` in the project's convention (docs/formulation.md §1, §3; derivation in
 the closed form's docstring).
 
 **The discretization error at small μ.** The stick zones shrink to the two points |x| = b =
@@ -27,7 +27,7 @@ DY = 1000 mm strip (16.2019 N/mm: a_H = 0.1 mm), 216 elements of DX = 0.001 mm f
 CHI = 0 is d = −1, refdata README). Its cases 1–2 (μ = 1e-4) run with MAXOUT = 1, i.e. without
 CONTACT's outer (Panagiotopoulos) normal–tangential iteration: the pressure does not see the
 shear, rollqp's ``goodman``; case 4 (μ = 0.05) runs with MAXOUT = 10, the outer iteration, i.e.
-full coupling. The quoted creepages (issue; not in ../shared/refdata/contact): |ξ| = 5.260e-4
+full coupling. The quoted creepages (issue; not in tests/data/contact): |ξ| = 5.260e-4
 at μ = 1e-4 and 4.29e-4 at μ = 0.05.
 
 Numbers and the command that prints them: docs/validation.md, "Bentall–Johnson free rolling and

@@ -1,16 +1,16 @@
-"""Properties of the closed forms in rollqp.closedforms (FORMULATION.md §11).
+"""Properties of the closed forms in rollqp.closedforms (docs/formulation.md §12).
 
 The tests check physical properties (equilibrium, friction bound, stick conditions, symmetry,
-limits), not the formulas retyped. Sign convention of FORMULATION.md §1: p ≥ 0; t acts on
+limits), not the formulas retyped. Sign convention of docs/formulation.md §1: p ≥ 0; t acts on
 body A in +x; ξ = (V_A − V_B)/|V|; d = sgn(V), material enters at x = −d·a.
 
 Elasticity used for the stick checks (similar materials, half-space, plane strain): the
 relative tangential displacement is w = A_tt t with kernel (2/(πE*))·(−ln|x − s|)
-(FORMULATION.md §3), so
+(docs/formulation.md §3), so
 
     ∂w/∂x(x) = −(2/(πE*))·PV∫ t(s)/(x − s) ds,
 
-and the steady-rolling slip (FORMULATION.md §4, material derivative) is s = ξ + d·∂w/∂x.
+and the steady-rolling slip (docs/formulation.md §9, material derivative) is s = ξ + d·∂w/∂x.
 """
 from __future__ import annotations
 

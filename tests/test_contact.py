@@ -1,6 +1,6 @@
 """rollqp against CONTACT (Vollebregt & Kalker), on CONTACT's own grid.
 
-Reference numbers: ``../shared/refdata/contact`` beside the repository (README there for
+Reference numbers: ``tests/data/contact`` in the repository (README there for
 CONTACT's conventions); ``$ROLLQP_CONTACT_REFDATA`` overrides the place. The whole module is
 skipped, with the reason, only when that folder is absent (CI has it).
 
@@ -25,7 +25,7 @@ from rollqp import closedforms as cf
 from rollqp.refcases import REFDATA
 
 if not REFDATA.is_dir():
-    pytest.skip(f"CONTACT reference data not found at {REFDATA} (../shared/refdata/contact)",
+    pytest.skip(f"CONTACT reference data not found at {REFDATA} (tests/data/contact)",
                 allow_module_level=True)
 
 # CONTACT's inputs (refdata README): G = 82000, ν = 0.28 for both bodies, R = 500 mm

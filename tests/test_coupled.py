@@ -4,7 +4,7 @@ Tiers as in test_newton.py: the pseudo-Jacobian against finite differences and t
 choice of eq. 82–90 on every kink (consistency, round-off); convergence (quadratic at the
 end, clear errors); agreement of coupled Newton, N–T alternation with Newton halves and the
 alternation with QP halves on the same discrete coupled step; the coupling levels
-of FORMULATION.md §3 in the driver.
+of docs/formulation.md §10 in the march.
 """
 from __future__ import annotations
 
@@ -72,7 +72,7 @@ def _z(pb, sol):
 
 
 def _phi(pb, z, rN, rT):
-    """Φ(z) from the problem's own gap and slip (FORMULATION.md §6), not the method's matrices."""
+    """Φ(z) from the problem's own gap and slip (docs/formulation.md §4), not the method's matrices."""
     sc, n = pb.scales, pb.n
     p, t = z[:n], z[n:2 * n]
     g = pb.gap(p * sc.stress, t * sc.stress, z[2 * n] * sc.displacement) / sc.displacement
@@ -91,7 +91,7 @@ def test_jacobian_matches_finite_differences(case):
     rng = np.random.default_rng(3)
     z = _z(pb, sol) + 1e-3 * rng.standard_normal(2 * pb.n + 2)
     phi, J, (nc, tc) = meth.residual_and_jacobian(pb, z)
-    assert np.allclose(phi, _phi(pb, z, rN, rT), atol=TOL["roundoff"]), "Φ as defined in FORMULATION §6"
+    assert np.allclose(phi, _phi(pb, z, rN, rT), atol=TOL["roundoff"]), "Φ as defined in docs/formulation.md §4"
     h = 1e-6
     cols = []
     for k in range(z.size):
@@ -303,7 +303,7 @@ def test_full_coupling_methods_agree_over_a_transient(method):
 
 
 def test_swapping_bodies_flips_beta_shear_and_creepage():
-    """A ↔ B: β and the shear on 'A' change sign, the pressure does not (FORMULATION §3)."""
+    """A ↔ B: β and the shear on 'A' change sign, the pressure does not (docs/formulation.md §3)."""
     scene = dissimilar(**{"discretization.distance": 0.5})
     d = scene.to_dict()
     swapped = scene.replace(**{f"bodies.A.{k}": d["bodies"]["B"][k] for k in ("E", "nu")},

@@ -1,4 +1,4 @@
-"""The transient (rollqp.march; paper §4.1, §4.4; FORMULATION.md §9) on the built-in scenes.
+"""The transient (rollqp.march; paper §4.1, §4.4; docs/formulation.md §9) on the built-in scenes.
 
 Tier 1 (closed forms, discretization error of the paper's 40 QCE, Δq = Le/2): Cattaneo at
 the braked start, Carter after rolling, from a braked start, a ramp or a rolling start.

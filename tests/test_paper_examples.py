@@ -62,7 +62,7 @@ def test_builtin_scenes_follow_the_paper():
     assert "§6.2.1" in names["goodman-bentall"] and "§6.2.2" in names["harmonic"], "descriptions cite the paper"
 
     gb = rollqp.load_scene("goodman-bentall")
-    # "Dundurs' constant = 1" is 2β (FORMULATION.md §3): β = 0.5, asked to at least 5 digits
+    # "Dundurs' constant = 1" is 2β (docs/formulation.md §3): β = 0.5, asked to at least 5 digits
     assert abs(gb.beta - 0.5) <= 5e-6 and abs(gb.kappa - 1.0) <= 1e-5, f"beta = {gb.beta!r}"
     assert gb.contact.friction == 0.3 and gb.contact.coupling == "full", "mu = 0.3, full coupling (Fig. 7)"
     assert gb.load.tangential == rollqp.histories.Constant(0.0), "free rolling, Q = 0"
@@ -166,7 +166,7 @@ def test_pressure_peak_rolls_out_through_the_trailing_edge(goodman_bentall):
     results, _ = goodman_bentall
     f = results["runs"]["full"]["stats"]
     scene = results["runs"]["full"]["scene"]
-    trailing = scene.load.direction          # the trailing edge is at x = +d·a (FORMULATION.md §1)
+    trailing = scene.load.direction          # the trailing edge is at x = +d·a (docs/formulation.md §1)
     # the excess pressure is carried with the material (speed 1 in q): at q = 0.5 and 1.0 a_H
     # it has moved towards the trailing edge by 0.375 and 0.75 a_H (measured)
     assert trailing * f["peak_x_half"] >= 0.25, f"at q = 0.5 a_H the peak is at x = {f['peak_x_half']:+.3f} a_H"

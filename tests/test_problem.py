@@ -1,4 +1,4 @@
-"""Step problems and solutions (rollqp.problem; FORMULATION.md §5–7, paper eq. 49–71).
+"""Step problems and solutions (rollqp.problem; docs/formulation.md §4–6, paper eq. 49–71).
 
 No solver is called here: every check uses a solution known exactly by construction.
 
@@ -383,7 +383,7 @@ def test_tangential_multiplier_is_the_creepage(constant_problem):
     nu = -(grad + y * form.a)                         # multiplier of x <= u (t <= μp)
     upper = (p > 0) & ~stick                          # t = +μp, s < 0
     assert np.all(nu[upper] > 0), "upper-bound multipliers are positive where t = +μp slips backwards"
-    # and they are F̂ŝ scaled: ν = −f̂ ŝ/obj (KKT of the QP, FORMULATION.md §7)
+    # and they are F̂ŝ scaled: ν = −f̂ ŝ/obj (KKT of the QP, docs/formulation.md §6)
     fh = hp.f / hp.a
     expected = -fh[upper] * (s[upper] / hp.scales.slip) / form.obj_scale
     # ν is a difference of O(ξ̂ = 4) terms; where ŝ ~ 1e-2 the cancellation leaves ~1e-13 relative

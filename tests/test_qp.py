@@ -1,4 +1,4 @@
-"""The QP backends on the same discrete problems (FORMULATION.md §7; rollqp.methods).
+"""The QP backends on the same discrete problems (docs/formulation.md §7; rollqp.methods).
 
 Tier 2 of STYLE.md: methods agree with each other on one discrete problem, compared on
 rollqp's own numbers (pressures, tractions, approach, creepage, residuals), never on a

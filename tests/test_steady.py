@@ -1,7 +1,7 @@
 """The direct steady rolling solve (``load.start = "rolling"`` with ``newton``/``nt-newton``).
 
 ``rollqp.march`` (``_March.steady_direct``) solves the steady problem ``s = ξ e + d·D_up w`` at once
-(FORMULATION.md §4). Held here against:
+(docs/formulation.md §9). Held here against:
 
 * the long-run limit of the transient at constant loads: the QP methods' rolling start (which
   marches until the tractions change by less than ``rollqp.march.STEADY_TOL`` a step), and the Newton
@@ -12,7 +12,7 @@
 * the two transient formulations, material and convective-local, whose steady limits coincide
   exactly for linear interpolation and differ by less than the discretization error for QCE.
 
-When the transient's limit is the direct steady state exactly (FORMULATION.md §4):
+When the transient's limit is the direct steady state exactly (docs/formulation.md §9):
 
 * convective-local, any Δq: ``s = ξ e + d·D_up w^{k−1} + (w^k − w^{k−1})/Δq`` has the fixed point
   ``s = ξ e + d·D_up w``, the steady slip itself;

@@ -1,4 +1,4 @@
-"""Influence matrices of the two bodies at the strip nodes (paper eq. 23–30; FORMULATION.md §3).
+"""Influence matrices of the two bodies at the strip nodes (paper eq. 23–30; docs/formulation.md §3).
 
 ``MODELS`` maps a scene's ``contact.model`` to a builder ``f(strip, **kw) -> Influence``;
 :func:`build_influence` dispatches on it.
