@@ -45,6 +45,9 @@ def _parser():
     r.add_argument("--plot", help="draw tractions, slip and creepage to this PNG file")
     r.add_argument("--method", choices=METHOD_NAMES, help="overrides [solver].method")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
+                   help="solve three steps again with qp-clarabel and qp-osqp and show the differences "
+                        "(default: on for strips of at most 400 nodes run by a method other than those)")
     sub.add_parser("scenes", help="list the built-in scenes")
     s = sub.add_parser("show", help="print a scene's TOML with defaults filled in")
     s.add_argument("scene")
@@ -199,12 +202,13 @@ def cmd_run(args) -> int:
               file=sys.stderr)
         return 0
     cb, close = _progress(args.quiet)
+    keep, observe = _spot_steps(args, scene)
     t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         with OutputLock(out):
             try:
-                result = run(scene, progress=cb, resume=resume)
+                result = run(scene, progress=cb, resume=resume, observe=observe)
             except KeyboardInterrupt as err:
                 close()
                 print(f"rollqp: {_save_partial(err, out, 'interrupted')}", file=sys.stderr)
@@ -224,8 +228,34 @@ def cmd_run(args) -> int:
         plot_result(res, scene, args.plot)
     if not args.quiet:
         print(summary(res, scene, scene.solver.method, wall))
+        if keep:
+            from .crossval import spot_check
+            t1 = time.perf_counter()
+            check = spot_check(list(keep.values()))
+            print(f"  cross-check   {check} ({time.perf_counter() - t1:.2f} s)")
         print(f"  result        {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
     return 0
+
+
+def _spot_steps(args, scene):
+    """``(kept steps, observer)``: the run keeps steps 0, K/2 and K as step files for the cross-check."""
+    from .crossval import SPOT_MAX_NODES, SPOT_METHODS
+    wanted = args.cross_check
+    if wanted is None:
+        n = scene.discretization.elements * {"constant": 1, "linear": 1, "quadratic": 2}[scene.discretization.element] + 1
+        wanted = not args.quiet and n <= SPOT_MAX_NODES and scene.solver.method not in SPOT_METHODS
+    if not wanted or args.quiet:
+        return {}, None
+    from .stepfile import from_record
+    K = scene.n_steps
+    steps = sorted({0, K // 2, K})
+    keep = {}
+
+    def observe(rec, ops):
+        if rec.k in steps and rec.problem is not None:
+            keep[rec.k] = from_record(scene, ops, scene.solver.method, rec)
+
+    return keep, observe
 
 
 def cmd_scenes(args) -> int:

@@ -104,3 +104,58 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
                         states=int(np.count_nonzero(state != ref_state))))
     name = sf.scene.get("name", "?") if isinstance(sf.scene, dict) else "?"
     return Report(scene=name, step=sf.step, q=sf.q, kind=sf.kind, rows=rows)
+
+
+# ---------------------------------------------------------------------------- the run's cross-check
+#: The QP backends a run is cross-checked against (core dependencies only).
+SPOT_METHODS = ("qp-clarabel", "qp-osqp")
+#: Largest strip (nodes) cross-checked by default: the QP backends take seconds per step beyond it.
+SPOT_MAX_NODES = 400
+
+
+@dataclass
+class SpotCheck:
+    """Chosen steps of a run solved again by other methods, against the run's own solutions.
+
+    ``rows`` holds, per method, the largest differences over the steps (``p`` in p0, ``t`` in
+    μp0) and the largest rollqp residual of its solutions, or the error it raised. ``str()`` is
+    the summary line of ``rollqp run``.
+    """
+
+    steps: list
+    rows: dict
+
+    def __str__(self) -> str:
+        ok = {m: r for m, r in self.rows.items() if "error" not in r}
+        head = f"{', '.join(self.rows)} on steps {', '.join(map(str, self.steps))}"
+        if ok:
+            dp = max(r["p"] for r in ok.values())
+            dt = max(r["t"] for r in ok.values())
+            head += f": max |dp| {dp:.1e} p0, |dt| {dt:.1e} mu p0 from the run's own solutions"
+        bad = [f"{m} failed ({r['error'][:60]})" for m, r in self.rows.items() if "error" in r]
+        return head + ("; " + "; ".join(bad) if bad else "")
+
+
+def spot_check(steps, methods=SPOT_METHODS, tolerance: float = 1e-10) -> SpotCheck:
+    """Solve the stored steps (:class:`~rollqp.stepfile.StepFile`, from the run's records) with ``methods``.
+
+    Each step is solved from the state before it (the run's), as :func:`report` does, and
+    compared with the run's own solution of it (``ref_*``): the run's main job shows both routes
+    of the project — the complementarity system and the convex QPs — agreeing on the same
+    discrete steps.
+    """
+    rows = {}
+    for name in methods:
+        row = {"p": 0.0, "t": 0.0, "residual": 0.0}
+        for sf in steps:
+            try:
+                sol = solve_stored(sf, name, tolerance=tolerance)
+            except RollqpError as err:
+                row = {"error": str(err)}
+                break
+            sc = sf.scales
+            row["p"] = max(row["p"], float(np.max(np.abs(sol.p - sf.ref_p)) / sc.stress))
+            row["t"] = max(row["t"], float(np.max(np.abs(sol.t - sf.ref_t)) / (sc.stress * (sf.mu or 1.0))))
+            row["residual"] = max(row["residual"], sol.residual)
+        rows[name] = row
+    return SpotCheck([sf.step for sf in steps], rows)

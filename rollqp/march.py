@@ -448,7 +448,7 @@ def resumed_state(scene, ops: SceneOperators, arrays: dict) -> State:
     return State(p, t, ops.w(p, t), nsol, tsol, None)
 
 
-def run(scene, method=None, progress=None, resume=None) -> Result:
+def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -463,6 +463,9 @@ def run(scene, method=None, progress=None, resume=None) -> Result:
         The arrays of an earlier, incomplete result file of this scene
         (:func:`~rollqp.result.load_result`): its states are kept and the run continues after
         the last one (:func:`resumed_state`); ``meta["resumed_from"]`` records where.
+    observe : callable, optional
+        Called as ``observe(record, operators)`` with every :class:`StepRecord` (to keep some
+        steps' problems, e.g. for a cross-check: :func:`rollqp.crossval.spot_check`).
 
     Raises
     ------
@@ -484,6 +487,8 @@ def run(scene, method=None, progress=None, resume=None) -> Result:
     try:
         for rec in march(scene, prepared=prepared, resume=resume):
             result.add(rec, ops)
+            if observe is not None:
+                observe(rec, ops)
             if progress is not None and rec.k > 0:
                 progress(rec.k, K)
     except (SolverError, InputError, KeyboardInterrupt) as err:

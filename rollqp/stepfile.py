@@ -85,6 +85,11 @@ def export_step(scene, k: int, method: str | None = None) -> "StepFile":
     return _from_record(prepared[0], prepared[2], int(k), method, rec)
 
 
+def from_record(scene, ops, method, rec) -> "StepFile":
+    """The :class:`StepFile` of a :class:`~rollqp.march.StepRecord` of ``scene`` (``ops`` its operators)."""
+    return _from_record(scene, ops, rec.k, method, rec)
+
+
 def _from_record(scene, ops, k, method, rec):
     n = ops.n
     problem, sol = rec.problem, rec.solution

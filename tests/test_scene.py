@@ -443,7 +443,7 @@ def test_builtin_scenes_listed():
 def test_builtin_contents():
     cc, ramp = load_scene("cattaneo-carter"), load_scene("ramp")
     for s in (cc, ramp):
-        assert s.solver.method == "qp-clarabel", f"{s.name}: built-ins use Clarabel"
+        assert s.solver.method == "newton", f"{s.name}: built-ins run Newton (the run cross-checks steps with the QPs)"
         assert s.A == Body(150.0, 210000.0, 0.3, 15.0), f"{s.name}: body A"
         assert s.B == Body(300.0, 210000.0, 0.3, 30.0), f"{s.name}: body B"
         assert s.contact.friction == 0.1 and s.load.normal == 1000.0, f"{s.name}: mu, P"
@@ -494,7 +494,7 @@ def test_replace_changes_and_validates():
     s = load_scene("cattaneo-carter")
     t = s.replace(**{"solver.method": "qp-osqp", "discretization.elements": 80})
     assert t.solver.method == "qp-osqp" and t.discretization.elements == 80, "values replaced"
-    assert s.solver.method == "qp-clarabel", "the original is unchanged"
+    assert s.solver.method == "newton", "the original is unchanged"
     assert t.A == s.A and t.load == s.load, "everything else is kept"
     assert {m for m in METHODS if s.replace(**{"solver.method": m})} == set(METHODS), \
         "every listed method is accepted"
