@@ -120,3 +120,18 @@ def dtype_of(name: str):
     """The numpy dtype of field ``name`` (float64 for a key that is not registered)."""
     f = FIELDS.get(name)
     return np.dtype(f.dtype if f is not None else "float64")
+
+
+def markdown_table() -> str:
+    """The result-file reference table of docs/results.md, generated from :data:`FIELDS`."""
+    shapes = {"state": "(K+1, n)", "step": "(K+1,)", "node": "(n,)", "scalar": "()"}
+    rows = ["| key | shape | units | meaning |", "|---|---|---|---|"]
+    for f in FIELDS.values():
+        units = "–" if f.units == "1" else f.units
+        note = "" if f.contract else " *(beyond the contract)*"
+        text = f.description.replace("|", "\\|")
+        rows.append(f"| `{f.name}` | {shapes[f.shape]} | {units} | {text}{note} |")
+    rows.append("| `meta` | () | – | JSON string: the full scene with defaults, the method, the model's data, "
+                "package versions, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
+                "`rolling_start`) |")
+    return "\n".join(rows)

@@ -137,3 +137,40 @@ def test_every_quoted_command_names_an_existing_script_or_scene():
         for scene in runs.findall(text):
             assert scene in rollqp.builtin_scenes() or (ROOT / scene).is_file(), \
                 f"{page.name}: `rollqp run {scene}`: no such built-in scene or file"
+
+
+def test_result_file_reference_is_the_field_registry():
+    """docs/results.md's table is generated from rollqp.fields (regenerate it with
+    ``rollqp.fields.markdown_table()`` after adding a field)."""
+    from rollqp.fields import markdown_table
+    text = (DOCS / "results.md").read_text(encoding="utf-8")
+    table = text.split("<!-- fields table: begin -->\n", 1)[1].split("<!-- fields table: end -->", 1)[0]
+    assert table.strip() == markdown_table().strip(), "docs/results.md is stale: paste rollqp.fields.markdown_table()"
+
+
+def test_scene_reference_lists_every_key():
+    """docs/scenes.md documents every key a scene file accepts."""
+    import dataclasses
+    from rollqp.scene import Body, Contact, Discretization, Load, SolverSettings
+    text = (DOCS / "scenes.md").read_text(encoding="utf-8")
+    keys = [f"bodies.A.{f.name}" for f in dataclasses.fields(Body)]
+    keys += [f"{sec}.{f.name}" for sec, cls in (("contact", Contact), ("load", Load),
+                                               ("discretization", Discretization), ("solver", SolverSettings))
+             for f in dataclasses.fields(cls)]
+    missing = [k for k in keys + ["name", "description"] if f"`{k}`" not in text]
+    assert not missing, f"docs/scenes.md does not document {missing}"
+
+
+def test_readme_snippet_runs():
+    """The README's one-step snippet is complete: it runs as written and its two QP backends agree."""
+    import contextlib
+    import io
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = text.split("## One step from your own arrays", 1)[1].split("```python\n", 1)[1].split("```", 1)[0]
+    out = io.StringIO()
+    scope = {}
+    with contextlib.redirect_stdout(out):
+        exec(compile(block, "README.md", "exec"), scope)  # noqa: S102 - the project's own README
+    diff = rollqp.compare(scope["a"], scope["b"], mu=scope["mu"], scales=scope["scales"])
+    # constant elements: F·A exactly symmetric, both backends solve the same QP to 5e-9 (conftest.BACKENDS)
+    assert diff["t"] <= 1e-8 and scope["a"].residual <= 1e-8, out.getvalue()
