@@ -96,7 +96,10 @@ def _vec(name, v, n):
 
 
 def _set_weights(step) -> int:
-    """Validate a step's weights ``f`` (1-D, finite, all > 0), store them, return ``n``."""
+    """Validate a step's weights ``f`` (1-D, finite, all > 0) and its scales, store them, return ``n``."""
+    if not isinstance(step.scales, Scales):
+        raise InputError("scales", f"must be a rollqp.Scales (e.g. Scales.hertz(P, R, Estar), or Scales() for the "
+                                   f"problem's own units), got {type(step.scales).__name__}")
     n = np.asarray(step.f).shape[0] if np.ndim(step.f) == 1 else -1
     if n < 1:
         raise InputError("f", "must be a 1-D array of weights")

@@ -109,6 +109,7 @@ class QPMethod:
         check_kind(self, problem)
         t0 = time.perf_counter()
         sp = problem.A.split(problem.f)
+        check_convex(sp.sym, problem.f)
         sym_problem = problem.replace(A=sp.sym) if sp.asymmetry > 0 else problem
         x_prev = None
         if warm is not None:
@@ -201,6 +202,32 @@ class QPMethod:
     def _solve_form(self, form, x0, source=None):  # pragma: no cover - abstract
         """Return ``(x, y, status, iterations, solver_time, info)``; status 'solved' or the solver's."""
         raise NotImplementedError
+
+
+def check_convex(sym, f) -> None:
+    """The QP of a step is convex: ``sym(F·A)`` positive definite, checked once per operator.
+
+    An attempted Cholesky factorization of ``F·A_sym`` (scaled by its largest diagonal entry),
+    kept in the operator's memo. A matrix that fails it — indefinite, singular, zero — has no
+    convex QP: an :class:`InputError` on ``A`` before any solver sees it (a solver handed a
+    non-convex QP fails in its own words, or worse, returns something).
+    """
+    def test():
+        M = f[:, None] * sym.dense()
+        d = float(np.max(np.abs(np.diagonal(M)))) if M.size else 0.0
+        if not d > 0:
+            return "its diagonal is zero"
+        try:
+            np.linalg.cholesky(0.5 * (M + M.T) / d)
+        except np.linalg.LinAlgError:
+            lam = float(np.linalg.eigvalsh(0.5 * (M + M.T) / d)[0])
+            return f"its smallest eigenvalue is {lam:.3e} (relative to the largest diagonal entry)"
+        return None
+
+    why = sym.memo(("convex", np.asarray(f, dtype=float).tobytes()), test)
+    if why is not None:
+        raise InputError("A", f"the QP methods need sym(F·A) positive definite (a convex QP), but {why}; "
+                              "check the influence matrix (or its reference distance), or use method 'newton'")
 
 
 def constraint_rows(form):

@@ -14,6 +14,7 @@ import numpy as np
 import osqp
 import scipy.sparse as sp
 
+from ..errors import SolverError
 from ._qp import QPMethod, constraint_rows
 
 
@@ -53,8 +54,12 @@ class OsqpQP(QPMethod):
         A = sp.vstack(rows, format="csc")
         l, u = self._bounds(form)
         m = osqp.OSQP()
-        m.setup(P=sp.triu(sp.csc_matrix(form.H), format="csc"), q=form.q, A=A, l=l, u=u,
-                **self._settings(self._eps()))
+        try:
+            m.setup(P=sp.triu(sp.csc_matrix(form.H), format="csc"), q=form.q, A=A, l=l, u=u,
+                    **self._settings(self._eps()))
+        except (osqp.OSQPException, ValueError) as exc:  # reported as the QP's status, not leaked
+            raise SolverError(f"OSQP's set-up failed ({type(exc).__name__}: {exc})", method=self.name,
+                              status="setup failed") from None
         return m
 
     def _eps(self):
