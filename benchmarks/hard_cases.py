@@ -362,7 +362,7 @@ def run_case(case: Case, method: str, with_reference: bool = True) -> Row:
 def _with_augmentation(scene, r):
     """``scene`` with ``solver.augmentation = r``, the validated range lifted so that the band's
     outside can be measured too (a user gets an InputError there)."""
-    import rollqp.scene as sc
+    import rollqp.scene.checks as sc
     lo, hi = sc.AUGMENTATION_MIN, sc.AUGMENTATION_MAX
     sc.AUGMENTATION_MIN, sc.AUGMENTATION_MAX = 0.0, math.inf
     try:

@@ -1,7 +1,7 @@
 """Closed-form solutions of 2D (plane-strain) contact of cylinders, for checking the solvers.
 
-FORMULATION.md §11 restated as functions. Every function uses the project's sign convention
-(FORMULATION.md §1):
+docs/formulation.md §12 restated as functions. Every function uses the project's sign convention
+(docs/formulation.md §1):
 
 * ``p ≥ 0`` is the contact pressure (compression positive);
 * ``t`` is the tangential traction acting on body A in ``+x`` (B receives ``-t``),
@@ -21,7 +21,7 @@ array and return a float or an ndarray of the same shape; they are zero outside
 
 The 2D Hertz approach (rigid-body approach of the axes) is deliberately *not* given: in
 plane strain it depends on how the bodies are supported far from the contact (the
-logarithmic rigid constant ``d_ref`` of FORMULATION.md §3), so there is no definite
+logarithmic rigid constant ``d_ref`` of docs/formulation.md §3), so there is no definite
 half-space formula to check against.
 
 Sources are in :data:`SOURCES` (function name → citation).
@@ -33,6 +33,7 @@ import math
 import numpy as np
 
 from .errors import InputError
+from .scene.validate import nonnegative, positive, scalar
 
 __all__ = [
     "hertz_half_width",
@@ -65,7 +66,7 @@ _KALKER = ("J. J. Kalker, Three-Dimensional Elastic Bodies in Rolling Contact, K
            "the 2D linear creep coefficient)")
 _BENTALL = ("R. H. Bentall and K. L. Johnson, Slip in the rolling contact of two dissimilar elastic "
             "rollers, Int. J. Mech. Sci. 9, 389–404 (1967); as in " + _JOHNSON
-            + ", Ch. 8 (free rolling of dissimilar bodies); μ → 0 limit quoted in FORMULATION.md §11")
+            + ", Ch. 8 (free rolling of dissimilar bodies); μ → 0 limit quoted in docs/formulation.md §12")
 
 _LAME = ("G. Lamé, Leçons sur la théorie mathématique de l'élasticité des corps solides, 1852; "
          "thick-walled cylinder in plane strain as in S. P. Timoshenko and J. N. Goodier, Theory of "
@@ -102,35 +103,13 @@ def _bj_coefficient() -> float:
 
 #: Bentall–Johnson free-rolling coefficient at μ → 0, ``|ξ| = C·|κ|·a/R`` with
 #: ``C = ½√(1 − u²)`` and ``u`` the root of ``u√(1−u²) + arcsin u = π/4``
-#: (``C = 0.45739…``, the ``0.457`` of FORMULATION.md §11). See :func:`bentall_johnson_creepage`.
+#: (``C = 0.45739…``, the ``0.457`` of docs/formulation.md §12). See :func:`bentall_johnson_creepage`.
 BENTALL_JOHNSON_COEFFICIENT: float = _bj_coefficient()
 
 
 # --------------------------------------------------------------------------- validation
-def _scalar(name: str, value) -> float:
-    if isinstance(value, bool):
-        raise InputError(name, f"must be a real number, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(name, f"must be a real scalar, got {value!r}") from None
-    if not math.isfinite(v):
-        raise InputError(name, f"must be finite, got {value!r}")
-    return v
-
-
-def _positive(name: str, value) -> float:
-    v = _scalar(name, value)
-    if v <= 0.0:
-        raise InputError(name, f"must be > 0, got {value!r}")
-    return v
-
-
-def _nonnegative(name: str, value) -> float:
-    v = _scalar(name, value)
-    if v < 0.0:
-        raise InputError(name, f"must be >= 0, got {value!r}")
-    return v
+# the project's one set of validators (rollqp.scene.validate), lenient: numpy scalars accepted
+_scalar, _positive, _nonnegative = scalar, positive, nonnegative
 
 
 def _ratio(value) -> float:
@@ -217,7 +196,7 @@ def hertz_half_width(P, R, Estar):
 
     Notes
     -----
-    Sign convention: FORMULATION.md §1 (``p ≥ 0`` compression). Equivalently
+    Sign convention: docs/formulation.md §1 (``p ≥ 0`` compression). Equivalently
     ``p0 = 2P/(πa) = aE*/(2R)``. Source: Hertz (1882); Johnson (1985) Ch. 4, see
     ``SOURCES["hertz_half_width"]``.
     """
@@ -267,7 +246,7 @@ def hertz_pressure(x, a, p0):
     Returns
     -------
     float or ndarray
-        ``p(x) ≥ 0`` (compression positive, FORMULATION.md §1), shape of ``x``.
+        ``p(x) ≥ 0`` (compression positive, docs/formulation.md §1), shape of ``x``.
 
     Notes
     -----
@@ -330,7 +309,7 @@ def cattaneo_traction(x, a, p0, mu, ratio):
     Returns
     -------
     float or ndarray
-        ``t(x)``, the traction on body A in ``+x`` (FORMULATION.md §1), shape of ``x``. It is
+        ``t(x)``, the traction on body A in ``+x`` (docs/formulation.md §1), shape of ``x``. It is
         even in ``x``, has the sign of ``ratio`` and ``∫ t dx = ratio·μ·P`` with
         ``P = πa·p0/2``.
 
@@ -371,7 +350,7 @@ def carter_stick_zone(a, ratio, direction):
         Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
     direction : {-1, +1}
         ``d = sgn(V)``: material moves through the contact in ``+d·x`` and enters at the
-        leading edge ``x = −d·a`` (FORMULATION.md §1).
+        leading edge ``x = −d·a`` (docs/formulation.md §1).
 
     Returns
     -------
@@ -412,7 +391,7 @@ def carter_traction(x, a, p0, mu, ratio, direction):
     ratio : float
         Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
     direction : {-1, +1}
-        ``d = sgn(V)``; material enters at ``x = −d·a`` (FORMULATION.md §1).
+        ``d = sgn(V)``; material enters at ``x = −d·a`` (docs/formulation.md §1).
 
     Returns
     -------
@@ -462,7 +441,7 @@ def carter_creepage(a, R, mu, ratio):
     Returns
     -------
     float or ndarray
-        ``ξ = (V_A − V_B)/|V|`` (FORMULATION.md §1), shape of ``ratio``. ``ξ`` and ``Q`` have
+        ``ξ = (V_A − V_B)/|V|`` (docs/formulation.md §1), shape of ``ratio``. ``ξ`` and ``Q`` have
         opposite signs; ``ξ`` does not depend on the rolling direction.
 
     Notes
@@ -536,7 +515,7 @@ def bentall_johnson_creepage(kappa, a, R):
     ----------
     kappa : float
         Bentall–Johnson's dissimilarity constant ``κ = 2β`` (``β`` Dundurs' parameter,
-        FORMULATION.md §3; the paper's eq. 92 constant), ``|κ| ≤ 1``.
+        docs/formulation.md §3; the paper's eq. 92 constant), ``|κ| ≤ 1``.
     a : float
         Hertz half-width, ``a > 0``.
     R : float
@@ -550,7 +529,7 @@ def bentall_johnson_creepage(kappa, a, R):
 
     Notes
     -----
-    Free rolling (``Q = 0``) in the limit ``μ → 0`` quoted in FORMULATION.md §11 (for finite
+    Free rolling (``Q = 0``) in the limit ``μ → 0`` quoted in docs/formulation.md §12 (for finite
     μ the creepage is smaller). Derivation: as ``μ → 0``, ``t → 0``, so ``w`` comes from the
     pressure alone, ``∂w/∂x = −(κ/E*)·p(x)`` with §3's ``A_tn``; the steady slip
     ``s = ξ − d·κ·p(x)/E*`` changes sign where ``p(x) = d·ξ·E*/κ``, i.e. at ``|x| = b``, and

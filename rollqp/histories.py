@@ -1,6 +1,6 @@
 """Load histories: functions of the rolled distance q (in units of a_H).
 
-A scene prescribes its loads as histories (SPEC.md, "Histories"): the normal load as a
+A scene prescribes its loads as histories (docs/scenes.md, "Histories"): the normal load as a
 multiplier of the reference load P̄, the tangential load as the ratio Q/(μP̄), or the creepage
 ξ directly. Each history is a small frozen dataclass that
 
@@ -24,15 +24,14 @@ Strings are never evaluated.
 """
 from __future__ import annotations
 
-import difflib
 import math
 from dataclasses import dataclass, fields
-from numbers import Real
 from typing import Any, ClassVar
 
 import numpy as np
 
 from .errors import InputError
+from .scene.validate import finite_real, is_real, positive_real, real_sequence, suggestion
 
 __all__ = ["History", "Constant", "Ramp", "Harmonic", "Table", "HISTORY_KINDS",
            "parse_history"]
@@ -43,34 +42,9 @@ MAX_HARMONIC_PEAKS = 100_000
 
 
 # --------------------------------------------------------------------------- value checks
-def _is_real(v: Any) -> bool:
-    return isinstance(v, Real) and not isinstance(v, bool)
-
-
-def _finite_real(key: str, v: Any, what: str = "a finite number") -> float:
-    if not _is_real(v) or not math.isfinite(float(v)):
-        raise InputError(key, f"must be {what}, got {v!r}")
-    return float(v)
-
-
-def _positive_real(key: str, v: Any) -> float:
-    x = _finite_real(key, v, "a finite number > 0")
-    if not x > 0:
-        raise InputError(key, f"must be a finite number > 0, got {v!r}")
-    return x
-
-
-def _real_sequence(key: str, v: Any) -> tuple[float, ...]:
-    if isinstance(v, (str, bytes)) or not hasattr(v, "__iter__"):
-        raise InputError(key, f"must be an array of finite numbers, got {v!r}")
-    out = []
-    for i, x in enumerate(v):
-        out.append(_finite_real(f"{key}[{i}]", x))
-    return tuple(out)
-
-
+# (the project's one set of validators: rollqp.scene.validate)
 def _q_end(q_end: Any) -> float:
-    x = _finite_real("q_end", q_end, "a finite number >= 0")
+    x = finite_real("q_end", q_end, "a finite number >= 0")
     if x < 0:
         raise InputError("q_end", f"must be a finite number >= 0, got {q_end!r}")
     return x
@@ -160,7 +134,7 @@ class Constant(History):
 
     @classmethod
     def _normalize(cls, key, values):
-        return {"value": _finite_real(f"{key}.value", values["value"])}
+        return {"value": finite_real(f"{key}.value", values["value"])}
 
     def __call__(self, q):
         return _out(q, np.full(np.shape(q), self.value, dtype=float))
@@ -196,9 +170,9 @@ class Ramp(History):
 
     @classmethod
     def _normalize(cls, key, values):
-        return {"start": _finite_real(f"{key}.start", values["start"]),
-                "end": _finite_real(f"{key}.end", values["end"]),
-                "over": _positive_real(f"{key}.over", values["over"])}
+        return {"start": finite_real(f"{key}.start", values["start"]),
+                "end": finite_real(f"{key}.end", values["end"]),
+                "over": positive_real(f"{key}.over", values["over"])}
 
     def __call__(self, q):
         s = np.clip(np.asarray(q, dtype=float) / self.over, 0.0, 1.0)
@@ -238,10 +212,10 @@ class Harmonic(History):
 
     @classmethod
     def _normalize(cls, key, values):
-        return {"mean": _finite_real(f"{key}.mean", values["mean"]),
-                "amplitude": _finite_real(f"{key}.amplitude", values["amplitude"]),
-                "wavelength": _positive_real(f"{key}.wavelength", values["wavelength"]),
-                "phase": _finite_real(f"{key}.phase", values.get("phase", 0.0))}
+        return {"mean": finite_real(f"{key}.mean", values["mean"]),
+                "amplitude": finite_real(f"{key}.amplitude", values["amplitude"]),
+                "wavelength": positive_real(f"{key}.wavelength", values["wavelength"]),
+                "phase": finite_real(f"{key}.phase", values.get("phase", 0.0))}
 
     def __call__(self, q):
         theta = 2.0 * np.pi * np.asarray(q, dtype=float) / self.wavelength + self.phase
@@ -298,8 +272,8 @@ class Table(History):
 
     @classmethod
     def _normalize(cls, key, values):
-        q = _real_sequence(f"{key}.q", values["q"])
-        v = _real_sequence(f"{key}.value", values["value"])
+        q = real_sequence(f"{key}.q", values["q"])
+        v = real_sequence(f"{key}.value", values["value"])
         if len(q) < 1:
             raise InputError(f"{key}.q", "must have at least one point, got []")
         if len(v) != len(q):
@@ -325,14 +299,6 @@ HISTORY_KINDS: dict[str, type[History]] = {
 
 
 # --------------------------------------------------------------------------- parsing
-def _suggest(word: str, choices) -> str:
-    """``" (did you mean 'x'?)"`` for the closest of ``choices`` (case-insensitive), or ``""``."""
-    choices = list(choices)
-    lower = {c.lower(): c for c in choices}
-    m = difflib.get_close_matches(str(word).lower(), list(lower), n=1, cutoff=0.6)
-    return f"; did you mean {lower[m[0]]!r}?" if m else ""
-
-
 def parse_history(obj: Any, key: str, *, constant_default: float | None = None) -> History:
     """Build a history from its TOML inline table.
 
@@ -360,8 +326,8 @@ def parse_history(obj: Any, key: str, *, constant_default: float | None = None) 
     """
     if isinstance(obj, History):
         return obj
-    if _is_real(obj):
-        return Constant(_finite_real(key, obj))
+    if is_real(obj):
+        return Constant(finite_real(key, obj))
     if not isinstance(obj, dict):
         raise InputError(key, "must be an inline table such as { kind = \"constant\", "
                               f"value = 0.5 }} (kinds: {', '.join(HISTORY_KINDS)}), got {obj!r}")
@@ -370,14 +336,14 @@ def parse_history(obj: Any, key: str, *, constant_default: float | None = None) 
     kind = obj["kind"]
     if not isinstance(kind, str) or kind not in HISTORY_KINDS:
         raise InputError(f"{key}.kind", f"must be one of {', '.join(map(repr, HISTORY_KINDS))},"
-                                        f" got {kind!r}" + (_suggest(kind, HISTORY_KINDS)
+                                        f" got {kind!r}" + (suggestion(kind, HISTORY_KINDS)
                                                             if isinstance(kind, str) else ""))
     cls = HISTORY_KINDS[kind]
     names = [f.name for f in fields(cls)]  # type: ignore[arg-type]
     for k in obj:
         if k != "kind" and k not in names:
             raise InputError(f"{key}.{k}", f"unknown key for a {kind} history"
-                                           f"{_suggest(k, names)} (allowed: kind, "
+                                           f"{suggestion(k, names)} (allowed: kind, "
                                            f"{', '.join(names)})")
     values = {k: v for k, v in obj.items() if k != "kind"}
     if cls is Constant and "value" not in values and constant_default is not None:

@@ -67,8 +67,9 @@ class Scales:
     @classmethod
     def hertz(cls, P: float, R: float, Estar: float) -> "Scales":
         """Hertz half-width ``a`` and peak pressure ``p0`` for load ``P`` (docs/formulation.md §12)."""
-        a = np.sqrt(4.0 * P * R / (np.pi * Estar))
-        return cls(length=float(a), stress=float(2.0 * P / (np.pi * a)), modulus=float(Estar))
+        from .closedforms import hertz_half_width, hertz_peak_pressure
+        a = hertz_half_width(P, R, Estar)
+        return cls(length=a, stress=hertz_peak_pressure(P, a), modulus=float(Estar))
 
     @property
     def displacement(self) -> float:

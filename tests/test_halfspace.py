@@ -1,4 +1,4 @@
-"""Half-space influence matrices (rollqp.influence.halfspace; paper eq. 23–30, FORMULATION.md §3).
+"""Half-space influence matrices (rollqp.influence.halfspace; paper eq. 23–30, docs/formulation.md §3).
 
 Three kinds of checks: the element integrals against independent quadrature and exact values
 (consistency, ~1e-10..1e-14), the symmetry/reciprocity structure the QPs rely on, and the
@@ -218,7 +218,7 @@ def test_quadratic_FK_asymmetry_small_and_decreasing():
         strip = _strip("quadratic", ne)
         asym[ne] = hs.asymmetry(hs.log_kernel_matrix(strip, R_REL), strip.weights)
     print("asymmetry of F·K, quadratic, d_ref = R:", {k: f"{v:.2e}" for k, v in asym.items()})
-    # FORMULATION.md §7 quotes ≈ 0.2 % for 40 elements (the value depends on d_ref: ~0.1 % here).
+    # docs/formulation.md §7 quotes ≈ 0.2 % for 40 elements (the value depends on d_ref: ~0.1 % here).
     assert 1e-4 < asym[40] < 1e-2, f"asymmetry of F K with 40 QCE is {asym[40]:.2e}, not ~1e-3"
     assert asym[20] > asym[40] > asym[80], f"asymmetry of F K does not shrink under refinement: {asym}"
 
@@ -227,7 +227,7 @@ def test_quadratic_K_itself_far_from_symmetric():
     strip = _strip("quadratic", 40)
     K = hs.log_kernel_matrix(strip, R_REL)
     asym = np.linalg.norm(K - K.T) / np.linalg.norm(K)
-    # FORMULATION.md §7: ≈ 45 % in norm (end nodes carry 1/6 of the element, midnodes 2/3).
+    # docs/formulation.md §7: ≈ 45 % in norm (end nodes carry 1/6 of the element, midnodes 2/3).
     assert asym > 0.3, f"K for quadratic elements should be far from symmetric, asymmetry {asym:.2f}"
 
 

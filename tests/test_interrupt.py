@@ -102,18 +102,26 @@ def test_stale_lock_and_temporary_files_are_cleaned_up(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([mine.name, "r.npz"])
 
 
-def test_default_output_stays_in_the_working_folder(tmp_path):
-    scene = rollqp.load_scene("cattaneo-carter").replace(**{"name": "../../escape", "discretization.distance": 0.0})
+def test_scene_name_cannot_steer_the_output_path(tmp_path):
+    """A name with a path in it is refused by the scene (docs/scenes.md); a file stem (the
+    default name) and the default output name are reduced to safe characters, so whatever
+    the scene, the result is written in the working folder."""
+    from rollqp.cli import default_output
+    from rollqp.scene.checks import safe_name
+    scene = rollqp.load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.0})
+    text = scene.to_toml().replace('name = "cattaneo-carter"', 'name = "../../escape"')
     (tmp_path / "sub").mkdir()
-    (tmp_path / "sub" / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
+    (tmp_path / "sub" / "scene.toml").write_text(text, encoding="utf-8")
     proc = _cli("run", "scene.toml", "--quiet", cwd=tmp_path / "sub")
     _, err = proc.communicate(timeout=60)
-    assert proc.returncode == 0, err
-    written = [p.name for p in (tmp_path / "sub").iterdir() if p.suffix == ".npz"]
-    assert written == ["_.._escape.npz"], f"'/' and leading dots replaced: {written}"
-    assert not list(tmp_path.glob("*.npz")) and not (tmp_path.parent / "escape.npz").exists()
-    meta = json.loads(str(np.load(tmp_path / "sub" / written[0])["meta"]))
-    assert meta["scene"]["name"] == "../../escape"
+    assert proc.returncode == 2 and err.startswith("rollqp: error: name: must be") and err.count("\n") == 1, err
+    assert not list(tmp_path.rglob("*.npz")) and not (tmp_path.parent / "escape.npz").exists()
+    assert default_output("../../escape") == "_.._escape.npz" and default_output("a/b\\c") == "a_b_c.npz"
+    stem = "..%2f x;rm -rf"
+    (tmp_path / "sub" / f"{stem}.toml").write_text(scene.to_toml().replace('name = "cattaneo-carter"\n', ""),
+                                                   encoding="utf-8")
+    named = rollqp.load_scene(str(tmp_path / "sub" / f"{stem}.toml"))
+    assert named.name == safe_name(stem) == "2f x_rm -rf", named.name
 
 
 def test_bad_plot_and_output_fail_before_the_run(tmp_path, capsys):

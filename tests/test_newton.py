@@ -74,7 +74,7 @@ def _z(problem, sol):
 
 
 def _phi(problem, z, r):
-    """Φ(z) from rollqp's own gap/slip (FORMULATION.md §6), independent of the method's code."""
+    """Φ(z) from rollqp's own gap/slip (docs/formulation.md §4), independent of the method's code."""
     sc = problem.scales
     n = problem.n
     if problem.kind == "normal":

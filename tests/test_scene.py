@@ -394,8 +394,9 @@ def test_builtin_round_trip(name, tmp_path):
 
 def test_round_trip_of_every_feature(tmp_path):
     d = base_dict()
-    d["name"] = 'odd "name" \\ with\ttabs'
-    d["description"] = "é §6 \n two lines \x7f"
+    d["name"] = "Prüfung (v2) 6.1.1"
+    d["description"] = 'é §6 \n two lines \x7f, "quoted" \\ with\ttabs'
+
     d["contact"]["reference_distance"] = 123.456789012345678
     d["bodies"]["A"]["nu"] = 0.1 + 0.2  # not a short decimal
     d["load"]["normal_history"] = {"kind": "table", "q": [0.0, 1.0 / 3.0, 2.0],
@@ -415,7 +416,7 @@ def test_round_trip_of_every_feature(tmp_path):
     back = load_scene(path)
     assert back == s, "round trip with every optional feature"
     assert back.name == d["name"] and back.description == d["description"], \
-        "strings with quotes, backslashes and control characters survive"
+        "names in any script, strings with quotes, backslashes and control characters survive"
     assert back.A.nu == 0.1 + 0.2, "floats are written with repr precision"
 
 
@@ -520,3 +521,13 @@ def test_replace_histories_and_removal():
     assert v.A.shaft_radius is None, "None removes an optional key"
     with pytest.raises(InputError, match="exactly one"):
         s.replace(**{"load.creepage": 1e-4, "load.tangential": 0.5})
+
+
+@pytest.mark.parametrize("name", ["../escape", "a/b", 'quo"te', "back\\slash", "tab\tname", "", " lead", ".hidden",
+                                  "x" * 101])
+def test_scene_name_alphabet(name):
+    """A scene's name names output files and appears in generated scripts: letters, digits,
+    space and ._+()- only, starting with a letter or digit (docs/scenes.md)."""
+    d = base_dict()
+    d["name"] = name
+    expect_error(d, "name", "letters, digits")

@@ -1,4 +1,4 @@
-"""Half-space influence matrices of two elastic cylinders (paper eq. 23–30; FORMULATION.md §3).
+"""Half-space influence matrices of two elastic cylinders (paper eq. 23–30; docs/formulation.md §3).
 
 For both bodies together, at the strip nodes (collocation at ``x_i``),
 
@@ -9,7 +9,7 @@ For both bodies together, at the strip nodes (collocation at ``x_i``),
     w = A_{tn} p + A_{tt} t \\qquad \\text{(eq. 28)}
 
 with ``w = u_x^A - u_x^B``, ``p`` the pressure (≥ 0 in compression) and ``t`` the traction on
-body A in +x (sign convention of FORMULATION.md §1). In the half-space approximation
+body A in +x (sign convention of docs/formulation.md §1). In the half-space approximation
 (plane strain) the combined compliances are (the paper's eq. 26 and 29 with ``S^α`` of eq. 24
 replaced by the half-space Green's functions):
 
@@ -39,7 +39,7 @@ a rigid normal displacement ``c P e`` and a rigid tangential one ``c Q e``.
   not depend on ``d_ref``; ``δ`` and ``ξ`` do, by these rigid amounts.
 * With ``δ`` or ``ξ`` prescribed they do not cancel: the tractions then depend on ``d_ref``.
   The 2D half-space approach is **undetermined** (it grows like ``ln(d_ref)``); only a
-  finite-body model (BEM, FORMULATION.md §8) fixes it. Results with prescribed ``δ`` hold for
+  finite-body model (BEM, docs/bem.md) fixes it. Results with prescribed ``δ`` hold for
   the chosen ``d_ref`` only.
 
 The QP of each step needs a positive definite Hessian ``sym(F A)``. The operator with kernel
@@ -83,6 +83,7 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import InputError
+from ..scene.validate import positive_real
 from .operator import asymmetry
 
 __all__ = [
@@ -226,13 +227,6 @@ def _assemble(strip, moments, offsets) -> np.ndarray:
     return M
 
 
-def _check_positive(value, key, what):
-    value = float(value)
-    if not (np.isfinite(value) and value > 0):
-        raise InputError(key, f"{what} must be a finite number > 0, got {value!r}")
-    return value
-
-
 def log_kernel_matrix(strip, d_ref: float, lattice: bool | None = None) -> np.ndarray:
     """Collocation matrix of the 2D log kernel (the shape of ``A_nn``, eq. 25–26).
 
@@ -265,7 +259,7 @@ def log_kernel_matrix(strip, d_ref: float, lattice: bool | None = None) -> np.nd
     ``∫_e N_a (-ln(|x_i - s|/d)) ds = -hl ∫ N_a ln|ξ - ξ_i| dξ + hl ln(d/hl) ∫ N_a dξ``,
     so ``K(d') = K(d) + ln(d'/d) e fᵀ``.
     """
-    d_ref = _check_positive(d_ref, "contact.reference_distance", "the reference distance")
+    d_ref = positive_real("contact.reference_distance", float(d_ref))
     offsets = element_offsets(strip, lattice)
     K = -_assemble(strip, _log_moments, offsets)
     hl = offsets[2]
@@ -338,7 +332,7 @@ def _weights(F) -> np.ndarray:
 def min_eigenvalue(F, A) -> float:
     """Smallest eigenvalue of ``sym(F A)`` relative to the largest in magnitude.
 
-    ``sym(F A) = (F A + (F A)ᵀ)/2`` is the Hessian the QPs use (FORMULATION.md §7).
+    ``sym(F A) = (F A + (F A)ᵀ)/2`` is the Hessian the QPs use (docs/formulation.md §7).
 
     Parameters
     ----------
@@ -476,7 +470,7 @@ def _check_definite(f, K, d_ref, L):
 
 def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: float = np.inf,
                         coupling: str = "off", d_ref: float | None = None) -> Influence:
-    """Half-space influence of two cylinders (eq. 25–30; FORMULATION.md §3).
+    """Half-space influence of two cylinders (eq. 25–30; docs/formulation.md §3).
 
     ``A_nn = A_tt = (2/(πE*)) K``, ``A_nt = (β/E*) S``, ``A_tn = -(β/E*) S`` with ``K`` of
     :func:`log_kernel_matrix` and ``S`` of :func:`sgn_kernel_matrix`; ``h`` from eq. 10.
@@ -514,7 +508,7 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
     dominates the cost for large strips (≈ 0.3 s for 1281 nodes, ≈ 2 s for 2601), while the
     matrices themselves take ``O(n²)``.
     """
-    Estar = _check_positive(Estar, "Estar", "E*")
+    Estar = positive_real("Estar", float(Estar))
     beta = float(beta)
     if not (np.isfinite(beta) and abs(beta) <= 0.5):
         raise InputError("beta", f"Dundurs' beta must lie in [-0.5, 0.5], got {beta!r}")
@@ -527,7 +521,7 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
     R = 1.0 / (1.0 / float(R_A) + 1.0 / float(R_B))
     if d_ref is None:
         d_ref = R
-    d_ref = _check_positive(d_ref, "contact.reference_distance", "the reference distance")
+    d_ref = positive_real("contact.reference_distance", float(d_ref))
     f = np.asarray(strip.weights, dtype=float)
     L = 0.5 * float(np.asarray(strip.edges)[-1] - np.asarray(strip.edges)[0])
 

@@ -1,4 +1,4 @@
-r"""Normal–tangential alternation (paper §6.3, the PANA process; FORMULATION.md §7).
+r"""Normal–tangential alternation (paper §6.3, the PANA process; docs/formulation.md §10).
 
 The coupled step (:class:`~rollqp.problem.CoupledStep`) is not a QP: the friction bound
 ``μ p`` depends on the unknown pressure, and with ``A_nt ≠ 0`` the gap depends on the

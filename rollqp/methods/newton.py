@@ -1,12 +1,12 @@
 r"""Generalized Newton method with line search (GNMls; Pang 1990; paper §4, eq. 74–90).
 
 Solves the *uncoupled* normal and tangential step problems (:class:`~rollqp.problem.NormalStep`,
-:class:`~rollqp.problem.TangentialStep`) as the nonsmooth equations of FORMULATION.md §5–6,
+:class:`~rollqp.problem.TangentialStep`) as the nonsmooth equations of docs/formulation.md §4,
 with the problem's own collocation operator ``A`` (no symmetrization), so that its solution is
 the one the QP backends reach by symmetric–skew splitting (``operator="exact"``).
 
 Nondimensional unknowns (:class:`~rollqp.problem.Scales`: ``p0``, ``a_H``, ``E*``;
-``u0 = a_H p0/E*``) with the linear rows eliminated — the "halved system" of FORMULATION.md §7:
+``u0 = a_H p0/E*``) with the linear rows eliminated — the "halved system" of docs/formulation.md §10:
 
 .. math::
     \hat g = \hat h - \hat\delta\, e + \hat A \hat p, \qquad

@@ -1,0 +1,299 @@
+"""The scene's checks: each part key by key, then the scene as a whole, before any work.
+
+Per part (:func:`check_body` … :func:`check_solver`): types and ranges of every key, through the
+one set of validators (:mod:`.validate`). As a whole (:func:`check_whole`,
+docs/formulation.md §1, §9): the loads over the rolled distance, the contact inside the zone, the
+convective-local step, the BEM geometry, the derived quantities finite (no overflow from extreme
+but finite inputs) and the work a scene asks for within bounds (nodes, steps, memory) — each
+failure an :class:`~rollqp.errors.InputError` naming the key, the limit and what it would need.
+"""
+from __future__ import annotations
+
+import math
+import os
+import re
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..histories import Constant, Harmonic, parse_history
+from ..methods import check_name as check_method
+from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, COUPLINGS, EDGE_ELEMENTS,
+                     ELEMENT_TYPES, FORMULATION_TYPES, MAX_NODES, MAX_START_STEPS, MAX_STEPS, MODELS, STARTS,
+                     Body, Contact, Discretization, Load, SolverSettings)
+from .validate import choice, integer, number, string
+
+#: A scene's ``name``: letters and digits (any script), space, and ``._+()-``; no path separators,
+#: quotes or control characters (it names output files and appears in generated scripts).
+NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
+
+
+# =========================================================================== names
+def check_scene_name(key: str, v: Any) -> str:
+    """A scene's name (:data:`NAME_PATTERN`)."""
+    v = string(key, v)
+    if not NAME_PATTERN.match(v):
+        raise InputError(key, f"must be 1 to 100 letters, digits, spaces or ._+()- starting with a letter or digit "
+                              f"(no path separators or quotes), got {v[:60]!r}")
+    return v
+
+
+def safe_name(stem: str) -> str:
+    """A default name made from a file stem: characters outside :data:`NAME_PATTERN` become ``_``."""
+    s = re.sub(r"[^\w .+()-]", "_", stem)[:100].lstrip(" ._+()-")
+    return s or "scene"
+
+
+# =========================================================================== parts
+def check_body(key: str, b: Any) -> Body:
+    if not isinstance(b, Body):
+        raise InputError(key, f"must be a Body, got {b!r}")
+    radius = number(f"{key}.radius", b.radius, "> 0", lambda x: x > 0)
+    E = number(f"{key}.E", b.E, "> 0", lambda x: x > 0)
+    nu = number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5)
+    shaft = b.shaft_radius
+    if shaft is not None:
+        shaft = number(f"{key}.shaft_radius", shaft, f"in (0, radius = {radius!r}) or absent",
+                        lambda x: 0.0 < x < radius)
+    return Body(radius, E, nu, shaft)
+
+
+def check_contact(c: Any) -> Contact:
+    if not isinstance(c, Contact):
+        raise InputError("contact", f"must be a Contact, got {c!r}")
+    mu = number("contact.friction", c.friction, ">= 0", lambda x: x >= 0)
+    model = choice("contact.model", c.model, MODELS)
+    coupling = choice("contact.coupling", c.coupling, COUPLINGS)
+    d = c.reference_distance
+    if d is not None:
+        d = number("contact.reference_distance", d, "> 0 or absent (then R)", lambda x: x > 0)
+    mesh = [None if getattr(c, k) is None else
+            integer(f"contact.{k}", getattr(c, k), "in [3, 2000] or absent", lambda n: 3 <= n <= 2000)
+            for k in ("bem_outer_elements", "bem_inner_elements")]
+    return Contact(mu, model, coupling, d, *mesh)
+
+
+def check_load(ld: Any) -> Load:
+    if not isinstance(ld, Load):
+        raise InputError("load", f"must be a Load, got {ld!r}")
+    normal = number("load.normal", ld.normal, "> 0", lambda x: x > 0)
+    nh = parse_history(ld.normal_history, "load.normal_history", constant_default=1.0)
+    tang = None if ld.tangential is None else parse_history(ld.tangential, "load.tangential")
+    creep = None if ld.creepage is None else parse_history(ld.creepage, "load.creepage")
+    if tang is not None and creep is not None:
+        raise InputError("load.creepage", "give exactly one of load.tangential and "
+                                          "load.creepage, not both")
+    if tang is None and creep is None:
+        tang = Constant(0.0)
+    start = choice("load.start", ld.start, STARTS)
+    direction = ld.direction
+    if not isinstance(direction, (int, np.integer)) or isinstance(direction, bool) \
+            or direction not in (-1, 1):
+        raise InputError("load.direction", f"must be -1 or +1, got {direction!r}")
+    steps = integer("load.start_steps", ld.start_steps, f">= 1 (and <= {MAX_START_STEPS})",
+                    lambda n: 1 <= n <= MAX_START_STEPS)
+    approach = None if ld.approach is None else parse_history(ld.approach, "load.approach")
+    if approach is not None and nh != Constant(1.0):
+        raise InputError("load.approach", "give at most one of load.normal_history and load.approach "
+                                          "(with a prescribed approach the normal load is an unknown)")
+    return Load(normal, nh, tang, creep, start, int(direction), steps, approach)
+
+
+def check_discretization(d: Any) -> Discretization:
+    if not isinstance(d, Discretization):
+        raise InputError("discretization", f"must be a Discretization, got {d!r}")
+    return Discretization(
+        elements=integer("discretization.elements", d.elements, ">= 2 (and <= 20000)",
+                          lambda n: 2 <= n <= 20000),
+        element=choice("discretization.element", d.element, ELEMENT_TYPES),
+        zone=number("discretization.zone", d.zone, "> 1", lambda x: x > 1),
+        step=number("discretization.step", d.step, "in (0, 8]", lambda x: 0 < x <= 8),
+        formulation=choice("discretization.formulation", d.formulation, FORMULATION_TYPES),
+        distance=number("discretization.distance", d.distance, ">= 0", lambda x: x >= 0))
+
+
+def check_solver(s: Any) -> SolverSettings:
+    if not isinstance(s, SolverSettings):
+        raise InputError("solver", f"must be a SolverSettings, got {s!r}")
+    return SolverSettings(
+        method=check_method(s.method, "solver.method"),
+        tolerance=number("solver.tolerance", s.tolerance, "in [1e-15, 1e-2]",
+                          lambda x: 1e-15 <= x <= 1e-2),
+        max_iterations=None if s.max_iterations is None else integer(
+            "solver.max_iterations", s.max_iterations, ">= 1 (and <= 100000) or absent (each method's default)",
+            lambda n: 1 <= n <= 100_000),
+        augmentation=None if s.augmentation is None else number(
+            "solver.augmentation", s.augmentation,
+            f"in [{AUGMENTATION_MIN:g}, {AUGMENTATION_MAX:g}] or absent (automatic)",
+            lambda x: AUGMENTATION_MIN <= x <= AUGMENTATION_MAX))
+
+
+
+# =========================================================================== the scene as a whole
+def check_whole(scene) -> None:
+    """Every whole-scene check, in the order a user should meet them (module docstring)."""
+    check_derived(scene)
+    check_work(scene)
+    check_loads(scene)
+    check_convective_step(scene)
+    check_bem(scene)
+    check_zone(scene)
+    check_tangential(scene)
+    check_sampling(scene)
+
+
+def check_derived(scene) -> None:
+    """The derived quantities are finite and positive: extreme inputs (a tiny E, a huge load or
+    zone, a tiny step) must not overflow into inf, 0 or NaN and fail later with a traceback."""
+    values = (("a_H", "load.normal, bodies.*.E, bodies.*.radius", lambda: scene.a_H),
+              ("p0", "load.normal, bodies.*.E, bodies.*.radius", lambda: scene.p0),
+              ("E*", "bodies.A.E, bodies.B.E", lambda: scene.Estar),
+              ("L = zone·a_H", "discretization.zone", lambda: scene.half_width),
+              ("Δq = step·Le", "discretization.step", lambda: scene.dq))
+    for what, keys, value in values:
+        with np.errstate(all="ignore"):
+            try:
+                v = float(value())
+            except (OverflowError, ZeroDivisionError, ValueError):
+                v = float("nan")
+        if not (math.isfinite(v) and v > 0.0 and v < 1e300):
+            raise InputError(keys.split(",")[0], f"the derived {what} = {v!r} is out of range: "
+                                                 f"{keys} are too extreme to compute with")
+    ratio = scene.discretization.distance * scene.a_H / scene.dq
+    if not math.isfinite(ratio) or ratio > MAX_STEPS:
+        raise InputError("discretization.distance",
+                         f"asks for {ratio:.3g} steps of {scene.discretization.step:g} Le; at most {MAX_STEPS} "
+                         f"are run (distance <= {MAX_STEPS * scene.dq / scene.a_H:.6g} a_H at this step)")
+
+
+def available_memory() -> float:
+    """Physical memory of this machine in bytes (``inf`` if it cannot be read)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return float("inf")
+
+
+def check_work(scene) -> None:
+    """The work a scene asks for fits: nodes within :data:`MAX_NODES`, and the dense influence
+    matrices and the result arrays within this machine's memory — refused before any work, with
+    what they would need."""
+    n, K = scene.n_nodes, scene.n_steps
+    if n > MAX_NODES:
+        raise InputError("discretization.elements",
+                         f"{scene.discretization.elements} {scene.discretization.element} elements make {n} nodes; "
+                         f"the dense path takes at most {MAX_NODES}")
+    need, memory = scene.memory_estimate(), available_memory()
+    if need > 0.8 * memory:
+        raise InputError("discretization.elements" if n * n * 8 * 6 > 0.5 * need else "discretization.distance",
+                         f"this scene needs about {need / 2**30:.3g} GiB ({n} nodes, {K + 1} states), more than "
+                         f"80 % of this machine's {memory / 2**30:.3g} GiB: use fewer elements or a shorter distance")
+
+
+def check_loads(scene) -> None:
+    """The normal load stays >= 0 over the run (0: out of contact)."""
+    q_end = scene.q_end
+    nmin, _ = scene.load.normal_history.extremes(q_end)
+    if not nmin >= 0:
+        raise InputError("load.normal_history",
+                         f"must stay >= 0 over the rolled distance [0, {q_end:.6g}] a_H (a "
+                         f"pull, P < 0, is not a contact problem), but its minimum is {nmin:.6g}")
+
+
+def check_zone(scene) -> None:
+    """The largest Hertz half-width stays :data:`EDGE_ELEMENTS`/2 elements inside each end of the zone."""
+    disc = scene.discretization
+    _, nmax = scene.load.normal_history.extremes(scene.q_end)
+    free = 1.0 - EDGE_ELEMENTS / disc.elements
+    if not math.sqrt(nmax) < disc.zone * free:
+        raise InputError(
+            "discretization.zone",
+            f"the contact reaches the edge of the zone (needs zone > "
+            f"{math.sqrt(nmax) / free:.6g} for the largest normal load {nmax:.6g}·P̄ with "
+            f"{disc.elements} elements, leaving {EDGE_ELEMENTS / 2} of an element free at each end;"
+            f" got {disc.zone!r})")
+
+
+def check_tangential(scene) -> None:
+    """Where a tangential load is prescribed, a stick solution exists at every step: ``|Q| < μP``."""
+    load, q_end = scene.load, scene.q_end
+    tang = load.tangential
+    if tang is None:
+        return
+    tmin, tmax = tang.extremes(q_end)
+    if scene.contact.friction == 0.0:
+        if tmin != 0.0 or tmax != 0.0:
+            raise InputError("load.tangential",
+                             "must be 0 when contact.friction = 0 (it is Q/(mu P̄) and "
+                             f"|Q| <= mu P = 0), got values in [{tmin:.6g}, {tmax:.6g}]")
+        return
+    nmin, _ = load.normal_history.extremes(q_end)
+    if nmin > 0 and max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
+        return
+    q = np.unique(np.concatenate((scene.q_steps / scene.a_H, load.normal_history.critical_points(q_end),
+                                  tang.critical_points(q_end))))
+    Qr, Pr = np.abs(np.asarray(tang(q), dtype=float)), np.asarray(load.normal_history(q), dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):  # P = 0 (contact lost): Q must be 0 too
+        ratio = np.where(Pr > 0, Qr / np.where(Pr > 0, Pr, 1.0), np.where(Qr > 0, np.inf, 0.0))
+    i = int(np.argmax(ratio))
+    if np.isinf(ratio[i]):
+        raise InputError("load.tangential",
+                         f"must be 0 where the normal load is 0 (contact lost), but Q/(mu P̄) = "
+                         f"{float(tang(q[i])):.6g} at q = {q[i]:.6g} a_H where P = 0")
+    if not ratio[i] < 1.0:
+        raise InputError("load.tangential",
+                         f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"
+                         f" is not supported), but it reaches {ratio[i]:.6g} at q = "
+                         f"{q[i]:.6g} a_H")
+
+
+def check_sampling(scene) -> None:
+    """A harmonic history is resolved by the steps: at least two steps per wavelength (Nyquist),
+    else it would be sampled silently at an aliased frequency."""
+    dq = scene.dq / scene.a_H
+    if scene.n_steps == 0:
+        return
+    for key in ("normal_history", "tangential", "creepage", "approach"):
+        h = getattr(scene.load, key)
+        if isinstance(h, Harmonic) and h.amplitude != 0.0 and h.wavelength < 2.0 * dq:
+            raise InputError(f"load.{key}.wavelength",
+                             f"must be at least two steps, 2·Δq = {2 * dq:.6g} a_H, to be resolved (got "
+                             f"{h.wavelength!r}: it would be sampled at an aliased wavelength); use a "
+                             f"smaller discretization.step")
+
+
+def check_bem(scene) -> None:
+    """``model = "bem"``: both shafts given, and the strip shorter than half a circumference."""
+    if scene.contact.model != "bem":
+        return
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
+        if body.shaft_radius is None:
+            raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' (the "
+                                                    f"rigid shaft's radius, in (0, {body.radius!r}))")
+        if not 2.0 * scene.half_width < math.pi * body.radius:
+            raise InputError("discretization.zone",
+                             f"the strip (2L = {2 * scene.half_width:.6g}) must be shorter than half the "
+                             f"circumference of {key} (radius {body.radius!r}) for model = 'bem'")
+
+
+def check_convective_step(scene) -> None:
+    """Convective-local slip is stable only for Δq up to the node spacing h.
+
+    Its upwind term ``d·D_up w^{k−1}`` is explicit transport of ``w`` by Δq per step: a
+    CFL condition, Δq ≤ h, with h = Le for constant and linear elements and Le/2 for
+    quadratic ones (a midnode). Beyond it the transient does not settle: measured on
+    §6.1.1 (``docs/stability.md``) the creepage oscillates by 3–17 % of Carter's from
+    step to step and ends 4–34 % off, against ≤ 1.7 % (material, same Δq) and exactly
+    the steady limit for Δq ≤ h. Rejected, naming ``discretization.step``.
+    """
+    disc = scene.discretization
+    if disc.formulation != "convective-local":
+        return
+    limit = CONVECTIVE_STEP_MAX[disc.element]
+    if disc.step > limit:
+        raise InputError("discretization.step",
+                         f"must be in (0, {limit:g}] with formulation = 'convective-local' and "
+                         f"{disc.element} elements (Δq at most the node spacing: the upwind "
+                         f"transport is unstable beyond it, docs/stability.md), got {disc.step!r}; "
+                         f"use a smaller step or formulation = 'material'")
