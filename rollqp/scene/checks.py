@@ -24,6 +24,9 @@ from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, CO
                      Body, Contact, Discretization, Load, SolverSettings)
 from .validate import choice, integer, number, string
 
+#: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
+MAX_FRICTION = 1e6
+
 #: A scene's ``name``: letters and digits (any script), space, and ``._+()-``; no path separators,
 #: quotes or control characters (it names output files and appears in generated scripts).
 NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
@@ -62,7 +65,7 @@ def check_body(key: str, b: Any) -> Body:
 def check_contact(c: Any) -> Contact:
     if not isinstance(c, Contact):
         raise InputError("contact", f"must be a Contact, got {c!r}")
-    mu = number("contact.friction", c.friction, ">= 0", lambda x: x >= 0)
+    mu = number("contact.friction", c.friction, f">= 0 (and <= {MAX_FRICTION:g})", lambda x: 0 <= x <= MAX_FRICTION)
     model = choice("contact.model", c.model, MODELS)
     coupling = choice("contact.coupling", c.coupling, COUPLINGS)
     d = c.reference_distance
@@ -160,11 +163,31 @@ def check_derived(scene) -> None:
         if not (math.isfinite(v) and v > 0.0 and v < 1e300):
             raise InputError(keys.split(",")[0], f"the derived {what} = {v!r} is out of range: "
                                                  f"{keys} are too extreme to compute with")
+    check_strip_fits(scene)
     ratio = scene.discretization.distance * scene.a_H / scene.dq
     if not math.isfinite(ratio) or ratio > MAX_STEPS:
         raise InputError("discretization.distance",
                          f"asks for {ratio:.3g} steps of {scene.discretization.step:g} Le; at most {MAX_STEPS} "
                          f"are run (distance <= {MAX_STEPS * scene.dq / scene.a_H:.6g} a_H at this step)")
+
+
+def check_strip_fits(scene) -> None:
+    """The potential contact zone is shorter than either radius (the half-space strip lies on the
+    cylinders), and their undeformed gap over it is computable (no overflow)."""
+    L = scene.half_width
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
+        if not L < body.radius:
+            raise InputError("discretization.zone",
+                             f"the zone half-width L = {L:.6g} (zone·a_H, a_H = {scene.a_H:.6g} from load.normal, "
+                             f"the moduli and radii) is not below the radius of {key} ({body.radius!r}): "
+                             f"the contact would be as wide as the roller")
+        with np.errstate(over="raise", invalid="raise"):  # an underflow is harmless (a tiny gap)
+            try:
+                radius = np.float64(body.radius)
+                float(L * L / (radius * (1.0 + np.sqrt(1.0 - (L / radius) ** 2))))
+            except (FloatingPointError, OverflowError):
+                raise InputError(f"{key}.radius", f"{body.radius!r} is too large to compute the gap with "
+                                                  f"(over a zone of {L:.6g})") from None
 
 
 def available_memory() -> float:
