@@ -188,7 +188,7 @@ def test_newton_never_returns_a_step_above_its_tolerance():
     """At r = 1e-8 (outside the accepted band; set past the scene's check as the hard-case
     script does) Newton's r-scaled stopping test is met in the braked start while rollqp's own
     residual is 3.4e-10 > 1e-10 (round-off in the r-scaled rows). That is a SolverError naming
-    the residual, not a step handed back as solved (NewtonMethod._checked)."""
+    the residual, not a step handed back as solved (NewtonMethod.checked)."""
     scene = load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.5, "solver.method": "newton"})
     with pytest.raises(SolverError, match="exceeds the tolerance") as info:
         rollqp.run(hc._with_augmentation(scene, 1e-8))

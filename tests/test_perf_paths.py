@@ -1,13 +1,13 @@
 """The fast linear-algebra paths give the answers of the plain ones (correctness, never timing).
 
-* Newton's reduced system (rollqp.methods.newton._System.direction): the identity rows of
+* Newton's reduced system (rollqp.methods.newton.linear.ReducedSystem.direction): the identity rows of
   the separated/slipping nodes eliminated, the LU factors reused through a Schur complement
   while the active set moves by a few nodes, against ``numpy.linalg.solve`` on the full
   pseudo-Jacobian ``J`` — direction by direction, and over a whole transient (same iteration
   counts, same tractions).
-* The coupled Newton step's reused LU (rollqp.methods.newton._CoupledFactors: Woodbury updates
+* The coupled Newton step's reused LU (rollqp.methods.newton.linear.CoupledFactors: Woodbury updates
   of the changed rows on the factored J) against the direct reduced solve
-  (NewtonMethod._coupled_direction): direction by direction on random case patterns, the
+  (rollqp.methods.newton.linear.direct_coupled_direction): direction by direction on random case patterns, the
   fallbacks (singular, ill-conditioned, inaccurate updates), and whole coupled runs.
 * The QP backends' solver cache keyed by a Hessian fingerprint: a changed Hessian builds a
   new solver object, the same Hessian reuses it.
@@ -19,7 +19,7 @@ import pytest
 
 import rollqp
 from rollqp.operators import SceneOperators
-from rollqp.methods import newton as newton_module
+from rollqp.methods.newton import linear, ncp
 from rollqp.methods.newton import NewtonMethod
 
 # Tolerances, each with its reason.
@@ -42,7 +42,7 @@ def _tangential_system(elements=80, element="quadratic"):
     nsol = NewtonMethod().solve(model.normal_step(scene.load.normal))
     pb = model.tangential_step(nsol.p, np.zeros(model.strip.n), scene.dq, Q=0.5 * 0.1 * scene.load.normal)
     meth = NewtonMethod()
-    sys_ = meth._system(pb, pb.dq / pb.scales.length)
+    sys_ = meth.system(pb, pb.dq / pb.scales.length)
     return model, sys_
 
 
@@ -114,7 +114,7 @@ def test_transient_same_iterates_as_full_solve(monkeypatch, element):
            "solver.method": "newton"})
     fast = rollqp.run(scene).arrays()
     with monkeypatch.context() as mp:
-        mp.setattr(newton_module._System, "direction", _full_direction)
+        mp.setattr(linear.ReducedSystem, "direction", _full_direction)
         plain = rollqp.run(scene).arrays()
     assert np.array_equal(fast["iterations"], plain["iterations"])
     assert np.array_equal(fast["backtracks"], plain["backtracks"])
@@ -156,7 +156,7 @@ def test_qp_solver_cache_follows_the_hessian(backend):
 
 def _full_coupled_direction(S, contact, stick, slip_sign, mu, phi):
     """The plain path for the coupled step: the full pseudo-Jacobian, dense LU."""
-    J = NewtonMethod._coupled_jacobian(S, contact, stick, slip_sign, mu)
+    J = ncp.coupled_jacobian(S, contact, stick, slip_sign, mu)
     try:
         return np.linalg.solve(J, -phi)
     except np.linalg.LinAlgError:
@@ -175,7 +175,7 @@ def test_coupled_transient_same_iterates_as_full_solve(monkeypatch):
            "load.start_steps": 10})
     fast = rollqp.run(scene, method="newton").arrays()
     with monkeypatch.context() as mp:
-        mp.setattr(NewtonMethod, "_coupled_direction", staticmethod(_full_coupled_direction))
+        mp.setattr(linear, "direct_coupled_direction", _full_coupled_direction)
         plain = rollqp.run(scene, method="newton").arrays()
     assert np.array_equal(fast["iterations"][1:], plain["iterations"][1:])
     assert np.array_equal(fast["backtracks"][1:], plain["backtracks"][1:])
@@ -226,25 +226,25 @@ def _coupled_patterns(n, rng):
 @pytest.mark.parametrize("loads", ["P,Q", "none"])
 def test_coupled_updated_direction_matches_direct(loads):
     """Every direction of the reused/updated factorization (Woodbury on the factored J) equals
-    the direct reduced solve (NewtonMethod._coupled_direction) on random case patterns."""
+    the direct reduced solve (rollqp.methods.newton.linear.direct_coupled_direction) on random case patterns."""
     pb = _coupled_problem()
     if loads == "none":  # δ and ξ prescribed: no load rows
         pb = pb.replace(P=None, Q=None, delta=0.0, xi=0.0)
     meth = NewtonMethod()
-    S = meth._coupled_system(pb)
-    fac = newton_module._CoupledFactors(S)
-    assert S["N"] >= fac.DIRECT_BELOW  # the reuse path, not the direct fallback
+    S, _ = meth.coupled_system(pb)
+    fac = linear.CoupledFactors(S)
+    assert S.N >= fac.DIRECT_BELOW  # the reuse path, not the direct fallback
     n, mu = pb.n, pb.mu
     rng = np.random.default_rng(7)
     for contact, stick, slip_sign in _coupled_patterns(n, rng):
-        phi = rng.standard_normal(S["N"])
+        phi = rng.standard_normal(S.N)
         d, dN, dT = fac.direction(contact, stick, slip_sign, mu, phi)
-        ref = NewtonMethod._coupled_direction(S, contact, stick, slip_sign, mu, phi)
+        ref = linear.direct_coupled_direction(S, contact, stick, slip_sign, mu, phi)
         assert np.max(np.abs(d - ref)) <= TOL["direction"] * np.max(np.abs(ref))
         # the returned K_N d, K_T d are those products (recomputed here in another order of
         # summation: round-off of a 324-term dot product, ≲ 1e-13 relative)
-        assert np.allclose(dN, S["KN"] @ d, rtol=0, atol=1e-12 * np.max(np.abs(dN)))
-        assert np.allclose(dT, S["KT"] @ d, rtol=0, atol=1e-12 * np.max(np.abs(dT)))
+        assert np.allclose(dN, S.KN @ d, rtol=0, atol=1e-12 * np.max(np.abs(dN)))
+        assert np.allclose(dT, S.KT @ d, rtol=0, atol=1e-12 * np.max(np.abs(dT)))
     assert fac.factorizations >= 2 and fac.updates >= 4 and fac.rejected == 0
 
 
@@ -254,7 +254,7 @@ def test_coupled_update_falls_back_when_singular_or_inaccurate(monkeypatch):
     replaced by a new factorization — the direct path's direction, bit for bit."""
     pb = _coupled_problem()
     meth = NewtonMethod()
-    S = meth._coupled_system(pb)
+    S, _ = meth.coupled_system(pb)
     n, mu = pb.n, pb.mu
     rng = np.random.default_rng(3)
     # contact at 4 nodes only, every node sticking: J regular
@@ -262,24 +262,24 @@ def test_coupled_update_falls_back_when_singular_or_inaccurate(monkeypatch):
     contact[n // 2 - 2:n // 2 + 2] = True
     stick = np.ones(n, dtype=bool)
     sign = np.zeros(n)
-    fac = newton_module._CoupledFactors(S)
-    phi = rng.standard_normal(S["N"])
+    fac = linear.CoupledFactors(S)
+    phi = rng.standard_normal(S.N)
     assert fac.direction(contact, stick, sign, mu, phi) is not None
     # separating those 4 nodes (4 changed rows: an update) leaves no row with a δ̂ entry
     none = np.zeros(n, dtype=bool)
-    assert NewtonMethod._coupled_direction(S, none, stick, sign, mu, phi) is None
+    assert linear.direct_coupled_direction(S, none, stick, sign, mu, phi) is None
     assert fac.direction(none, stick, sign, mu, phi) is None
     assert fac.updates == 0
     # the checks reject every update: refactor, the direct path's direction exactly
     for attr, value in (("MAX_CONDITION", 0.0), ("MAX_RESIDUAL", 0.0)):
-        fac = newton_module._CoupledFactors(S)
+        fac = linear.CoupledFactors(S)
         with monkeypatch.context() as mp:
-            mp.setattr(newton_module._CoupledFactors, attr, value)
+            mp.setattr(linear.CoupledFactors, attr, value)
             patterns = _coupled_patterns(n, rng)[:3]
             for c, s, g in patterns:
-                phi = rng.standard_normal(S["N"])
+                phi = rng.standard_normal(S.N)
                 d = fac.direction(c, s, g, mu, phi)[0]
-                assert np.array_equal(d, NewtonMethod._coupled_direction(S, c, s, g, mu, phi))
+                assert np.array_equal(d, linear.direct_coupled_direction(S, c, s, g, mu, phi))
         assert fac.rejected == 2 and fac.updates == 0
 
 
@@ -294,11 +294,11 @@ def test_coupled_reuse_same_run_as_direct(monkeypatch, scene_changes, direct_bel
     round-off, and the reuse really taken (Woodbury updates counted)."""
     scene = rollqp.load_scene("goodman-bentall").replace(**scene_changes)
     made = []
-    init = newton_module._CoupledFactors.__init__
+    init = linear.CoupledFactors.__init__
     with monkeypatch.context() as mp:
-        mp.setattr(newton_module._CoupledFactors, "__init__", lambda self, S: init(self, S) or made.append(self))
+        mp.setattr(linear.CoupledFactors, "__init__", lambda self, S: init(self, S) or made.append(self))
         if direct_below is not None:
-            mp.setattr(newton_module._CoupledFactors, "DIRECT_BELOW", direct_below)
+            mp.setattr(linear.CoupledFactors, "DIRECT_BELOW", direct_below)
         fast = rollqp.run(scene, method="newton").arrays()
     with monkeypatch.context() as mp:
         mp.setattr(NewtonMethod, "coupled_reuse", False)

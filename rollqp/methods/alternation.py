@@ -32,7 +32,20 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from .base import check_options
-from .newton import NewtonMethod
+
+
+def sweep(method, problem, t, warm_n=None, warm_t=None):
+    """One N–T sweep of a :class:`~rollqp.problem.CoupledStep` (paper §6.3): ``(normal, tangential)``.
+
+    The normal half with the shear ``t`` fixed (eq. 53: gap offset ``A_nt t``), then the
+    tangential half at the pressure found (eq. 61/62: bound ``μ p⁺``, history ``c + A_tn p``),
+    each solved by ``method`` and warm-started from ``warm_n`` and ``warm_t``. The one sweep of
+    rollqp: the alternation's outer iteration, and the coupled Newton method's cold start and
+    its fallback when a line search fails.
+    """
+    nsol = method.solve(problem.normal_half(t), warm=warm_n)
+    tsol = method.solve(problem.tangential_half(nsol.p), warm=warm_t)
+    return nsol, tsol
 
 
 class Alternation:
@@ -93,8 +106,7 @@ class Alternation:
         outer = 0
         while True:
             outer += 1
-            nsol = self.inner.solve(problem.normal_half(t), warm=nwarm)
-            tsol = self.inner.solve(problem.tangential_half(nsol.p), warm=twarm)
+            nsol, tsol = sweep(self.inner, problem, t, nwarm, twarm)
             it_n += nsol.iterations
             it_t += tsol.iterations
             t = tsol.t
@@ -162,6 +174,7 @@ class AlternationNewton(Alternation):
     name = "nt-newton"
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
+        from .newton import NewtonMethod
         super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),
                          max_outer=max_outer)
         self.name = "nt-newton"

@@ -1,0 +1,535 @@
+r"""The linear algebra of the Newton directions: reduced systems, and factorizations reused across iterations.
+
+The pseudo-Jacobian of ``Φ`` (eq. 80–90, :mod:`.ncp`) has an identity row at every separated
+or slipping node, so the direction is known there (``d_i = −Φ_i``) and the rest is solved on the
+free nodes only — the *reduced system*. Its LU factors are kept while the free set drifts by a
+few nodes: :class:`ReducedSystem` (uncoupled steps) solves the bordered system through a Schur
+complement on the old factors; :class:`CoupledFactors` (the coupled step, whose rows are one of
+a few kinds per node) updates by Sherman–Morrison–Woodbury. Both refactor when the change is
+large or the update ill-conditioned, and a fresh factorization gives the direct path's direction
+exactly (same matrix, same LAPACK calls). :class:`CoupledSystem` is the coupled step's r-scaled
+linear part, a typed record built once per operator set (:func:`coupled_system`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
+
+from ...errors import InputError
+from .ncp import slip_rows
+
+__all__ = ["ReducedSystem", "CoupledSystem", "coupled_system", "coupled_vectors", "CoupledFactors",
+           "direct_coupled_direction"]
+
+
+class ReducedSystem:
+    """The r-scaled linear part of one uncoupled step's ``Φ`` and its reduced solves (per ``A``, ``f``, scales, ``Δq``, ``r``).
+
+    ``K`` (``n × (n+1)``) maps ``z = (x, δ̂|ξ̂)`` to the linear part of ``y = r ĝ`` or ``r ŝ``;
+    ``K_nl`` is its first ``n`` columns (``δ``/``ξ`` prescribed, no load row). The
+    pseudo-Jacobian has a ``K`` row at the contact/stick nodes (``mask``), an identity row at
+    the separated/slipping nodes, and the load row ``[f̂ᵀ, 0]`` last; :meth:`direction` solves
+    with it on the free nodes only (the reduced system) and keeps the LU factors of the last
+    few active sets.
+    """
+
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "_base", "factorizations", "updates")
+
+    #: Largest change of the active set, against the factored one, solved by a Schur complement
+    #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
+    UPDATE_FRACTION = 0.125
+    UPDATE_MIN = 4
+    #: Below this many free nodes a new factorization is cheaper than the bordered solve.
+    UPDATE_MIN_SIZE = 64
+
+    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale):
+        n = fhat.size
+        self.A, self.f, self.Ahat, self.fhat, self.r = A, f, Ahat, fhat, r
+        K = np.empty((n, n + 1))
+        K[:, :n] = (r / t_scale) * Ahat
+        K[:, n] = r * last_column
+        self.K = K
+        self.K_nl = np.ascontiguousarray(K[:, :n])
+        self._base = {}  # with_load -> (mask, free, position of each node in free or -1, lu, piv)
+        self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
+        self.updates = 0  # directions solved by a Schur complement on an older factorization
+
+    def matrices(self, with_load):
+        """``K`` with or without the load column."""
+        return self.K if with_load else self.K_nl
+
+    def jacobian(self, mask, with_load):
+        """The full pseudo-Jacobian ``J`` (for tests and diagnostics; the iteration never forms it)."""
+        n = self.fhat.size
+        K = self.matrices(with_load)
+        N = K.shape[1]
+        J = np.zeros((N, N))
+        J[:n] = np.where(mask[:n, None], K, np.eye(n, N))
+        if with_load:
+            J[n, :n] = self.fhat
+        return J
+
+    def _factor(self, m, with_load):
+        """LU of the reduced matrix on the free set ``m`` (below); ``None`` if singular."""
+        n = self.fhat.size
+        K = self.K
+        free = np.flatnonzero(m)
+        nf = free.size
+        M = np.empty((nf + with_load, nf + with_load), order="F")
+        M[:nf, :nf] = K[np.ix_(free, free)]
+        if with_load:
+            M[:nf, nf] = K[free, n]
+            M[nf, :nf] = self.fhat[free]
+            M[nf, nf] = 0.0
+        if M.size:
+            lu, piv, info = dgetrf(M, overwrite_a=True)
+            if info != 0 or not np.all(np.isfinite(np.diag(lu))):
+                return None
+        else:
+            lu, piv = M, np.empty(0, dtype=np.int32)
+        pos = np.full(n, -1)
+        pos[free] = np.arange(nf)
+        self.factorizations += 1
+        return m.copy(), free, pos, lu, piv, {}
+
+    def direction(self, mask, phi, with_load):
+        r"""The Newton direction ``d``: ``J d = −Φ`` solved on the free nodes (eq. 80).
+
+        A node without a ``K`` row (``mask`` false: separated, slipping) has the identity row,
+        so ``d_i = −Φ_i`` there. Eliminating those nodes leaves, on the free set ``F``,
+
+        .. math::
+            \begin{bmatrix} K_{FF} & k_F \\ \hat f_F^T & 0 \end{bmatrix}
+            \begin{bmatrix} d_F \\ d_\lambda \end{bmatrix} =
+            -\begin{bmatrix} \Phi_F + K_{F,P} d_P \\ \Phi_\lambda + \hat f_P^T d_P \end{bmatrix}
+
+        (``k_F`` the ``δ̂``/``ξ̂`` column; without the load row and column if prescribed), whose
+        determinant is that of ``J``. Its LU factors are kept. When the free set ``F`` differs
+        from the factored one ``F₀`` by a few nodes (``R = F₀∖F`` released, ``A = F∖F₀`` added:
+        the stick/slip boundary moving by a node or two between iterations and steps), the
+        system is solved on the old factors, bordered:
+
+        .. math::
+            \begin{bmatrix} M_0 & B & E_R \\ C & D & 0 \\ E_R^T & 0 & 0 \end{bmatrix}
+            \begin{bmatrix} u \\ v \\ w \end{bmatrix} =
+            \begin{bmatrix} r_0 \\ r_A \\ -\Phi_R \end{bmatrix},
+
+        (``B``, ``C``, ``D`` the rows and columns of ``K`` for ``A``; ``E_R`` unit columns: the
+        slack ``w`` frees the old rows of ``R`` and the last block pins ``d_R``), through its
+        Schur complement of size ``|A| + |R|`` (two triangular solves per bordering column, no
+        new factorization). A larger change refactors. Returns ``None`` if singular.
+        """
+        n = self.fhat.size
+        K = self.K if with_load else self.K_nl
+        m = mask[:n]
+        base = self._base.get(with_load)
+        if base is not None:
+            m0, free0, pos0, lu, piv, cols = base
+            released = np.flatnonzero(m0 & ~m)
+            added = np.flatnonzero(m & ~m0)
+            k = released.size + added.size
+            if k and (k > max(self.UPDATE_MIN, self.UPDATE_FRACTION * free0.size)
+                      or free0.size < self.UPDATE_MIN_SIZE):
+                base = None
+        if base is None:
+            base = self._factor(m, with_load)
+            if base is None:
+                return None
+            self._base[with_load] = base
+            m0, free0, pos0, lu, piv, cols = base
+            released = added = np.empty(0, dtype=int)
+            k = 0
+        d = np.empty(K.shape[1])
+        pinned = np.flatnonzero(~m)
+        d[pinned] = -phi[pinned]
+        known = np.flatnonzero(~m & ~m0)  # pinned now and not in the factored set
+        if known.size:
+            e = np.zeros(K.shape[1])
+            e[known] = d[known]
+            Ke = K @ e
+        else:
+            Ke = np.zeros(n)
+        nf0 = free0.size
+        r0 = np.empty(nf0 + with_load)
+        r0[:nf0] = -phi[free0] - Ke[free0]
+        if with_load:
+            r0[nf0] = -phi[n] - self.fhat[known] @ d[known]
+        if r0.size == 0 and k == 0:
+            return d
+        u0, info = dgetrs(lu, piv, r0)
+        if info != 0:
+            return None
+        if k == 0:
+            d[free0] = u0[:nf0]
+            if with_load:
+                d[n] = u0[nf0]
+            return d
+        return self._bordered(K, phi, d, u0, Ke, base, added, released, with_load)
+
+    def _bordered(self, K, phi, d, u0, Ke, base, added, released, with_load):
+        """The direction on the factors of another free set, bordered by the rows and columns of
+        the ``added`` and ``released`` nodes (:meth:`direction`); ``None`` if singular."""
+        n = self.fhat.size
+        m0, free0, pos0, lu, piv, cols = base
+        nf0 = free0.size
+        k = released.size + added.size
+        # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z.
+        # The columns of Z are kept per node (``cols``): as the set drifts away from the factored
+        # one, each step adds a node or two, and only their columns cost triangular solves.
+        na = added.size
+        keys = added.tolist() + [-1 - i for i in released.tolist()]
+        missing = [c for c in keys if c not in cols]
+        if missing:
+            order = [c for c in missing if c >= 0] + [c for c in missing if c < 0]  # W's columns
+            W = np.zeros((nf0 + with_load, len(missing)), order="F")
+            ma = np.array([c for c in order if c >= 0], dtype=int)
+            mr = np.array([-1 - c for c in order if c < 0], dtype=int)
+            W[:nf0, :ma.size] = K[np.ix_(free0, ma)]
+            if with_load:
+                W[nf0, :ma.size] = self.fhat[ma]
+            W[pos0[mr], ma.size + np.arange(mr.size)] = 1.0
+            Zm, info = dgetrs(lu, piv, W)
+            if info != 0:
+                return None
+            for j, c in enumerate(order):
+                cols[c] = Zm[:, j]
+        Z = np.column_stack([cols[c] for c in keys])
+        S = np.empty((k, k))
+        Ca = K[np.ix_(added, free0)]
+        S[:na] = -(Ca @ Z[:nf0])
+        if with_load:
+            S[:na] -= np.outer(K[added, n], Z[nf0])
+        S[na:] = -Z[pos0[released]]
+        S[:na, :na] += K[np.ix_(added, added)]
+        Cu0 = np.empty(k)
+        Cu0[:na] = Ca @ u0[:nf0] + (K[added, n] * u0[nf0] if with_load else 0.0)
+        Cu0[na:] = u0[pos0[released]]
+        rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu0
+        try:
+            vw = np.linalg.solve(S, rhs)
+        except np.linalg.LinAlgError:
+            return None
+        u = u0 - Z @ vw
+        d[free0] = u[:nf0]
+        d[released] = -phi[released]  # what the last block pins them to, without round-off
+        d[added] = vw[:na]
+        if with_load:
+            d[n] = u[nf0]
+        self.updates += 1
+        return d
+
+
+
+@dataclass
+class CoupledSystem:
+    """The r-scaled linear parts of the coupled step, ``y_N = K_N z + k_N``, ``y_T = K_T z + k_T`` (eq. 63–64).
+
+    ``z = (p̂, t̂, δ̂?, ξ̂?)`` of length ``N``; ``iP``/``iQ`` the indices of ``δ̂``/``ξ̂`` (``None``:
+    prescribed); ``J0`` the identity and load rows of the pseudo-Jacobian; ``rN``, ``rT`` the
+    augmentations; ``dqh = Δq/a_H``. Per step only the vectors change (:func:`coupled_vectors`).
+    """
+
+    N: int
+    iP: int | None
+    iQ: int | None
+    KN: np.ndarray
+    KT: np.ndarray
+    J0: np.ndarray
+    fhat: np.ndarray
+    rN: float
+    rT: float
+    dqh: float
+    factors: dict = field(default_factory=dict, repr=False)
+
+
+def coupled_system(pb, r) -> CoupledSystem:
+    """The :class:`CoupledSystem` of a :class:`~rollqp.problem.CoupledStep` (``r``: the method's
+    augmentation, or ``None`` for the default ``1/mean(diag Â)``, ``Δq̂/mean(diag Â)``)."""
+    sc = pb.scales
+    n = pb.n
+    m = sc.modulus / sc.length
+    dqh = pb.dq / sc.length
+    Ann, Att = pb.Ann.dense() * m, pb.Att.dense() * m
+    sN, sT = float(np.mean(np.diag(Ann))), float(np.mean(np.diag(Att)))
+    if not (sN > 0 and sT > 0):
+        raise InputError("A", "the influence matrices must have a positive mean diagonal")
+    rN = r if r is not None else 1.0 / sN
+    rT = r if r is not None else dqh / sT
+    iP = 2 * n if pb.P is not None else None
+    iQ = (2 * n + (iP is not None)) if pb.Q is not None else None
+    N = 2 * n + (iP is not None) + (iQ is not None)
+    KN = np.zeros((n, N))
+    KT = np.zeros((n, N))
+    KN[:, :n] = rN * Ann
+    KT[:, n:2 * n] = (rT / dqh) * Att
+    if pb.Ant is not None:
+        KN[:, n:2 * n] = rN * m * pb.Ant.dense()
+    if pb.Atn is not None:
+        KT[:, :n] = (rT / dqh) * m * pb.Atn.dense()
+    if iP is not None:
+        KN[:, iP] = -rN
+    if iQ is not None:
+        KT[:, iQ] = rT
+    fhat = pb.f / sc.length
+    J0 = np.zeros((N, N))
+    J0[:2 * n, :2 * n] = np.eye(2 * n)
+    if iP is not None:
+        J0[iP, :n] = fhat
+    if iQ is not None:
+        J0[iQ, n:2 * n] = fhat
+    return CoupledSystem(N=N, iP=iP, iQ=iQ, KN=KN, KT=KT, J0=J0, fhat=fhat, rN=rN, rT=rT, dqh=dqh)
+
+
+def coupled_vectors(S: CoupledSystem, pb):
+    """``(k_N, k_T)`` of one step: the gap and history terms, and the prescribed ``δ``/``ξ``."""
+    sc = pb.scales
+    u0 = sc.displacement
+    kN = S.rN * (pb.h / u0 - (pb.delta / u0 if pb.delta is not None else 0.0))
+    kT = S.rT * (pb.c / u0 / S.dqh + (pb.xi / sc.slip if pb.xi is not None else 0.0))
+    return kN, kT
+
+
+class CoupledFactors:
+    r"""LU factors of one coupled pseudo-Jacobian ``J_f``, reused for nearby ones (Woodbury).
+
+    The rows of the coupled ``J`` (:func:`~.ncp.coupled_jacobian`) take one of a few
+    kinds per node: the ``p̂_i`` row is ``K_N`` (contact) or ``e_i`` (separated); the ``t̂_i``
+    row is ``K_T`` (stick), ``e_{n+i} − σμ(e_i − K_N)`` (slip, ``σ = ±1``) or ``e_{n+i}`` (zero
+    bound); the load rows never change. ``J_f`` is factored on its free rows only (the reduced
+    system of :func:`direct_coupled_direction`, identity rows eliminated), which is a
+    factorization of the whole ``J_f``:
+
+    .. math::
+        J_f^{-1} b:\quad x_P = b_P, \qquad M x_F = b_F - R_{F,P}\, b_P .
+
+    A later ``J`` differs from ``J_f`` in the rows ``C`` of the nodes whose case changed,
+    ``J = J_f + E_C\,\Delta R`` (``E_C`` unit columns), and is solved on the old factors by the
+    Sherman–Morrison–Woodbury formula
+
+    .. math::
+        J^{-1} b = y - Z\,(I + \Delta R\, Z)^{-1} \Delta R\, y, \qquad y = J_f^{-1} b,\;
+        Z = J_f^{-1} E_C ,
+
+    whose columns ``J_f⁻¹ e_c`` are kept per row ``c`` until the next factorization (a drifting
+    case pattern costs triangular solves only for rows new to it). ``J`` is refactored when
+    ``|C|`` exceeds :attr:`UPDATE_FRACTION` of the factored size (at least :attr:`UPDATE_MIN`
+    rows), when the factored system is small (:attr:`UPDATE_MIN_SIZE`), when the capacitance
+    matrix ``I + ΔR Z`` is ill-conditioned (:attr:`MAX_CONDITION`), or when the updated
+    direction's residual ``‖J d + Φ‖`` is not at round-off; a fresh factorization gives the
+    direct path's direction exactly (same matrix, same LAPACK calls).
+    """
+
+    __slots__ = ("S", "n", "N", "kind", "mu", "free", "pinned", "posF", "posP", "lu", "piv", "Rp", "cols",
+                 "factorizations", "updates", "rejected", "scale")
+
+    #: Largest number of changed rows solved by the Woodbury update, as a fraction of the factored
+    #: (free) size, at least :attr:`UPDATE_MIN`; beyond, refactor. Measured (median rolling step of
+    #: benchmarks/coupled_scaling.py's scene, 321 / 641 nodes): 0.03 → 7.1 / 44.7 ms (refactors
+    #: nearly every step), 0.0625 → 2.07 / 12.1 ms, 0.125 → 2.34 / 13.0 ms, 0.25 → 3.5 ms,
+    #: 0.5 → 4.2 ms (321 nodes; the k × k capacitance and k new columns grow); the rolling
+    #: pattern drifts by ~30 rows (median; 90 % ≤ 50) from the factored one at 321 nodes.
+    UPDATE_FRACTION = 0.0625
+    UPDATE_MIN = 8
+    #: Below this many free unknowns a new factorization is as cheap as the update.
+    UPDATE_MIN_SIZE = 48
+    #: Below this many unknowns (``N``) every direction is solved directly
+    #: (:func:`direct_coupled_direction`): the bookkeeping costs more than the LU.
+    #: Measured (same scene, direct / updated): 41 nodes 0.28 / 0.44 ms, 81 nodes 0.54 /
+    #: 0.60 ms, 101 nodes 0.72 / 0.70 ms, 121 nodes 0.94 / 0.78 ms.
+    DIRECT_BELOW = 200
+    #: Largest condition number of the capacitance matrix accepted.
+    MAX_CONDITION = 1e8
+    #: Largest accepted ‖J d + Φ‖∞ / (‖Φ‖∞ + ‖J‖∞‖d‖∞) of an updated direction (round-off is ~1e-15).
+    MAX_RESIDUAL = 1e-10
+
+    def __init__(self, S):
+        self.S, self.n, self.N = S, S.KN.shape[0], S.N
+        self.kind = None
+        self.mu = None
+        self.factorizations = self.updates = self.rejected = 0
+        self.scale = 1.0 + max(float(np.max(np.sum(np.abs(S.KN), axis=1))),
+                               float(np.max(np.sum(np.abs(S.KT), axis=1))))
+
+    @staticmethod
+    def kinds(S, contact, stick, slip_sign):
+        """Row kind codes (length ``N``): p rows 0 identity / 1 ``K_N``; t rows 0 identity /
+        2 ``K_T`` / 3 slip σ = +1 / 4 slip σ = −1; load rows 5."""
+        n = contact.size
+        k = np.full(S.N, 5, dtype=np.int8)
+        k[:n] = contact
+        k[n:2 * n] = np.where(stick, 2, np.where(slip_sign > 0, 3, np.where(slip_sign < 0, 4, 0)))
+        return k
+
+    def rows(self, idx, kind):
+        """The rows ``idx`` of ``J`` with the kinds ``kind`` (dense, ``len(idx) × N``)."""
+        S, n, mu = self.S, self.n, self.mu
+        out = np.zeros((idx.size, self.N))
+        for code in np.unique(kind).tolist():
+            w = np.flatnonzero(kind == code)
+            r = idx[w]
+            if code == 0:
+                out[w, r] = 1.0
+            elif code == 1:
+                out[w] = S.KN[r]
+            elif code == 2:
+                out[w] = S.KT[r - n]
+            elif code == 5:
+                out[w] = S.J0[r]
+            else:  # slip, σ = +1 (3) or −1 (4)
+                i = r - n
+                out[w] = slip_rows(S.KN, i, np.full(i.size, (1.0 if code == 3 else -1.0) * mu))
+        return out
+
+    def _factor(self, kind, mu):
+        """Factor ``J`` of the row kinds ``kind`` on its free rows; ``False`` if singular."""
+        self.mu = mu
+        free = np.flatnonzero(kind != 0)
+        pinned = np.flatnonzero(kind == 0)
+        R = self.rows(free, kind[free])
+        self.kind, self.free, self.pinned = kind, free, pinned
+        self.posF = np.full(self.N, -1)
+        self.posF[free] = np.arange(free.size)
+        self.posP = np.full(self.N, -1)
+        self.posP[pinned] = np.arange(pinned.size)
+        self.Rp = R[:, pinned]
+        self.cols = {}
+        self.lu = None
+        self.factorizations += 1
+        if free.size:
+            lu, piv, info = dgetrf(np.asfortranarray(R[:, free]), overwrite_a=True)
+            if info != 0:
+                self.kind = None
+                return False
+            self.lu, self.piv = lu, piv
+        return True
+
+    def _solve(self, b):
+        """``J_f⁻¹ b`` (``b`` of length ``N``)."""
+        x = np.empty(self.N)
+        x[self.pinned] = b[self.pinned]
+        if self.free.size:
+            rhs = b[self.free] - self.Rp @ x[self.pinned]
+            sol, info = dgetrs(self.lu, self.piv, rhs)
+            if info != 0:
+                return None
+            x[self.free] = sol
+        return x
+
+    def _columns(self, C):
+        """``Z = J_f⁻¹ E_C``, from the kept columns, computing the missing ones together."""
+        miss = [c for c in C.tolist() if c not in self.cols]
+        if miss:
+            miss = np.array(miss)
+            m = miss.size
+            X = np.zeros((self.N, m))
+            B = np.zeros((self.free.size, m), order="F")
+            inF = self.posF[miss] >= 0
+            jF, jP = np.flatnonzero(inF), np.flatnonzero(~inF)
+            B[self.posF[miss[jF]], jF] = 1.0
+            X[miss[jP], jP] = 1.0
+            if jP.size and self.free.size:
+                B[:, jP] = -self.Rp[:, self.posP[miss[jP]]]
+            if self.free.size:
+                sol, info = dgetrs(self.lu, self.piv, B)
+                if info != 0:
+                    return None
+                X[self.free] = sol
+            for j, c in enumerate(miss.tolist()):
+                self.cols[c] = X[:, j]
+        return np.column_stack([self.cols[c] for c in C.tolist()])
+
+    def direction(self, contact, stick, slip_sign, mu, phi):
+        """``(d, K_N d, K_T d)`` with ``J d = −Φ``; ``None`` if ``J`` is singular (see the class)."""
+        S = self.S
+        if self.N < self.DIRECT_BELOW:
+            d = direct_coupled_direction(S, contact, stick, slip_sign, mu, phi)
+            return None if d is None else (d, S.KN @ d, S.KT @ d)
+        kind = self.kinds(S, contact, stick, slip_sign)
+        C = None
+        if self.kind is not None and mu == self.mu:
+            C = np.flatnonzero(kind != self.kind)
+            if C.size and (C.size > max(self.UPDATE_MIN, self.UPDATE_FRACTION * self.free.size)
+                           or self.free.size < self.UPDATE_MIN_SIZE):
+                C = None
+        if C is None or C.size == 0:
+            if C is None and not self._factor(kind, mu):
+                return None
+            d = self._solve(-phi)
+            return None if d is None else (d, S.KN @ d, S.KT @ d)
+        y = self._solve(-phi)
+        Z = self._columns(C)
+        if y is None or Z is None:
+            return None
+        dR = self.rows(C, kind[C]) - self.rows(C, self.kind[C])
+        cap = dR @ Z
+        cap[np.diag_indices_from(cap)] += 1.0
+        d = None
+        if np.all(np.isfinite(cap)) and np.linalg.cond(cap) <= self.MAX_CONDITION:
+            d = y - Z @ np.linalg.solve(cap, dR @ y)
+            dN, dT = S.KN @ d, S.KT @ d
+            if self._residual(kind, d, dN, dT, phi) <= self.MAX_RESIDUAL * (
+                    np.max(np.abs(phi)) + self.scale * np.max(np.abs(d))):
+                self.updates += 1
+                return d, dN, dT
+        self.rejected += 1  # refactor at this J: the direct path's direction
+        if not self._factor(kind, mu):
+            return None
+        d = self._solve(-phi)
+        return None if d is None else (d, S.KN @ d, S.KT @ d)
+
+    def _residual(self, kind, d, dN, dT, phi):
+        """``‖J d + Φ‖∞`` from ``K_N d`` and ``K_T d``."""
+        n, S = self.n, self.S
+        kp, kt = kind[:n], kind[n:2 * n]
+        dp, dt = d[:n], d[n:2 * n]
+        sig = np.where(kt == 3, 1.0, -1.0) * self.mu
+        Jd = np.empty(self.N)
+        Jd[:n] = np.where(kp == 1, dN, dp)
+        Jd[n:2 * n] = np.where(kt == 2, dT, np.where(kt == 0, dt, dt - sig * (dp - dN)))
+        loads = np.arange(2 * n, self.N)
+        if loads.size:
+            Jd[loads] = S.J0[loads] @ d
+        r = Jd + phi
+        return float(np.max(np.abs(r))) if np.all(np.isfinite(r)) else np.inf
+
+
+
+def direct_coupled_direction(S, contact, stick, slip_sign, mu, phi):
+    """The coupled Newton direction, ``J d = −Φ`` on the free unknowns only (eq. 80).
+
+    The rows of :meth:`_coupled_jacobian` for ``p̂_i`` of a separated node and for ``t̂_i`` of
+    a node with a zero bound are identity rows, so ``d = −Φ`` there; the rest (contact
+    pressures, tractions under a positive bound, ``δ̂``, ``ξ̂``) is assembled directly,
+    row by row, and solved (LAPACK ``gesv``). Returns ``None`` if it is singular. The
+    reference path (``coupled_reuse = False``) and :class:`CoupledFactors`' solve on small
+    systems; otherwise the iteration reuses factorizations (:class:`CoupledFactors`).
+    """
+    n = contact.size
+    KN, KT = S.KN, S.KT
+    ic = np.flatnonzero(contact)
+    it_ = np.flatnonzero(stick | (slip_sign != 0))  # t rows that are not identity rows
+    loads = np.array([k for k in (S.iP, S.iQ) if k is not None], dtype=int)
+    free = np.concatenate([ic, n + it_, loads])
+    pinned = np.concatenate([np.flatnonzero(~contact), n + np.flatnonzero(~stick & (slip_sign == 0))])
+    R = np.empty((free.size, S.N))
+    R[:ic.size] = KN[ic]
+    st = stick[it_]
+    rows = np.empty((it_.size, S.N))
+    rows[st] = KT[it_[st]]
+    isl = it_[~st]
+    if isl.size:
+        rows[~st] = slip_rows(KN, isl, slip_sign[isl] * mu)
+    R[ic.size:ic.size + it_.size] = rows
+    R[ic.size + it_.size:] = S.J0[loads]
+    d = np.empty(S.N)
+    d[pinned] = -phi[pinned]
+    rhs = -phi[free] - R[:, pinned] @ d[pinned]
+    if free.size:
+        _, _, x, fail = dgesv(np.asfortranarray(R[:, free]), rhs, overwrite_a=True, overwrite_b=True)
+        if fail != 0:
+            return None
+        d[free] = x
+    return d
+

@@ -1,0 +1,301 @@
+r"""GNMls on the uncoupled step problems: the normal step (eq. 53) and the tangential step (eq. 61/62).
+
+Steps 1–7 of the paper's §4 on ``Φ(z) = [φ(x, y); f̂ᵀx − load]`` with ``y = K z + k0`` linear in
+``z`` (the "halved system": ``g`` and ``s`` eliminated): the start (Step 1: the previous step, else
+a Hertz-like profile or zero shear), the direction on the reduced system (eq. 80,
+:class:`~.linear.ReducedSystem`), the Armijo line search (eq. 75–79), the repair of degenerate
+iterates, and the creepage search that rescues a tangential step with ``Q`` prescribed. The node
+rows ``φ`` and their cases (eq. 82–88) are :mod:`.ncp`'s.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import SolverError
+from .ncp import NormalNCP, TangentialNCP
+
+__all__ = ["ALPHA_MIN", "Stalled", "solve_uncoupled", "solve_normal", "solve_tangential", "tangential_by_creepage"]
+
+#: Smallest Armijo step tried before the full step is taken anyway (see the package docstring).
+ALPHA_MIN = 1e-10
+
+
+class Stalled(Exception):
+    """The Armijo search failed from a warm start (the step is then restarted cold)."""
+
+
+def solve_uncoupled(meth, problem, warm, t0):
+    """A normal or tangential step; a warm start that stalls is restarted once cold."""
+    solve = solve_normal if problem.kind == "normal" else solve_tangential
+    try:
+        return solve(meth, problem, warm, t0)
+    except Stalled:
+        # the warm start led to a Newton fixed point that is not a solution (a wrong
+        # active set that the Newton step reproduces): restart once from the cold start
+        sol = solve(meth, problem, None, t0)
+        sol.info["restarts"] = 1
+        return sol
+
+
+# ------------------------------------------------------------------------------ the two kinds
+def _normal_start(pb, sys_, warm):
+    """Step 1 of the normal step: ``(z, start)`` from the previous pressure and approach, else a
+    Hertz-like profile scaled to the load (or to close the gap at a prescribed approach)."""
+    sc = pb.scales
+    u0 = sc.displacement
+    n = pb.n
+    hhat = pb.h_total / u0
+    with_load = pb.P is not None
+    Phat = pb.P / sc.force if with_load else None
+    dhat_fixed = None if with_load else pb.delta / u0
+    start = "cold"
+    p0 = None
+    if warm is not None and warm.p is not None and np.shape(warm.p) == (n,):
+        p0, start = np.asarray(warm.p, dtype=float) / sc.stress, "warm"
+    if p0 is None:
+        # ĥ = x̂² for two cylinders in Hertz units: p̂ = √(1 − x̂²) is the Hertz solution
+        p0 = np.sqrt(np.maximum(0.0, 1.0 - (hhat - hhat.min())))
+    guess = p0 > 0
+    if not guess.any():
+        guess = hhat == hhat.min()
+    if with_load:
+        if start == "cold" and sys_.fhat @ p0 > 0:
+            p0 = p0 * (Phat / (sys_.fhat @ p0))
+        if start == "warm" and warm.delta is not None:
+            d0 = warm.delta / u0
+        else:  # the approach that closes the gap on average over the guessed contact
+            d0 = float(np.mean((hhat + sys_.Ahat @ p0)[guess]))
+        return np.append(p0, d0), start
+    if start == "cold":  # scale the profile to close the gap on average over it
+        Ap = (sys_.Ahat @ p0)[guess].mean()
+        c = (dhat_fixed - hhat[guess].mean()) / Ap if Ap > 0 else 0.0
+        p0 = p0 * max(c, 0.0)
+    return p0.copy(), start
+
+
+def solve_normal(meth, pb, warm, t0):
+    """GNMls on the normal step ``min(p̂, r ĝ) = 0``, ``f̂ᵀp̂ = P̂`` (eq. 52–53, 67)."""
+    sc = pb.scales
+    u0 = sc.displacement
+    sys_ = meth.system(pb, None)
+    n, r = pb.n, sys_.r
+    hhat = pb.h_total / u0
+    with_load = pb.P is not None
+    Phat = pb.P / sc.force if with_load else None
+    dhat_fixed = None if with_load else pb.delta / u0
+    z, start = _normal_start(pb, sys_, warm)
+    k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
+    z, it, info = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm")
+    p = z[:n] * sc.stress
+    delta = z[n] * u0 if with_load else pb.delta
+    info["start"] = start
+    return meth.finish(pb.solution(p, delta), it, info, t0)
+
+
+def solve_tangential(meth, pb, warm, t0):
+    """GNMls on the tangential step ``t̂ = Proj_[−b, b](t̂ − r ŝ)``, ``f̂ᵀt̂ = Q̂`` (eq. 60–62, 67)."""
+    sc = pb.scales
+    sys_ = meth.system(pb, pb.dq / sc.length)
+    n, r = pb.n, sys_.r
+    dqh = pb.dq / sc.length
+    b = pb.bound / sc.stress
+    with_load = pb.Q is not None
+    Qhat = pb.Q / sc.force if with_load else None
+    xi_fixed = None if with_load else pb.xi / sc.slip
+    start = "cold"
+    t = np.zeros(n)
+    xi0 = 0.0
+    if warm is not None and warm.t is not None and np.shape(warm.t) == (n,):
+        t, start = np.asarray(warm.t, dtype=float) / sc.stress, "warm"
+        if warm.xi is not None:
+            xi0 = warm.xi / sc.slip
+    z = np.append(t, xi0) if with_load else t.copy()
+    k0 = r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
+    z, it, info = iterate(meth, pb, sys_, z, k0, Qhat, TangentialNCP(b), start == "warm")
+    tt = z[:n] * sc.stress
+    xi = z[n] * sc.slip if with_load else pb.xi
+    info["start"] = start
+    return meth.finish(pb.solution(tt, xi), it, info, t0)
+
+
+# ------------------------------------------------------------------------------ the iteration
+class _Iterate:
+    """The state of one GNMls iteration (Steps 2–7): the iterate, ``y = K z + k0``, ``Φ`` and the counts."""
+
+    def __init__(self, meth, pb, sys_, z, k0, load, ncp):
+        self.meth, self.pb, self.sys, self.ncp = meth, pb, sys_, ncp
+        self.n = pb.n
+        self.load = load
+        self.with_load = load is not None
+        self.K = sys_.matrices(self.with_load)
+        self.k0 = k0
+        self.z = z
+        self.x = z[:self.n]
+        self.y = self.K @ z + k0
+        self.phi = self.residual(self.x, self.y)
+        self.history, self.merits, self.steps = [], [], []
+        self.backtracks = self.nonmono = self.shifts = 0
+
+    def residual(self, x, y):
+        ph = self.ncp.phi(x, y)
+        return np.append(ph, self.sys.fhat @ x - self.load) if self.with_load else ph
+
+    def update(self, z):
+        self.z = z
+        self.x = z[:self.n]
+        self.y = self.K @ z + self.k0  # fresh, not accumulated: no drift of the linear part
+        self.phi = self.residual(self.x, self.y)
+
+    def rows(self, mask):
+        """The node rows of the pseudo-Jacobian (eq. 80–90) in ``mask``; a degenerate iterate (no
+        ``δ̂``/``ξ̂`` column) is repaired by moving the nearest node onto its kink first."""
+        n, ncp = self.n, self.ncp
+        m = ncp.mask(self.x, self.y)
+        if self.with_load and not m.any():
+            try:
+                j, dy = ncp.nearest(self.x, self.y)
+            except SolverError as err:
+                raise SolverError(err.message, method=self.meth.name, status=err.status) from None
+            self.z[n] += dy / self.K[j, n]
+            self.y = self.K @ self.z + self.k0
+            self.phi = self.residual(self.x, self.y)
+            m = ncp.mask(self.x, self.y)
+            m[j] = True
+            self.shifts += 1
+        mask[:n] = m
+
+    def line_search(self, d, warm):
+        """Armijo (eq. 75–78, ``s = 1``): ``α = ρ^m``, the first with ``θ(z + αd) <= (1 − 2σα) θ(z)``;
+        below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start)."""
+        meth = self.meth
+        rho, two_sigma = meth.rho, 2.0 * meth.sigma
+        dx = d[:self.n]
+        Kd = self.K @ d
+        theta = self.merits[-1]
+        alpha = 1.0
+        while True:
+            pa = self.residual(self.x + alpha * dx, self.y + alpha * Kd)
+            if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
+                return alpha
+            alpha *= rho
+            self.backtracks += 1
+            if alpha < ALPHA_MIN:
+                if warm:
+                    raise Stalled()
+                self.nonmono += 1
+                return 1.0
+
+
+def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False):
+    """GNMls Steps 2–7 on ``Φ(z) = [φ(x, y); f̂ᵀx − load]`` with ``y = K z + k0``.
+
+    ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z);
+    ``ncp`` gives ``φ`` and its node cases (:class:`~.ncp.NormalNCP`, :class:`~.ncp.TangentialNCP`).
+    Returns ``(z, iterations, info)``.
+    """
+    n, r = pb.n, sys_.r
+    st = _Iterate(meth, pb, sys_, z, k0, load, ncp)
+    stop = meth.tolerance * min(1.0, r)
+    mask = np.ones(n + 1 if st.with_load else n, dtype=bool)  # last entry: load row (always the JK row)
+    it = 0
+    while True:
+        nrm = float(np.max(np.abs(st.phi)))
+        st.history.append(nrm)
+        st.merits.append(0.5 * float(st.phi @ st.phi))
+        if nrm <= stop:
+            break
+        if it >= meth.max_iterations:
+            theta = st.merits[-1]
+            raise SolverError(f"the {pb.kind} Newton iteration did not converge: merit θ = {theta:.3e} "
+                              f"after {it} iterations (‖Φ‖∞ = {nrm:.3e} > {stop:.1e})",
+                              method=meth.name, status=f"merit {theta:.3e}", iterations=it, residual=nrm)
+        it += 1
+        st.rows(mask)
+        d = sys_.direction(mask, st.phi, st.with_load)  # reduced system on the free nodes
+        if d is None or not np.all(np.isfinite(d)):
+            raise SolverError(f"the {pb.kind} Newton matrix is singular",
+                              method=meth.name, status="singular", iterations=it, residual=nrm)
+        alpha = st.line_search(d, warm)
+        st.steps.append(alpha)
+        st.update(st.z + alpha * d)  # eq. 79
+    info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
+            "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
+            "tolerance_phi": stop}
+    return st.z, it, info
+
+
+# ------------------------------------------------------------------------------ the creepage search
+def tangential_by_creepage(meth, pb, warm, t0, err):
+    r"""Fallback when GNMls fails on a tangential step with ``Q`` prescribed: solve for ``ξ``.
+
+    The failure this repairs: with a single stick node (free rolling at μ ≲ 3e-4) the load
+    row's only ``ξ̂`` entry is that node's, and the "nearest node onto its kink" repair (package
+    docstring) makes Newton cycle between active sets. With ``ξ`` prescribed instead the load
+    row is gone and GNMls converges (CONTACT's workaround: solve with ξ given first). The
+    load is then met by a root search on ``F(ξ̂) = f̂ᵀt̂(ξ̂) − Q̂``, continuous, piecewise
+    linear and monotone (friction opposes slip), each evaluation a ξ-prescribed solve warm
+    started from the previous one: bracketing by doubling steps from the warm ``ξ``, then
+    Brent's method. The root's traction then warm-starts the Q-prescribed GNMls (one or two
+    iterations on the right active set); if that fails too, the ξ-prescribed solution at the
+    root is kept when rollqp's residual of the original problem is within tolerance.
+    Counted in ``info["creepage_search"]`` (evaluations). Otherwise ``err`` is raised.
+    """
+    search = _CreepageSearch(meth, pb, warm, t0, int(err.iterations or 0))
+    try:
+        at_root = search.root()
+    except (SolverError, ValueError, RuntimeError):  # a ξ-prescribed solve failed, or Brent did not converge
+        raise err from None
+    if at_root is None:
+        raise err
+    try:
+        sol = solve_tangential(meth, pb, at_root, t0)
+    except (SolverError, Stalled):
+        sol = pb.solution(at_root.t, at_root.xi)
+        if not sol.residual <= meth.tolerance:
+            raise err from None
+        sol = meth.finish(sol, at_root.iterations, dict(at_root.info), t0)
+    sol.info["creepage_search"] = search.evals + 1
+    sol.iterations += search.its + at_root.iterations  # all Newton iterations of the step
+    return sol
+
+
+class _CreepageSearch:
+    """The root search of :func:`tangential_by_creepage` on ``F(ξ̂) = f̂ᵀt̂(ξ̂) − Q̂``."""
+
+    def __init__(self, meth, pb, warm, t0, its):
+        self.meth, self.pb, self.t0 = meth, pb, t0
+        self.sol, self.evals, self.its = warm, 0, its
+        sc = pb.scales
+        self.Qhat = pb.Q / sc.force
+        self.fhat = pb.f / sc.length
+
+    def solve_at(self, xh):
+        sc = self.pb.scales
+        return solve_uncoupled(self.meth, self.pb.replace(Q=None, xi=xh * sc.slip), self.sol, self.t0)
+
+    def F(self, xh):
+        self.evals += 1
+        sol = self.solve_at(xh)
+        self.sol = sol
+        self.its += sol.iterations
+        return float(self.fhat @ (sol.t / self.pb.scales.stress)) - self.Qhat
+
+    def root(self):
+        """The ξ-prescribed solution at the root of ``F``, or ``None`` if no sign change is found."""
+        from scipy.optimize import brentq
+        pb, sc, warm = self.pb, self.pb.scales, self.sol
+        x0 = warm.xi / sc.slip if warm is not None and warm.xi is not None else 0.0
+        f0 = self.F(x0)
+        h = 2.0 * pb.mu * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
+        lo = hi = x0
+        flo = fhi = f0
+        for _ in range(80):  # widen both ways until F changes sign
+            if flo * fhi <= 0.0:
+                break
+            lo, hi = lo - h, hi + h
+            flo, fhi = self.F(lo), self.F(hi)
+            h *= 2.0
+        else:
+            return None
+        root = brentq(self.F, lo, hi, xtol=1e-15, rtol=1e-15, maxiter=200) if flo * fhi < 0 else (lo if flo == 0 else hi)
+        return self.solve_at(root)
