@@ -27,20 +27,16 @@ rims are wider than a_H).
 """
 from __future__ import annotations
 
+from harness import machine_table, table  # noqa: F401  (pins BLAS first)
+
 import numpy as np  # noqa: E402
 import rollqp  # noqa: E402
-from rollqp.bench import pin_threads  # noqa: E402
-
-#: BLAS/OpenMP pools limited to one thread for the whole benchmark (kept alive here).
-_THREAD_LIMIT = pin_threads()
 
 import argparse  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_qp import _table  # noqa: E402
 
 from rollqp import closedforms as cf  # noqa: E402
 from rollqp import run  # noqa: E402
@@ -114,7 +110,7 @@ def figure(rows, path):
     plt.close(fig)
 
 
-def grading_table():
+def gradingtable():
     """The default mesh's grading cap: Lamé error against the §6.1.1 transient's departure.
 
     For caps of ``f·2πR/n_outer`` (``f = MAX_ANGLE_FACTOR``): the Lamé error on the contact mesh
@@ -144,7 +140,7 @@ def grading_table():
     finally:
         bem.MAX_ANGLE_FACTOR = keep
         bem.GEOMETRY_MEMO.clear()
-    return _table(["cap factor", "first free element (mm)", "largest (mm)", "Lamé error", "§6.1.1 max|Δt|/(μp0)",
+    return table(["cap factor", "first free element (mm)", "largest (mm)", "Lamé error", "§6.1.1 max|Δt|/(μp0)",
                    "max|Δp|/p0", "asymmetry F·A_nn"], rows)
 
 
@@ -189,10 +185,10 @@ def main(argv=None):
         mesh_figure(args.mesh)
         return
     if args.grading:
-        print(grading_table())
+        print(gradingtable())
         return
     rows = study()
-    print(_table(["shaft/R", "a_H/R", "max p (BEM/HS)", "a_eq (BEM/HS)", "ξ (BEM/HS)", "ξ full (BEM/HS)",
+    print(table(["shaft/R", "a_H/R", "max p (BEM/HS)", "a_eq (BEM/HS)", "ξ (BEM/HS)", "ξ full (BEM/HS)",
                   "|F A_nt|/|F A_nn|", "HS: max p/p0", "HS: a_eq/a_H", "HS: ξ/ξ_Carter"],
                  [[f"{r['shaft']:g}", f"{r['aR']:g}", f"{r['p']:.4f}", f"{r['a']:.4f}", f"{r['xi']:.4f}",
                    f"{r['xi_full']:.4f}", f"{r['coupling']:.2e}", f"{r['hs_p']:.4f}", f"{r['hs_a']:.4f}",

@@ -24,20 +24,16 @@ from __future__ import annotations
 
 import os
 
+from harness import machine_table, table  # noqa: F401  (pins BLAS first)
+
 import numpy as np  # noqa: E402
 import rollqp  # noqa: E402
-from rollqp.bench import pin_threads  # noqa: E402
-
-#: BLAS/OpenMP pools limited to one thread for the whole benchmark (kept alive here).
-_THREAD_LIMIT = pin_threads()
 
 import argparse  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_qp import _table, machine_table  # noqa: E402
 
 from rollqp import run  # noqa: E402
 from rollqp.influence import bem  # noqa: E402
@@ -90,13 +86,13 @@ def main(argv=None):
     print(machine_table())
     print("\nA. BEM assembly + condensation, paper meshes (`python benchmarks/bench_bem.py`)\n")
     rows, total = assembly(scene, args.repeats)
-    print(_table(["body", "geometry", "nodes", "elements", "assembly s", "LU + 162 solves s", "total s",
+    print(table(["body", "geometry", "nodes", "elements", "assembly s", "LU + 162 solves s", "total s",
                   "H, G, system MiB"], rows))
     print(f"\nBoth bodies and the combination (bem_influence, uncached): {total:.3f} s "
           f"(target <= 2 s: {'met' if total <= 2.0 else 'NOT met'})")
     print("\nB. Per-step cost of the §6.1.1 transient (median rolling step_time, ms)\n")
     res = per_step(scene, ["newton", "qp-osqp"], args.repeats)
-    print(_table(["method", "half-space ms", "BEM ms", "BEM / half-space (median)", "min", "max"],
+    print(table(["method", "half-space ms", "BEM ms", "BEM / half-space (median)", "min", "max"],
                  [[m, f"{1e3 * h:.3f}", f"{1e3 * b:.3f}", f"{r:.3f}", f"{lo:.3f}", f"{hi:.3f}"]
                   for m, (h, b, r, lo, hi) in res.items()]))
 

@@ -30,30 +30,22 @@ C: the §6.1.1 stepping time with Newton at most 0.5 s.
 Timings are medians: over the steps, then over ``--repeats`` repetitions in which the methods
 alternate (a change of the machine's load then hits all of them alike). Ratios are taken
 within each repetition, then the median. BLAS is pinned to one thread (threadpoolctl) at
-import, before any matrix is built; the machine table is ``bench_qp.py``'s.
+import, before any matrix is built (``harness.py``).
 """
 from __future__ import annotations
 
-import numpy as np  # noqa: E402
-import rollqp  # noqa: E402
-from rollqp.bench import pin_threads  # noqa: E402
+from harness import goodman_bentall_scene, machine_table, ms, run_once, source_line, table  # (pins BLAS first)
 
-#: BLAS/OpenMP pools limited to one thread for the whole benchmark (kept alive here).
-_THREAD_LIMIT = pin_threads()
+import argparse
+import sys
+import time
 
-import argparse  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_qp import _ms, _run_once, _table, machine_table  # noqa: E402
-from coupled_table import goodman_bentall_scene, source_line  # noqa: E402
-
+import rollqp
 from rollqp.methods import QP_METHODS, scene_method  # noqa: E402
 from rollqp.operators import SceneOperators  # noqa: E402
 from rollqp.problem import StepSolution  # noqa: E402
-from rollqp.report import closed_form_errors  # noqa: E402
 
 SCENE = "cattaneo-carter"
 #: Rolled-distance windows (q/a_H) of the timed steps.
@@ -158,7 +150,7 @@ def section_a(repeats, backends):
     for m in methods:
         r = res[m]
         newton = m == "newton"
-        rows.append((f"`{m}`", _ms(r["wall"]), _ms(r["cpu"]), _ms(r["max"]), f"{r['ratio']:.1f}",
+        rows.append((f"`{m}`", ms(r["wall"]), ms(r["cpu"]), ms(r["max"]), f"{r['ratio']:.1f}",
                      f"{r['it']:.1f}", "–" if newton else f"{r['qps']:.1f}", f"{r['residual']:.1e}",
                      f"{r['dt']:.1e}"))
     k0, k1 = steps[0].k, steps[-1].k
@@ -170,9 +162,9 @@ def section_a(repeats, backends):
             f"iterations (`newton`), the solver's own iterations summed over the QPs of the symmetric–skew "
             f"splitting (QP backends). Δt: max over the steps of \\|t − t_ref\\|/(μp0), t_ref the `newton` run's "
             f"state k (for `newton` itself: how exactly the rebuilt step reproduces the run).\n")
-    table = _table(["method", "solve wall [ms]", "solve CPU [ms]", "slowest step [ms]", "time / `newton`",
+    text = table(["method", "solve wall [ms]", "solve CPU [ms]", "slowest step [ms]", "time / `newton`",
                     "iterations per step", "QPs per step", "max residual", "max Δt/(μp0)"], rows)
-    return head + "\n" + table + "\n", res
+    return head + "\n" + text + "\n", res
 
 
 def section_b(repeats, methods, stride):
@@ -185,7 +177,7 @@ def section_b(repeats, methods, stride):
         newton = m == "newton"
         alt = not newton
         qp = m in QP_METHODS
-        rows.append((f"`{m}`" + (" (alternation)" if qp else ""), _ms(r["wall"]), _ms(r["cpu"]), _ms(r["max"]),
+        rows.append((f"`{m}`" + (" (alternation)" if qp else ""), ms(r["wall"]), ms(r["cpu"]), ms(r["max"]),
                      f"{r['ratio']:.1f}", f"{r['it']:.2f}" + (" outer" if alt else ""),
                      f"{r['n']:.1f} + {r['t']:.1f}" if alt else "–", f"{r['bt']:.2f}", f"{r['residual']:.1e}",
                      f"{r['dp']:.1e} / {r['dt']:.1e}"))
@@ -199,10 +191,10 @@ def section_b(repeats, methods, stride):
             f"Newton iterations (`newton`), outer N–T iterations (alternations), with the halves' inner "
             f"iterations (Newton for `nt-newton`, interior-point/ADMM for the QP halves). Δp/Δt: max over the "
             f"steps of \\|p − p_ref\\|/p0 and \\|t − t_ref\\|/(μp0), p_ref and t_ref the `newton` run's state k.\n")
-    table = _table(["method", "step wall [ms]", "step CPU [ms]", "slowest step [ms]", "time / `newton`",
+    text = table(["method", "step wall [ms]", "step CPU [ms]", "slowest step [ms]", "time / `newton`",
                     "iterations per step", "inner normal + tangential", "backtracks per step", "max residual",
                     "max Δp/p0 / Δt/(μp0)"], rows)
-    return head + "\n" + table + "\n", res
+    return head + "\n" + text + "\n", res
 
 
 def section_c(repeats, qp_repeats, backends):
@@ -211,13 +203,13 @@ def section_c(repeats, qp_repeats, backends):
     for rep in range(max(repeats, qp_repeats)):
         for m in methods:
             if rep < (repeats if m == "newton" else qp_repeats):
-                runs[m].append(_run_once(m))
+                runs[m].append(run_once(rollqp.load_scene(SCENE), m))
     med = {m: {k: float(np.median([r[k] for r in rs])) for k in rs[0]} for m, rs in runs.items()}
     rows = []
     for m in methods:
         r = med[m]
-        rows.append((f"`{m}`", f"{r['stepping']:.3f}", f"{r['start']:.3f}", f"{r['rolling']:.3f}", _ms(r["median"]),
-                     _ms(r["max"]), f"{r['stepping'] / med['newton']['stepping']:.1f}", f"{r['wall']:.3f}",
+        rows.append((f"`{m}`", f"{r['stepping']:.3f}", f"{r['start']:.3f}", f"{r['rolling']:.3f}", ms(r["median"]),
+                     ms(r["max"]), f"{r['stepping'] / med['newton']['stepping']:.1f}", f"{r['wall']:.3f}",
                      f"{r['cpu']:.3f}", f"{r['influence']:.3f}", f"{r['iters']:.0f}", f"{r['residual']:.1e}",
                      f"{r['carter']:.4f}"))
     head = (f"### C. The whole §6.1.1 transient: `rollqp.run(\"{SCENE}\", method=m)`\n\n"
@@ -226,10 +218,10 @@ def section_c(repeats, qp_repeats, backends):
             f"medians over {repeats} run(s) of `newton` and {qp_repeats} of each QP backend. *Stepping*: "
             f"Σ `step_time` of the result, state 0 included; *call*: the whole `rollqp.run`, with the influence "
             f"matrices and the result's assembly.\n")
-    table = _table(["method", "stepping Σ`step_time` [s]", "state 0 [s]", "rolling steps [s]", "median step [ms]",
+    text = table(["method", "stepping Σ`step_time` [s]", "state 0 [s]", "rolling steps [s]", "median step [ms]",
                     "slowest step [ms]", "stepping / `newton`", "call wall [s]", "call CPU [s]",
                     "influence matrices [s]", "iterations", "max residual", "Carter error (rms/μp0)"], rows)
-    return head + "\n" + table + "\n", med
+    return head + "\n" + text + "\n", med
 
 
 def targets(res_a, res_b, med_c):
@@ -240,19 +232,19 @@ def targets(res_a, res_b, med_c):
         ok = ratio >= TARGET_RATIO_A and n["residual"] <= c["residual"]
         rows.append(("A: tangential step, Clarabel time / Newton time (same steps, same warm starts)",
                      f"≥ {TARGET_RATIO_A:g} at ≤ residual",
-                     f"{ratio:.0f} ({_ms(c['wall'])} / {_ms(n['wall'])} ms); residual {n['residual']:.1e} "
+                     f"{ratio:.0f} ({ms(c['wall'])} / {ms(n['wall'])} ms); residual {n['residual']:.1e} "
                      f"(Newton) vs {c['residual']:.1e} (Clarabel)", "met" if ok else "**missed**"))
     if res_b is not None:
         n = res_b["newton"]
         ok = n["wall"] <= TARGET_STEP_B and n["max"] <= TARGET_STEP_B
         rows.append(("B: coupled Newton step, 81 nodes", f"≤ {1e3 * TARGET_STEP_B:g} ms",
-                     f"median {_ms(n['wall'])} ms, slowest {_ms(n['max'])} ms", "met" if ok else "**missed**"))
+                     f"median {ms(n['wall'])} ms, slowest {ms(n['max'])} ms", "met" if ok else "**missed**"))
     if med_c is not None:
         s = med_c["newton"]["stepping"]
         rows.append(("C: §6.1.1 transient with Newton, Σ `step_time`", f"≤ {TARGET_RUN_C:g} s",
                      f"{s:.3f} s (whole call {med_c['newton']['wall']:.3f} s)",
                      "met" if s <= TARGET_RUN_C else "**missed**"))
-    return "### Targets\n\n" + _table(["target", "required", "measured", ""], rows) + "\n"
+    return "### Targets\n\n" + table(["target", "required", "measured", ""], rows) + "\n"
 
 
 def main(argv=None) -> int:
@@ -280,7 +272,7 @@ def main(argv=None) -> int:
     parts = {p.strip().upper() for p in args.parts.split(",")}
     print("## Machine\n")
     print(machine_table())
-    print("\n" + source_line() + "\n")
+    print("\nrollqp source: " + source_line() + "\n")
     res_a = res_b = med_c = None
     t_all = time.perf_counter()
     if "A" in parts:

@@ -11,14 +11,14 @@ steel cylinders braked at Q/(μP) = 0.75, then rolling 6 a_H; half-space, μ = 0
 A. **Per-step cost** of a tangential step in the middle of the transient (rolled distance
    0.5 < q/a_H <= 1.5, where the stick zone is moving) for each QP backend, on 40 quadratic
    elements (81 nodes, the paper's mesh) and on 80 constant elements (80 nodes, exactly
-   symmetric F·A: one QP per step). The step is marched here with the public
-   :class:`rollqp.SceneOperators` (braked start, then rolling steps, as ``rollqp.run`` does),
-   and each step's :class:`~rollqp.problem.StepSolution` gives rollqp's wall time
-   (``time``), the external solver's own time (``solver_time``) and the number of QPs of the
-   symmetric–skew splitting (``info["qp_solves"]``). The backend's native calls are timed
-   separately by wrapping the method instance's ``_solve_form`` (benchmark-only
-   instrumentation: nothing in the library is changed), and a "cold" step re-solves the same
-   step with a fresh method object, i.e. without the solver set-up that rollqp reuses.
+   symmetric F·A: one QP per step). The steps are those of ``rollqp.march`` (the step's wall and
+   CPU time cover the loads, the history vector, the problem's construction, the solve and
+   ``w``), and each step's :class:`~rollqp.problem.StepSolution` gives rollqp's wall time
+   (``time``), the external solver's own time (``solver_time``), the wall time of the backend's
+   calls (``info["backend_time"]``: data update, solve, retries), the solver objects built
+   (``info["setups"]``) and the number of QPs of the symmetric–skew splitting
+   (``info["qp_solves"]``); a "cold" step re-solves the same step with a fresh method object,
+   i.e. without the solver set-up that rollqp reuses.
 B. **The whole run** ``rollqp.run("cattaneo-carter", method=m)`` for each backend: wall time,
    stepping time (sum of ``Result.step_time``), median step time, max residual, and the error
    against Carter's steady state at the end.
@@ -39,22 +39,18 @@ at import, before any heavy work.
 """
 from __future__ import annotations
 
-import numpy as np  # noqa: E402
-import rollqp  # noqa: E402
-from rollqp.bench import pin_threads  # noqa: E402
+from harness import interleaved, machine_table, medians, ms, run_once, step_records, table  # (pins BLAS first)
 
-#: BLAS/OpenMP pools limited to one thread for the whole benchmark (kept alive here).
-_THREAD_LIMIT = pin_threads()
+import argparse
+import sys
+import time
 
-import argparse  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
+import numpy as np
 
-from rollqp import bench as _bench  # noqa: E402
-from rollqp import closedforms as cf  # noqa: E402
-from rollqp.operators import SceneOperators  # noqa: E402
-from rollqp.methods import QP_METHODS, get_method  # noqa: E402
-from rollqp.report import closed_form_errors  # noqa: E402
+import rollqp
+from rollqp import closedforms as cf
+from rollqp.methods import QP_METHODS, get_method
+from rollqp.operators import SceneOperators
 
 SCENE = "cattaneo-carter"
 #: Window of the transient whose tangential steps are timed: 0.5 < q/a_H <= 1.5.
@@ -63,96 +59,9 @@ WINDOW = (0.5, 1.5)
 COLD_EVERY = 4
 
 
-# ----------------------------------------------------------------------------------- machine
-def machine_table() -> str:
-    """The machine, packages, thread pools, load and command (``rollqp.bench.machine_table``)."""
-    return _bench.machine_table()
-
-
-_table = _bench.table
-
-
-def _ms(seconds) -> str:
-    return f"{1e3 * seconds:.2f}"
-
-
-class Probe:
-    """Times a method's native backend calls, counts its solver set-ups and polish retries.
-
-    Wraps ``_solve_form`` and ``_build`` on the *instance* (the class is untouched):
-    ``QPMethod.solve`` calls ``self._solve_form`` once per QP, and the backend builds its
-    solver object through ``self._build`` only when no cached one fits.
-    """
-
-    def __init__(self, method):
-        self.backend = 0.0
-        self.builds = 0
-        self.qps = 0
-        self.retried = 0  # QPs the backend solved more than once (OSQP polish retries)
-        self.iterates = []
-        solve_form, build = method._solve_form, method._build
-
-        def timed_solve_form(form, x0, source=None):
-            t0 = time.perf_counter()
-            out = solve_form(form, x0, source)
-            self.backend += time.perf_counter() - t0
-            self.iterates.append(np.array(out[0], dtype=float))
-            self.qps += 1
-            self.retried += int(out[5].get("tries", 1) > 1)
-            return out
-
-        def counted_build(form):
-            self.builds += 1
-            return build(form)
-
-        method._solve_form = timed_solve_form
-        method._build = counted_build
-
-
 def new_method(name, scene, **kw):
     """The method as ``rollqp.run`` creates it (scene tolerance), plus ``kw``."""
     return get_method(name, tolerance=scene.solver.tolerance, **kw)
-
-
-def march(scene, model, method, k_stop, on_step=None):
-    """Braked start and rolling steps 1..k_stop, as ``rollqp.run`` does.
-
-    Restricted to what the benchmark needs: β = 0 (or coupling off) and constant loads, so
-    the normal step is solved once and each rolling step is one tangential step problem.
-    ``on_step(k, problem, warm, solution, (wall, cpu))`` is called after rolling step ``k``; the
-    wall-clock and process CPU times cover the history vector, the problem's construction, the
-    solve and ``w``.
-
-    Returns the normal solution and the wall time of the normal solve.
-    """
-    if model.Ant is not None or model.Atn is not None:
-        raise ValueError("the benchmark march handles uncoupled scenes only")
-    qs = scene.q_steps
-    P = float(scene.normal_load(0.0))
-    Q = float(scene.tangential_load(0.0))
-    if np.ptp(scene.normal_load(qs)) != 0 or np.ptp(scene.tangential_load(qs)) != 0:
-        raise ValueError("the benchmark march handles constant loads only")
-    t0 = time.perf_counter()
-    nsol = method.solve(model.normal_step(P))
-    t_normal = time.perf_counter() - t0
-    p = nsol.p
-    w = np.zeros(model.strip.n)
-    tsol = None
-    N = scene.load.start_steps
-    for j in range(1, N + 1):  # static shift, Δ = a_H (§4.4)
-        tsol = method.solve(model.tangential_step(p, -w, model.scales.length, Q=Q * j / N), warm=tsol)
-        w = model.w(p, tsol.t)
-    for k in range(1, k_stop + 1):
-        t0, c0 = time.perf_counter(), time.process_time()
-        c = -(model.history() @ w)
-        prob = model.tangential_step(p, c, scene.dq, Q=Q)
-        warm = tsol
-        tsol = method.solve(prob, warm=warm)
-        w = model.w(p, tsol.t)
-        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-        if on_step is not None:
-            on_step(k, prob, warm, tsol, (wall, cpu))
-    return nsol, t_normal
 
 
 def window_steps(scene):
@@ -161,26 +70,27 @@ def window_steps(scene):
     return int(ks[0]), int(ks[-1])
 
 
-def step_costs(scene, name, symmetric=False, operator="exact", cold=True):
+def step_costs(scene, name, operator="exact", cold=True):
     """Median per-step numbers of the tangential steps in the window, one march (module docstring)."""
     k0, k1 = window_steps(scene)
-    model = SceneOperators.build(scene, symmetrized=symmetric)
     meth = new_method(name, scene, operator=operator)
-    probe = Probe(meth)
+    recs = step_records(scene, meth, stop=k1)
+    start = recs[0][0]
     rows, keep = [], []
     residual = 0.0
-
-    def on_step(k, prob, warm, sol, times):
-        nonlocal residual
-        if k >= k0:
-            rows.append((times[0], times[1], sol.time, probe.backend, sol.solver_time, sol.info["qp_solves"],
+    setups = start.state.nsol.info.get("setups", 0) + start.solution.info.get("setups", 0)
+    qps = retried = 0
+    for rec, wall, cpu in recs[1:]:
+        sol = rec.solution
+        setups += sol.info["setups"]
+        qps += sol.info["qp_solves"]
+        retried += sol.info["retried"]
+        if rec.k >= k0:
+            rows.append((wall, cpu, sol.time, sol.info["backend_time"], sol.solver_time, sol.info["qp_solves"],
                          sol.iterations))
             residual = max(residual, sol.residual)
-            if cold and (k - k0) % COLD_EVERY == 0:
-                keep.append((prob, warm))
-        probe.backend = 0.0
-
-    _, t_normal = march(scene, model, meth, k1, on_step)
+            if cold and (rec.k - k0) % COLD_EVERY == 0:
+                keep.append((rec.problem, rec.previous.tsol))
     colds = []
     for prob, warm in keep:  # the same step, without the solver set-up rollqp reuses
         fresh = new_method(name, scene, operator=operator)
@@ -190,26 +100,17 @@ def step_costs(scene, name, symmetric=False, operator="exact", cold=True):
     med = np.median(np.array(rows), axis=0)
     return dict(step=med[0], cpu=med[1], time=med[2], backend=med[3], solver=med[4], qps=med[5], iters=med[6],
                 cold=float(np.median(colds)) if colds else float("nan"), residual=residual,
-                builds=probe.builds, steps=(k0, k1), normal=t_normal, all_qps=probe.qps, retried=probe.retried)
+                builds=setups, steps=(k0, k1), normal=start.state.nsol.time, all_qps=qps, retried=retried)
 
 
-def interleaved(repeats, backends, measure):
-    """``{backend: {key: median over repeats}}``; the backends alternate within each repeat, so
-    that a change in the machine's load hits all of them alike."""
-    runs = {b: [] for b in backends}
-    for _ in range(repeats):
-        for b in backends:
-            runs[b].append(measure(b))
+def interleaved_medians(repeats, cases, measure):
+    """``{case: medians of measure(case)}`` over ``repeats`` repetitions, the cases alternating
+    (``harness.interleaved``); the residual is the largest, not the median."""
+    runs = interleaved(repeats, {c: c for c in cases}, measure)
     out = {}
-    for b, rs in runs.items():
-        out[b] = {}
-        for key, v in rs[0].items():
-            if isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(v, bool):
-                vals = [r[key] for r in rs if not np.isnan(r[key])]
-                out[b][key] = float(np.median(vals)) if vals else float("nan")
-            else:
-                out[b][key] = v
-        out[b]["residual"] = max(r["residual"] for r in rs)
+    for c, rs in runs.items():
+        out[c] = medians(rs)
+        out[c]["residual"] = max(r["residual"] for r in rs)
     return out
 
 
@@ -221,9 +122,18 @@ def clarabel_setup_in_solve_time(scene, samples=21):
     the solver object (``DefaultInfo::finalize``, "includes setup"), so on every re-solve of a
     reused object it exceeds the solve's own wall time by that set-up time.
     """
+    import clarabel
+    import scipy.sparse as sp
+    from rollqp.methods.qp_clarabel import clarabel_rows, clarabel_settings
     model = SceneOperators.build(scene)
     form = model.normal_step(float(scene.normal_load(0.0))).qp_form()
-    solver = new_method("qp-clarabel", scene)._build(form)
+    A, b, cones = clarabel_rows(form)
+    settings = clarabel.DefaultSettings()
+    for k, v in clarabel_settings(scene.solver.tolerance).items():
+        setattr(settings, k, v)
+    solver = clarabel.DefaultSolver(sp.triu(sp.csc_matrix(form.H), format="csc"), form.q, A, b,
+                                    [getattr(clarabel, c)(m) for c, m in cones if m or c == "NonnegativeConeT"],
+                                    settings)
     diffs = []
     for _ in range(samples):
         t0 = time.perf_counter()
@@ -239,14 +149,14 @@ def section_step_costs(repeats, backends):
                  base.replace(**{"discretization.element": "constant", "discretization.elements": 80}))]
     out = []
     for label, scene in variants:
-        costs = interleaved(repeats, backends, lambda b: step_costs(scene, b))
+        costs = interleaved_medians(repeats, backends, lambda b: step_costs(scene, b))
         rows, notes = [], []
         for name in backends:
             c = costs[name]
             own = c["time"] - c["backend"]
-            rows.append((f"`{name}`", _ms(c["step"]), _ms(c["cpu"]), _ms(c["time"]), _ms(c["backend"]),
-                         _ms(c["solver"]), f"{c['time'] / c['solver']:.2f}", f"{100 * own / c['time']:.0f} %",
-                         f"{c['qps']:.0f}", f"{c['iters']:.0f}", _ms(c["cold"]), f"{c['cold'] / c['time']:.1f}"))
+            rows.append((f"`{name}`", ms(c["step"]), ms(c["cpu"]), ms(c["time"]), ms(c["backend"]),
+                         ms(c["solver"]), f"{c['time'] / c['solver']:.2f}", f"{100 * own / c['time']:.0f} %",
+                         f"{c['qps']:.0f}", f"{c['iters']:.0f}", ms(c["cold"]), f"{c['cold'] / c['time']:.1f}"))
             notes.append(f"`{name}`: {c['builds']:.0f} solver set-ups in the whole march, "
                          f"{c['retried']:.0f} of its {c['all_qps']:.0f} QPs solved again after a failed polish, "
                          f"max residual {c['residual']:.1e}")
@@ -255,7 +165,7 @@ def section_step_costs(repeats, backends):
         out.append(f"### A. Per-step cost: {label}\n\n"
                    f"Tangential rolling steps k = {k0}…{k1} (q/a_H = {q0:.3f}…{q1:.3f}) of `{SCENE}`; "
                    f"medians over the steps, then over {repeats} repeat(s). Times in ms.\n")
-        out.append(_table(["backend", "step wall", "step CPU", "rollqp `time`", "backend calls", "`solver_time`",
+        out.append(table(["backend", "step wall", "step CPU", "rollqp `time`", "backend calls", "`solver_time`",
                            "`time`/`solver_time`", "share of `time` outside the backend calls",
                            "QPs per step (`qp_solves`)", "solver iterations per step", "cold step (fresh method)",
                            "cold / warm"], rows))
@@ -263,41 +173,23 @@ def section_step_costs(repeats, backends):
         if "qp-clarabel" in backends:
             off = clarabel_setup_in_solve_time(scene)
             out.append(f"Clarabel's `solve_time` exceeds the wall time of its own `solve()` call by "
-                       f"{_ms(off)} ms per QP on this problem (median of 21 re-solves of one solver object): "
+                       f"{ms(off)} ms per QP on this problem (median of 21 re-solves of one solver object): "
                        f"it includes the object's one-time set-up, which rollqp reuses.\n")
     return "\n".join(out)
 
 
-def _run_once(name):
-    """One ``rollqp.run`` of the scene: wall and CPU time, stepping time and its parts, iterations,
-    largest residual, Carter's error (also used by bench_newton.py)."""
-    scene = rollqp.load_scene(SCENE)
-    t0, c0 = time.perf_counter(), time.process_time()
-    res = rollqp.run(scene, method=name)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    arr = res.arrays()
-    errs = {n: v for n, v, _ in closed_form_errors(arr, scene)}
-    st = arr["step_time"]
-    return dict(wall=wall, cpu=cpu, influence=float(res.meta["model"].get("influence_seconds", np.nan)),
-                stepping=float(st.sum()), start=float(st[0]), rolling=float(st[1:].sum()),
-                median=float(np.median(st[1:])), max=float(st[1:].max()), residual=float(arr["residual"].max()),
-                iters=int(arr["iterations"].sum()), carter=errs.get("carter", float("nan")), K=len(st) - 1)
-
-
 def section_runs(repeats, backends):
-    runs = interleaved(repeats, backends, _run_once)
+    runs = interleaved_medians(repeats, backends, lambda name: run_once(rollqp.load_scene(SCENE), name))
     rows = []
     for name in backends:
         r = runs[name]
-        rows.append((f"`{name}`", f"{r['wall']:.2f}", f"{r['cpu']:.2f}", f"{r['stepping']:.2f}", _ms(r["median"]),
+        rows.append((f"`{name}`", f"{r['wall']:.2f}", f"{r['cpu']:.2f}", f"{r['stepping']:.2f}", ms(r["median"]),
                      f"{r['iters']:.0f}", f"{r['residual']:.1e}", f"{r['carter']:.4f}"))
     # QPs of the splitting along the transient (one march; OSQP when available, it is the fastest)
     scene = rollqp.load_scene(SCENE)
     probe_backend = "qp-osqp" if "qp-osqp" in backends else backends[0]
-    qps = []
-    march(scene, SceneOperators.build(scene), new_method(probe_backend, scene), scene.n_steps,
-          lambda k, prob, warm, sol, times: qps.append((scene.q_steps[k] / scene.a_H, sol.info["qp_solves"])))
-    qps = np.array(qps)
+    qps = np.array([(rec.q / scene.a_H, rec.solution.info["qp_solves"])
+                    for rec, _, _ in step_records(scene, new_method(probe_backend, scene))[1:]])
     bands = [(0.0, 0.5), (0.5, 1.5), (1.5, 3.0), (3.0, scene.q_steps[-1] / scene.a_H)]
     along = ", ".join(f"{np.median(qps[(qps[:, 0] > lo) & (qps[:, 0] <= hi), 1]):.0f} for {lo:g} < q/a_H ≤ {hi:g}"
                       for lo, hi in bands)
@@ -306,7 +198,7 @@ def section_runs(repeats, backends):
     head = (f"### B. The whole §6.1.1 run: `rollqp.run(\"{SCENE}\", method=m)`\n\n"
             f"{r['K']:.0f} rolling steps of Δq = Le/2 after the braked start (40 quadratic elements, 81 nodes); "
             f"medians over {repeats} run(s).\n")
-    return head + "\n" + _table(["backend", "wall [s]", "CPU [s]", "stepping Σ`step_time` [s]", "median step [ms]",
+    return head + "\n" + table(["backend", "wall [s]", "CPU [s]", "stepping Σ`step_time` [s]", "median step [ms]",
                                   "solver iterations", "max residual", "Carter error (rms/μp0)"], rows) + "\n" + note
 
 
@@ -314,8 +206,7 @@ def section_splitting(repeats, backends):
     scene = rollqp.load_scene(SCENE)
     x, a, p0 = None, scene.a_H, scene.p0
     pairs = [(b, op) for b in backends for op in ("exact", "symmetrized")]
-    costs = interleaved(repeats, pairs, lambda bo: step_costs(scene, bo[0], symmetric=bo[1] == "symmetrized",
-                                                              operator=bo[1], cold=False))
+    costs = interleaved_medians(repeats, pairs, lambda bo: step_costs(scene, bo[0], operator=bo[1], cold=False))
     rows = []
     for name in backends:
         for op in ("exact", "symmetrized"):
@@ -326,7 +217,7 @@ def section_splitting(repeats, backends):
             x = model.strip.x
             err = (sol.p - cf.hertz_pressure(x, a, p0)) / p0
             inside = np.abs(x) <= a
-            rows.append((f"`{name}`", f"`{op}`", _ms(c["normal"]), f"{sol.info['qp_solves']}", _ms(c["time"]),
+            rows.append((f"`{name}`", f"`{op}`", ms(c["normal"]), f"{sol.info['qp_solves']}", ms(c["time"]),
                          f"{c['qps']:.0f}", f"{np.max(np.abs(err)):.4f}",
                          f"{np.sqrt(np.mean(err[inside] ** 2)):.4f}", f"{err[x.size // 2]:+.4f}",
                          f"{err[x.size // 2 + 1]:+.4f}"))
@@ -337,14 +228,15 @@ def section_splitting(repeats, backends):
             f"the window of part A; medians over {repeats} repeat(s). Errors: starting pressure against "
             f"Hertz, divided by p0 (node {x.size // 2} is x = 0, an element end; node {x.size // 2 + 1} "
             f"the next mid-node).\n")
-    return head + "\n" + _table(["backend", "operator", "normal step [ms]", "normal QPs", "tangential step [ms]",
+    return head + "\n" + table(["backend", "operator", "normal step [ms]", "normal QPs", "tangential step [ms]",
                                   "QPs per tangential step", "max |p − p_Hertz|/p0",
                                   "rms in contact", "error at x = 0", "error at next node"], rows) + "\n"
 
 
-def _observed_contraction(iterates):
-    """Geometric mean of successive ratios of max|x_k − x_{k−1}|, above the solvers' noise."""
-    d = [float(np.max(np.abs(iterates[i + 1] - iterates[i]))) for i in range(len(iterates) - 1)]
+def _observed_contraction(changes):
+    """Geometric mean of successive ratios of max|x_k − x_{k−1}| (``info["splitting_changes"]``;
+    the first change, from the start, left out), above the solvers' noise."""
+    d = list(changes[1:])
     ratios = [d[i + 1] / d[i] for i in range(len(d) - 1) if d[i + 1] > 1e-9]
     return float(np.exp(np.mean(np.log(ratios)))) if ratios else float("nan"), (max(ratios) if ratios else float("nan"))
 
@@ -361,7 +253,7 @@ def section_contraction(meshes):
         for ne in meshes:
             scene = base.replace(**{"discretization.element": element, "discretization.elements": ne})
             model = SceneOperators.build(scene)
-            A, f = model.Ann, model.f
+            A, f = model.Ann.dense(), model.f
             FA = f[:, None] * A
             H, S = 0.5 * (FA + FA.T), 0.5 * (FA - FA.T)
             lam, V = np.linalg.eigh(H)
@@ -370,10 +262,8 @@ def section_contraction(meshes):
             nS = np.linalg.norm(S)
             inner = float(np.linalg.norm(S[1:-1, 1:-1]) / nS) if nS > 0 else 0.0
             P = float(scene.normal_load(0.0))
-            meth = new_method("qp-osqp", scene)
-            probe = Probe(meth)
-            sol = meth.solve(model.normal_step(P))
-            gm, worst = _observed_contraction(probe.iterates)
+            sol = new_method("qp-osqp", scene).solve(model.normal_step(P))
+            gm, worst = _observed_contraction(sol.info["splitting_changes"])
             sym_model = SceneOperators.build(scene, symmetrized=True)
             sym = new_method("qp-osqp", scene, operator="symmetrized").solve(sym_model.normal_step(P))
             rows.append((element, ne, model.strip.n, f"{np.linalg.norm(A - A.T) / np.linalg.norm(A):.3f}",
@@ -397,7 +287,7 @@ def section_contraction(meshes):
             "max|p_k − p_{k−1}| in the normal step of `qp-osqp` (tolerance 1e-10, from p = 0), geometric "
             "mean (largest), counting changes above 1e-9 p0 only. Hertz: max|p − p_Hertz|/p0 of the "
             "starting pressure, `exact` and `symmetrized` operator.\n")
-    return head + "\n" + _table(["element", "elements", "nodes", "‖A−Aᵀ‖/‖A‖", "‖FA−(FA)ᵀ‖/‖FA‖",
+    return head + "\n" + table(["element", "elements", "nodes", "‖A−Aᵀ‖/‖A‖", "‖FA−(FA)ᵀ‖/‖FA‖",
                                   "skew off the end nodes", "ρ", "observed per QP", "normal-step QPs",
                                   "Hertz error, exact", "Hertz error, symmetrized"], rows) + "\n\n" + note + "\n"
 
@@ -410,12 +300,9 @@ def section_multipliers(backends):
     k_probe = window_steps(scene)[1]
     rows = []
     for name in backends:
-        meth = new_method(name, scene)
-        got = {}
-        nsol, _ = march(scene, model, meth, k_probe,
-                        lambda k, prob, warm, sol, times: got.update(prob=prob, sol=sol) if k == k_probe else None)
+        rec = step_records(scene, new_method(name, scene), stop=k_probe, keep=lambda k: k == k_probe)[-1][0]
+        nsol, prob, sol = rec.state.nsol, rec.problem, rec.solution
         contact = nsol.p > 1e-8 * sc.stress
-        prob, sol = got["prob"], got["sol"]
         bound = prob.bound
         stick = (nsol.p > 1e-8 * sc.stress) & (bound - np.abs(sol.t) > 1e-6 * sc.stress)
         rows.append((f"`{name}`", f"{nsol.delta / sc.displacement:.6f}",
@@ -428,7 +315,7 @@ def section_multipliers(backends):
             f"read from the solvers' equality multipliers (`QPForm.unscaled_multiplier`); the gap g "
             f"(in u0 = a_H p0/E\\*) must vanish on the contact nodes (p > 1e-8 p0) and the slip s "
             f"(in p0/E\\*) on the stick nodes (μp − |t| > 1e-6 p0).\n")
-    return head + "\n" + _table(["backend", "δ/u0", "max |g|/u0 in contact", "contact nodes", "ξ/(p0/E*)",
+    return head + "\n" + table(["backend", "δ/u0", "max |g|/u0 in contact", "contact nodes", "ξ/(p0/E*)",
                                   "max |s|/(p0/E*) in stick", "stick nodes"], rows) + "\n"
 
 

@@ -9,7 +9,7 @@ factorization. The coupled step of ``goodman-bentall`` (β = 0.5, μ = 0.3) has 
 and (from N = 200 unknowns) reuses one LU across iterations and steps through a Woodbury
 update of the rows whose node case changed. This script measures what that costs: median ``step_time``
 of the rolling steps after the start, iterations per step, and the dense floors
-``cho_factor`` of size n and of size 2n. Same harness as rollqp.bench (BLAS pinned,
+``cho_factor`` of size n and of size 2n. Same harness as the suite (benchmarks/harness.py: BLAS pinned,
 failures recorded, sizes skipped when the previous one predicts more than the budget).
 """
 from __future__ import annotations
@@ -19,7 +19,8 @@ import sys
 
 import numpy as np
 
-from rollqp.bench import cholesky_time, coupled_scene, fit_exponent, machine_table, pin_threads, table, timed_run
+from harness import cholesky_time, fit_exponent, machine_table, table, timed_run  # (pins BLAS first)
+from suite import coupled_scene
 
 
 def main(argv=None) -> int:
@@ -28,7 +29,6 @@ def main(argv=None) -> int:
     ap.add_argument("--elements", default="20,40,80,160,320,640")
     ap.add_argument("--budget", type=float, default=60.0, help="largest predicted run time (s) of a size")
     args = ap.parse_args(argv)
-    pin_threads()
     methods = args.methods.split(",")
     elements = [int(e) for e in args.elements.split(",")]
     print(machine_table("python benchmarks/coupled_scaling.py"))

@@ -33,27 +33,19 @@ iteration, and the augmentation r of the coupled Newton method.
 
 Timings: medians over repeated runs in which the methods alternate (a change of the machine's
 load then hits all of them alike); ratios compare runs of the same invocation. BLAS is pinned
-to one thread (threadpoolctl) at import, as in ``bench_qp.py``, whose machine table is reused.
+to one thread (threadpoolctl) at import (``harness.py``, whose machine table is used).
 """
 from __future__ import annotations
 
-import numpy as np  # noqa: E402
-import rollqp  # noqa: E402
-from rollqp.bench import pin_threads  # noqa: E402
+from harness import goodman_bentall_scene, interleaved, machine_table, ms, source_line, table  # (pins BLAS first)
 
-#: BLAS/OpenMP pools limited to one thread for the whole benchmark (kept alive here).
-_THREAD_LIMIT = pin_threads()
+import argparse
+import sys
+import time
 
-import argparse  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_qp import _ms, _table, machine_table  # noqa: E402
-
-from rollqp import bench as _bench  # noqa: E402
-import rollqp  # noqa: E402
+import rollqp
 from rollqp.march import new_result  # noqa: E402
 from rollqp.operators import SceneOperators  # noqa: E402
 from rollqp.errors import SolverError  # noqa: E402
@@ -65,23 +57,6 @@ METHODS = ("newton", "nt-newton", "qp-clarabel", "qp-osqp")
 #: Bands of the rolled distance q/a_H for the iteration counts along the transient (the paper:
 #: the transient is gone after 1.8 contact widths, 3.6 a_H).
 BANDS = ((0.0, 0.5), (0.5, 1.0), (1.0, 2.0), (2.0, 3.6), (3.6, None))
-
-
-def goodman_bentall_scene():
-    """``(scene, label)``: the built-in ``goodman-bentall`` if present, else the inline equivalent."""
-    builtin = Path(rollqp.__file__).resolve().parent / "scenes" / f"{SCENE}.toml"
-    if builtin.exists():
-        return rollqp.load_scene(SCENE), f"built-in scene `{SCENE}`"
-    scene = rollqp.load_scene("cattaneo-carter").replace(**{
-        "bodies.A.E": 1000.0, "bodies.A.nu": 0.0, "bodies.B.E": 1e9, "bodies.B.nu": 0.3,
-        "contact.friction": 0.3, "load.tangential": rollqp.histories.Constant(0.0), "load.start_steps": 40,
-        "discretization.step": 0.25, "discretization.distance": 6.0})
-    return scene, "inline scene (`cattaneo-carter` with E_A = 1000, ν_A = 0, E_B = 1e9, ν_B = 0.3, μ = 0.3, Q = 0)"
-
-
-def source_line() -> str:
-    """The rollqp source measured (``rollqp.bench.source_line``)."""
-    return "rollqp source: " + _bench.source_line()
 
 
 def scene_line(scene) -> str:
@@ -155,15 +130,10 @@ def run_variant(scene, model, method, label):
                     calls=dict(contraction=rec.contraction()))
 
 
-def interleaved(jobs, repeats):
+def interleaved_jobs(jobs, repeats):
     """``{key: [runs]}``: each job ``key -> callable`` run ``repeats[key]`` times, the jobs alternating."""
-    out = {k: [] for k in jobs}
-    for rep in range(max(repeats.values())):
-        for key, job in jobs.items():
-            if rep < repeats[key]:
-                out[key].append(job())
-                print(f"<!-- {key}: run {rep + 1}/{repeats[key]} done -->", file=sys.stderr, flush=True)
-    return out
+    return interleaved(repeats, jobs, lambda job: job(),
+                       log=lambda key, i, n: print(f"<!-- {key}: run {i}/{n} done -->", file=sys.stderr, flush=True))
 
 
 def combine(runs):
@@ -192,7 +162,7 @@ def _f(v, fmt="{:.2f}"):
     return "–" if v is None or (isinstance(v, float) and np.isnan(v)) else fmt.format(v)
 
 
-def main_table(scene, res, methods):
+def maintable(scene, res, methods):
     ref = res.get("newton")
     rows = [("paper, coupled GNMls", "≈ 6", "–", "–", "–", "–", "–", "–", "–", "1", "–", "–", "–"),
             ("paper, N–T with GNMls halves", "≈ 90 (derived: 6 × (3 + 12))", "≈ 6", "≈ 18 (≈ 3)", "≈ 72 (≈ 12)",
@@ -212,7 +182,7 @@ def main_table(scene, res, methods):
         ratio = r["total"] / ref["total"] if ref and ref.get("ok") else float("nan")
         dp, dt = _diff(r, ref, scene) if ref and ref.get("ok") and not coupled else (0.0, 0.0)
         rows.append((label, _f(newton_its), _f(r["it"]) if alt else "–", inner(r["n"]), inner(r["t"]), _f(r["bt"]),
-                     _ms(r["mean"]), _ms(r["median"]), f"{r['total']:.3f}", _f(ratio, "{:.1f}"),
+                     ms(r["mean"]), ms(r["median"]), f"{r['total']:.3f}", _f(ratio, "{:.1f}"),
                      "0 (reference)" if coupled else f"{dp:.1e}", "0 (reference)" if coupled else f"{dt:.1e}",
                      f"{r['residual']:.1e}"))
         if r.get("failures"):
@@ -227,10 +197,10 @@ def main_table(scene, res, methods):
             "inner normal per step (per outer)", "inner tangential per step (per outer)", "backtracks per step",
             "time per step, mean [ms]", "median [ms]", "stepping total Σ`step_time` [s]", "time / coupled Newton",
             "max |p − p_newton|/p0", "max |t − t_newton|/(μp0)", "max residual"]
-    return _table(head, rows) + "\n\n" + "".join(f"- {n}.\n" for n in notes)
+    return table(head, rows) + "\n\n" + "".join(f"- {n}.\n" for n in notes)
 
 
-def start_table(scene, res, methods):
+def starttable(scene, res, methods):
     N = scene.load.start_steps
     ref = res.get("newton")
     rows = []
@@ -241,15 +211,15 @@ def start_table(scene, res, methods):
         coupled = name == "newton"
         rows.append((f"`{name}`", _f(r["it0"] / N) if coupled else "–", "–" if coupled else _f(r["it0"] / N),
                      "–" if coupled else _f(r["n0"] / N), "–" if coupled else _f(r["t0"] / N), _f(r["bt0"] / N),
-                     _ms(r["start"] / N), f"{r['start']:.3f}",
+                     ms(r["start"] / N), f"{r['start']:.3f}",
                      _f(r["start"] / ref["start"], "{:.1f}") if ref and ref.get("ok") else "–"))
     head = ["method", "Newton iterations per load step", "outer iterations per load step", "inner normal per load step",
             "inner tangential per load step", "backtracks per load step", "time per load step [ms]",
             "start total [s]", "time / coupled Newton"]
-    return _table(head, rows)
+    return table(head, rows)
 
 
-def bands_table(scene, res, methods):
+def bandstable(scene, res, methods):
     rows = []
     for name in methods:
         r = res[name]
@@ -267,7 +237,7 @@ def bands_table(scene, res, methods):
                 cells.append(f"{it:.2f} ({a['inner_normal'][sel].mean():.1f} + {a['inner_tangential'][sel].mean():.1f})")
         rows.append((f"`{name}`", *cells))
     head = ["method"] + [f"{lo:g} < q/a_H ≤ {hi:g}" if hi is not None else f"q/a_H > {lo:g}" for lo, hi in BANDS]
-    return _table(head, rows)
+    return table(head, rows)
 
 
 def variants(scene, repeats):
@@ -304,11 +274,11 @@ def variants(scene, repeats):
     for r in (0.01, 1.0):
         makers[f"N–T, r = {r:g} in the halves"] = (lambda r=r: nt(r=r))
     jobs = {k: (lambda mk=mk, k=k: run_variant(scene, model, mk(), k)) for k, mk in makers.items()}
-    raw = interleaved(jobs, {k: repeats for k in jobs})
+    raw = interleaved_jobs(jobs, {k: repeats for k in jobs})
     return {k: combine(v) for k, v in raw.items()}, model
 
 
-def variants_table(scene, var, ref, model):
+def variantstable(scene, var, ref, model):
     rows = []
     base = var["coupled Newton, default r"]
     for label, r in var.items():
@@ -320,14 +290,14 @@ def variants_table(scene, var, ref, model):
         rows.append((label, _f(r["it"]) if coupled else _f(r["it"]) + " outer",
                      "–" if coupled else f"{r['n'] / r['it']:.2f} + {r['t'] / r['it']:.2f}",
                      _f(r["bt"]), _f(r["contraction"], "{:.3f}") if not coupled else "–",
-                     _ms(r["mean"]), _f(r["total"] / base["total"], "{:.1f}") if base.get("ok") else "–",
+                     ms(r["mean"]), _f(r["total"] / base["total"], "{:.1f}") if base.get("ok") else "–",
                      _f(r["it0"] / scene.load.start_steps) + ("" if coupled else " outer"),
                      f"{dp:.1e} / {dt:.1e}", f"{r['residual']:.1e}"))
     head = ["variant", "iterations per rolling step", "inner normal + tangential per outer iteration",
             "backtracks per step", "residual ratio per outer iteration (median)", "time per step [ms]",
             "time / coupled Newton (default r)", "iterations per start load step",
             "max |Δp|/p0 / max |Δt|/(μp0) vs `newton`", "max residual"]
-    return _table(head, rows)
+    return table(head, rows)
 
 
 def accounting(scene, model, repeats):
@@ -384,10 +354,10 @@ def accounting(scene, model, repeats):
         m = med[kind]
         halves = m["halves"] if kind == "nt" else float("nan")
         per = "Newton iteration" if kind == "coupled" else "outer iteration"
-        rows.append((label, _ms(m["step"] / K), _ms(m["solve"] / K),
-                     "–" if kind == "coupled" else _ms(halves / K),
-                     "–" if kind == "coupled" else _ms((m["solve"] - halves) / K),
-                     _ms((m["step"] - m["solve"]) / K), f"{m['its'] / K:.2f}",
+        rows.append((label, ms(m["step"] / K), ms(m["solve"] / K),
+                     "–" if kind == "coupled" else ms(halves / K),
+                     "–" if kind == "coupled" else ms((m["solve"] - halves) / K),
+                     ms((m["step"] - m["solve"]) / K), f"{m['its'] / K:.2f}",
                      f"{1e6 * m['solve'] / m['its']:.0f} µs per {per}",
                      "–" if kind == "coupled" else
                      f"{1e6 * halves / m['half_calls']:.0f} µs per half, "
@@ -399,10 +369,10 @@ def accounting(scene, model, repeats):
             f"{repeats} march(es). *Rest of the alternation*: `normal_half`/`tangential_half` (A_nt t, A_tn p, "
             "the half problems' construction and validation) and the coupled residual of each outer iterate "
             "(`CoupledStep.solution`). *Driver*: history vector, problem construction, w, the result record.\n\n")
-    return note + _table(head, rows)
+    return note + table(head, rows)
 
 
-def micro_table(model, number=200, repeat=7):
+def microtable(model, number=200, repeat=7):
     """LAPACK solves of the coupled and the half systems, and ``Residuals.max``; medians, µs."""
     import timeit
 
@@ -426,7 +396,7 @@ def micro_table(model, number=200, repeat=7):
             (f"LAPACK `dgesv` (copy + LU + solve), {n + 1}×{n + 1}: one Newton iteration of a half",
              f"{us(lambda: dgesv(Jh.copy(order='F'), bh)):.0f}"),
             ("`Residuals.max` (every `StepSolution.residual`; `dataclasses.astuple`)", f"{us(lambda: res.max):.1f}")]
-    return f"Medians of {repeat} × {number} calls.\n\n" + _table(["piece", "µs"], rows)
+    return f"Medians of {repeat} × {number} calls.\n\n" + table(["piece", "µs"], rows)
 
 
 def default_r(scene, model):
@@ -457,10 +427,10 @@ def main(argv=None) -> int:
 
     print("## Machine\n")
     print(machine_table())
-    print("\n" + source_line() + "\n")
+    print("\nrollqp source: " + source_line() + "\n")
     t_all = time.perf_counter()
     jobs = {m: (lambda m=m: run_public(scene, m)) for m in methods}
-    res = {m: combine(v) for m, v in interleaved(jobs, {m: (qreps if m.startswith("qp-") else reps)
+    res = {m: combine(v) for m, v in interleaved_jobs(jobs, {m: (qreps if m.startswith("qp-") else reps)
                                                         for m in methods}).items()}
     model = SceneOperators.build(scene)
     rN, rT = default_r(scene, model)
@@ -470,12 +440,12 @@ def main(argv=None) -> int:
           f"methods and {qreps} of the QP alternations. Inner iterations: Newton iterations for `nt-newton`, "
           f"interior-point (Clarabel) or ADMM (OSQP) iterations for the QP alternations. The default "
           f"augmentation of the coupled Newton method here is r_N = {rN:.3g}, r_T = {rT:.3g} (nondimensional).\n")
-    print(main_table(scene, res, methods))
+    print(maintable(scene, res, methods))
     print(f"#### The braked start: {scene.load.start_steps} normal-load steps at Q = 0 (state 0)\n")
-    print(start_table(scene, res, methods))
+    print(starttable(scene, res, methods))
     print("\n#### Iterations per step along the rolled distance\n")
     print("`newton`: Newton iterations; alternations: outer iterations (inner normal + inner tangential).\n")
-    print(bands_table(scene, res, methods))
+    print(bandstable(scene, res, methods))
     print()
     var, model = variants(scene, vreps)
     print(f"#### What the counts depend on (variants through the driver's march; medians over {vreps} run(s))\n")
@@ -485,11 +455,11 @@ def main(argv=None) -> int:
           "started cold (pressure from a Hertz-like profile, traction from zero) instead of from the previous "
           "outer iteration, or with a fixed r in the halves. Residual ratio: median of successive coupled "
           "residuals over the outer iterations (above 1e-12).\n")
-    print(variants_table(scene, var, res["newton"], model))
+    print(variantstable(scene, var, res["newton"], model))
     print("\n#### Where the time of a step goes\n")
     print(accounting(scene, model, vreps))
     print()
-    print(micro_table(model))
+    print(microtable(model))
     print(f"\n<!-- measured in {time.perf_counter() - t_all:.0f} s -->")
     return 0
 

@@ -27,10 +27,7 @@ BLAS is pinned to one thread. The test suite (tests/test_hard_cases.py) imports
 """
 from __future__ import annotations
 
-import os
-
-for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+import harness  # noqa: F401  (pins BLAS first)
 
 import argparse  # noqa: E402
 import math  # noqa: E402
@@ -415,7 +412,7 @@ def _line(r, c) -> str:
             f"{_f(r.error)} | {_f(r.closed)} | {held} | {r.seconds:.2f} | {'yes' if r.ok else 'NO'} |")
 
 
-def table(rows, selected) -> str:
+def results_table(rows, selected) -> str:
     by = {c.name: c for c in selected}
     return "\n".join([_HEADER] + [_line(r, by[r.case]) for r in rows])
 
@@ -453,8 +450,7 @@ def main(argv=None):
     ap.add_argument("--convective-sweep", action="store_true",
                     help="only the material/convective-local sweep over Δq (docs/stability.md)")
     args = ap.parse_args(argv)
-    from threadpoolctl import threadpool_limits
-    with threadpool_limits(1):
+    if True:  # BLAS pinned by harness at import
         if args.convective_sweep:
             return convective_sweep()
         only = args.only.split(",")

@@ -31,7 +31,7 @@ import sys
 import time
 
 import numpy as np
-from threadpoolctl import threadpool_limits
+from harness import table  # (pins BLAS first)
 
 import rollqp
 from rollqp import closedforms as cf
@@ -72,14 +72,6 @@ def settle_distance(q, rel, threshold):
     if bad.size == 0:
         return float(q[0])
     return float(q[bad[-1] + 1]) if bad[-1] + 1 < q.size else float("nan")
-
-
-def table(header, rows):
-    """A Markdown table; ``|`` inside a cell (absolute values) is escaped."""
-    cell = lambda c: str(c).replace("|", "\\|")  # noqa: E731
-    out = ["| " + " | ".join(map(cell, header)) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    out += ["| " + " | ".join(map(cell, r)) + " |" for r in rows]
-    return "\n".join(out)
 
 
 def timed_run(scene, method=None):
@@ -392,7 +384,7 @@ def main(argv=None):
           f"{rollqp.__version__}, numpy {np.__version__}, osqp {md.version('osqp')}, "
           f"clarabel {md.version('clarabel')}, cvxpy {md.version('cvxpy')}; BLAS pinned to 1 thread -->\n")
     t0 = time.perf_counter()
-    with threadpool_limits(limits=1):
+    if True:  # BLAS pinned by harness at import
         paper_runs = None
         for name in todo:
             if name == "paper":

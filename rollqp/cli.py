@@ -6,7 +6,7 @@
     rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
     rollqp crossval SCENE [--step K] [--methods M1,M2]
-    rollqp bench [--quick] [--docs] [...]   (rollqp.bench: work–precision and scaling)
+    rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first).
@@ -317,14 +317,30 @@ def cmd_crossval(args) -> int:
     return 0
 
 
+def benchmarks_folder():
+    """The source repository's ``benchmarks/`` folder beside the package, or ``None`` (installed from a wheel)."""
+    from pathlib import Path
+    folder = Path(__file__).resolve().parent.parent / "benchmarks"
+    return folder if (folder / "suite.py").is_file() else None
+
+
 def cmd_bench(args) -> int:
-    from .bench import main as bench_main
-    return bench_main(args.bench_args)
+    """``rollqp bench ARGS``: the benchmark suite of the source repository (``benchmarks/suite.py``)."""
+    import runpy
+    folder = benchmarks_folder()
+    if folder is None:
+        from .errors import InputError
+        raise InputError("bench", "the benchmarks ship with the source repository (benchmarks/suite.py), which this "
+                                  "installation does not have; clone it and run rollqp bench there")
+    if str(folder) not in sys.path:
+        sys.path.insert(0, str(folder))
+    suite = runpy.run_path(str(folder / "suite.py"), run_name="rollqp_bench_suite")
+    return suite["main"](args.bench_args)
 
 
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] == ["bench"]:  # the harness parses its own options (rollqp.bench.main)
+    if argv[:1] == ["bench"]:  # the suite parses its own options (benchmarks/suite.py)
         args = argparse.Namespace(command="bench", bench_args=argv[1:])
     else:
         args = _parser().parse_args(argv)

@@ -380,16 +380,8 @@ def carter_traction(x, a, p0, mu, ratio, direction):
 
     Parameters
     ----------
-    x : float or array_like
-        Coordinate along the strip (Eulerian, fixed to the contact).
-    a : float
-        Hertz half-width, ``a > 0``.
-    p0 : float
-        Hertz peak pressure, ``p0 ≥ 0``.
-    mu : float
-        Coulomb friction coefficient, ``μ ≥ 0``.
-    ratio : float
-        Signed load ratio ``Q/(μP)``, ``|ratio| < 1``.
+    x, a, p0, mu, ratio
+        As for :func:`cattaneo_traction` (``x`` Eulerian, fixed to the contact).
     direction : {-1, +1}
         ``d = sgn(V)``; material enters at ``x = −d·a`` (docs/formulation.md §1).
 

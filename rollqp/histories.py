@@ -105,10 +105,16 @@ class History:
             d[f.name] = list(v) if isinstance(v, tuple) else v
         return d
 
+    #: each field's validator (rollqp.scene.validate), named ``key.field`` in its errors
+    checks: ClassVar[dict] = {}
+
     # normalization shared by __post_init__ and parse_history
     @classmethod
-    def _normalize(cls, key: str, values: dict) -> dict:  # pragma: no cover - abstract
-        raise NotImplementedError
+    def _normalize(cls, key: str, values: dict) -> dict:
+        """Every field through its validator (:attr:`checks`); an absent optional one at its default."""
+        defaults = {f.name: f.default for f in fields(cls)}
+        return {name: check(f"{key}.{name}", values.get(name, defaults.get(name)))
+                for name, check in cls.checks.items()}
 
     def __post_init__(self):
         values = {f.name: getattr(self, f.name) for f in fields(self)}  # type: ignore[arg-type]
@@ -131,10 +137,7 @@ class Constant(History):
 
     kind: ClassVar[str] = "constant"
     required: ClassVar[tuple[str, ...]] = ("value",)
-
-    @classmethod
-    def _normalize(cls, key, values):
-        return {"value": finite_real(f"{key}.value", values["value"])}
+    checks: ClassVar[dict] = {"value": finite_real}
 
     def __call__(self, q):
         return _out(q, np.full(np.shape(q), self.value, dtype=float))
@@ -167,12 +170,7 @@ class Ramp(History):
 
     kind: ClassVar[str] = "ramp"
     required: ClassVar[tuple[str, ...]] = ("start", "end", "over")
-
-    @classmethod
-    def _normalize(cls, key, values):
-        return {"start": finite_real(f"{key}.start", values["start"]),
-                "end": finite_real(f"{key}.end", values["end"]),
-                "over": positive_real(f"{key}.over", values["over"])}
+    checks: ClassVar[dict] = {"start": finite_real, "end": finite_real, "over": positive_real}
 
     def __call__(self, q):
         s = np.clip(np.asarray(q, dtype=float) / self.over, 0.0, 1.0)
@@ -209,13 +207,8 @@ class Harmonic(History):
 
     kind: ClassVar[str] = "harmonic"
     required: ClassVar[tuple[str, ...]] = ("mean", "amplitude", "wavelength")
-
-    @classmethod
-    def _normalize(cls, key, values):
-        return {"mean": finite_real(f"{key}.mean", values["mean"]),
-                "amplitude": finite_real(f"{key}.amplitude", values["amplitude"]),
-                "wavelength": positive_real(f"{key}.wavelength", values["wavelength"]),
-                "phase": finite_real(f"{key}.phase", values.get("phase", 0.0))}
+    checks: ClassVar[dict] = {"mean": finite_real, "amplitude": finite_real, "wavelength": positive_real,
+                              "phase": finite_real}
 
     def __call__(self, q):
         theta = 2.0 * np.pi * np.asarray(q, dtype=float) / self.wavelength + self.phase

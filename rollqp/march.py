@@ -78,11 +78,11 @@ class State:
 class Counters:
     """What the solves of one state report to the result file."""
 
-    iterations: int = 0
-    residual: float = 0.0
-    inner_normal: int = 0
-    inner_tangential: int = 0
-    backtracks: int = 0
+    iterations: int = 0          # the method's iterations (N–T: outer iterations), all solves of the state
+    residual: float = 0.0        # the largest rollqp residual of those solves
+    inner_normal: int = 0        # iterations of the normal halves
+    inner_tangential: int = 0    # iterations of the tangential halves
+    backtracks: int = 0          # Armijo step reductions (Newton)
 
     def add(self, sol, half=None):
         """Count a solution of a normal or tangential half (two-QP path)."""

@@ -111,6 +111,27 @@ def _set_weights(step) -> int:
     return n
 
 
+def _check_arrays(step, operators=(), vectors=(), optional=()) -> int:
+    """Validate a step's weights, its operators (``n × n``) and vectors (``n``; ``optional`` may be
+    ``None``) in place; return ``n``."""
+    n = _set_weights(step)
+    for name in operators:
+        if getattr(step, name) is not None or name in ("A", "Ann", "Att"):
+            object.__setattr__(step, name, as_operator(getattr(step, name), name, n))
+    for name in vectors + optional:
+        if getattr(step, name) is not None or name in vectors:
+            object.__setattr__(step, name, _vec(name, getattr(step, name), n))
+    return n
+
+
+def _check_friction(step) -> None:
+    """``μ`` finite and ``>= 0``, ``Δq`` finite and ``> 0``."""
+    if not (np.isfinite(step.mu) and step.mu >= 0):
+        raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {step.mu!r}")
+    if not (np.isfinite(step.dq) and step.dq > 0):
+        raise InputError("dq", f"the step must be a finite number > 0, got {step.dq!r}")
+
+
 def _exactly_one(names, values):
     given = [n for n, v in zip(names, values) if v is not None]
     if len(given) != 1:
@@ -204,11 +225,7 @@ class NormalStep:
     kind = "normal"
 
     def __post_init__(self):
-        n = _set_weights(self)
-        object.__setattr__(self, "A", as_operator(self.A, "A", n))
-        object.__setattr__(self, "h", _vec("h", self.h, n))
-        if self.offset is not None:
-            object.__setattr__(self, "offset", _vec("offset", self.offset, n))
+        _check_arrays(self, ("A",), ("h",), ("offset",))
         _exactly_one(("P", "delta"), (self.P, self.delta))
         if self.delta is not None and not np.isfinite(self.delta):
             raise InputError("delta", f"the prescribed approach must be finite, got {self.delta!r}")
@@ -311,26 +328,20 @@ class TangentialStep:
     scales : Scales
     """
 
-    A: np.ndarray
-    f: np.ndarray
-    p: np.ndarray
+    A: np.ndarray                 # A_tt (eq. 28, 29): an Operator once validated
+    f: np.ndarray                 # weights, eq. 65–67
+    p: np.ndarray                 # the fixed pressure: bound μ p̄⁺ (eq. 60)
     mu: float
-    c: np.ndarray
-    dq: float
-    Q: float | None = None
-    xi: float | None = None
+    c: np.ndarray                 # history vector + A_tn p̄ (eq. 37, 48)
+    dq: float                     # Δq, or the static shift's length unit
+    Q: float | None = None        # load row (eq. 67) …
+    xi: float | None = None       # … or the creepage prescribed
     scales: Scales = field(default_factory=Scales)
     kind = "tangential"
 
     def __post_init__(self):
-        n = _set_weights(self)
-        object.__setattr__(self, "A", as_operator(self.A, "A", n))
-        object.__setattr__(self, "p", _vec("p", self.p, n))
-        object.__setattr__(self, "c", _vec("c", self.c, n))
-        if not (np.isfinite(self.mu) and self.mu >= 0):
-            raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {self.mu!r}")
-        if not (np.isfinite(self.dq) and self.dq > 0):
-            raise InputError("dq", f"the step must be a finite number > 0, got {self.dq!r}")
+        _check_arrays(self, ("A",), ("p", "c"))
+        _check_friction(self)
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
         if self.xi is not None and not np.isfinite(self.xi):
             raise InputError("xi", f"the prescribed creepage must be finite, got {self.xi!r}")
@@ -458,35 +469,25 @@ class CoupledStep:
     ``Δ·d·D_up·A_tn`` and ``Δ·d·D_up·A_tt`` with ``dq = Δ`` and ``c = 0``.
     """
 
-    Ann: np.ndarray
-    Att: np.ndarray
-    Ant: np.ndarray | None
-    Atn: np.ndarray | None
-    f: np.ndarray
-    h: np.ndarray
+    Ann: np.ndarray               # eq. 25–26
+    Att: np.ndarray               # eq. 28–29 (steady rolling: the steady slip operator)
+    Ant: np.ndarray | None        # gap per unit shear (None: the Goodman level)
+    Atn: np.ndarray | None        # tangential displacement per unit pressure
+    f: np.ndarray                 # weights, eq. 65–67
+    h: np.ndarray                 # undeformed gap, eq. 10
     mu: float
-    c: np.ndarray
+    c: np.ndarray                 # history vector, eq. 37, 48
     dq: float
-    P: float | None = None
-    delta: float | None = None
-    Q: float | None = None
-    xi: float | None = None
+    P: float | None = None        # normal load row …
+    delta: float | None = None    # … or the approach prescribed
+    Q: float | None = None        # tangential load row …
+    xi: float | None = None       # … or the creepage prescribed
     scales: Scales = field(default_factory=Scales)
     kind = "coupled"
 
     def __post_init__(self):
-        n = _set_weights(self)
-        for name in ("Ann", "Att"):
-            object.__setattr__(self, name, as_operator(getattr(self, name), name, n))
-        for name in ("Ant", "Atn"):
-            if getattr(self, name) is not None:
-                object.__setattr__(self, name, as_operator(getattr(self, name), name, n))
-        object.__setattr__(self, "h", _vec("h", self.h, n))
-        object.__setattr__(self, "c", _vec("c", self.c, n))
-        if not (np.isfinite(self.mu) and self.mu >= 0):
-            raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {self.mu!r}")
-        if not (np.isfinite(self.dq) and self.dq > 0):
-            raise InputError("dq", f"the step must be a finite number > 0, got {self.dq!r}")
+        _check_arrays(self, ("Ann", "Att", "Ant", "Atn"), ("h", "c"))
+        _check_friction(self)
         _exactly_one(("P", "delta"), (self.P, self.delta))
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
         if self.P is not None and not (np.isfinite(self.P) and self.P > 0):

@@ -57,6 +57,11 @@ class QPMethod:
     on 40 quadratic elements it puts a vertex/midnode checkerboard of 13 % of p0 on the
     Hertz pressure, because ``S`` feeds the log kernel's weakest mode.
 
+    ``info`` of a solution: ``qp_solves`` (QPs of the splitting), ``backend_time`` (wall time of
+    the backend's calls: data update, solve, retries), ``setups`` (solver objects built),
+    ``retried`` (QPs solved again after a failed polish), ``splitting_changes`` (max change of
+    ``x/p0`` from QP to QP: its ratios are the splitting's contraction), ``asymmetry``, ``operator``.
+
     One solver object is kept per constraint structure (:meth:`structure_key`) with the Hessian
     it was built for, recognized by its source (the symmetrized operator, the weights and the
     scales: the Hessian is normalized by its largest diagonal entry, so ``Δq`` drops out);
@@ -120,13 +125,18 @@ class QPMethod:
         # what the QP Hessian is a function of (the solver objects are kept per source, _solver_for)
         source = (sym_problem.A, sym_problem.f.tobytes(), sym_problem.scales)
         iters, solver_time, outer, change = 0, 0.0, 0, np.inf
+        backend, setups, retried, changes = 0.0, 0, 0, []
         x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
         while True:
             outer += 1
             prob = sym_problem.shifted(sp.skew @ x_phys) if exact else sym_problem  # F⁻¹ S x_{k−1}
             form = prob.qp_form()
             x0 = None if x_prev is None else x_prev / problem.scales.stress
+            tb = time.perf_counter()
             x, y, status, it, st, info = self._solve_form(form, x0, source)
+            backend += time.perf_counter() - tb
+            setups += int(bool(info.get("built", False)))
+            retried += int(info.get("tries", 1) > 1)
             iters += int(it)
             solver_time += float(st)
             if status == "solved" and self.refine:
@@ -139,6 +149,7 @@ class QPMethod:
                 break
             x_new = problem.traction(sol)
             last, change = change, float(np.max(np.abs(x_new - x_phys))) / problem.scales.stress
+            changes.append(change)
             x_phys = x_prev = x_new
             if change <= self.tolerance or (change >= 0.5 * last and change <= self.residual_limit):
                 break  # converged, or stalled at the QP solver's own accuracy
@@ -152,7 +163,8 @@ class QPMethod:
         final.time = time.perf_counter() - t0
         final.info.update(info)
         final.info.update(asymmetry=sp.asymmetry, operator="exact" if (exact or sp.asymmetry == 0) else "symmetrized",
-                          qp_solves=outer)
+                          qp_solves=outer, backend_time=backend, setups=setups, retried=retried,
+                          splitting_changes=changes)
         if not final.residual <= self.residual_limit:
             raise SolverError(f"the {problem.kind} QP solution's residual is above {self.residual_limit:.1e}",
                               method=self.name, status=status, residual=final.residual, iterations=iters)

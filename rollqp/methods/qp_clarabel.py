@@ -106,7 +106,7 @@ class ClarabelQP(QPMethod):
         # Clarabel's own ``solve_time`` includes the solver object's one-time set-up, and a
         # reused object reports it again on every solve; rollqp reports the wall time of the
         # ``solve()`` call instead, and the set-up (when built here) separately.
-        info = {"solver_status": status, "clarabel_solve_time": float(sol.solve_time)}
+        info = {"solver_status": status, "clarabel_solve_time": float(sol.solve_time), "built": fresh}
         if fresh:
             info["setup_time"] = setup
         return (np.asarray(sol.x), y, "solved" if status in _SOLVED else status, sol.iterations,

@@ -86,7 +86,7 @@ class CvxpyQP(QPMethod):
         return kw
 
     def _solve_form(self, form, x0, source=None):
-        (prob, x, params, cons), _ = self._solver_for(form, source, self._build)
+        (prob, x, params, cons), fresh = self._solver_for(form, source, self._build)
         params["q"].value = form.q
         if "b" in params:
             params["b"].value = float(form.b)
@@ -102,7 +102,7 @@ class CvxpyQP(QPMethod):
         except cp.error.SolverError as exc:
             return (np.zeros(form.H.shape[0]), 0.0, f"solver error: {exc}", 0, 0.0, {})
         status = prob.status
-        info = {"solver_status": status}
+        info = {"solver_status": status, "built": fresh}
         if self.solver == "OSQP":
             # OSQP's polish is passed on, but inside cvxpy it is refused on most of these QPs
             # (its active-set guess is not better than the ADMM iterate). Retrying with tighter

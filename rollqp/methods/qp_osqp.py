@@ -92,4 +92,4 @@ class OsqpQP(QPMethod):
         y = res.y[0] if form.a is not None else 0.0
         return (np.asarray(res.x), y, status, iters, spent,
                 {"solver_status": res.info.status, "status_polish": int(res.info.status_polish),
-                 "tries": tries})
+                 "tries": tries, "built": fresh})

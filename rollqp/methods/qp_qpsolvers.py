@@ -169,7 +169,7 @@ class QpsolversQP(QPMethod):
         x = np.asarray(sol.x, dtype=float) if sol.x is not None else np.zeros(form.H.shape[0])
         y = float(sol.y[0]) if (form.a is not None and sol.y is not None and len(sol.y)) else 0.0
         iters = _iterations(sol.extras)
-        return x, y, "solved" if ok else "not found", iters, spent, {"solver": self.solver,
+        return x, y, "solved" if ok else "not found", iters, spent, {"solver": self.solver, "built": True,
                                                                       "iterations_reported": iters > 0}
 
 

@@ -148,33 +148,13 @@ class Derived:
         return self.load.normal * self.load.normal_history(np.asarray(q, dtype=float) / self.a_H)
 
     def tangential_load(self, q):
-        """Tangential load on body A, Q(q) = μ·P̄·tangential(q/a_H).
-
-        Parameters
-        ----------
-        q : float or ndarray
-            Rolled distance, length units.
-
-        Raises
-        ------
-        InputError
-            If the scene prescribes the creepage instead.
-        """
+        """Tangential load on body A, Q(q) = μ·P̄·tangential(q/a_H), at the rolled distance ``q``
+        (length units); an :class:`~rollqp.errors.InputError` if the scene prescribes the creepage."""
         return self.contact.friction * self.load.normal * self._history("tangential", "creepage", q)
 
     def prescribed_creepage(self, q):
-        """Prescribed creepage ξ(q) = creepage(q/a_H).
-
-        Parameters
-        ----------
-        q : float or ndarray
-            Rolled distance, length units.
-
-        Raises
-        ------
-        InputError
-            If the scene prescribes the tangential load instead.
-        """
+        """Prescribed creepage ξ(q) = creepage(q/a_H) at the rolled distance ``q`` (length units);
+        an :class:`~rollqp.errors.InputError` if the scene prescribes the tangential load."""
         return self._history("creepage", "tangential", q)
 
     def _history(self, key: str, other: str, q):

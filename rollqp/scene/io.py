@@ -121,14 +121,8 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     default_name : str
         Name of a scene without ``name``.
 
-    Returns
-    -------
-    Scene
-
-    Raises
-    ------
-    InputError
-        Naming the dotted key.
+    Returns the validated :class:`Scene`; every invalid input is an :class:`InputError` naming
+    the dotted key.
     """
     if not isinstance(d, dict):
         raise InputError("SCENE", f"must be a table of tables, got {type(d).__name__}")

@@ -123,14 +123,14 @@ class Load:
         (rigid shafts); on the half-space δ depends on ``reference_distance`` (docs/bem.md).
     """
 
-    normal: float
-    normal_history: History = Constant(1.0)
-    tangential: History | None = None
-    creepage: History | None = None
+    normal: float                                # P̄, the reference load
+    normal_history: History = Constant(1.0)      # P(q)/P̄
+    tangential: History | None = None            # Q(q)/(μP̄) …
+    creepage: History | None = None              # … or ξ(q)
     start: str = "braked"
-    direction: int = -1
+    direction: int = -1                          # d = sgn(V)
     start_steps: int = 1
-    approach: History | None = None
+    approach: History | None = None              # δ(q) instead of P(q)
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ from ...problem import StepSolution
 from . import linear
 from .linear import coupled_vectors
 from .ncp import coupled_cases, coupled_phi
-from .uncoupled import ALPHA_MIN
+from .uncoupled import ALPHA_MIN, not_converged
 
 __all__ = ["solve_coupled"]
 
@@ -178,10 +178,7 @@ def solve_coupled(meth, pb, warm, t0):
             st.merits.pop()
             continue
         if it >= meth.max_iterations:
-            theta = st.merits[-1]
-            raise SolverError(f"the coupled Newton iteration did not converge: merit θ = {theta:.3e} "
-                              f"after {it} iterations (‖Φ‖∞ = {nrm:.3e} > {stop:.1e})",
-                              method=meth.name, status=f"merit {theta:.3e}", iterations=it, residual=nrm)
+            raise not_converged(meth, "coupled", st.merits, it, nrm, stop)
         it += 1
         d, dN, dT = st.direction(st.cases(it, nrm), it, nrm)
         alpha = st.line_search(d, dN, dT)

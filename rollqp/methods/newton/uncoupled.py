@@ -14,7 +14,8 @@ import numpy as np
 from ...errors import SolverError
 from .ncp import NormalNCP, TangentialNCP
 
-__all__ = ["ALPHA_MIN", "Stalled", "solve_uncoupled", "solve_normal", "solve_tangential", "tangential_by_creepage"]
+__all__ = ["ALPHA_MIN", "Stalled", "not_converged", "solve_uncoupled", "solve_normal", "solve_tangential",
+           "tangential_by_creepage"]
 
 #: Smallest Armijo step tried before the full step is taken anyway (see the package docstring).
 ALPHA_MIN = 1e-10
@@ -22,6 +23,14 @@ ALPHA_MIN = 1e-10
 
 class Stalled(Exception):
     """The Armijo search failed from a warm start (the step is then restarted cold)."""
+
+
+def not_converged(meth, kind: str, merits, it: int, nrm: float, stop: float) -> SolverError:
+    """The error of an iteration that reached ``max_iterations``: the merit, the iterations, ``‖Φ‖∞``."""
+    theta = merits[-1]
+    return SolverError(f"the {kind} Newton iteration did not converge: merit θ = {theta:.3e} after {it} iterations "
+                       f"(‖Φ‖∞ = {nrm:.3e} > {stop:.1e})", method=meth.name, status=f"merit {theta:.3e}",
+                       iterations=it, residual=nrm)
 
 
 def solve_uncoupled(meth, problem, warm, t0):
@@ -205,10 +214,7 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False):
         if nrm <= stop:
             break
         if it >= meth.max_iterations:
-            theta = st.merits[-1]
-            raise SolverError(f"the {pb.kind} Newton iteration did not converge: merit θ = {theta:.3e} "
-                              f"after {it} iterations (‖Φ‖∞ = {nrm:.3e} > {stop:.1e})",
-                              method=meth.name, status=f"merit {theta:.3e}", iterations=it, residual=nrm)
+            raise not_converged(meth, pb.kind, st.merits, it, nrm, stop)
         it += 1
         st.rows(mask)
         d = sys_.direction(mask, st.phi, st.with_load)  # reduced system on the free nodes

@@ -1,13 +1,13 @@
-"""Benchmark harness: work–precision diagrams and scaling (``python -m rollqp.bench``).
+"""The benchmark suite: work–precision diagrams and scaling (``rollqp bench``, or ``python benchmarks/suite.py``).
 
 Usage::
 
-    python -m rollqp.bench --quick          # a smoke test, under a minute: prints the tables
-    python -m rollqp.bench                  # the full study (about 10 minutes on 2 idle cores)
-    python -m rollqp.bench --docs           # the full study, written into docs/performance.md
-                                            # (between its <!-- bench:... --> markers) and
-                                            # docs/figures/perf-*.png
-    python -m rollqp.bench --parts scaling --methods newton,qp-osqp
+    rollqp bench --quick          # a smoke test: prints the tables (time: docs/performance.md)
+    rollqp bench                  # the full study (about 16 minutes on 2 idle cores)
+    rollqp bench --docs           # the full study, written into docs/performance.md
+                                  # (between its <!-- bench:... --> markers) and
+                                  # docs/figures/perf-*.png
+    rollqp bench --parts scaling --methods newton,qp-osqp
 
 Parts
 -----
@@ -39,24 +39,18 @@ versions, load average and the rollqp commit are printed first.
 from __future__ import annotations
 
 import argparse
-import datetime
-import importlib.metadata as md
 import json
-import os
-import platform
-import re
-import subprocess
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .errors import RollqpError
-from .methods import METHOD_NAMES
-from .report import closed_form_errors
-from .scene import load_scene
+from harness import (Run, fit_exponent, cholesky_time, machine_table, table, fmt_err, timed_run, diff_to,  # noqa: F401
+                     write_sections)
+from rollqp.methods import METHOD_NAMES
+from rollqp.scene import load_scene
 
 #: Tolerances of the work–precision sweep.
 TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
@@ -76,175 +70,6 @@ TARGET_RUN = 0.5            # s, §6.1.1 stepping time with Newton (40 QCE), at 
 FIGURES = Path("docs") / "figures"
 DOC = Path("docs") / "performance.md"
 
-
-# ------------------------------------------------------------------------------- machine
-#: Thread-count variables read by BLAS/OpenMP libraries when they load.
-THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS",
-                    "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
-
-
-def pin_threads():
-    """Limit every BLAS/OpenMP pool to one thread for the rest of the process; the limiter.
-
-    The pools already loaded (numpy's and scipy's OpenBLAS, each wheel bundles its own) are
-    limited by threadpoolctl; libraries loaded later start single-threaded through the
-    environment variables (set unless the user set them). Every benchmark calls this once.
-    """
-    for var in THREAD_VARIABLES:
-        os.environ.setdefault(var, "1")
-    from threadpoolctl import threadpool_limits
-    import scipy.linalg  # noqa: F401  (load scipy's BLAS before the limit is applied)
-    return threadpool_limits(limits=1)
-
-
-def cpu_model() -> str:
-    try:
-        with open("/proc/cpuinfo") as fh:
-            for line in fh:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor() or "unknown"
-
-
-def source_line() -> str:
-    """The rollqp source measured: git commit and whether the package's files differ from it."""
-    root = Path(__file__).resolve().parent.parent
-    try:
-        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True, text=True,
-                              timeout=10).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "rollqp"], cwd=root, capture_output=True,
-                               text=True, timeout=10).stdout.split("\n")
-    except (OSError, subprocess.SubprocessError):
-        return "unknown (no git)"
-    changed = [ln[3:] for ln in dirty if ln.strip()]
-    return (f"commit {head or 'unknown'}"
-            + (f", with uncommitted changes in {', '.join(changed)}" if changed else ", no uncommitted changes in rollqp/"))
-
-
-def machine_rows(command: str | None = None) -> list[tuple[str, str]]:
-    """(key, value) rows: date, platform, CPU, Python, packages, thread pools, load, command, source."""
-    from threadpoolctl import threadpool_info
-    try:
-        usable = len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        usable = os.cpu_count()
-    versions = []
-    for p in ("rollqp", "numpy", "scipy", "clarabel", "osqp", "cvxpy", "threadpoolctl"):
-        try:
-            versions.append(f"{p} {md.version(p)}")
-        except md.PackageNotFoundError:
-            versions.append(f"{p} (not installed)")
-    pools = "; ".join(f"{d.get('internal_api')} {d.get('version') or ''} "
-                      f"({d.get('num_threads')} thread{'s' if d.get('num_threads') != 1 else ''})".replace("  ", " ")
-                      for d in threadpool_info()) or "none found"
-    return [("date", datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")),
-            ("platform", platform.platform()),
-            ("cpu", f"{cpu_model()}; os.cpu_count() = {os.cpu_count()}, usable = {usable}"),
-            ("python", f"{platform.python_implementation()} {platform.python_version()}"),
-            ("packages", ", ".join(versions)),
-            ("thread pools", pools),
-            ("load average", " / ".join(f"{v:.2f}" for v in os.getloadavg()) + " (1, 5, 15 min, at start)"),
-            ("command", command or "python " + " ".join([os.path.relpath(sys.argv[0])] + sys.argv[1:])),
-            ("rollqp source", source_line())]
-
-
-def machine_table(command: str | None = None) -> str:
-    return table(["", ""], machine_rows(command))
-
-
-def table(header, rows) -> str:
-    """A markdown table; bars and lone stars (E*) in cells are escaped."""
-    def cell(c):
-        return re.sub(r"(?<!\*)\*(?!\*)", r"\\*", str(c).replace("|", "\\|"))
-
-    out = ["| " + " | ".join(cell(h) for h in header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    out += ["| " + " | ".join(cell(c) for c in r) + " |" for r in rows]
-    return "\n".join(out)
-
-
-def fmt_err(e) -> str:
-    return "–" if e is None or not np.isfinite(e) else f"{e:.1e}"
-
-
-# ------------------------------------------------------------------------------- runs
-@dataclass
-class Run:
-    """One scene run by one method: times, errors, or the failure."""
-
-    method: str
-    label: str
-    n: int = 0
-    steps: int = 0
-    stepping: float = float("nan")   # Σ step_time [s], median over repeats
-    step: float = float("nan")       # median rolling step_time [s], median over repeats
-    wall: float = float("nan")       # the whole rollqp.run call [s], median over repeats
-    repeats: int = 0
-    residual: float = float("nan")
-    errors: dict = field(default_factory=dict)
-    failed: str | None = None
-    skipped: str | None = None
-    arrays: dict | None = field(default=None, repr=False)
-
-    @property
-    def ok(self) -> bool:
-        return self.failed is None and self.skipped is None
-
-
-def _short(exc) -> str:
-    msg = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-    return f"{type(exc).__name__}: {msg[:160]}"
-
-
-def timed_run(scene, method, label="", repeats=3, budget=2.0, keep=True) -> Run:
-    """Run ``scene`` with ``method`` up to ``repeats`` times (stopping once ``budget`` seconds
-    are spent, at least once); medians of the times. Never raises: failures are recorded."""
-    from .march import run as drive
-
-    out = Run(method=method, label=label)
-    stepping, steps, walls = [], [], []
-    spent = 0.0
-    res = None
-    for _ in range(max(1, repeats)):
-        t0 = time.perf_counter()
-        try:
-            res = drive(scene, method=method)
-        except (RollqpError, ValueError, ArithmeticError, np.linalg.LinAlgError, MemoryError) as exc:
-            out.failed = _short(exc)
-            part = getattr(exc, "partial", None)
-            if part is not None and len(part):
-                out.steps = len(part) - 1
-            return out
-        except Exception as exc:  # a backend's own exception: recorded, the study goes on
-            out.failed = _short(exc)
-            return out
-        w = time.perf_counter() - t0
-        a = res.arrays()
-        walls.append(w)
-        stepping.append(float(a["step_time"].sum()))
-        steps.append(float(np.median(a["step_time"][2:] if len(a["step_time"]) > 3 else a["step_time"][1:])))
-        spent += w
-        if spent > budget:
-            break
-    a = res.arrays()
-    out.n, out.steps, out.repeats = int(a["x"].size), len(a["q"]) - 1, len(walls)
-    out.stepping, out.step, out.wall = map(lambda v: float(np.median(v)), (stepping, steps, walls))
-    out.residual = float(a["residual"].max())
-    out.errors = {k: v for k, v, _ in closed_form_errors(a, scene)}
-    if keep:
-        out.arrays = {k: a[k] for k in ("x", "q", "pn", "pt", "creepage", "a_H", "p0")}
-    return out
-
-
-def diff_to(run: Run, ref: Run, mu: float) -> float | None:
-    """Largest ``|t − t_ref|/(μp0)`` and ``|p − p_ref|/p0`` over all states (same discretization)."""
-    if not (run.ok and ref.ok) or run.arrays["pt"].shape != ref.arrays["pt"].shape:
-        return None
-    p0 = float(ref.arrays["p0"])
-    dt = float(np.max(np.abs(run.arrays["pt"] - ref.arrays["pt"]))) / (max(mu, 1e-300) * p0)
-    dp = float(np.max(np.abs(run.arrays["pn"] - ref.arrays["pn"]))) / p0
-    return max(dt, dp)
 
 
 def mid_error(run: Run, ref: Run, mu: float, q_mid: float = Q_MID, key: str = "pt") -> float | None:
@@ -476,21 +301,6 @@ def equal_accuracy(res, key, levels) -> str:
 
 
 # ------------------------------------------------------------------------------- part: scaling
-def cholesky_time(n, repeats=5) -> float:
-    import scipy.linalg as sl
-
-    rng = np.random.default_rng(0)
-    B = rng.standard_normal((n, n))
-    M = B @ B.T + n * np.eye(n)
-    ts = []
-    for _ in range(repeats):
-        C = M.copy(order="F")
-        t0 = time.perf_counter()
-        sl.cho_factor(C, overwrite_a=True, check_finite=False)
-        ts.append(time.perf_counter() - t0)
-    return float(np.median(ts))
-
-
 def part_scaling(methods, elements, repeats, step_budget, log):
     """{method: [Run per size]}, {n: cho_factor seconds}."""
     chol = {}
@@ -521,14 +331,6 @@ def part_scaling(methods, elements, repeats, step_budget, log):
             log(f"  scaling {m} n = {n}: " + (f"{1e3 * r.step:.3f} ms/step (cho {1e3 * chol[n]:.3f} ms)"
                                               if r.ok else r.failed))
     return per, chol
-
-
-def fit_exponent(ns, ts, n_min=161):
-    ns, ts = np.asarray(ns, float), np.asarray(ts, float)
-    m = (ns >= n_min) & np.isfinite(ts) & (ts > 0)
-    if m.sum() < 2:
-        return float("nan")
-    return float(np.polyfit(np.log(ns[m]), np.log(ts[m]), 1)[0])
 
 
 def scaling_table(per, chol) -> tuple[str, dict]:
@@ -703,20 +505,6 @@ def figure_scaling(per, chol, expo, path):
     return _save(fig, plt, path)
 
 
-# ------------------------------------------------------------------------------- docs
-def write_sections(doc: Path, sections: dict) -> list[str]:
-    """Replace ``<!-- bench:NAME -->`` … ``<!-- /bench:NAME -->`` blocks of ``doc``; names written."""
-    text = doc.read_text()
-    done = []
-    for name, body in sections.items():
-        pat = re.compile(rf"(<!-- bench:{re.escape(name)} -->\n).*?(<!-- /bench:{re.escape(name)} -->)", re.S)
-        if pat.search(text):
-            text = pat.sub(lambda mt: mt.group(1) + body.rstrip() + "\n" + mt.group(2), text)
-            done.append(name)
-    doc.write_text(text)
-    return done
-
-
 # ------------------------------------------------------------------------------- main
 PARTS = ("tolerance", "discretization", "scaling")
 
@@ -752,7 +540,6 @@ def main(argv: list[str] | None = None) -> int:
     if args.docs and quick:
         print("rollqp bench: --docs writes the full study; drop --quick", file=sys.stderr)
         return 2
-    limiter = pin_threads()  # noqa: F841  (kept alive for the whole study)
     repeats = args.repeats or (1 if quick else 3)
     run_budget = args.run_budget or (2.0 if quick else 20.0)
     step_budget = args.step_budget or (0.05 if quick else 2.0)
@@ -763,7 +550,7 @@ def main(argv: list[str] | None = None) -> int:
     def log(msg):
         print(msg, file=sys.stderr, flush=True)
 
-    command = "python -m rollqp.bench " + " ".join(argv if argv is not None else sys.argv[1:])
+    command = "rollqp bench " + " ".join(argv if argv is not None else sys.argv[1:])
     sections = {"machine": machine_table(command.strip())}
     print("## Machine\n\n" + sections["machine"] + "\n", flush=True)
     t_all = time.perf_counter()
