@@ -98,18 +98,23 @@ def _real(name, v) -> np.ndarray:
     """``v`` as a float array; an InputError naming ``name`` unless it holds real, finite numbers
     within ±:data:`MAX_MAGNITUDE` (booleans, complex numbers, strings, objects and ragged lists
     are refused, never cast)."""
-    try:
-        a = np.asarray(v)
-    except (ValueError, TypeError) as exc:
-        raise InputError(name, f"must hold real numbers ({exc})") from None
-    if a.dtype.kind not in "iuf":
-        raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
-    a = a.astype(float)
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite")
-    if a.size and np.max(np.abs(a)) > MAX_MAGNITUDE:
-        raise InputError(name, f"values must be within ±{MAX_MAGNITUDE:g} (beyond, the products of the step "
-                               f"problem overflow; rescale, e.g. with Scales), got {np.max(np.abs(a)):.3g}")
+    if type(v) is np.ndarray and v.dtype == np.float64:  # the common case: no copy, two numpy calls
+        a = v
+    else:
+        try:
+            a = np.asarray(v)
+        except (ValueError, TypeError) as exc:
+            raise InputError(name, f"must hold real numbers ({exc})") from None
+        if a.dtype.kind not in "iuf":
+            raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
+        a = a.astype(float)
+    if a.size:
+        big = np.max(np.abs(a))
+        if not big <= MAX_MAGNITUDE:  # NaN compares false: one test for both
+            if not np.all(np.isfinite(a)):
+                raise InputError(name, "must be finite")
+            raise InputError(name, f"values must be within ±{MAX_MAGNITUDE:g} (beyond, the products of the step "
+                                   f"problem overflow; rescale, e.g. with Scales), got {big:.3g}")
     return a
 
 
@@ -117,6 +122,10 @@ def _scalar(name, v):
     """``v`` as a float, or ``None``; an InputError naming ``name`` unless it is one real number."""
     if v is None:
         return None
+    if isinstance(v, (float, int)) and not isinstance(v, bool):  # the common case, without numpy
+        x = float(v)
+        if abs(x) <= MAX_MAGNITUDE:
+            return x
     a = _real(name, v)
     if a.ndim != 0:
         raise InputError(name, f"must be a real number, got an array of shape {a.shape}")
@@ -129,11 +138,9 @@ def _set_scalars(step, names) -> None:
 
 
 def _vec(name, v, n):
-    a = _real(name, v)
+    a = _real(name, v)  # real and finite
     if a.shape != (n,):
         raise InputError(name, f"must have shape ({n},), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite")
     return a
 
 
