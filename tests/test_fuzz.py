@@ -347,7 +347,7 @@ def _mutate_array(v, rng):
         return np.array(rng.choice([0.0, -1.0, np.nan, 1e300])), op
     if op == "bool":
         return np.ones(v.shape, dtype=bool), op
-    if op == "int" and v.dtype.kind == "f":
+    if op == "int" and v.dtype.kind == "f" and np.all(np.isfinite(v)):
         return v.astype(np.int64), op
     if op == "transpose" and v.ndim == 1:
         return v[:, None], op
