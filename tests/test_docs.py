@@ -174,3 +174,19 @@ def test_readme_snippet_runs():
     diff = rollqp.compare(scope["a"], scope["b"], mu=scope["mu"], scales=scope["scales"])
     # constant elements: F·A exactly symmetric, both backends solve the same QP to 5e-9 (conftest.BACKENDS)
     assert diff["t"] <= 1e-8 and scope["a"].residual <= 1e-8, out.getvalue()
+
+
+def test_every_cited_formulation_section_exists():
+    """Code, docs, tests, examples and benchmarks cite the equations as ``docs/formulation.md §N``
+    (the one source; issue 11): every cited N must be a numbered section of that page."""
+    page = (ROOT / "docs" / "formulation.md").read_text(encoding="utf-8")
+    sections = set(re.findall(r"^## (\d+)\. ", page, flags=re.M))
+    cited = {}
+    for folder in ("rollqp", "docs", "tests", "examples", "benchmarks"):
+        for path in sorted((ROOT / folder).rglob("*")):
+            if path.suffix not in (".py", ".md") or "_build" in path.parts:
+                continue
+            for n in re.findall(r"formulation\.md ?§ ?(\d+)", path.read_text(encoding="utf-8")):
+                cited.setdefault(n, path.relative_to(ROOT))
+    missing = {n: str(p) for n, p in cited.items() if n not in sections}
+    assert cited and not missing, f"cited sections that docs/formulation.md does not have: {missing}"
