@@ -219,6 +219,29 @@ def figure(results, path):
     fig.savefig(path, dpi=110)
 
 
+def checks() -> list[str]:
+    """Steel/steel, shafts 0.1 R_α: (1) the half-space's c is its kernel constant,
+    c(d_ref) = c(R) + 2 ln(d_ref/R)/(πE*); the d_ref that gives the BEM's c makes the half-space
+    reproduce the BEM's ramp; (2) a prescribed steady creepage returns the load it came from."""
+    sH, sB = ramp_scene("halfspace", None, 0.1, 8.0), ramp_scene("bem", None, 0.1, 8.0)
+    cH, cB = windup_compliance(sH), windup_compliance(sB)
+    c10 = windup_compliance(sH.replace(**{"contact.reference_distance": 10.0 * sH.R}))
+    out = [f"c_HS(10 R) − c_HS(R) = {c10 - cH:.6e}, 2 ln(10)/(πE*) = {2 * math.log(10) / (math.pi * sH.Estar):.6e}"]
+    d = sH.R * math.exp((cB - cH) * math.pi * sH.Estar / 2.0)
+    q, _, xH = creepage(sH.replace(**{"contact.reference_distance": d}))
+    _, _, xB = creepage(sB)
+    out.append(f"half-space with d_ref = {d:.3g} mm (c_HS = c_BEM): max |ξ_HS − ξ_BEM|/|ξ_BEM| = "
+               f"{np.max(np.abs(xH - xB)[1:] / np.abs(xB[1:])):.2e} over 8 a_H")
+    for name, s in (("half-space", sH), ("BEM", sB)):
+        xi = steady_creepage(s)
+        sp = s.replace(**{"load.start": "rolling", "discretization.distance": 0.0,
+                          "load.creepage": {"kind": "constant", "value": xi}})
+        Q = float(rollqp.run(sp, method="newton").arrays()["Q"][0])
+        out.append(f"{name}: steady ξ = {xi:.6e} at Q/(μP) = 0.75; prescribed back: Q/(μP) = "
+                   f"{Q / (s.contact.friction * s.load.normal):.10f}")
+    return out
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--figure", metavar="PNG", help="also draw ξ(q) of the shaft-0.1 cases to PNG")
@@ -233,6 +256,8 @@ def main(argv=None):
     print(tables(results, args.distance))
     print("\nThe coupling difference against a_H/R (radii and shafts scaled, same load; steady solves):\n")
     print(scaling_table())
+    print("\nChecks (steel/steel, shafts 0.1 R_α):\n")
+    print("\n".join("* " + line for line in checks()))
     if args.figure:
         figure(results, args.figure)
         print(f"\nfigure: {args.figure}")
