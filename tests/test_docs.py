@@ -54,6 +54,7 @@ def _script_options(script):
     out = io.StringIO()
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out):
         mp.setattr("sys.argv", [str(script), "--help"])
+        mp.syspath_prepend(str(script.parent))   # as `python benchmarks/x.py` does (harness.py beside it)
         with pytest.raises(SystemExit):
             runpy.run_path(str(script), run_name="__main__")
     return set(re.findall(r"--[a-z][a-z-]*", out.getvalue()))
