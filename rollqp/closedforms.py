@@ -589,8 +589,9 @@ _MINDLIN = ("R. D. Mindlin and H. Deresiewicz, Elastic spheres in contact under 
 _CIAVARELLA = ("M. Ciavarella, D. A. Hills and G. Monno, The influence of rounded edges on indentation by a flat "
                "punch, Proc. IMechE C 212, 319–328 (1998) (2D flat punch with rounded corners); derived again "
                "in docs/kinematics.md from the 2D inversion formula (" + _JOHNSON + ", §2.8, eq. 2.49)")
-SOURCES.update({"mindlin_traction": _MINDLIN, "mindlin_dissipation": _MINDLIN,
-                "rounded_punch_load": _CIAVARELLA, "rounded_punch_pressure": _CIAVARELLA})
+SOURCES.update({"mindlin_turning_points": _MINDLIN, "mindlin_traction": _MINDLIN, "mindlin_dissipation": _MINDLIN,
+                "rounded_punch_load": _CIAVARELLA, "rounded_punch_half_width": _CIAVARELLA,
+                "rounded_punch_pressure": _CIAVARELLA})
 __all__ += ["mindlin_turning_points", "mindlin_traction", "mindlin_dissipation", "rounded_punch_load",
             "rounded_punch_half_width", "rounded_punch_pressure"]
 
@@ -601,7 +602,17 @@ def mindlin_turning_points(ratios) -> tuple[list, float]:
     Masing's memory rule for Mindlin–Deresiewicz: a reversal from ``r_m`` is forgotten, with the
     one before it, once the load goes past ``r_{m−1}`` (the slip annulus of the earlier branch is
     swept again); the first (virgin) turning point ``r_1`` is forgotten once the load passes
-    ``−r_1``. Returns ``(stack, current)`` with ``stack[0] = 0``.
+    ``−r_1``. Source: ``SOURCES["mindlin_turning_points"]``.
+
+    Parameters
+    ----------
+    ratios : sequence of float
+        The path of ``Q/(μP)`` from 0, each ``|r| < 1``, piecewise linear between the values.
+
+    Returns
+    -------
+    (list of float, float)
+        The remembered turning points (``stack[0] = 0``) and the current value.
     """
     vals = _ratio_array(ratios).ravel()
     stack, cur = [0.0], 0.0
@@ -680,6 +691,18 @@ def mindlin_dissipation(ratio, mu, P, Estar):
     in 2D (the part linear in Q and the constant, which depend on the reference distance of the
     2D half-space, do no work over a closed cycle; docs/kinematics.md). Source:
     ``SOURCES["mindlin_dissipation"]``.
+
+    Parameters
+    ----------
+    ratio : float
+        Amplitude ``Q*/(μP)``, ``|ratio| < 1``.
+    mu, P, Estar : float
+        Friction coefficient (>= 0), normal load per unit length (> 0), contact modulus (> 0).
+
+    Returns
+    -------
+    float
+        Energy per cycle and unit axial length (force units).
     """
     r = abs(_ratio(ratio))
     mu, P, Estar = _nonnegative("mu", mu), _positive("P", P), _positive("Estar", Estar)
@@ -693,6 +716,18 @@ def rounded_punch_load(a, b, R, Estar):
     Profile ``z = 0`` for ``|x| ≤ b``, ``(|x| − b)²/(2R)`` outside; for ``a > b``:
     ``P = (E* a²/(4R))·(π − 2φ0 − sin 2φ0)``, ``sin φ0 = b/a`` (``b = 0``: Hertz). Source:
     ``SOURCES["rounded_punch_load"]``.
+
+    Parameters
+    ----------
+    a, b : float
+        Contact half-width (> 0) and flat half-width (``0 <= b < a``).
+    R, Estar : float
+        Edge radius and contact modulus, > 0.
+
+    Returns
+    -------
+    float
+        P per unit axial length.
     """
     a, b = _positive("a", a), _nonnegative("b", b)
     R, Estar = _positive("R", R), _positive("Estar", Estar)
@@ -703,7 +738,22 @@ def rounded_punch_load(a, b, R, Estar):
 
 
 def rounded_punch_half_width(P, b, R, Estar):
-    """Contact half-width ``a`` of the rounded punch under ``P`` (:func:`rounded_punch_load` inverted, bisection)."""
+    """Contact half-width ``a`` of the rounded punch under ``P`` (:func:`rounded_punch_load` inverted, bisection).
+
+    Source: ``SOURCES["rounded_punch_half_width"]``.
+
+    Parameters
+    ----------
+    P : float
+        Normal load per unit length, > 0.
+    b, R, Estar : float
+        Flat half-width (>= 0), edge radius and contact modulus (> 0).
+
+    Returns
+    -------
+    float
+        ``a > b``.
+    """
     P = _positive("P", P)
     lo, hi = max(_nonnegative("b", b), 0.0), max(2.0 * b, 1.0)
     while rounded_punch_load(hi, b, R, Estar) < P:
@@ -726,6 +776,18 @@ def rounded_punch_pressure(x, a, b, R, Estar):
     (no edge singularity), and Hertz's ``p0√(1 − x²/a²)`` for ``b = 0``. From
     ``p = (E*/(2π))√(a² − x²)·PV∫ z'(s)/((s − x)√(a² − s²)) ds`` (docs/kinematics.md). Source:
     ``SOURCES["rounded_punch_pressure"]``.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Coordinates along the strip.
+    a, b, R, Estar : float
+        As for :func:`rounded_punch_load`.
+
+    Returns
+    -------
+    float or ndarray
+        ``p(x) >= 0``, zero for ``|x| >= a``.
     """
     x = _coords(x)
     a, b = _positive("a", a), _nonnegative("b", b)

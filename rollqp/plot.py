@@ -55,10 +55,14 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     x, a, p0 = res["x"], float(res["a_H"]), float(res["p0"])
     mu = scene.contact.friction or 1.0
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
-    idx = snapshot_indices(res["q"], a)
+    # a load path (load.rolled, rollqp.kinematics): states against the time-like τ, Carter in the last direction
+    clock, tname = (res["time"], "tau") if "time" in res else (res["q"], "q")
+    d = res["direction"][res["direction"] != 0] if "direction" in res else np.zeros(0)
+    direction = int(d[-1]) if d.size else scene.load.direction
+    idx = snapshot_indices(clock, a)
     colors = plt.cm.viridis(np.linspace(0, 0.9, len(idx)))
     for c, k in zip(colors, idx):
-        lab = f"q = {res['q'][k] / a:.2f} a_H"
+        lab = f"{tname} = {clock[k] / a:.2f} a_H"
         ax[0].plot(x / a, res["pt"][k] / (mu * p0), "-", color=c, lw=1.4, label=lab)
         slip = np.where(res["state"][k] == 0, np.nan, res["slip"][k])  # no slip where separated
         ax[1].plot(x / a, slip * scene.R / (mu * a), "-", color=c, lw=1.2, label=lab)
@@ -71,17 +75,17 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
                        label="Cattaneo")
         r1 = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
         if abs(r1) < 1:
-            ax[0].plot(xf / a, cf.carter_traction(xf, a, p0, mu, r1, scene.load.direction) / (mu * p0), "k-.",
+            ax[0].plot(xf / a, cf.carter_traction(xf, a, p0, mu, r1, direction) / (mu * p0), "k-.",
                        lw=0.9, label="Carter")
     ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="tangential traction on body A")
     ax[1].set(xlabel="x / a_H", ylabel="s R / (mu a_H)", title="slip (per unit rolled distance)")
-    ax[2].plot(res["q"] / a, res["creepage"] * scene.R / (mu * a), "-", lw=1.2, label="rollqp")
+    ax[2].plot(clock / a, res["creepage"] * scene.R / (mu * a), "-", lw=1.2, label="rollqp")
     if scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0:
         r1 = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
         if abs(r1) < 1:
             ax[2].axhline(cf.carter_creepage(a, scene.R, mu, r1) * scene.R / (mu * a), color="k", ls="-.", lw=0.9,
                           label="Carter (steady)")
-    ax[2].set(xlabel="q / a_H", ylabel="xi R / (mu a_H)", title="creepage")
+    ax[2].set(xlabel=f"{tname} / a_H", ylabel="xi R / (mu a_H)", title="creepage")
     for axis in ax:
         axis.grid(alpha=0.3)
         axis.legend(fontsize=7)

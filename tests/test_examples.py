@@ -218,6 +218,7 @@ def test_examples_are_documented(name):
     assert 'if __name__ == "__main__":' in text, f"{name} is a script"
 
 
+@pytest.mark.slow
 def test_gallery_load_paths(tmp_path, capsys):
     """examples/load_paths.py (docs/kinematics.md), run as its command runs it: the stop keeps the state
     to round-off, the reversal ends at the mirrored Carter state, the fretting cycle follows

@@ -94,9 +94,9 @@ def test_table_sampled_from_a_circle_reproduces_the_circle():
 
 @pytest.mark.parametrize("profile", [
     {"kind": "defect", "depth": 0.003, "width": 0.8, "position": 2.0},
-    {"kind": "flat", "length": 1.2, "position": 2.0},
-    [{"kind": "defect", "depth": -0.001, "width": 0.4, "position": 1.6, "shape": "parabolic"},
-     {"kind": "defect", "depth": 0.004, "width": 0.6, "position": 2.6}],
+    pytest.param({"kind": "flat", "length": 1.2, "position": 2.0}, marks=pytest.mark.slow),
+    pytest.param([{"kind": "defect", "depth": -0.001, "width": 0.4, "position": 1.6, "shape": "parabolic"},
+                  {"kind": "defect", "depth": 0.004, "width": 0.6, "position": 2.6}], marks=pytest.mark.slow),
 ], ids=["dent", "flat", "bump-and-dent"])
 def test_features_roll_through_under_every_method(profile):
     """A dent, a flat and a bump with a dent roll through the braked Carter contact (constant elements,
