@@ -1,7 +1,7 @@
 """Kinematics as a history: the rolled distance q(τ) of a time-like parameter τ, step by step (paper eq. 21, 32–40).
 
 Without ``load.rolled`` a scene's steps are ``q_k = k·Δq`` and the time-like parameter is the
-rolled distance itself, τ = q (the paper's eq. 21 with |V| = 1). With ``load.rolled`` the steps
+rolled distance itself, τ = q (the paper's eq. 21 with ``|V| = 1``). With ``load.rolled`` the steps
 are ``τ_k = k·Δτ`` (``Δτ = step·Le``, the same grid) and the rolled distance is
 ``q(τ) = a_H·rolled(τ/a_H)``, any history (:mod:`rollqp.histories`): its increments
 ``Δq_k = q(τ_k) − q(τ_{k−1})`` may
@@ -28,13 +28,13 @@ import numpy as np
 
 __all__ = ["Plan", "plan", "HistoryCache", "hysteresis", "STOP_TOL"]
 
-#: |Δq| below this fraction of the element length is a stop (a table's flat segment gives exactly 0).
+#: ``|Δq|`` below this fraction of the element length is a stop (a table's flat segment gives exactly 0).
 STOP_TOL = 1e-12
 
 
 @dataclass(frozen=True)
 class Plan:
-    """The steps of a scene: ``tau`` (τ_k), ``q`` (q(τ_k)), and per step ``dq`` = |Δq_k| and ``d``.
+    """The steps of a scene: ``tau`` (τ_k), ``q`` (q(τ_k)), and per step ``dq`` = ``|Δq_k|`` and ``d``.
 
     ``d[k]`` is the direction of the material in step k (±1), 0 for a stop; ``d[0] = load.direction``.
     ``rolled`` is False for a scene without ``load.rolled`` (then ``q`` is ``tau``, every

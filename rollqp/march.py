@@ -23,7 +23,7 @@ benchmarks, post-processing — consumes the records; it needs no private call. 
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
   ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step. With
   ``load.rolled`` (:mod:`rollqp.kinematics`) the steps are ``τ_k``, the loads ``P(τ_k)``, …, each
-  step's ``M`` is that of its own |Δq_k| and direction (a reversal flips the shift and upwind
+  step's ``M`` is that of its own ``|Δq_k|`` and direction (a reversal flips the shift and upwind
   operators, eq. 32–40), and a stop (Δq_k = 0) is a static-shift step (phase ``"static-shift"``);
   a profile that moves (:mod:`rollqp.profiles`) gives each step its own undeformed gap.
 * **contact lost** (``P(q) = 0``): an unloaded state (:func:`_unloaded`), nothing solved;
@@ -350,7 +350,7 @@ class _March:
 
         Without ``load.rolled``: a rolling step at ``q = k·Δq`` with the scene's ``M``. With it: the
         loads at τ_k; a stop is a static shift (``c = −w^{k−1}``, ``Δ = a_H``, the rigid shift ξ·Δ
-        recorded in ``shift``), a rolling step uses ``M`` of its own |Δq_k| and direction.
+        recorded in ``shift``), a rolling step uses ``M`` of its own ``|Δq_k|`` and direction.
         """
         scene, pl = self.scene, self.plan
         t0 = time.perf_counter()

@@ -117,11 +117,12 @@ def test_dent_lifting_the_middle_makes_two_patches():
     """A dent deeper than the approach in the middle of the contact: two contact patches at once."""
     s = base(**{"discretization.distance": 0.0, "bodies.A.profile": {"kind": "defect", "depth": 0.02, "width": 0.6,
                                                                      "position": 0.0}})
-    for method in ("newton", "qp-clarabel"):
+    for method in ("newton", "qp-clarabel", "qp-osqp"):
         a = rollqp.run(s, method).arrays()
-        inside = (a["pn"][0] > 0).astype(int)
+        # in contact: above the backends' accuracy (OSQP leaves ~1e-14 p0 on separated nodes)
+        inside = (a["pn"][0] > 1e-8 * s.p0).astype(int)
         assert np.count_nonzero(np.diff(inside) == 1) == 2, method
-        assert a["pn"][0][a["x"].size // 2] == 0.0
+        assert a["pn"][0][a["x"].size // 2] < 1e-8 * s.p0
 
 
 def test_profile_api_for_other_modules():

@@ -151,7 +151,7 @@ def check_whole(scene) -> None:
 
 
 def check_kinematics(scene) -> None:
-    """``load.rolled``: every step's |Δq| within the step limits (``discretization.step``'s range, the
+    """``load.rolled``: every step's ``|Δq|`` within the step limits (``discretization.step``'s range, the
     convective-local CFL bound), and each body's profile against the strip and the run
     (:func:`rollqp.profiles.check_cover`)."""
     from ..kinematics import plan
