@@ -135,3 +135,17 @@ def markdown_table() -> str:
                 "package versions, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
                 "`rolling_start`) |")
     return "\n".join(rows)
+
+
+# ------------------------------------------------------------------------- kinematics (issue 13)
+def _with_rolled(scene) -> bool:
+    return scene.load.rolled is not None
+
+
+register(Field("time", "step", LENGTH, "time-like parameter tau of each state (load.rolled: q = q(tau) and the "
+                                       "loads are histories of tau; 0: the starting state)",
+               compute=lambda rec, ops: 0.0 if rec.tau is None else rec.tau, needed=_with_rolled))
+register(Field("direction", "step", "1", "direction of the material in the step (load.rolled): +1 or -1, "
+                                         "0 for a stop (a static shift step)", dtype="int64",
+               compute=lambda rec, ops: rec.direction if rec.k > 0 else int(ops.scene.load.direction),
+               needed=_with_rolled))

@@ -61,15 +61,19 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     mu = scene.contact.friction or 1.0
     braked = scene.load.start == "braked"
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
-    idx = snapshot_indices(res["q"], a)
+    # a load path (load.rolled, rollqp.kinematics): states against the time-like τ, Carter in the last direction
+    clock, tname = (res["time"], "tau") if "time" in res else (res["q"], "q")
+    d = res["direction"][res["direction"] != 0] if "direction" in res else np.zeros(0)
+    direction = int(d[-1]) if d.size else scene.load.direction
+    idx = snapshot_indices(clock, a)
     for c, k in zip(_colors(plt, len(idx)), idx):
-        lab = f"q = {res['q'][k] / a:.2f} a_H"
+        lab = f"{tname} = {clock[k] / a:.2f} a_H"
         ax[0].plot(x / a, res["pt"][k] / (mu * p0), "-", color=c, lw=1.4, label=lab)
         if not (k == 0 and braked):
             slip = np.where(res["state"][k] == 0, np.nan, res["slip"][k])  # no slip where separated
             ax[1].plot(x / a, slip * scene.R / a, "-", color=c, lw=1.2, label=lab)
     ax[0].plot(x / a, res["pn"][0] / p0, ":", color="0.5", lw=1, label="p/p0 (q = 0)")
-    ax[2].plot(res["q"] / a, res["creepage"] * scene.R / a, "-", lw=1.2, label="rollqp")
+    ax[2].plot(clock / a, res["creepage"] * scene.R / a, "-", lw=1.2, label="rollqp")
     xf = np.linspace(-1, 1, 801) * a
     closed = scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0
     marks = []
@@ -80,9 +84,9 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
                        label="Cattaneo")
         r1 = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
         if abs(r1) < 1:
-            d = scene.load.direction
-            ax[0].plot(xf / a, cf.carter_traction(xf, a, p0, mu, r1, d) / (mu * p0), "k-.", lw=0.9, label="Carter")
-            ax[1].plot(xf / a, cf.carter_slip(xf, a, scene.R, mu, r1, d) * scene.R / a, "k-.", lw=0.9,
+            ax[0].plot(xf / a, cf.carter_traction(xf, a, p0, mu, r1, direction) / (mu * p0), "k-.", lw=0.9,
+                       label="Carter")
+            ax[1].plot(xf / a, cf.carter_slip(xf, a, scene.R, mu, r1, direction) * scene.R / a, "k-.", lw=0.9,
                        label="Carter (steady)")
             marks.append(cf.carter_creepage(a, scene.R, mu, r1) * scene.R / a)
             ax[2].axhline(marks[-1], color="k", ls="-.", lw=0.9, label="Carter (steady)")
@@ -90,7 +94,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="tangential traction on body A")
     note = " (q = 0 braked: no rolling slip)" if braked else ""
     ax[1].set(xlabel="x / a_H", ylabel="s R / a_H", title="slip per unit rolled distance" + note)
-    ax[2].set(xlabel="q / a_H", ylabel="xi R / a_H", title="creepage")
+    ax[2].set(xlabel=f"{tname} / a_H", ylabel="xi R / a_H", title="creepage")
     for axis in ax:
         axis.grid(alpha=0.3)
         axis.legend(fontsize=7, loc="best")

@@ -59,7 +59,9 @@ def check_body(key: str, b: Any) -> Body:
     if shaft is not None:
         shaft = number(f"{key}.shaft_radius", shaft, f"in (0, radius = {radius!r}) or absent",
                         lambda x: 0.0 < x < radius)
-    return Body(radius, E, nu, shaft)
+    from ..profiles import parse_profile
+    profile = parse_profile(b.profile, f"{key}.profile", radius)
+    return Body(radius, E, nu, shaft, None if profile.is_circle else profile)
 
 
 def check_contact(c: Any) -> Contact:
@@ -100,7 +102,8 @@ def check_load(ld: Any) -> Load:
     if approach is not None and nh != Constant(1.0):
         raise InputError("load.approach", "give at most one of load.normal_history and load.approach "
                                           "(with a prescribed approach the normal load is an unknown)")
-    return Load(normal, nh, tang, creep, start, int(direction), steps, approach)
+    rolled = None if ld.rolled is None else parse_history(ld.rolled, "load.rolled")
+    return Load(normal, nh, tang, creep, start, int(direction), steps, approach, rolled)
 
 
 def check_discretization(d: Any) -> Discretization:
@@ -144,6 +147,28 @@ def check_whole(scene) -> None:
     check_zone(scene)
     check_tangential(scene)
     check_sampling(scene)
+    check_kinematics(scene)
+
+
+def check_kinematics(scene) -> None:
+    """``load.rolled``: every step's ``|Δq|`` within the step limits (``discretization.step``'s range, the
+    convective-local CFL bound), and each body's profile against the strip and the run
+    (:func:`rollqp.profiles.check_cover`)."""
+    from ..kinematics import plan
+    from ..profiles import check_cover
+    pl = plan(scene)
+    if pl.rolled and pl.dq.size > 1:
+        disc = scene.discretization
+        limit = 8.0 if disc.formulation == "material" else CONVECTIVE_STEP_MAX[disc.element]
+        big = float(np.max(pl.dq)) / scene.element_length
+        if big > limit * (1 + 1e-12):
+            k = int(np.argmax(pl.dq))
+            raise InputError("load.rolled", f"|Δq| must stay in [0, {limit:g}] Le per step with formulation = "
+                                            f"{disc.formulation!r}, but step {k} (τ = {pl.tau[k] / scene.a_H:.6g} a_H) "
+                                            f"rolls {big:.6g} Le: use a smaller discretization.step")
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
+        if body.profile is not None:
+            check_cover(body.profile, f"{key}.profile", scene.half_width, pl.shift_range(), scene.contact.model)
 
 
 def check_derived(scene) -> None:
@@ -254,7 +279,7 @@ def check_tangential(scene) -> None:
     nmin, _ = load.normal_history.extremes(q_end)
     if nmin > 0 and max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
         return
-    q = np.unique(np.concatenate((scene.q_steps / scene.a_H, load.normal_history.critical_points(q_end),
+    q = np.unique(np.concatenate((scene.time_steps / scene.a_H, load.normal_history.critical_points(q_end),
                                   tang.critical_points(q_end))))
     Qr, Pr = np.abs(np.asarray(tang(q), dtype=float)), np.asarray(load.normal_history(q), dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):  # P = 0 (contact lost): Q must be 0 too

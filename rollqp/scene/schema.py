@@ -53,12 +53,16 @@ class Body:
     shaft_radius : float or None
         Inner (shaft) radius of the annular cylinder, in (0, radius); used by
         ``contact.model = "bem"`` only. None: not given.
+    profile : Profile or None
+        The body's undeformed shape (:mod:`rollqp.profiles`: a contact-frame table, flats,
+        defects, material tables); None: the circle of ``radius``.
     """
 
     radius: float
     E: float
     nu: float
     shaft_radius: float | None = None
+    profile: object = None
 
     @property
     def G(self) -> float:
@@ -121,6 +125,11 @@ class Load:
         of the normal load (the normal-side analogue of ``creepage``); ``normal`` stays the
         reference load P̄ of a_H, p0 and the zone. Meaningful with ``contact.model = "bem"``
         (rigid shafts); on the half-space δ depends on ``reference_distance`` (docs/bem.md).
+    rolled : History or None
+        Kinematics as a history (:mod:`rollqp.kinematics`): the rolled distance
+        q(τ) = a_H·rolled(τ/a_H) of the time-like parameter τ, which then steps by Δτ = step·Le
+        up to ``distance`` and is the argument of every load history. Increasing q rolls in
+        ``direction``, decreasing q reverses, a constant q stops (static shift steps). None: τ = q.
     """
 
     normal: float                                # P̄, the reference load
@@ -131,6 +140,7 @@ class Load:
     direction: int = -1                          # d = sgn(V)
     start_steps: int = 1
     approach: History | None = None              # δ(q) instead of P(q)
+    rolled: History | None = None                # q(τ)/a_H (None: τ = q)
 
 
 @dataclass(frozen=True)
