@@ -292,7 +292,7 @@ class _CreepageSearch:
         pb, sc, warm = self.pb, self.pb.scales, self.sol
         x0 = warm.xi / sc.slip if warm is not None and warm.xi is not None else 0.0
         f0 = self.F(x0)
-        h = 2.0 * pb.mu * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
+        h = 2.0 * (pb.mu if np.ndim(pb.mu) == 0 else float(np.max(pb.mu))) * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
         lo = hi = x0
         flo = fhi = f0
         for _ in range(80):  # widen both ways until F changes sign
