@@ -52,7 +52,7 @@ def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponentia
         "solver": {"method": method, "tolerance": 1e-10}})
 
 
-def patch_scene(mu=0.1, inside=0.02, start=2.0, end=3.0, elements=88, ratio=0.75, distance=8.0, method="newton",
+def patch_scene(mu=0.1, inside=0.05, start=2.0, end=2.5, elements=88, ratio=0.5, distance=8.0, method="newton",
                 frame="material"):
     """CONTACT's Cattaneo → Carter problem (``rollqp.refcases.contact_scene``) with a patch ``[start, end]``
     (a_H units, at q = 0) of coefficient ``inside`` carried by the material through the contact."""

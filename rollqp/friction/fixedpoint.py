@@ -12,7 +12,8 @@ bound). Its fixed points are exactly the solutions of the slip-dependent step.
 
 **Stopping test.** rollqp's residual of the *slip-dependent* problem at the iterate
 (:meth:`TangentialStep.residuals <rollqp.problem.TangentialStep.residuals>` with the bound at the
-iterate's own slip) below the inner method's ``residual_limit`` (its tolerance if it has none): after a
+iterate's own slip) below the inner method's tolerance, or below its ``residual_limit`` (what its
+QP solutions are trusted to) once it no longer halves per iteration: after a
 fixed-bound solve only the bound's change ``|μ(s^{(k+1)}) − μ^{(k)}| p`` at slipping nodes remains
 in it.
 
@@ -77,8 +78,9 @@ class BoundFixedPoint:
             its += sol.iterations
             true = problem.evaluate(sol)
             history.append(true.residual)
-            if true.residual <= self.limit:
-                break
+            if true.residual <= self.tolerance or (true.residual <= self.limit and len(history) > 1
+                                                   and true.residual >= 0.5 * history[-2]):
+                break  # converged, or stalled at the inner QPs' own accuracy (their residual_limit)
             self._check(history, k)
             mu = (1.0 - self.relaxation) * mu + self.relaxation * law.mu(sol.s)
         else:
