@@ -135,3 +135,15 @@ def markdown_table() -> str:
                 "package versions, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
                 "`rolling_start`) |")
     return "\n".join(rows)
+
+
+def _friction_coefficient(rec, operators):
+    """``μ`` at the nodes of a step with a friction law (kept by the march in ``info["mu"]``)."""
+    sol = rec.solution
+    mu = None if sol is None else sol.info.get("mu")
+    return np.full(operators.n, float(operators.mu)) if mu is None else np.asarray(mu, dtype=float)
+
+
+register(Field("friction_coefficient", "state", "1",
+               "coefficient of friction mu at each node in the step (scenes with a friction law, docs/friction.md)",
+               compute=_friction_coefficient, needed=lambda scene: not isinstance(scene.contact.friction, float)))

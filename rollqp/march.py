@@ -373,7 +373,8 @@ def prepare(scene, method=None):
     coupled = scene.coupling_level == "full"
     kind = law_kind(scene.contact.friction)
     if method is None or isinstance(method, str):
-        meth = scene_method(scene.solver, coupled=coupled, friction=kind)
+        law = {} if kind == "constant" else {"friction": kind}  # Coulomb: the call as before
+        meth = scene_method(scene.solver, coupled=coupled, **law)
     else:
         meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
     ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")

@@ -53,7 +53,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     """Save a three-panel figure: t/(μp0), slip, and creepage against q."""
     plt = pyplot()
     x, a, p0 = res["x"], float(res["a_H"]), float(res["p0"])
-    mu = scene.contact.friction or 1.0
+    mu = scene.contact.mu or 1.0
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
     idx = snapshot_indices(res["q"], a)
     colors = plt.cm.viridis(np.linspace(0, 0.9, len(idx)))
@@ -64,7 +64,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
         ax[1].plot(x / a, slip * scene.R / (mu * a), "-", color=c, lw=1.2, label=lab)
     ax[0].plot(x / a, res["pn"][0] / p0, ":", color="0.5", lw=1, label="p/p0 (q = 0)")
     xf = np.linspace(-1, 1, 801) * a
-    if scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0:
+    if scene.coupling_level == "off" and scene.load.tangential is not None and isinstance(scene.contact.friction, float) and scene.contact.friction > 0:
         P0, Q0 = float(res["P"][0]), float(res["Q"][0])
         if scene.load.start == "braked" and abs(Q0) < mu * P0:
             ax[0].plot(xf / a, cf.cattaneo_traction(xf, a, p0, mu, Q0 / (mu * P0)) / (mu * p0), "k--", lw=0.9,
@@ -76,7 +76,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="tangential traction on body A")
     ax[1].set(xlabel="x / a_H", ylabel="s R / (mu a_H)", title="slip (per unit rolled distance)")
     ax[2].plot(res["q"] / a, res["creepage"] * scene.R / (mu * a), "-", lw=1.2, label="rollqp")
-    if scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0:
+    if scene.coupling_level == "off" and scene.load.tangential is not None and isinstance(scene.contact.friction, float) and scene.contact.friction > 0:
         r1 = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
         if abs(r1) < 1:
             ax[2].axhline(cf.carter_creepage(a, scene.R, mu, r1) * scene.R / (mu * a), color="k", ls="-.", lw=0.9,
@@ -119,13 +119,14 @@ class _Info:
         meta = _meta(res)
         sd = meta.get("scene", {})
         if scene is not None:
-            self.mu = float(scene.contact.friction)
+            self.mu = float(scene.contact.mu)
             self.name, self.description = scene.name, scene.description
             self.start, self.direction = scene.load.start, int(scene.load.direction)
             self.normal = float(scene.load.normal)
             self.coupling = scene.coupling_level
         else:
-            self.mu = float(sd.get("contact", {}).get("friction", 1.0))
+            fr = sd.get("contact", {}).get("friction", 1.0)
+            self.mu = float(fr) if not isinstance(fr, dict) else float(fr.get("mu", fr.get("static", max(fr.get("values", [1.0])))))
             self.name, self.description = sd.get("name", "result"), sd.get("description", "")
             self.start = sd.get("load", {}).get("start", "braked")
             self.direction = int(sd.get("load", {}).get("direction", -int(res.get("leading_edge", 1))))

@@ -11,12 +11,12 @@ Three families, each a small frozen record whose fields are the keys of ``[conta
   ``s`` the slip per unit rolled distance), CONTACT's forms with ``Δμ = static − kinetic`` and a
   characteristic velocity ``v_h``:
 
-  =============  ============================================================
-  ``linear``     ``μ = μ_k + Δμ max(0, 1 − v/v_h)``
-  ``rational``   ``μ = μ_k + Δμ / (1 + v/v_h)``
-  ``exponential`` ``μ = μ_k + Δμ exp(−v/v_h)``
-  ``plateau``    ``μ = μ_k + Δμ exp(−max(0, v − v_p)/v_h)`` (flat up to ``v_p``)
-  =============  ============================================================
+  ===============  ============================================================
+  ``linear``       ``μ = μ_k + Δμ max(0, 1 − v/v_h)``
+  ``rational``     ``μ = μ_k + Δμ / (1 + v/v_h)``
+  ``exponential``  ``μ = μ_k + Δμ exp(−v/v_h)``
+  ``plateau``      ``μ = μ_k + Δμ exp(−max(0, v − v_p)/v_h)`` (flat up to ``v_p``)
+  ===============  ============================================================
 
   with an optional memory length ``L``: the coefficient of a material point relaxes towards
   ``μ(v)`` over the rolled distance ``L`` (implicit Euler per step, :mod:`.bound`).

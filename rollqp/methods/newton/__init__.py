@@ -181,14 +181,7 @@ class NewtonMethod:
                                                   "(Newton halves in the N–T alternation) or a qp-* method")
             return solve_coupled(self, problem, warm, t0)
         if problem.kind == "tangential" and getattr(problem, "law", None) is not None:
-            try:
-                return self.checked(solve_slip(self, problem, warm, t0))
-            except SolverError:
-                if warm is None:
-                    raise
-                sol = solve_slip(self, problem, None, t0)  # the warm start's branch lost: once from zero shear
-                sol.info["restarts"] = 1
-                return self.checked(sol)
+            return self._solve_slip(problem, warm, t0)
         if problem.kind not in ("normal", "tangential"):
             raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
                                         f"not {problem.kind!r}")
@@ -199,6 +192,25 @@ class NewtonMethod:
                 raise
             sol = tangential_by_creepage(self, problem, warm, t0, err)
         return self.checked(sol)
+
+    def _solve_slip(self, problem, warm, t0):
+        """A slip-dependent tangential step (:mod:`.slip`): from the warm start; if that fails, once from zero
+        shear (``info["restarts"]``); with ``Q`` prescribed and both failing, by the creepage search
+        (:func:`~.uncoupled.tangential_by_creepage`, the ξ-prescribed solves being slip-dependent too)."""
+        try:
+            return self.checked(solve_slip(self, problem, warm, t0))
+        except SolverError as err:
+            first = err
+        try:
+            if warm is None:
+                raise first
+            sol = self.checked(solve_slip(self, problem, None, t0))  # the warm start's branch lost
+            sol.info["restarts"] = 1
+            return sol
+        except SolverError as err:
+            if problem.Q is None:
+                raise
+            return self.checked(tangential_by_creepage(self, problem, warm, t0, err))
 
     def augmentation(self, problem) -> float:
         """The nondimensional ``r`` used for ``problem`` (package docstring)."""
