@@ -147,3 +147,27 @@ def test_examples_run(monkeypatch, tmp_path):
     assert 0 < peak < len(xs) - 1, "the creep curve rises to a peak and falls (falling friction)"
     assert xs[-1] > VELDEP["FKIN"] / 0.30 - 1e-9, "never below the kinetic limit"
     assert any(x is None for _, x in out["by_force"]), "a force above the peak has no steady state"
+
+
+def test_long_memory_keeps_the_static_coefficient():
+    """Memory L → ∞: the material keeps the static value it enters with (w = L/(L + Δq) → 1): Coulomb at μ_s,
+    to O(Δq/L) (L = 1e6 a_H: measured 1e-8 μ_s p0)."""
+    sc = veldep_scene(elements=46, memory=1e6, start="braked", distance=0.5)
+    r = run(sc, "newton").arrays()
+    c = run(sc.replace(**{"contact.friction": 0.30}), "newton").arrays()
+    assert np.max(np.abs(r["pt"] - c["pt"])) <= 1e-6 * 0.3 * sc.p0
+    assert np.all(r["friction_coefficient"][-1] > 0.3 - 1e-6)
+
+
+def test_patch_on_a_coupled_scene_by_alternation():
+    """A law on a coupled scene: nt-newton and qp-osqp (both in the N–T alternation) agree."""
+    sc = load_scene("goodman-bentall").replace(**{"contact.coupling": "full", "discretization.distance": 1.0,
+                                                   "load.start_steps": 2, "discretization.elements": 20,
+                                                   "discretization.step": 1.0,
+                                                   "contact.friction": {"law": "patch", "mu": 0.3, "inside": 0.2,
+                                                                        "start": 0.5, "end": 1.5, "frame": "material"}})
+    a = run(sc, "nt-newton").arrays()
+    b = run(sc, "qp-osqp").arrays()
+    assert not np.allclose(a["friction_coefficient"][0], a["friction_coefficient"][-1])  # the patch moved
+    # the alternation stops at the coupled residual 1e-8 (qp-osqp's residual_limit); measured below 1e-7 μ p0
+    assert np.max(np.abs(a["pt"] - b["pt"])) <= 1e-6 * 0.3 * sc.p0
