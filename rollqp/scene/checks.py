@@ -288,10 +288,24 @@ def check_sampling(scene) -> None:
                              f"smaller discretization.step")
 
 
+#: Smallest strip element length over the smaller radius for ``model = "bem"``: the BEM nodes are
+#: points ``R (cos θ, sin θ)`` and its collocation integrals need their separations resolved far
+#: above round-off (1e-7 R is 1e9 ulps of R). Contacts this small are half-space contacts: the
+#: BEM's departure from the half-space is of order a/R (docs/bem.md).
+MIN_BEM_ELEMENT_RATIO = 1e-7
+
+
 def check_bem(scene) -> None:
-    """``model = "bem"``: both shafts given, and the strip shorter than half a circumference."""
+    """``model = "bem"``: both shafts given, the strip shorter than half a circumference, its
+    elements resolvable on the circles."""
     if scene.contact.model != "bem":
         return
+    smaller = min(scene.A.radius, scene.B.radius)
+    if not scene.element_length >= MIN_BEM_ELEMENT_RATIO * smaller:
+        raise InputError("contact.model", f"'bem' needs strip elements of at least {MIN_BEM_ELEMENT_RATIO:g} × the "
+                                          f"smaller radius, got {scene.element_length:.3g} on radius {smaller:g} "
+                                          f"(a_H/R = {scene.a_H / scene.R:.3g}); a contact this small is a half-space "
+                                          f"contact: use model = 'halfspace'")
     for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
         if body.shaft_radius is None:
             raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' (the "
