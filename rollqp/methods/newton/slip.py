@@ -7,7 +7,7 @@ The rows are those of eq. 60 with the bound now a function of the unknowns throu
     b_i = \mu_i(s_i)\,\hat p_i^+ ,
 
 and the pseudo-Jacobian keeps the node cases of eq. 85–88 with one change, at slipping nodes
-(eq. 88 with ``b`` no longer fixed; docs/formulation.md §4, "eq. 88s")::
+(eq. 88 with ``b`` no longer fixed; docs/formulation.md §13, "eq. 88s")::
 
     stick (eq. 86/87):  ∂(r ŝ_i)
     zero bound (eq. 85): e_{t,i}
