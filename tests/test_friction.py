@@ -114,6 +114,7 @@ def test_newton_refuses_a_law_on_a_coupled_step():
     ({"law": "patch", "mu": 0.1, "inside": 0.0, "start": 2, "end": 1}, "contact.friction.end"),
     ({"law": "plateau", "static": 0.3, "kinetic": 0.2, "velocity": 1.0, "rolling_speed": 1.0}, "contact.friction.plateau"),
     ({"law": "stribeck"}, "contact.friction.law"),
+    ({"law": "patch", "mu": 0.1, "inside": 0.0, "start": 0, "end": 1, "rolling_speed": 1.0}, "contact.friction.rolling_speed"),
     ({"law": "linear", "static": 0.3, "kinetic": 0.2, "velocity": 1.0, "rolling_speed": 1.0, "sped": 1}, "contact.friction.sped"),
 ])
 def test_bad_input(ramp, friction, key):
