@@ -172,3 +172,17 @@ def test_patch_on_a_coupled_scene_by_alternation():
     assert not np.allclose(a["friction_coefficient"][0], a["friction_coefficient"][-1])  # the patch moved
     # the alternation stops at the coupled residual 1e-8 (qp-osqp's residual_limit); measured below 1e-7 μ p0
     assert np.max(np.abs(a["pt"] - b["pt"])) <= 1e-6 * 0.3 * sc.p0
+
+
+def test_slip_law_on_a_coupled_scene_by_alternation():
+    """A slip-velocity law on a coupled scene: nt-newton (Newton halves with eq. 88s) and qp-osqp (the fixed
+    point on the bound inside the N–T alternation) agree (measured 3.6e-11 μ_s p0); newton refuses up front."""
+    sc = load_scene("goodman-bentall").replace(**{
+        "contact.coupling": "full", "discretization.distance": 1.0, "load.start_steps": 2,
+        "discretization.elements": 20, "discretization.step": 1.0,
+        "contact.friction": {"law": "exponential", "static": 0.3, "kinetic": 0.2, "velocity": 1.0, "rolling_speed": 10.0}})
+    a, b = run(sc, "nt-newton").arrays(), run(sc, "qp-osqp").arrays()
+    assert np.ptp(a["friction_coefficient"][-1][a["state"][-1] == 2]) > 0  # μ varies over the slip zone
+    assert np.max(np.abs(a["pt"] - b["pt"])) <= 1e-8 * 0.3 * sc.p0  # the alternation's limit 1e-8 (qp-osqp)
+    with pytest.raises(InputError, match="nt-newton"):
+        prepare(sc, "newton")
