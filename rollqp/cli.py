@@ -244,6 +244,8 @@ def _spot_steps(args, scene):
     if wanted is None:
         n = scene.discretization.elements * {"constant": 1, "linear": 1, "quadratic": 2}[scene.discretization.element] + 1
         wanted = not args.quiet and n <= SPOT_MAX_NODES and scene.solver.method not in SPOT_METHODS
+    if not isinstance(scene.contact.friction, float):  # step files hold one constant μ (a law: docs/friction.md)
+        wanted = False
     if not wanted or args.quiet:
         return {}, None
     from .stepfile import from_record

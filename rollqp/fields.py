@@ -149,3 +149,15 @@ register(Field("direction", "step", "1", "direction of the material in the step 
                                          "0 for a stop (a static shift step)", dtype="int64",
                compute=lambda rec, ops: rec.direction if rec.k > 0 else int(ops.scene.load.direction),
                needed=_with_rolled))
+
+
+def _friction_coefficient(rec, operators):
+    """``μ`` at the nodes of a step with a friction law (kept by the march in ``info["mu"]``)."""
+    sol = rec.solution
+    mu = None if sol is None else sol.info.get("mu")
+    return np.full(operators.n, float(operators.mu)) if mu is None else np.asarray(mu, dtype=float)
+
+
+register(Field("friction_coefficient", "state", "1",
+               "coefficient of friction mu at each node in the step (scenes with a friction law, docs/friction.md)",
+               compute=_friction_coefficient, needed=lambda scene: not isinstance(scene.contact.friction, float)))

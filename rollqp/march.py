@@ -208,17 +208,26 @@ class _March:
 
     # ------------------------------------------------------------ one step
     def step(self, state: State, cnt: Counters, *, P, c, dq, Q=None, xi=None, normal_fixed=False,
-             steady=False, delta=None, h=None):
-        """One step (rolling, static shift or steady): ``(new state, problem, solution)``."""
+             steady=False, delta=None, h=None, q=0.0, transport=None):
+        """One step (rolling, static shift or steady): ``(new state, problem, solution)``.
+
+        ``h``: the gap of a moving profile (else the operators' own); ``q`` places a friction law
+        that varies along the surface; ``transport`` (the step's rolled distance, rolling steps
+        only) carries a friction memory with the material."""
         ops, meth = self.ops, self.method
         if P is not None and P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
             return _unloaded(ops, xi), None, None
-        if ops.mu == 0.0:
+        if ops.frictionless:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
+        fr = None
+        if not isinstance(ops.friction, float):  # a law: this step's μ (Coulomb keeps the old path)
+            prev = None if state.tsol is None else state.tsol.info.get("mu")
+            fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
-            pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta, h=h)
+            pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta, h=h, friction=fr)
             sol = meth.solve(pb, warm=state.tsol)
             cnt.add_coupled(sol)
+            _keep_mu(pb, sol)
             return State(sol.p, sol.t, ops.w(sol.p, sol.t), sol, sol, None), pb, sol
         nsol, npb = state.nsol, state.normal
         if not normal_fixed or nsol is None:
@@ -226,9 +235,10 @@ class _March:
             npb = ops.normal_step(P, state.t, delta=delta, h=h)
             nsol = meth.solve(npb, warm=state.nsol)
             cnt.add(nsol, "normal")
-        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady)
+        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady, friction=fr)
         tsol = meth.solve(pb, warm=state.tsol)
         cnt.add(tsol, "tangential")
+        _keep_mu(pb, tsol)
         return State(nsol.p, tsol.t, ops.w(nsol.p, tsol.t), nsol, tsol, npb), pb, tsol
 
     def _frictionless(self, state, cnt, *, P, c, dq, xi=None, steady=False, delta=None, h=None):
@@ -254,7 +264,8 @@ class _March:
     def record(self, k, phase, q, state, previous, problem, sol, cnt, *, P, shift, t0) -> StepRecord:
         ops = self.ops
         tsol = state.tsol
-        nodes = classify(state.p, state.t, tsol.s, ops.mu, ops.scales)
+        mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s)
+        nodes = classify(state.p, state.t, tsol.s, mu, ops.scales)
         gross = bool(np.any(nodes == 2) and not np.any(nodes == 1))
         return StepRecord(k=k, phase=phase, q=float(q), P=float(ops.f @ state.p) if P is None else P,
                           Q=float(ops.f @ state.t), state=state, previous=previous, problem=problem, solution=sol, counters=cnt,
@@ -335,7 +346,7 @@ class _March:
         for _ in range(max_steps):
             previous = state
             state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                                            normal_fixed=self.fixed, delta=self.approach(0.0))
+                                            normal_fixed=self.fixed, delta=self.approach(0.0), transport=scene.dq)
             change = np.max(np.abs(state.t - previous.t)) / (max(ops.mu, 1e-300) * ops.scales.stress)
             if not self.fixed:
                 change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
@@ -367,7 +378,8 @@ class _March:
         else:
             c, dq, phase = -(M @ state.w), scene.dq, "rolling"
         new, problem, sol = self.step(state, cnt, P=P, c=c, dq=dq, Q=Q, xi=xi,
-                                      normal_fixed=self.fixed, delta=self.approach(tau), h=h)
+                                      normal_fixed=self.fixed, delta=self.approach(tau), h=h,
+                                      q=q, transport=dq if phase == "rolling" else None)
         if not self.fixed:
             self.ops.check_inside(new.p, k)
         shift = new.tsol.xi * dq if d == 0 else 0.0
@@ -391,11 +403,14 @@ def prepare(scene, method=None):
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
+    from .friction import law_kind
     coupled = scene.coupling_level == "full"
+    kind = law_kind(scene.contact.friction)
     if method is None or isinstance(method, str):
-        meth = scene_method(scene.solver, coupled=coupled)
+        law = {} if kind == "constant" else {"friction": kind}  # Coulomb: the call as before
+        meth = scene_method(scene.solver, coupled=coupled, **law)
     else:
-        meth = compose(method, coupled, max_outer=scene.solver.max_iterations)
+        meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
     ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")
     meth.setup(ops)
     return scene, meth, ops
@@ -578,3 +593,10 @@ def _unloaded(ops: SceneOperators, xi=None) -> State:
     tsol = StepSolution(t=zero, s=zero, xi=0.0 if xi is None else float(xi), method="unloaded",
                         status="unloaded")
     return State(zero, zero, zero, nsol, tsol, None)
+
+
+def _keep_mu(problem, sol) -> None:
+    """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
+    the result field ``friction_coefficient``); Coulomb steps are left as they were."""
+    if problem.law is not None or np.ndim(problem.mu) != 0:
+        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s), (problem.n,)).astype(float)

@@ -58,7 +58,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     """
     plt = pyplot()
     x, a, p0 = res["x"], float(res["a_H"]), float(res["p0"])
-    mu = scene.contact.friction or 1.0
+    mu = scene.contact.mu or 1.0
     braked = scene.load.start == "braked"
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
     # a load path (load.rolled, rollqp.kinematics): states against the time-like τ, Carter in the last direction
@@ -75,7 +75,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     ax[0].plot(x / a, res["pn"][0] / p0, ":", color="0.5", lw=1, label="p/p0 (q = 0)")
     ax[2].plot(clock / a, res["creepage"] * scene.R / a, "-", lw=1.2, label="rollqp")
     xf = np.linspace(-1, 1, 801) * a
-    closed = scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0
+    closed = scene.coupling_level == "off" and scene.load.tangential is not None and isinstance(scene.contact.friction, float) and scene.contact.friction > 0
     marks = []
     if closed:
         P0, Q0 = float(res["P"][0]), float(res["Q"][0])
@@ -164,13 +164,14 @@ class _Info:
         meta = _meta(res)
         sd = meta.get("scene", {})
         if scene is not None:
-            self.mu = float(scene.contact.friction)
+            self.mu = float(scene.contact.mu)
             self.name, self.description = scene.name, scene.description
             self.start, self.direction = scene.load.start, int(scene.load.direction)
             self.normal = float(scene.load.normal)
             self.coupling = scene.coupling_level
         else:
-            self.mu = float(sd.get("contact", {}).get("friction", 1.0))
+            fr = sd.get("contact", {}).get("friction", 1.0)
+            self.mu = float(fr) if not isinstance(fr, dict) else float(fr.get("mu", fr.get("static", max(fr.get("values", [1.0])))))
             self.name, self.description = sd.get("name", "result"), sd.get("description", "")
             self.start = sd.get("load", {}).get("start", "braked")
             self.direction = int(sd.get("load", {}).get("direction", -int(res.get("leading_edge", 1))))

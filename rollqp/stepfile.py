@@ -93,6 +93,9 @@ def from_record(scene, ops, method, rec) -> "StepFile":
 def _from_record(scene, ops, k, method, rec):
     n = ops.n
     problem, sol = rec.problem, rec.solution
+    if getattr(problem, "law", None) is not None or np.ndim(problem.mu) != 0:
+        raise InputError("contact.friction", "a step file holds one constant coefficient of friction; this scene's "
+                                             "friction law (docs/friction.md) cannot be exported")
     if problem.kind == "coupled":
         pb = problem
         ref = sol

@@ -67,7 +67,8 @@ def check_body(key: str, b: Any) -> Body:
 def check_contact(c: Any) -> Contact:
     if not isinstance(c, Contact):
         raise InputError("contact", f"must be a Contact, got {c!r}")
-    mu = number("contact.friction", c.friction, f">= 0 (and <= {MAX_FRICTION:g})", lambda x: 0 <= x <= MAX_FRICTION)
+    from ..friction import parse_friction
+    mu = parse_friction(c.friction)  # a number (Coulomb, as before) or a law record
     model = choice("contact.model", c.model, MODELS)
     coupling = choice("contact.coupling", c.coupling, COUPLINGS)
     d = c.reference_distance
@@ -148,6 +149,7 @@ def check_whole(scene) -> None:
     check_tangential(scene)
     check_sampling(scene)
     check_kinematics(scene)
+    check_friction(scene)
 
 
 def check_kinematics(scene) -> None:
@@ -270,7 +272,7 @@ def check_tangential(scene) -> None:
     if tang is None:
         return
     tmin, tmax = tang.extremes(q_end)
-    if scene.contact.friction == 0.0:
+    if scene.contact.mu == 0.0:
         if tmin != 0.0 or tmax != 0.0:
             raise InputError("load.tangential",
                              "must be 0 when contact.friction = 0 (it is Q/(mu P̄) and "
@@ -359,3 +361,15 @@ def check_convective_step(scene) -> None:
                          f"{disc.element} elements (Δq at most the node spacing: the upwind "
                          f"transport is unstable beyond it, docs/stability.md), got {disc.step!r}; "
                          f"use a smaller step or formulation = 'material'")
+
+
+def check_friction(scene) -> None:
+    """A friction law varying along the surface meets the strip during the run (:mod:`rollqp.friction`)."""
+    law = scene.contact.friction
+    if not isinstance(law, float) and scene.load.rolled is not None:
+        # the laws place their μ(x) and transport their memory with the scene's one direction and
+        # q = direction·τ; stops and reversals (load.rolled) are not wired into them yet
+        raise InputError("contact.friction", "a friction law cannot be combined with load.rolled yet (stops and "
+                                             "reversals); use a constant coefficient, or roll one way")
+    if hasattr(law, "check_strip"):
+        law.check_strip(scene.half_width / scene.a_H, scene.q_end / scene.a_H, scene.load.direction)

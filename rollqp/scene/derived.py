@@ -164,7 +164,7 @@ class Derived:
     def tangential_load(self, q):
         """Tangential load on body A, Q(q) = μ·P̄·tangential(q/a_H), at the rolled distance ``q``
         (length units); an :class:`~rollqp.errors.InputError` if the scene prescribes the creepage."""
-        return self.contact.friction * self.load.normal * self._history("tangential", "creepage", q)
+        return self.contact.mu * self.load.normal * self._history("tangential", "creepage", q)
 
     def prescribed_creepage(self, q):
         """Prescribed creepage ξ(q) = creepage(q/a_H) at the rolled distance ``q`` (length units);

@@ -76,8 +76,9 @@ class Contact:
 
     Parameters
     ----------
-    friction : float
-        Coulomb coefficient μ, finite and ``>= 0``.
+    friction : float or friction law
+        Coulomb coefficient μ, finite and ``>= 0``; or a law of :mod:`rollqp.friction`
+        (``[contact.friction]`` table: a patch, a table μ(x), a slip-velocity law).
     model : {"halfspace", "bem"}
         Half-space influence (docs/formulation.md §3) or true geometry by BEM (docs/bem.md).
     coupling : {"auto", "full", "goodman", "off"}
@@ -96,6 +97,12 @@ class Contact:
     reference_distance: float | None = None
     bem_outer_elements: int | None = None
     bem_inner_elements: int | None = None
+
+    @property
+    def mu(self) -> float:
+        """The reference coefficient (the number itself for Coulomb; :func:`rollqp.friction.reference`):
+        ``load.tangential`` is ``Q/(μ P̄)`` with it."""
+        return self.friction if isinstance(self.friction, float) else float(self.friction.reference)
 
 
 @dataclass(frozen=True)
