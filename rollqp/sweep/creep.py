@@ -158,7 +158,7 @@ def creep_curve(scene, ratios="0.05:0.95:19", friction=None, out="creep.zarr", *
     from . import sweep
     base, axes = creep_sweep(scene, ratios, friction)
     summary = sweep(base, axes, out, **run)
-    ds = xr.open_zarr(out)
+    ds = xr.open_zarr(out, chunks=None)
     done = (ds["status"] == 1).values
     first = {"step": 0}
     P = np.where(done, ds["P"].isel(first).values, np.nan)

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import InputError
 from ..fields import FIELDS, dtype_of, fields_for
 
-__all__ = ["open_result", "create_store", "open_store", "write_point", "result_fields", "STATUS"]
+__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "write_point", "result_fields", "STATUS"]
 
 #: Values of the per-point ``status`` variable.
 STATUS = {"missing": 0, "done": 1, "failed": 2}
@@ -114,44 +114,36 @@ def _padded(rows, shape, keys_shape):
     return out
 
 
-def _coords(sweep, fields) -> dict:
-    xr = _xr()
+def _coords(sweep) -> dict:
+    """``name -> (dims, values, attrs)`` of the coordinates: the swept values, ``q`` and ``x``."""
     keys, shape = sweep.keys, sweep.shape
-    coords = {a.key: (a.key, np.array(a.values)) for a in sweep.axes}
+    coords = {a.key: ((a.key,), np.array(a.values), {}) for a in sweep.axes}
     qs, xs = _grids(sweep)
     for name, rows, dim in (("q", qs, "step"), ("x", xs, "node")):
-        attrs = _attrs(FIELDS[name])
         if _shared(rows):
-            coords[name] = xr.Variable((dim,), rows[0], attrs)
+            coords[name] = ((dim,), rows[0], _attrs(FIELDS[name]))
         else:
-            coords[name] = xr.Variable(keys + (dim,), _padded(rows, None, shape), attrs)
+            coords[name] = (keys + (dim,), _padded(rows, None, shape), _attrs(FIELDS[name]))
     return coords
 
 
-def _template(sweep, fields, n_states, n_nodes):
-    """The empty Dataset of a sweep (lazy dask arrays: only metadata is written)."""
-    import dask.array as da
-    xr = _xr()
-    keys, shape = sweep.keys, sweep.shape
-    sizes = dict(zip(keys, shape), step=n_states, node=n_nodes)
-    chunk = dict(zip(keys, (1,) * len(keys)))
-    data, encoding = {}, {}
+def _variables(sweep, fields) -> dict:
+    """``name -> (dims, dtype, fill, attrs)`` of the data variables."""
+    keys = sweep.keys
+    out = {}
     for f in fields:
-        dims = _dims(f, keys)
         dt = dtype_of(f.name)
-        fill = np.nan if dt.kind == "f" else -1
-        arr = da.full(tuple(sizes[d] for d in dims), fill, dtype=dt, chunks=tuple(chunk.get(d, sizes[d]) for d in dims))
-        data[f.name] = xr.Variable(dims, arr, _attrs(f))
-        encoding[f.name] = {"_FillValue": fill}
-    point = tuple(1 for _ in keys)
-    data["status"] = xr.Variable(keys, da.zeros(shape, dtype="int8", chunks=point),
-                                 {"long_name": "0 not computed, 1 done, 2 failed", "units": "1"})
-    data["error"] = xr.Variable(keys, da.full(shape, "", dtype=f"<U{ERROR_CHARS}", chunks=point),
-                                {"long_name": "one-line error of a failed point"})
-    data["point_time"] = xr.Variable(keys, da.full(shape, np.nan, chunks=point),
-                                     {"units": "s", "long_name": "wall seconds of the point on its worker"})
-    encoding.update(status={"_FillValue": None}, error={"_FillValue": None})
-    return xr.Dataset(data, coords=_coords(sweep, fields)), encoding
+        dims = _dims(f, keys)
+        out[f.name] = (dims, dt, np.nan if dt.kind == "f" else -1, dict(_attrs(f), coordinates=_coord_names(dims)))
+    out["status"] = (keys, np.dtype("int8"), None, {"long_name": "0 not computed, 1 done, 2 failed", "units": "1"})
+    out["error"] = (keys, np.dtype(f"<U{ERROR_CHARS}"), None, {"long_name": "one-line error of a failed point"})
+    out["point_time"] = (keys, np.dtype("float64"), np.nan,
+                         {"units": "s", "long_name": "wall seconds of the point on its worker"})
+    return out
+
+
+def _coord_names(dims) -> str:
+    return " ".join(n for n, d in (("q", "step"), ("x", "node")) if d in dims)
 
 
 def _global_attrs(sweep, fields) -> dict:
@@ -210,41 +202,71 @@ def open_store(path, sweep):
 
 
 def create_store(path, sweep):
-    """Create the empty store of ``sweep`` (metadata only) and return its zarr group."""
+    """Create the empty store of ``sweep`` (metadata and coordinates only) and return its zarr group.
+
+    Written with zarr directly in xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes,
+    consolidated metadata), chunked one point per chunk; ``xarray.open_zarr`` reads it.
+    """
     import zarr
     fields = result_fields(sweep.scenes)
-    n_states = max(s.n_steps + 1 for s in sweep.scenes)
-    n_nodes = max(s.n_nodes for s in sweep.scenes)
-    ds, encoding = _template(sweep, fields, n_states, n_nodes)
-    ds.attrs.update(_global_attrs(sweep, fields))
-    ds.to_zarr(path, mode="w-", compute=False, encoding=encoding, zarr_format=2, consolidated=True)
-    return zarr.open_group(path, mode="r+")
+    sizes = dict(zip(sweep.keys, sweep.shape), step=max(s.n_steps + 1 for s in sweep.scenes),
+                 node=max(s.n_nodes for s in sweep.scenes))
+    group = zarr.open_group(path, mode="w-", zarr_format=2)
+    group.attrs.update(_global_attrs(sweep, fields))
+    for name, (dims, values, attrs) in _coords(sweep).items():
+        fill = None if values.dtype.kind == "U" else np.nan if values.dtype.kind == "f" else 0
+        arr = group.create_array(name, shape=values.shape, chunks=values.shape, dtype=values.dtype, fill_value=fill,
+                                 attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
+        arr[...] = values
+    point = dict(zip(sweep.keys, (1,) * len(sweep.keys)))
+    for name, (dims, dt, fill, attrs) in _variables(sweep, fields).items():
+        group.create_array(name, shape=tuple(sizes[d] for d in dims), chunks=tuple(point.get(d, sizes[d]) for d in dims),
+                           dtype=dt, fill_value=fill, attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
+    zarr.consolidate_metadata(path, zarr_format=2)
+    return zarr.open_group(path, mode="r+", zarr_format=2)
+
+
+class StoreWriter:
+    """Writes points into a sweep's store: each point's region of every variable, ``status`` last.
+
+    The arrays are opened once; the variables of one point are written concurrently (zarr's
+    asynchronous API: one file per chunk, so the writes are independent), then ``status``.
+    """
+
+    def __init__(self, group, sweep):
+        self.sweep = sweep
+        self.arrays = {k: group[k] for k in group.array_keys()}
+        self.per_point_grid = {k for k in ("q", "x") if self.arrays[k].ndim > 1}
+
+    def _items(self, idx, out: dict) -> list:
+        if out.get("error") is not None:
+            return [("error", idx, out["error"][:ERROR_CHARS]), ("point_time", idx, out["time"])]
+        items = [("error", idx, ""), ("point_time", idx, out["time"])]
+        for name, value in out["arrays"].items():
+            if name not in self.arrays or name in ("q", "x") and name not in self.per_point_grid:
+                continue
+            value = np.asarray(value)
+            items.append((name, idx + tuple(slice(0, s) for s in value.shape), value))
+        return items
+
+    def write(self, i: int, out: dict) -> None:
+        """Store point ``i``'s result (``out`` of :func:`rollqp.sweep.executor.compute_point`)."""
+        idx = self.sweep.index(i)
+        items = [(self.arrays[name], sel, value) for name, sel, value in self._items(idx, out)]
+        try:
+            import asyncio
+
+            from zarr.core.sync import sync
+
+            async def _all():
+                await asyncio.gather(*(a._async_array.setitem(sel, v) for a, sel, v in items))
+            sync(_all())
+        except (ImportError, AttributeError):  # pragma: no cover - another zarr: one array at a time
+            for a, sel, v in items:
+                a[sel] = v
+        self.arrays["status"][idx] = STATUS["done" if out.get("error") is None else "failed"]
 
 
 def write_point(group, sweep, i: int, out: dict) -> None:
-    """Write point ``i``'s result (``out`` from :func:`rollqp.sweep.executor.compute_point`) into its
-    region; ``status`` last, so the point counts as done only once its data are stored."""
-    idx = sweep.index(i)
-    if out.get("error") is not None:
-        group["error"][idx] = out["error"][:ERROR_CHARS]
-        group["point_time"][idx] = out["time"]
-        group["status"][idx] = STATUS["failed"]
-        return
-    arrays = out["arrays"]
-    for name in group.array_keys():
-        if name in ("status", "error", "point_time") or name in sweep.keys:
-            continue
-        if name in ("q", "x"):
-            if group[name].ndim == 1:
-                continue
-            value = arrays[name]
-        elif name not in arrays:
-            continue
-        else:
-            value = arrays[name]
-        value = np.asarray(value)
-        sel = idx + tuple(slice(0, s) for s in value.shape)
-        group[name][sel] = value
-    group["point_time"][idx] = out["time"]
-    group["error"][idx] = ""
-    group["status"][idx] = STATUS["done"]
+    """Write point ``i``'s result into its region (:class:`StoreWriter`, for one point)."""
+    StoreWriter(group, sweep).write(i, out)

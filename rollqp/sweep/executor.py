@@ -8,7 +8,7 @@
   gets the same pinning as the local ones), returning its result arrays and wall time, or its
   one-line error.
 * :func:`run_sweep` submits the points not yet in the store, writes each result into its
-  region as it arrives (:func:`rollqp.sweep.dataset.write_point`, in the client process: the
+  region as it arrives (:class:`rollqp.sweep.dataset.StoreWriter`, in the client process: the
   store needs no shared file system), shows progress, and returns a :class:`Summary`.
 * :func:`map_jobs` runs any picklable function over independent cases (the benchmark harness
   and the hard-case suite): one task per worker at a time, so a timed case never shares its
@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import os
+import socket
 import sys
 import time
 from dataclasses import dataclass, field
@@ -68,7 +69,7 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
 
 
 def compute_point(scene_dict: dict) -> dict:
-    """Run one scene on a worker: ``{"arrays", "time"}``, or ``{"error", "time"}`` with its one-line error."""
+    """Run one scene on a worker: ``{"arrays", "time", "worker"}``, or ``{"error", "time"}`` with its one-line error."""
     from threadpoolctl import threadpool_limits
 
     from ..errors import RollqpError
@@ -84,7 +85,7 @@ def compute_point(scene_dict: dict) -> dict:
             return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0}
     arrays = result.arrays()
     arrays.pop("meta")
-    return {"arrays": arrays, "time": time.perf_counter() - t0}
+    return {"arrays": arrays, "time": time.perf_counter() - t0, "worker": f"{socket.gethostname()}:{os.getpid()}"}
 
 
 @dataclass
@@ -151,22 +152,24 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     SIGTERM cancels the points in flight and returns the summary with ``interrupted`` set:
     the stored points stay, and running the sweep again computes only the rest.
     """
-    from .dataset import STATUS, write_point
+    from .dataset import STATUS, StoreWriter
     distributed = _dask()
     todo = [i for i in range(len(sweep.scenes)) if status[i] != STATUS["done"]]
     summary = Summary(total=len(sweep.scenes), kept=len(sweep.scenes) - len(todo))
     update, close = _bar(len(todo), quiet)
+    writer = StoreWriter(group, sweep)
+    prefix = f"rollqp-point-{sweep.fingerprint()[:10]}-{time.time_ns()}"
     t0 = time.perf_counter()
     futures = {}
     try:
         for i in todo:
             fut = client.submit(compute_point, sweep.scenes[i].to_dict(), pure=False,
-                                key=f"rollqp-point-{sweep.fingerprint()[:10]}-{i}-{time.time_ns()}")
+                                key=f"{prefix}-{i}")
             futures[fut] = i
         for n, fut in enumerate(distributed.as_completed(futures), 1):
             i = futures.pop(fut)
             out = fut.result()
-            write_point(group, sweep, i, out)
+            writer.write(i, out)
             if out.get("error") is None:
                 summary.done += 1
             else:
