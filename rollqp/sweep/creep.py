@@ -134,6 +134,7 @@ class CreepCurve:
             xb = -self.bentall_johnson_xi()
             ax.axvline(xb, color="k", ls="--", lw=1, label="Bentall–Johnson, μ → 0, Q = 0")
             bx.axhline(0.0, color="k", lw=0.5)
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(0, 0))
         ax.set_xlabel("−ξ (creepage of A, sign of Q opposite)")
         ax.set_ylabel("Q/(μP)")
         bx.set_xlabel("−ξR/(μa)")

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from ..errors import InputError
 
-__all__ = ["connect", "compute_point", "run_sweep", "map_jobs", "Summary", "CONNECT_TIMEOUT"]
+__all__ = ["connect", "compute_point", "run_sweep", "iter_jobs", "map_jobs", "Summary", "CONNECT_TIMEOUT"]
 
 #: Seconds to reach a scheduler given by ``--scheduler`` before giving up.
 CONNECT_TIMEOUT = 5.0
@@ -187,6 +187,16 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     return summary
 
 
+def iter_jobs(fn, jobs, client):
+    """``fn(*job)`` for each job on ``client``'s cluster, yielded in the order of ``jobs`` as they finish."""
+    futures = [client.submit(fn, *job, pure=False) for job in jobs]
+    try:
+        for fut in futures:
+            yield fut.result()
+    finally:
+        client.cancel([f for f in futures if not f.done()])
+
+
 def map_jobs(fn, jobs, workers: int | None = None, scheduler: str | None = None, client=None):
     """``[fn(*job) for job in jobs]`` on a dask cluster, in order; one job per worker at a time.
 
@@ -197,8 +207,7 @@ def map_jobs(fn, jobs, workers: int | None = None, scheduler: str | None = None,
     own = client is None
     client = client or connect(scheduler, workers)
     try:
-        futures = [client.submit(fn, *job, pure=False) for job in jobs]
-        return client.gather(futures)
+        return list(iter_jobs(fn, jobs, client))
     finally:
         if own:
             _close(client)
