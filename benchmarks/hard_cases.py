@@ -383,23 +383,25 @@ def _clear(err) -> bool:
     return False
 
 
-def run_named(name: str, method: str, with_reference: bool) -> Row:
-    """:func:`run_case` of the case called ``name`` (a job of :func:`harness.map_cases`: cases hold
-    functions, so a worker rebuilds the case from its name)."""
-    return run_case({c.name: c for c in cases()}[name], method, with_reference=with_reference)
+def run_named(name: str, methods: tuple, with_reference: bool) -> list:
+    """:func:`run_case` of the case called ``name`` with each of ``methods`` (a job of
+    :func:`harness.map_cases`: cases hold functions, so a worker rebuilds the case from its name;
+    one job per case, so that its ``newton 1e-12`` reference is computed once)."""
+    case = {c.name: c for c in cases()}[name]
+    return [run_case(case, m, with_reference=with_reference) for m in methods]
 
 
 def run_all(selected, stream=sys.stdout, workers=None):
     rows = []
     by = {c.name: c for c in selected}
     print(_HEADER, file=stream, flush=True)
-    jobs = [(c.name, m, c.expect in ("converge", "any")) for c in selected for m in c.methods]
+    jobs = [(c.name, tuple(c.methods), c.expect in ("converge", "any")) for c in selected]
     if workers and workers > 1:
         import hard_cases  # the workers import the function from this module, not from __main__
         fn = hard_cases.run_named
     else:
         fn = run_named
-    for row in harness.map_cases(fn, jobs, workers=workers):
+    for row in (r for case_rows in harness.map_cases(fn, jobs, workers=workers) for r in case_rows):
         rows.append(row)
         print(_line(row, by[row.case]), file=stream, flush=True)
         print(f"{row.case:28s} {row.method:12s} {row.outcome:11s} it {row.iterations:4d} "

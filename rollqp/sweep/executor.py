@@ -63,8 +63,12 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
     n = (os.cpu_count() or 1) if workers is None else workers
     if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 1024:
         raise InputError("--workers", f"must be an integer in [1, 1024], got {workers!r}")
-    cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, env=dict(_THREAD_ENV), silence_logs=50)
+    import dask
+    # the workers' statistical profiler samples the task thread's stack every 10 ms: time
+    # taken from the points (the GIL), for a profile nobody reads here
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, env=dict(_THREAD_ENV), silence_logs=50)
     return distributed.Client(cluster)
 
 
