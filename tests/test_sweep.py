@@ -278,3 +278,21 @@ def test_cli_errors_are_one_line(capsys, tmp_path, monkeypatch):
     assert cli.main(["creep-curve", "cattaneo-carter", "--friction", "0,0.1"]) == cli.EXIT_INPUT
     assert "--friction" in capsys.readouterr().err
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_failed_point_is_stored_with_its_error_and_tried_again_by_a_rerun(client, tmp_path):
+    """A point whose solver fails (one Newton iteration allowed) is stored as failed with its
+    one-line error; the other point is done; a re-run computes the failed point only."""
+    store = tmp_path / "f.zarr"
+    vary = ["solver.max_iterations=1,200"]
+    summary = sweep(_small(), vary, store, client=client)
+    assert summary.done == 1 and len(summary.failed) == 1
+    label, message = summary.failed[0]
+    assert label == "solver.max_iterations=1" and message.startswith("SolverError: step 0, newton")
+    ds = xr.open_zarr(store, chunks=None)
+    assert list(ds["status"].values) == [2, 1]
+    assert ds["error"].values[0].startswith("SolverError: step 0") and ds["error"].values[1] == ""
+    assert np.all(np.isnan(ds["pt"].values[0]))  # nothing stored for the failed point
+    computed = []
+    again = sweep(_small(), vary, store, client=client, on_point=lambda i, out: computed.append(i))
+    assert again.kept == 1 and computed == [0] and len(again.failed) == 1
