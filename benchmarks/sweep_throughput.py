@@ -19,6 +19,10 @@ Per-point overhead of the executor, three ways: a no-op task's round trip throug
 scheduler (200 tasks), the client's write of one point into the store (``StoreWriter.write``),
 and ``(workers × sweep wall − Σ point times)/points`` — what a point costs beyond its own
 computation on a worker, start-up and tail included.
+
+Control: the machine's parallelism at the moment (``workers`` pure-Python loops in processes at
+once against one alone; 2× on an idle 2-core machine), measured between the repetitions: on a
+shared machine it bounds what any parallel run can gain.
 """
 from __future__ import annotations
 
@@ -41,6 +45,27 @@ VARY = ("load.tangential=0.1:0.85:6", "contact.friction=0.1,0.15,0.2,0.3")
 
 def _noop(i):
     return i
+
+
+def _spin(_=None) -> float:
+    """A fixed pure-Python loop; its wall time."""
+    t0 = time.perf_counter()
+    s = 0
+    for i in range(2_000_000):
+        s += i * i
+    return time.perf_counter() - t0
+
+
+def _parallelism(workers: int) -> float:
+    """The machine's parallelism at the moment: ``workers`` × (one loop alone) / (``workers``
+    loops at once, in processes): ``workers`` on an idle machine, less when it is shared."""
+    import multiprocessing as mp
+    alone = _spin()
+    with mp.get_context("spawn").Pool(workers) as pool:
+        t0 = time.perf_counter()
+        pool.map(_spin, range(workers))
+        together = time.perf_counter() - t0
+    return workers * alone / together
 
 
 def _serial(scenes) -> float:
@@ -98,8 +123,9 @@ def main(argv=None):
         sweep(base.replace(**{"discretization.distance": 0.5}), ["contact.friction=0.1,0.2"],
               os.path.join(folder, "warm.zarr"), client=client)
         summaries = []
-        walls = harness.interleaved(args.repeats, {"serial": "serial", "sweep": "sweep"},
-                                    lambda c: _serial(sw.scenes) if c == "serial" else _sweep(base, client, folder, summaries),
+        cases = {"serial": lambda: _serial(sw.scenes), "sweep": lambda: _sweep(base, client, folder, summaries),
+                 "control": lambda: _parallelism(args.workers)}
+        walls = harness.interleaved(args.repeats, cases, lambda f: f(),
                                     log=lambda k, i, n: print(f"  {k} {i}/{n}", flush=True))
         rt = _roundtrip(client)
     finally:
@@ -115,6 +141,9 @@ def main(argv=None):
         ("serial, one process (median of runs)", f"{ser:.2f} s  ({', '.join(f'{w:.2f}' for w in walls['serial'])})"),
         (f"sweep, {args.workers} workers (median of runs)", f"{par:.2f} s  ({', '.join(f'{w:.2f}' for w in walls['sweep'])})"),
         ("**throughput ratio serial/sweep**", f"**{ser / par:.2f}×**"),
+        (f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
+         f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
+         f"{args.workers}× on an idle machine)"),
         ("Σ point times on the workers (median)", f"{statistics.median(pts):.2f} s"),
         ("cluster start-up (once, not in the sweep times)", f"{startup:.2f} s"),
         ("overhead: no-op task round trip", f"{1e3 * rt:.1f} ms per task"),

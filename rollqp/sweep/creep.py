@@ -81,7 +81,7 @@ class CreepCurve:
         return np.array([np.gradient(q, x) if x.size > 1 else np.full(x.size, np.nan) for q, x in zip(Q, self.xi)])
 
     def carter_slope(self) -> np.ndarray:
-        """Carter's dQ/dξ = −2PR(1 − |ξ|R/(μa))/a at the computed creepages."""
+        """Carter's ``dQ/dξ = −2PR(1 − |ξ|R/(μa))/a`` at the computed creepages."""
         s = self.scene
         u = np.abs(self.xi) * s.R / (self.mu[:, None] * s.a_H)
         return -2.0 * self.P * s.R * (1.0 - np.minimum(u, 1.0)) / s.a_H
