@@ -1,4 +1,4 @@
-"""The ``rollqp`` command (SPEC.md, "Command line").
+"""The ``rollqp`` command (docs/scenes.md and docs/results.md: the command line, scene and result files).
 
     rollqp run SCENE [--out RESULT.npz] [--plot FIGURE.png] [--method METHOD] [--quiet]
     rollqp scenes

@@ -44,6 +44,7 @@ __all__ = [
     "carter_stick_zone",
     "carter_traction",
     "carter_creepage",
+    "carter_slip",
     "creep_force_ratio",
     "bentall_johnson_creepage",
     "BENTALL_JOHNSON_COEFFICIENT",
@@ -82,6 +83,7 @@ SOURCES: dict[str, str] = {
     "carter_stick_zone": _CARTER,
     "carter_traction": _CARTER,
     "carter_creepage": _CARTER,
+    "carter_slip": _CARTER,
     "creep_force_ratio": _CARTER + "; " + _KALKER,
     "bentall_johnson_creepage": _BENTALL,
     "lame_ring_displacement": _LAME,
@@ -579,3 +581,48 @@ def lame_ring_displacement(r, inner, outer, pressure, E, nu):
     A = -pressure / (2.0 * (lam + G) + 2.0 * G * inner ** 2 / outer ** 2)
     r = np.asarray(r, dtype=float)
     return _out(A * r - A * inner ** 2 / r)
+
+
+def carter_slip(x, a, R, mu, ratio, direction):
+    """Carter's steady-rolling slip per unit rolled distance (similar cylinders).
+
+    ``s(x) = −d·sgn(ratio)·(μ/R)·sgn(y)·√(y² − c²)`` in the slip zone (``|x| < a``,
+    ``|y| > c`` with ``y = x − x_c``), ``s = 0`` in the stick zone ``|y| ≤ c``, and NaN
+    outside the contact (separated: no slip is defined). ``c = a√(1 − |ratio|)`` and
+    ``x_c = −d·(a − c)`` as in :func:`carter_traction`.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Positions (Eulerian, fixed to the contact).
+    a, R, mu, ratio, direction
+        As for :func:`carter_traction` and :func:`carter_creepage`.
+
+    Returns
+    -------
+    float or ndarray
+        ``s`` (dimensionless, as the result file's ``slip``), shape of ``x``. Its sign is
+        opposite to the traction's, ``t = −μp·sgn(s)`` (the friction law of
+        docs/formulation.md §5).
+
+    Notes
+    -----
+    Derivation in the project's convention (the same steps as :func:`carter_creepage`): the
+    steady slip is ``s = ξ + d·∂w/∂x`` with ``∂w/∂x = −(2/(πE*))·PV∫ t(s')/(x − s') ds'``.
+    With ``(1/π)·PV∫_{−c}^{c} √(c² − s²)/(y − s) ds = y − sgn(y)·√(y² − c²)·[|y| > c]``
+    and ``p0 = aE*/(2R)``, the two semi-ellipses of Carter's traction give
+    ``∂w/∂x = −sgn(ratio)·(μ/R)·[x_c + sgn(y)√(y² − c²)·[|y| > c]]``; the constant part
+    cancels ξ, what remains is the formula above. Source: Carter (1926); Johnson (1985)
+    Ch. 8, see ``SOURCES["carter_slip"]``.
+    """
+    x = _coords(x)
+    a = _positive("a", a)
+    R = _positive("R", R)
+    mu = _nonnegative("mu", mu)
+    ratio = _ratio(ratio)
+    d = _direction(direction)
+    c = a * math.sqrt(1.0 - abs(ratio))
+    y = x - (-d * (a - c))
+    sign_r = math.copysign(1.0, ratio) * (ratio != 0.0)
+    s = -d * sign_r * (mu / R) * np.sign(y) * np.sqrt(np.maximum(y * y - c * c, 0.0))
+    return _out(np.where(np.abs(x) < a, s, np.nan))

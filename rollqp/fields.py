@@ -50,7 +50,7 @@ class Field:
         ``needed(scene) -> bool``: whether a scene's result holds the field (model only what a
         scene needs); the core fields are always there.
     contract : bool
-        Part of the outer contract (SPEC: names and meanings never change).
+        Part of the outer contract (docs/results.md: names and meanings never change).
     """
 
     name: str

@@ -35,6 +35,7 @@ coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
 """
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 from typing import Iterator
@@ -512,6 +513,13 @@ def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
 
 
 def _versions() -> dict:
+    return dict(_installed_versions())
+
+
+@functools.lru_cache(maxsize=1)
+def _installed_versions() -> tuple:
+    """The versions recorded in every result's meta, read once per process (importlib.metadata
+    scans sys.path: ~5 ms, more than the stepping of a small scene)."""
     import importlib.metadata as md
     out = {}
     for pkg in ("numpy", "scipy", "clarabel", "osqp", "cvxpy"):
@@ -519,7 +527,7 @@ def _versions() -> dict:
             out[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
             out[pkg] = None
-    return out
+    return tuple(out.items())
 
 
 def _unloaded(ops: SceneOperators, xi=None) -> State:

@@ -42,7 +42,7 @@ import numpy as np
 from .errors import InputError
 from .influence.operator import Operator, as_operator, asymmetry, split  # noqa: F401 - re-exported
 
-# Node states in result files (SPEC.md): 0 separation, 1 stick, 2 slip.
+# Node states in result files (docs/results.md): 0 separation, 1 stick, 2 slip.
 SEPARATION, STICK, SLIP = 0, 1, 2
 
 
@@ -87,12 +87,60 @@ class Scales:
         return self.length * self.stress
 
 
+#: Largest magnitude of any number given to a step problem. rollqp forms products of up to four
+#: of them (the QP objective pᵀ F A p, fᵀp, A·p): with every factor ≤ 1e60 these stay below
+#: 1e240 · n, far from float64's 1.8e308, while any physical input in any units is far below
+#: it (stresses ~1e11 Pa, compliances ~1e-12).
+MAX_MAGNITUDE = 1e60
+
+
+def _real(name, v) -> np.ndarray:
+    """``v`` as a float array; an InputError naming ``name`` unless it holds real, finite numbers
+    within ±:data:`MAX_MAGNITUDE` (booleans, complex numbers, strings, objects and ragged lists
+    are refused, never cast)."""
+    if type(v) is np.ndarray and v.dtype == np.float64:  # the common case: no copy, two numpy calls
+        a = v
+    else:
+        try:
+            a = np.asarray(v)
+        except (ValueError, TypeError) as exc:
+            raise InputError(name, f"must hold real numbers ({exc})") from None
+        if a.dtype.kind not in "iuf":
+            raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
+        a = a.astype(float)
+    if a.size:
+        big = np.max(np.abs(a))
+        if not big <= MAX_MAGNITUDE:  # NaN compares false: one test for both
+            if not np.all(np.isfinite(a)):
+                raise InputError(name, "must be finite")
+            raise InputError(name, f"values must be within ±{MAX_MAGNITUDE:g} (beyond, the products of the step "
+                                   f"problem overflow; rescale, e.g. with Scales), got {big:.3g}")
+    return a
+
+
+def _scalar(name, v):
+    """``v`` as a float, or ``None``; an InputError naming ``name`` unless it is one real number."""
+    if v is None:
+        return None
+    if isinstance(v, (float, int)) and not isinstance(v, bool):  # the common case, without numpy
+        x = float(v)
+        if abs(x) <= MAX_MAGNITUDE:
+            return x
+    a = _real(name, v)
+    if a.ndim != 0:
+        raise InputError(name, f"must be a real number, got an array of shape {a.shape}")
+    return float(a)
+
+
+def _set_scalars(step, names) -> None:
+    for name in names:
+        object.__setattr__(step, name, _scalar(name, getattr(step, name)))
+
+
 def _vec(name, v, n):
-    a = np.asarray(v, dtype=float)
+    a = _real(name, v)  # real and finite
     if a.shape != (n,):
         raise InputError(name, f"must have shape ({n},), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite")
     return a
 
 
@@ -116,8 +164,11 @@ def _check_arrays(step, operators=(), vectors=(), optional=()) -> int:
     ``None``) in place; return ``n``."""
     n = _set_weights(step)
     for name in operators:
-        if getattr(step, name) is not None or name in ("A", "Ann", "Att"):
-            object.__setattr__(step, name, as_operator(getattr(step, name), name, n))
+        value = getattr(step, name)
+        if value is not None or name in ("A", "Ann", "Att"):
+            if not isinstance(value, Operator):
+                value = _real(name, value)
+            object.__setattr__(step, name, as_operator(value, name, n))
     for name in vectors + optional:
         if getattr(step, name) is not None or name in vectors:
             object.__setattr__(step, name, _vec(name, getattr(step, name), n))
@@ -126,9 +177,9 @@ def _check_arrays(step, operators=(), vectors=(), optional=()) -> int:
 
 def _check_friction(step) -> None:
     """``μ`` finite and ``>= 0``, ``Δq`` finite and ``> 0``."""
-    if not (np.isfinite(step.mu) and step.mu >= 0):
+    if step.mu is None or not (np.isfinite(step.mu) and step.mu >= 0):
         raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {step.mu!r}")
-    if not (np.isfinite(step.dq) and step.dq > 0):
+    if step.dq is None or not (np.isfinite(step.dq) and step.dq > 0):
         raise InputError("dq", f"the step must be a finite number > 0, got {step.dq!r}")
 
 
@@ -226,6 +277,7 @@ class NormalStep:
 
     def __post_init__(self):
         _check_arrays(self, ("A",), ("h",), ("offset",))
+        _set_scalars(self, ("P", "delta"))
         _exactly_one(("P", "delta"), (self.P, self.delta))
         if self.delta is not None and not np.isfinite(self.delta):
             raise InputError("delta", f"the prescribed approach must be finite, got {self.delta!r}")
@@ -341,6 +393,7 @@ class TangentialStep:
 
     def __post_init__(self):
         _check_arrays(self, ("A",), ("p", "c"))
+        _set_scalars(self, ("mu", "dq", "Q", "xi"))
         _check_friction(self)
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
         if self.xi is not None and not np.isfinite(self.xi):
@@ -487,6 +540,7 @@ class CoupledStep:
 
     def __post_init__(self):
         _check_arrays(self, ("Ann", "Att", "Ant", "Atn"), ("h", "c"))
+        _set_scalars(self, ("mu", "dq", "P", "delta", "Q", "xi"))
         _check_friction(self)
         _exactly_one(("P", "delta"), (self.P, self.delta))
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
