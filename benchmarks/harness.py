@@ -342,11 +342,11 @@ def map_cases(fn, jobs, workers: int | None = None, client=None):
         for job in jobs:
             yield fn(*job)
         return
-    from rollqp.sweep.executor import _close, connect, iter_jobs
+    from rollqp.sweep.executor import close_client, connect, iter_jobs
     own = client is None
     client = client or connect(workers=workers)
     try:
         yield from iter_jobs(fn, jobs, client)
     finally:
         if own:
-            _close(client)
+            close_client(client)

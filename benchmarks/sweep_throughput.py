@@ -38,7 +38,7 @@ import time  # noqa: E402
 import rollqp  # noqa: E402
 from rollqp.sweep import build_sweep, sweep  # noqa: E402
 from rollqp.sweep import dataset  # noqa: E402
-from rollqp.sweep.executor import _close, connect  # noqa: E402
+from rollqp.sweep.executor import close_client, connect  # noqa: E402
 
 VARY = ("load.tangential=0.1:0.85:6", "contact.friction=0.1,0.15,0.2,0.3")
 
@@ -129,7 +129,7 @@ def main(argv=None):
                                     log=lambda k, i, n: print(f"  {k} {i}/{n}", flush=True))
         rt = _roundtrip(client)
     finally:
-        _close(client)
+        close_client(client)
         shutil.rmtree(folder, ignore_errors=True)
     ser, par = statistics.median(walls["serial"]), statistics.median(walls["sweep"])
     pts = [sum(s.point_times) for _, s in summaries]

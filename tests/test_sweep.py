@@ -263,8 +263,11 @@ def test_unreachable_scheduler_is_a_one_line_error_within_the_timeout(tmp_path):
     with pytest.raises(InputError, match=r"--scheduler: cannot reach a dask scheduler at 'tcp://127.0.0.1:9' within 1 s"):
         connect("tcp://127.0.0.1:9", timeout=1.0)
     assert time.perf_counter() - t0 < 15  # the timeout, plus dask's own retry granularity
-    with pytest.raises(InputError, match="--workers"):
-        connect(workers=0)
+    for bad in (0, -1, 1000, 2.0, True):
+        with pytest.raises(InputError, match=r"--workers: must be an integer in \[1, "):
+            connect(workers=bad)
+    with pytest.raises(InputError, match="--workers: applies to the local cluster only"):
+        connect("tcp://127.0.0.1:9", workers=2)
 
 
 def test_cli_errors_are_one_line(capsys, tmp_path, monkeypatch):

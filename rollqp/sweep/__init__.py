@@ -55,7 +55,7 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
     """
     from ..result import OutputLock
     from .dataset import create_store, open_store
-    from .executor import _close, connect, run_sweep
+    from .executor import close_client, connect, run_sweep
     sw, path = prepare(scene, vary, out)
     with OutputLock(path):
         own = client is None
@@ -69,4 +69,4 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
             return run_sweep(sw, group, status, client, quiet=quiet, on_point=on_point)
         finally:
             if own:
-                _close(client)
+                close_client(client)

@@ -24,10 +24,13 @@ from dataclasses import dataclass, field
 
 from ..errors import InputError
 
-__all__ = ["connect", "compute_point", "run_sweep", "iter_jobs", "map_jobs", "Summary", "CONNECT_TIMEOUT"]
+__all__ = ["connect", "close_client", "compute_point", "run_sweep", "iter_jobs", "map_jobs", "Summary", "CONNECT_TIMEOUT"]
 
 #: Seconds to reach a scheduler given by ``--scheduler`` before giving up.
 CONNECT_TIMEOUT = 5.0
+#: Most local worker processes per core (each is a Python process of ~100 MB; more than one per
+#: core only shares the cores, it never adds throughput).
+MAX_WORKERS_PER_CORE = 4
 #: BLAS/OpenMP thread variables set to 1 in the local workers' environment.
 _THREAD_ENV = {k: "1" for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
 
@@ -48,7 +51,8 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
     Raises
     ------
     InputError
-        ``--scheduler``: not reachable within ``timeout`` seconds; ``--workers``: not in [1, 1024].
+        ``--scheduler``: not reachable within ``timeout`` seconds; ``--workers``: not in
+        [1, :data:`MAX_WORKERS_PER_CORE` × cores], or given with ``--scheduler``.
     """
     distributed = _dask()
     if scheduler is not None:
@@ -60,9 +64,11 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
             reason = str(exc).splitlines()[0][:160] if str(exc) else type(exc).__name__
             raise InputError("--scheduler", f"cannot reach a dask scheduler at {scheduler!r} within "
                                             f"{timeout:g} s ({reason})") from None
-    n = (os.cpu_count() or 1) if workers is None else workers
-    if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 1024:
-        raise InputError("--workers", f"must be an integer in [1, 1024], got {workers!r}")
+    cores = os.cpu_count() or 1
+    n = cores if workers is None else workers
+    if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_WORKERS_PER_CORE * cores:
+        raise InputError("--workers", f"must be an integer in [1, {MAX_WORKERS_PER_CORE * cores}] "
+                                      f"({MAX_WORKERS_PER_CORE} per core of this machine), got {workers!r}")
     import dask
     # the workers' statistical profiler samples the task thread's stack every 10 ms: time
     # taken from the points (the GIL), for a profile nobody reads here
@@ -214,10 +220,10 @@ def map_jobs(fn, jobs, workers: int | None = None, scheduler: str | None = None,
         return list(iter_jobs(fn, jobs, client))
     finally:
         if own:
-            _close(client)
+            close_client(client)
 
 
-def _close(client) -> None:
+def close_client(client) -> None:
     """Close a client and, if it made one, its local cluster."""
     cluster = getattr(client, "cluster", None)
     client.close()
