@@ -60,11 +60,10 @@ def _parallelism(workers: int) -> float:
     """The machine's parallelism at the moment: ``workers`` × (one loop alone) / (``workers``
     loops at once, in processes): ``workers`` on an idle machine, less when it is shared."""
     import multiprocessing as mp
-    alone = _spin()
     with mp.get_context("spawn").Pool(workers) as pool:
-        t0 = time.perf_counter()
-        pool.map(_spin, range(workers))
-        together = time.perf_counter() - t0
+        pool.map(_noop, range(workers))  # the processes started and their imports done
+        alone = _spin()
+        together = max(pool.map(_spin, range(workers)))  # each loop's own wall time
     return workers * alone / together
 
 
