@@ -7,6 +7,12 @@ Usage::
     python benchmarks/hard_cases.py --only gross    # cases whose name contains "gross"
     python benchmarks/hard_cases.py --exclude mesh  # all but the fine meshes
     python benchmarks/hard_cases.py --convective-sweep   # the Δq sweep behind the convective-local bound
+    python benchmarks/hard_cases.py --workers 2     # the same runs on a local dask cluster (extra 'sweep')
+
+With ``--workers N`` the (case, method) runs go through rollqp's sweep executor
+(:func:`harness.map_cases`): N single-threaded worker processes, one run per worker at a time, so
+each timed run has a core to itself; the rows are printed in the same order, with the same
+numbers (only the wall times differ), and the whole table takes less wall time.
 
 Each case is a scene (:func:`cases`) run by ``rollqp.run`` with each method that applies to it
 (``nt-newton`` only on coupled scenes). A case either **converges** — then every state's
@@ -377,19 +383,31 @@ def _clear(err) -> bool:
     return False
 
 
-def run_all(selected, stream=sys.stdout):
+def run_named(name: str, methods: tuple, with_reference: bool) -> list:
+    """:func:`run_case` of the case called ``name`` with each of ``methods`` (a job of
+    :func:`harness.map_cases`: cases hold functions, so a worker rebuilds the case from its name;
+    one job per case, so that its ``newton 1e-12`` reference is computed once)."""
+    case = {c.name: c for c in cases()}[name]
+    return [run_case(case, m, with_reference=with_reference) for m in methods]
+
+
+def run_all(selected, stream=sys.stdout, workers=None):
     rows = []
     by = {c.name: c for c in selected}
     print(_HEADER, file=stream, flush=True)
-    for case in selected:
-        for m in case.methods:
-            row = run_case(case, m, with_reference=case.expect in ("converge", "any"))
-            rows.append(row)
-            print(_line(row, by[row.case]), file=stream, flush=True)
-            print(f"{row.case:28s} {row.method:12s} {row.outcome:11s} it {row.iterations:4d} "
-                  f"res {row.residual:9.2e} err {row.error:9.2e} cf {row.closed:9.2e} "
-                  f"{row.seconds:7.2f}s {'ok' if row.ok else 'FAIL'} {row.message}",
-                  file=sys.stderr, flush=True)
+    jobs = [(c.name, tuple(c.methods), c.expect in ("converge", "any")) for c in selected]
+    if workers and workers > 1:
+        import hard_cases  # the workers import the function from this module, not from __main__
+        fn = hard_cases.run_named
+    else:
+        fn = run_named
+    for row in (r for case_rows in harness.map_cases(fn, jobs, workers=workers) for r in case_rows):
+        rows.append(row)
+        print(_line(row, by[row.case]), file=stream, flush=True)
+        print(f"{row.case:28s} {row.method:12s} {row.outcome:11s} it {row.iterations:4d} "
+              f"res {row.residual:9.2e} err {row.error:9.2e} cf {row.closed:9.2e} "
+              f"{row.seconds:7.2f}s {'ok' if row.ok else 'FAIL'} {row.message}",
+              file=sys.stderr, flush=True)
     return rows
 
 
@@ -447,6 +465,8 @@ def main(argv=None):
     ap.add_argument("--fast", action="store_true", help="only the cases the default test suite runs")
     ap.add_argument("--only", default="", help="cases whose name contains one of these (comma-separated)")
     ap.add_argument("--exclude", default=None, help="leave out cases whose name contains this")
+    ap.add_argument("--workers", type=int, default=None,
+                    help="run the cases on a local dask cluster of N single-threaded worker processes")
     ap.add_argument("--convective-sweep", action="store_true",
                     help="only the material/convective-local sweep over Δq (docs/stability.md)")
     args = ap.parse_args(argv)
@@ -460,7 +480,7 @@ def main(argv=None):
             for c in selected:
                 c.methods = tuple(m for m in c.methods if c.runs_fast(m))
         t0 = time.perf_counter()
-        rows = run_all(selected)  # prints the table row by row
+        rows = run_all(selected, workers=args.workers)  # prints the table row by row
         print(f"\n{len(rows)} runs, {sum(r.ok for r in rows)} as expected, {time.perf_counter() - t0:.0f} s")
 
 

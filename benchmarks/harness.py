@@ -324,3 +324,29 @@ def pyplot():
 
 #: Pinned for the whole process at import (the limiter is kept alive here).
 THREAD_LIMIT = pin_threads()
+
+
+# ------------------------------------------------------------------------------- independent cases
+def map_cases(fn, jobs, workers: int | None = None, client=None):
+    """``fn(*job)`` for each job, yielded in order: in this process (``workers`` None or 1), or on a
+    local dask cluster of ``workers`` single-threaded worker processes (rollqp's sweep executor,
+    ``rollqp.sweep.executor``; needs the extra ``sweep``), or on ``client``'s cluster.
+
+    Timings stay clean: a worker has one thread and runs one case at a time, and with no more
+    workers than cores every timed case has a core to itself (the client process only waits).
+    ``fn`` must be a module-level function of an importable module (the workers import it: run
+    the script from the repository root, whose ``benchmarks/`` folder the workers inherit on
+    their path).
+    """
+    if client is None and (workers is None or workers <= 1):
+        for job in jobs:
+            yield fn(*job)
+        return
+    from rollqp.sweep.executor import close_client, connect, iter_jobs
+    own = client is None
+    client = client or connect(workers=workers)
+    try:
+        yield from iter_jobs(fn, jobs, client)
+    finally:
+        if own:
+            close_client(client)

@@ -17,6 +17,7 @@ StepSolution, Residuals, classify, compare
 solve_step                               solve one step with any method
 get_method, available_methods            the method registry
 closedforms                              Hertz, Cattaneo, Carter, creep law
+open_result                              a result file as an xarray Dataset (extra ``sweep``)
 """
 __version__ = "0.1.0"
 
@@ -43,7 +44,14 @@ def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> S
     return get_method(method, **settings).solve(problem, warm=warm)
 
 
-__all__ = ["load_scene", "builtin_scenes", "Scene", "march", "run", "StepRecord", "SceneOperators", "Result", "load_result", "Strip",
+def open_result(path):
+    """A result file (``.npz``) as a labelled :class:`xarray.Dataset` (:func:`rollqp.sweep.dataset.open_result`;
+    needs xarray, extra ``sweep``)."""
+    from .sweep.dataset import open_result as _open
+    return _open(path)
+
+
+__all__ = ["open_result", "load_scene", "builtin_scenes", "Scene", "march", "run", "StepRecord", "SceneOperators", "Result", "load_result", "Strip",
            "halfspace_influence", "Influence", "NormalStep", "TangentialStep", "Scales", "StepSolution",
            "Residuals", "classify", "compare", "solve_step", "get_method", "available_methods",
            "closedforms", "InputError", "SolverError", "RollqpError", "MissingBackendError"]

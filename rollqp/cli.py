@@ -7,6 +7,8 @@
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
     rollqp crossval SCENE [--step K] [--methods M1,M2]
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
+    rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
+    rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first).
@@ -69,6 +71,7 @@ def _parser():
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
                        "(docs/performance.md; 'rollqp bench --help' for the options)")
     b.add_argument("bench_args", nargs=argparse.REMAINDER)
+    _sweep_parsers(sub)
     return p
 
 
@@ -340,6 +343,81 @@ def cmd_bench(args) -> int:
     return suite["main"](args.bench_args)
 
 
+# --------------------------------------------------------------------------- sweeps (docs/sweeps.md)
+def _sweep_parsers(sub):
+    """The ``sweep`` and ``creep-curve`` subcommands (extra ``sweep``: dask, xarray, zarr)."""
+    w = sub.add_parser("sweep", help="a parameter study on dask: the product of --vary values, "
+                       "results in one labelled zarr store (docs/sweeps.md)")
+    w.add_argument("scene", help="the base scene: a TOML file or a built-in scene")
+    w.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
+                   help="a dotted scene key and its values: a,b,c | start:stop:count | start:stop:count:log "
+                        "(repeat for more keys; the points are the product)")
+    w.add_argument("--out", help="the zarr store (default <scene name>-sweep.zarr); run again to complete it")
+    _cluster_options(w)
+    c = sub.add_parser("creep-curve", help="the steady creep curve Q/(mu P) against the creepage, on dask, "
+                       "with Carter's law or the Bentall-Johnson limit (docs/sweeps.md)")
+    c.add_argument("scene", help="the base scene: a TOML file or a built-in scene")
+    c.add_argument("--ratios", default="0.05:0.95:19", help="load ratios Q/(mu P): a,b,c or start:stop:count "
+                   "(default 0.05:0.95:19)")
+    c.add_argument("--friction", help="friction coefficients mu (default: the scene's)")
+    c.add_argument("--plot", help="draw the creep-force figure to this file")
+    c.add_argument("--out", help="the zarr store (default <scene name>-creep.zarr)")
+    _cluster_options(c)
+
+
+def _cluster_options(p):
+    p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786); "
+                   "default: a local cluster")
+    p.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+
+def _sweep_signals(fn):
+    """Run ``fn()`` with SIGTERM handled as Ctrl-C (the stored points stay)."""
+    import signal
+    previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    try:
+        return fn()
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _sweep_exit(summary) -> int:
+    if summary.interrupted:
+        return EXIT_INTERRUPTED
+    return EXIT_SOLVER if summary.failed else 0
+
+
+def cmd_sweep(args) -> int:
+    from .scene import load_scene
+    from .sweep import sweep
+    scene = load_scene(args.scene)
+    out = args.out or default_output(scene.name, "-sweep.zarr")
+    summary = _sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
+                                           quiet=args.quiet))
+    if not args.quiet:
+        print(f"rollqp sweep of {scene.name}: {out}")
+        print(summary.table())
+    return _sweep_exit(summary)
+
+
+def cmd_creep_curve(args) -> int:
+    from .scene import load_scene
+    from .sweep.creep import creep_curve
+    scene = load_scene(args.scene)
+    out = args.out or default_output(scene.name, "-creep.zarr")
+    _check_plot(args.plot)
+    curve = _sweep_signals(lambda: creep_curve(scene, args.ratios, args.friction, out, scheduler=args.scheduler,
+                                               workers=args.workers, quiet=args.quiet))
+    if args.plot and not curve.summary.interrupted:
+        curve.plot(args.plot)
+    if not args.quiet:
+        print(curve.table())
+        print(curve.summary.table())
+        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
+    return _sweep_exit(curve.summary)
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv[:1] == ["bench"]:  # the suite parses its own options (benchmarks/suite.py)
@@ -354,7 +432,8 @@ def main(argv=None) -> int:
         limiter = None
     try:
         return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
-                "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench}[args.command](args)
+                "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
+                "sweep": cmd_sweep, "creep-curve": cmd_creep_curve}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
