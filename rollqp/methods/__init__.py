@@ -6,6 +6,7 @@
 ``qp-cvxpy``              convex QP, cvxpy textbook formulation (OSQP underneath)
 ``newton``                generalized Newton with line search (GNMls, paper §4)
 ``nt-newton``             normal–tangential alternation of Newton halves (paper §6.3)
+``mf-newton``             matrix-free generalized Newton, Krylov reduced systems (FFT products)
 ``qps-daqp``, …           convex QP through qpsolvers (optional extra ``qpsolvers``:
                           DAQP, quadprog, ProxQP, PIQP, HiGHS; :mod:`.qp_qpsolvers`)
 ========================  ==========================================================
@@ -34,6 +35,7 @@ _REGISTRY = {
     "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"),
     "newton": ("rollqp.methods.newton", "NewtonMethod", None),
     "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None),
+    "mf-newton": ("rollqp.methods.krylov", "KrylovNewton", None),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
     **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers")
        for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
