@@ -45,7 +45,7 @@ BYTES_PER_NODE = 8 * 200
 
 def mode(scene) -> str:
     """``"dense"`` or ``"matrix-free"``: the scene's ``solver.operator`` with ``"auto"`` resolved."""
-    asked = getattr(scene.solver, "operator", "auto")
+    asked = getattr(scene.solver, "operator", None) or "auto"
     if asked != "auto":
         return asked
     if (scene.solver.method in MATRIX_FREE_METHODS and scene.contact.model == "halfspace"

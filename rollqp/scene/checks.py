@@ -132,7 +132,8 @@ def check_solver(s: Any) -> SolverSettings:
             "solver.augmentation", s.augmentation,
             f"in [{AUGMENTATION_MIN:g}, {AUGMENTATION_MAX:g}] or absent (automatic)",
             lambda x: AUGMENTATION_MIN <= x <= AUGMENTATION_MAX),
-        operator=choice("solver.operator", getattr(s, "operator", "auto"), OPERATOR_MODES))
+        operator=None if getattr(s, "operator", None) is None else choice("solver.operator", s.operator,
+                                                                          OPERATOR_MODES))
 
 
 

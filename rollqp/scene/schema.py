@@ -188,15 +188,15 @@ class SolverSettings:
         ``1/mean(diag Â)`` (normal) and ``Δq̂/mean(diag Â)`` (tangential), see
         :mod:`rollqp.methods.newton`. Ignored by the QP methods. The solution does not depend
         on ``r``, only the Newton path does.
-    operator : {"auto", "dense", "matrix-free"}
+    operator : {"auto", "dense", "matrix-free"} or None
         Influence operators as dense matrices or as FFT products on the uniform half-space strip
-        (docs/matrix-free.md); "auto": matrix-free for the methods that work with products only
-        (``mf-newton``) from :data:`rollqp.matrixfree.THRESHOLD` nodes.
+        (docs/matrix-free.md); "auto" (or None, the default): matrix-free for the methods that
+        work with products only (``mf-newton``) from :data:`rollqp.matrixfree.THRESHOLD` nodes.
     """
 
     method: str = "newton"
     tolerance: float = 1e-10
     max_iterations: int | None = None
     augmentation: float | None = None
-    operator: str = "auto"
+    operator: str | None = None
 
