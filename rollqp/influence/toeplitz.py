@@ -231,7 +231,18 @@ def log_operator(strip, d_ref: float, scale: float = 1.0, name: str = "influence
     w_ref = 2.0 * coef[:, 0] + 2.0 * coef[:, 2] / 3.0
     G = -P + (hl * np.log(d_ref / hl) * w_ref)[:, None]
     conn = np.asarray(strip.connectivity)
-    return ToeplitzOperator(scale * G, r, strip.n, conn.shape[0], name)
+    op = ToeplitzOperator(scale * G, r, strip.n, conn.shape[0], name)
+    op.strip = strip
+    op.coarsen = lambda ne: _coarse_log(strip, ne, d_ref, scale, name)
+    return op
+
+
+def _coarse_log(strip, ne: int, d_ref: float, scale: float, name: str):
+    """``(coarse strip, its log operator)``: the same kernel on ``ne`` elements of the same zone
+    (a coarse model of the same problem, for the cold start of :mod:`rollqp.methods.krylov`)."""
+    from ..strip import Strip
+    coarse = Strip(float(strip.half_width), int(ne), strip.element)
+    return coarse, log_operator(coarse, d_ref, scale, name)
 
 
 def sgn_operator(strip, scale: float = 1.0, name: str = "influence") -> ToeplitzOperator:

@@ -41,6 +41,8 @@ __all__ = ["KrylovNewton"]
 PRECONDITIONERS = ("circulant", "none")
 #: Relative GMRES tolerance of the reduced solves while the node sets still change.
 LOOSE = 1e-6
+#: Nodes from which a cold normal step starts from a coarse solution, and the coarsening factor.
+COARSE_MIN, COARSE_FACTOR = 2000, 4
 
 
 class _Reduced:
@@ -67,13 +69,14 @@ class _Reduced:
         """``Â_II x = b`` to ``‖r‖₂ <= max(atol, rtol ‖b‖₂)`` (GMRES, restarted every 60)."""
         if self.idx.size == 0:
             return np.zeros(0)
-        atol = max(atol, rtol * float(np.linalg.norm(b)))
+        nb = float(np.linalg.norm(b))
+        atol = max(atol, rtol * nb, 1e-15 * nb)               # never below round-off of b
         x, info = spla.gmres(self.op, b, x0=x0, rtol=0.0, atol=atol, restart=min(60, self.idx.size),
                              maxiter=max(50, self.idx.size), M=self.M)
         self.stats["solves"] += 1
         if info != 0:
             r = float(np.linalg.norm(self.op @ x - b))
-            if not r <= 1e3 * atol:
+            if not r <= max(1e3 * atol, 1e-13 * nb):
                 raise SolverError(f"GMRES did not converge on {self.idx.size} nodes "
                                   f"(residual {r:.3e}, wanted {atol:.1e})", method="mf-newton", residual=r)
         return x
@@ -167,13 +170,15 @@ class KrylovNewton:
         seen, atol, rtol = set(), 1e-2 * self.tolerance, LOOSE
         for it in range(1, self.max_iterations + 1):
             sol, nxt, key = iterate(active, atol, rtol)
-            if key in seen or np.array_equal(nxt, active):
-                if rtol == 0.0 and sol.residual <= self.tolerance:
+            settled = np.array_equal(nxt, active)
+            if settled and rtol == 0.0:
+                if sol.residual <= self.tolerance:
                     return sol, it
-                if rtol == 0.0 and atol < 1e-8 * self.tolerance:
+                if atol < 1e-6 * self.tolerance:
                     break
-                atol, rtol = (atol if rtol else 1e-2 * atol), 0.0   # the sets are found: solve exactly
-                seen = set()
+                atol *= 1e-2                      # the sets are right: solve them more exactly
+            elif settled or (key in seen and rtol != 0.0):
+                rtol, seen = 0.0, set()           # found (or cycling on inexact solves): solve exactly
             seen.add(key)
             active = nxt
         raise SolverError(f"the {what} step did not converge in {self.max_iterations} set "
@@ -188,10 +193,12 @@ class KrylovNewton:
         state = self._warm["normal"] if len(self._warm["normal"].get("u", ())) == pb.n else {}
         self._warm["normal"] = state
         active = (warm.p > 0) if (warm is not None and warm.p is not None and np.any(warm.p > 0)) else \
-            np.ones(pb.n, dtype=bool)
+            self._coarse_start(pb)
 
         def iterate(act, atol, rtol):
             idx = np.flatnonzero(act)
+            if idx.size == 0:                                     # no contact: start at the closest node
+                idx = np.array([int(np.argmin(hh))])
             red = self._reduced(pb.A, scale, idx)
             u = red.solve(np.ones(idx.size), _restrict(state, "u", idx), atol, rtol)
             v = red.solve(-hh[idx], _restrict(state, "v", idx), atol, rtol)
@@ -209,6 +216,27 @@ class KrylovNewton:
         sol, it = self._loop(pb, active, iterate, "normal")
         return _with(sol, it)
 
+    def _coarse_start(self, pb) -> np.ndarray:
+        """The contact set of a cold normal step: all nodes, or, from :data:`COARSE_MIN` nodes on an
+        operator that has a coarse model (``A.coarsen``), the set of the same problem on
+        :data:`COARSE_FACTOR` times fewer elements (solved the same way, recursively), interpolated:
+        the fine iteration then starts next to its answer (nested iteration)."""
+        make, strip = getattr(pb.A, "coarsen", None), getattr(pb.A, "strip", None)
+        if make is None or strip is None or pb.n < COARSE_MIN or pb.offset is not None:
+            return np.ones(pb.n, dtype=bool)
+        coarse, Ac = make(max(2, int(strip.n_elements) // COARSE_FACTOR))
+        hc = np.interp(coarse.x, strip.x, pb.h)
+        sub = KrylovNewton(tolerance=max(self.tolerance, 1e-8), max_iterations=self.max_iterations,
+                           preconditioner=self.preconditioner)
+        try:
+            from ..problem import NormalStep
+            sol = sub.solve(NormalStep(A=Ac, f=coarse.weights, h=hc, P=pb.P, delta=pb.delta, scales=pb.scales))
+        except SolverError:
+            return np.ones(pb.n, dtype=bool)
+        for k in self.stats:
+            self.stats[k] += sub.stats[k]
+        return np.interp(strip.x, coarse.x, sol.p) > 0
+
     def _tangential(self, pb, warm):
         sc = pb.scales
         scale = sc.modulus / sc.length
@@ -219,8 +247,9 @@ class KrylovNewton:
         r = dqh / float(np.mean(pb.A.diagonal()) * scale)
         state = self._warm["tangential"] if len(self._warm["tangential"].get("v", ())) == pb.n else {}
         self._warm["tangential"] = state
-        if warm is not None and warm.t is not None:
-            sign = np.sign(warm.t) * (np.abs(warm.t) / sc.stress >= bh * (1 - 1e-12))
+        tw = warm.t if (warm is not None and warm.t is not None) else None
+        if tw is not None:
+            sign = np.sign(tw) * (np.abs(tw) / sc.stress >= bh * (1 - 1e-12))
             stick = (bh > 0) & (sign == 0)
         else:
             stick, sign = bh > 0, np.zeros(pb.n)
