@@ -157,7 +157,7 @@ def test_transient_matrix_free_equals_dense(reference, kw):
 
 def test_scene_operator_choice_and_refusals():
     base = load_scene("cattaneo-carter")
-    ops = SceneOperators.build(base.replace(**{"solver.method": "mf-newton", "discretization.elements": 600}))
+    ops = SceneOperators.build(base.replace(**{"solver.method": "mf-newton", "discretization.elements": 150}))
     assert ops.matrix_free and isinstance(ops.Ann, tp.ToeplitzOperator), "auto: FFT from the threshold"
     ops = SceneOperators.build(base.replace(**{"solver.method": "mf-newton"}))
     assert not ops.matrix_free, "auto: dense below the threshold"
