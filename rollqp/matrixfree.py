@@ -39,9 +39,6 @@ MODES = ("auto", "dense", "matrix-free")
 #: threshold (not measured separately).
 THRESHOLD = {"constant": 200, "linear": 200, "quadratic": 200}
 
-#: Methods that work with operator products only (the registry's name for them).
-MATRIX_FREE_METHODS = ("mf-newton",)
-
 #: Bytes per node of the matrix-free operators and solver work space (generators and their
 #: transforms, GMRES basis of 60 vectors, sparse history operators), measured at 131,073 nodes.
 BYTES_PER_NODE = 8 * 200
@@ -52,7 +49,8 @@ def mode(scene) -> str:
     asked = getattr(scene.solver, "operator", None) or "auto"
     if asked != "auto":
         return asked
-    if (scene.solver.method in MATRIX_FREE_METHODS and scene.contact.model == "halfspace"
+    from .methods import matrix_free
+    if (matrix_free(scene.solver.method) and scene.contact.model == "halfspace"
             and scene.n_nodes >= THRESHOLD[scene.discretization.element]):
         return "matrix-free"
     return "dense"
@@ -75,12 +73,13 @@ def check_scene(scene, dense_max_nodes: int) -> str:
         other than the half-space; ``discretization.elements`` when a method that needs the matrix
         is asked for more than ``dense_max_nodes`` nodes (naming ``mf-newton``).
     """
+    from .methods import matrix_free
     m = mode(scene)
     method = scene.solver.method
     if m == "matrix-free":
-        if method not in MATRIX_FREE_METHODS:
+        if not matrix_free(method):
             raise InputError("solver.operator", f"'matrix-free' needs a method that works with products only "
-                                                f"({', '.join(MATRIX_FREE_METHODS)}); {method!r} needs the "
+                                                f"(mf-newton); {method!r} needs the "
                                                 f"n × n matrix: use solver.method = 'mf-newton' or "
                                                 f"solver.operator = 'dense'")
         if scene.contact.model != "halfspace":

@@ -50,10 +50,10 @@ def test_lattice_assembly_is_the_element_by_element_gather(element, ne):
     """The dense assembly from O(n) generators adds the same products in the same order as the
     general gather over (node, element) pairs on the same offsets: bitwise equal."""
     strip = Strip(1.25, ne, element)
-    offsets = hs.element_offsets(strip, True)
-    for moments in (hs._log_moments, hs._sgn_moments):
+    for kernel in ("log", "sgn"):
+        moments = tp.kernel_moments(kernel)
         P, r = tp.generators(strip, moments)
-        assert np.array_equal(tp.assemble(P, r, strip.n, ne), hs._assemble(strip, moments, offsets))
+        assert np.array_equal(tp.assemble(P, r, strip.n, ne), tp.elementwise(strip, moments))
     # and the general (non-lattice) path agrees to round-off of the offsets
     assert _rel(hs.log_kernel_matrix(strip, 3.0), hs.log_kernel_matrix(strip, 3.0, lattice=False)) < 1e-12
 
@@ -66,7 +66,7 @@ def test_fft_operator_needs_a_uniform_lattice():
         coefficients = np.array([[1.0, 0.0, 0.0]])
         weights = np.diff(edges)
     with pytest.raises(InputError) as exc:
-        tp.generators(Bent(), hs._log_moments)
+        tp.generators(Bent(), tp.kernel_moments("log"))
     assert exc.value.key == "strip"
 
 

@@ -36,11 +36,28 @@ from numpy.lib.stride_tricks import as_strided
 from ..errors import InputError
 from .operator import Operator
 
-__all__ = ["generators", "assemble", "ToeplitzOperator", "log_operator", "sgn_operator",
+__all__ = ["kernel_moments", "elementwise", "generators", "assemble", "ToeplitzOperator", "log_operator", "sgn_operator",
            "halfspace_operators", "positive_definite_threshold"]
 
 #: Rows per block of the dense assembly (bounds its temporaries to a few MB).
 _ROWS = 256
+
+
+def kernel_moments(kernel: str):
+    """The reference moments of ``kernel`` (``"log"``: eq. 26's ``ln|ξ − ξ_i|``, ``"sgn"``: eq. 29's
+    ``sgn(ξ_i − ξ)``), the ``moments`` argument of :func:`generators` and :func:`elementwise`."""
+    from .halfspace import _log_moments, _sgn_moments
+    try:
+        return {"log": _log_moments, "sgn": _sgn_moments}[kernel]
+    except KeyError:
+        raise InputError("kernel", f"must be 'log' or 'sgn', got {kernel!r}") from None
+
+
+def elementwise(strip, moments) -> np.ndarray:
+    """The matrix of the general (node, element) gather on the lattice offsets: the reference
+    that :func:`assemble` reproduces bitwise (tests)."""
+    from .halfspace import _assemble, element_offsets
+    return _assemble(strip, moments, element_offsets(strip, True))
 
 
 def generators(strip, moments, lattice=None):

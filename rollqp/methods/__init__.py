@@ -128,3 +128,13 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None) -> Meth
         from .alternation import Alternation
         return Alternation(method, max_outer=max_outer)
     return method
+
+
+def matrix_free(name: str) -> bool:
+    """Whether method ``name`` works with operator products only (its class's ``matrix_free``),
+    so that a scene may give it FFT operators (:mod:`rollqp.matrixfree`); False for a method whose
+    package is not installed."""
+    try:
+        return bool(getattr(method_class(name), "matrix_free", False))
+    except MissingBackendError:
+        return False

@@ -124,6 +124,8 @@ class KrylovNewton:
     name = "mf-newton"
     solves = frozenset({"normal", "tangential"})
     operator = "exact"
+    #: works with operator products only (``A @ x``, ``x @ A``, ``diagonal()``): no stored matrix
+    matrix_free = True
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, preconditioner: str = "circulant"):
         if preconditioner not in PRECONDITIONERS:
@@ -131,7 +133,6 @@ class KrylovNewton:
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
         self.preconditioner = preconditioner
-        self._symbols = {}
         self._warm = {"normal": {}, "tangential": {}}      # reduced solutions of the last step
         self.stats = {"products": 0, "solves": 0}
 
@@ -141,14 +142,13 @@ class KrylovNewton:
         return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations or 100, **options)
 
     def setup(self, operators) -> None:
-        self._symbols = {}
         self._warm = {"normal": {}, "tangential": {}}
 
     def _reduced(self, A, scale, idx):
-        key = (id(A), scale)
-        if key not in self._symbols:
-            self._symbols[key] = chan_symbol(A, scale) if self.preconditioner == "circulant" else None
-        return _Reduced(A, scale, idx, self._symbols[key], self.stats)
+        symbol = None
+        if self.preconditioner == "circulant":   # kept with the operator (derived from it alone)
+            symbol = A.memo(("chan-circulant", float(scale)), lambda: chan_symbol(A, scale))
+        return _Reduced(A, scale, idx, symbol, self.stats)
 
     # ------------------------------------------------------------------ one step
     def solve(self, problem, warm=None):
