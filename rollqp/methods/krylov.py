@@ -167,7 +167,7 @@ class KrylovNewton:
         :data:`LOOSE`); once they repeat, to ``‖r‖₂ <= 10⁻² tol`` (tightened by 10⁻² until
         rollqp's residual is met): an inexact Newton method with exact final iterations.
         """
-        seen, atol, rtol = set(), 1e-2 * self.tolerance, LOOSE
+        seen, atol, rtol = set(), 1e-4 * self.tolerance, LOOSE
         for it in range(1, self.max_iterations + 1):
             sol, nxt, key = iterate(active, atol, rtol)
             settled = np.array_equal(nxt, active)
