@@ -133,14 +133,16 @@ def test_mf_newton_hertz_convergence_slope():
 
 @pytest.mark.parametrize("reference,kw", [
     ("newton", {}),                                                   # quadratic, material, similar
-    ("newton", {"discretization.element": "constant", "discretization.elements": 60,
-                "discretization.formulation": "convective-local", "discretization.distance": 2.0}),
+    pytest.param("newton", {"discretization.element": "constant", "discretization.elements": 60,
+                            "discretization.formulation": "convective-local", "discretization.distance": 2.0},
+                 marks=pytest.mark.slow),
     # dissimilar (full coupling): mf-newton runs the N–T alternation, which stops at a coupled
     # residual whose distance to the solution grows with its contraction rate: at the tolerance
     # 1e-10 the states differ from the dense coupled newton by up to 1.1e-10 μp0 (and 7e-10 from the
     # dense nt-newton); at 1e-12 by 1.4e-12 (measured), so this case runs at 1e-12
-    ("newton", {"discretization.element": "linear", "discretization.distance": 0.25,
-                "bodies.B.E": 70000.0, "bodies.B.nu": 0.33, "solver.tolerance": 1e-12}),
+    pytest.param("newton", {"discretization.element": "linear", "discretization.distance": 0.25,
+                            "bodies.B.E": 70000.0, "bodies.B.nu": 0.33, "solver.tolerance": 1e-12},
+                 marks=pytest.mark.slow),
 ])
 def test_transient_matrix_free_equals_dense(reference, kw):
     """Every state of a transient (braked start, rolling steps): the dense path and the
