@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import matrixfree
 from .errors import InputError
 from .influence import build_influence
 from .influence.operator import Operator, asymmetry
@@ -67,6 +68,8 @@ class SceneOperators:
         """Discretize ``scene``; ``symmetrized`` selects the QP operator ``F⁻¹ sym(F A)``."""
         d = scene.discretization
         strip = Strip(scene.half_width, d.elements, d.element)
+        if matrixfree.mode(scene) == "matrix-free":
+            return cls._build_matrix_free(scene, strip)
         t0 = time.perf_counter()
         kw = {}
         if scene.contact.model == "bem":  # true geometry: the rollers and their BEM meshes
@@ -117,6 +120,21 @@ class SceneOperators:
         h = np.asarray(h, dtype=float)
         h.setflags(write=False)
         return h
+
+    @classmethod
+    def _build_matrix_free(cls, scene, strip) -> "SceneOperators":
+        """FFT operators on the uniform strip (:mod:`rollqp.matrixfree`; docs/matrix-free.md)."""
+        t0 = time.perf_counter()
+        Ann, Att, Atn, Ant, h, info = matrixfree.build(scene, strip)
+        info["influence_seconds"] = time.perf_counter() - t0
+        info["operator"] = "collocation"
+        return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=h,
+                   scales=Scales(scene.a_H, scene.p0, scene.Estar), info=info)
+
+    @property
+    def matrix_free(self) -> bool:
+        """The influence operators are FFT products (no stored matrices; sparse slip operators)."""
+        return self.info.get("operator_mode") == "matrix-free"
 
     @property
     def f(self) -> np.ndarray:
@@ -169,7 +187,8 @@ class SceneOperators:
         direction = sc.load.direction if direction is None else direction
         key = ("history", formulation, float(dq), int(direction))
         if key not in self._memo:
-            self._memo[key] = self.strip.history_operator(formulation, dq, direction)
+            self._memo[key] = (matrixfree.sparse_history(self.strip, formulation, dq, direction) if self.matrix_free
+                               else self.strip.history_operator(formulation, dq, direction))
         return self._memo[key]
 
     def steady(self) -> tuple[Operator | None, Operator]:

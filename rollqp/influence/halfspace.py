@@ -171,14 +171,40 @@ def _snap(value: float) -> float:
     return float(np.round(value * 2.0 ** 20) / 2.0 ** 20)
 
 
+def lattice_offsets(strip):
+    """``(values, r, hl0)`` of a uniform lattice strip, ``None`` for any other node layout.
+
+    On a uniform lattice (nodes ``x_0 + i·Δx``, equal elements of length ``r·Δx`` with integer
+    ``r``) the offsets are ``ξ[i, e] = ξ_00 + (Δx/hl)(i - r e)``: ``values[k - k_min]`` holds the
+    value at ``k = i - r e``, ``k_min = -r (n_e - 1)``, computed from the ideal lattice: the
+    nodes and edges of :class:`~rollqp.strip.Strip` (``linspace``) deviate from it by round-off
+    only, checked to ``_LATTICE_TOL`` half-lengths. ``O(n)`` memory.
+    """
+    x = np.asarray(strip.x, dtype=float)
+    edges = np.asarray(strip.edges, dtype=float)
+    n, ne = x.size, edges.size - 1
+    if n < 2:
+        return None
+    hl0 = 0.5 * (edges[-1] - edges[0]) / ne
+    dx = (x[-1] - x[0]) / (n - 1)
+    step = _snap(dx / hl0)                    # Δx / hl: 2 (constant, linear), 1 (quadratic)
+    r = int(round(2.0 / step)) if step > 0 else 0
+    xi00 = _snap((x[0] - 0.5 * (edges[0] + edges[1])) / hl0)
+    tol = _LATTICE_TOL * hl0
+    if (r >= 1 and abs(r * step - 2.0) < 1e-12
+            and abs(x[0] - 0.5 * (edges[0] + edges[1]) - xi00 * hl0) <= tol
+            and np.max(np.abs(x - x[0] - step * hl0 * np.arange(n))) <= tol
+            and np.max(np.abs(edges - edges[0] - 2.0 * hl0 * np.arange(ne + 1))) <= tol):
+        kmin = -r * (ne - 1)
+        return xi00 + step * np.arange(kmin, n), r, hl0
+    return None
+
+
 def element_offsets(strip, lattice: bool | None = None):
     """Reference offsets ``ξ[i, e] = (x_i - c_e) / hl_e`` as ``(values, index, hl)``.
 
-    ``values[index]`` is the (n, n_elements) offset matrix. On a uniform lattice (nodes
-    ``x_0 + i·Δx``, equal elements of length ``r·Δx`` with integer ``r``) the offsets are
-    ``ξ_00 + (Δx/hl)(i - r e)``: only the distinct values are returned, computed from the ideal
-    lattice: the nodes and edges of :class:`~rollqp.strip.Strip` (``linspace``) deviate from it
-    by round-off only, checked to ``_LATTICE_TOL`` half-lengths.
+    ``values[index]`` is the (n, n_elements) offset matrix. On a uniform lattice
+    (:func:`lattice_offsets`) only the distinct values are evaluated.
     ``lattice=None`` detects the lattice, ``False`` forces the general path, ``True`` requires it.
     """
     x = np.asarray(strip.x, dtype=float)
@@ -187,20 +213,11 @@ def element_offsets(strip, lattice: bool | None = None):
     hl = 0.5 * np.diff(edges)
     if np.any(hl <= 0):
         raise InputError("strip", "element edges must be strictly increasing")
-    if lattice is not False and n >= 2:
-        hl0 = 0.5 * (edges[-1] - edges[0]) / ne
-        dx = (x[-1] - x[0]) / (n - 1)
-        step = _snap(dx / hl0)                    # Δx / hl: 2 (constant, linear), 1 (quadratic)
-        r = int(round(2.0 / step)) if step > 0 else 0
-        xi00 = _snap((x[0] - 0.5 * (edges[0] + edges[1])) / hl0)
-        tol = _LATTICE_TOL * hl0
-        if (r >= 1 and abs(r * step - 2.0) < 1e-12
-                and abs(x[0] - 0.5 * (edges[0] + edges[1]) - xi00 * hl0) <= tol
-                and np.max(np.abs(x - x[0] - step * hl0 * np.arange(n))) <= tol
-                and np.max(np.abs(edges - edges[0] - 2.0 * hl0 * np.arange(ne + 1))) <= tol):
-            kmin = -r * (ne - 1)
-            values = xi00 + step * np.arange(kmin, n)
-            index = np.arange(n)[:, None] - r * np.arange(ne)[None, :] - kmin
+    if lattice is not False:
+        lat = lattice_offsets(strip)
+        if lat is not None:
+            values, r, hl0 = lat
+            index = np.arange(n)[:, None] - r * np.arange(ne)[None, :] + r * (ne - 1)
             return values, index, np.full(ne, hl0)
         if lattice:
             raise InputError("strip", "nodes are not a uniform lattice")
@@ -225,6 +242,19 @@ def _assemble(strip, moments, offsets) -> np.ndarray:
         # Within one local index a, every node appears at most once: plain fancy-index add.
         M[:, conn[:, a]] += local[index, a] * hl[None, :]
     return M
+
+
+def _kernel_matrix(strip, moments, lattice) -> np.ndarray:
+    """The collocation matrix of a kernel: from its ``O(n)`` distinct entries on a uniform lattice
+    (:func:`rollqp.influence.toeplitz.assemble`, bitwise the general assembly's values without
+    its ``n × n_e`` index and gather temporaries), element by element otherwise."""
+    if lattice is not False:
+        lat = lattice_offsets(strip)
+        if lat is not None and np.all(np.diff(np.asarray(strip.edges, dtype=float)) > 0):
+            from . import toeplitz
+            P, r = toeplitz.generators(strip, moments, lat)
+            return toeplitz.assemble(P, r, np.asarray(strip.x).size, np.asarray(strip.connectivity).shape[0])
+    return _assemble(strip, moments, element_offsets(strip, lattice))
 
 
 def log_kernel_matrix(strip, d_ref: float, lattice: bool | None = None) -> np.ndarray:
@@ -260,15 +290,19 @@ def log_kernel_matrix(strip, d_ref: float, lattice: bool | None = None) -> np.nd
     so ``K(d') = K(d) + ln(d'/d) e fᵀ``.
     """
     d_ref = positive_real("contact.reference_distance", float(d_ref))
-    offsets = element_offsets(strip, lattice)
-    K = -_assemble(strip, _log_moments, offsets)
-    hl = offsets[2]
+    K = _kernel_matrix(strip, _log_moments, lattice)
+    np.negative(K, out=K)
+    lat = None if lattice is False else lattice_offsets(strip)
+    hl = 0.5 * np.diff(np.asarray(strip.edges, dtype=float))
+    if lat is not None:
+        hl = np.full(hl.size, lat[2])                            # the lattice's half-length
     coef = np.asarray(strip.coefficients, dtype=float)
     w_ref = 2.0 * coef[:, 0] + 2.0 * coef[:, 2] / 3.0            # ∫_{-1}^{1} N_a dξ
     conn = np.asarray(strip.connectivity)
     shift = np.zeros(K.shape[1])
     np.add.at(shift, conn, (hl * np.log(d_ref / hl))[:, None] * w_ref[None, :])
-    return K + shift[None, :]
+    K += shift[None, :]
+    return K
 
 
 def sgn_kernel_matrix(strip, lattice: bool | None = None) -> np.ndarray:
@@ -292,7 +326,7 @@ def sgn_kernel_matrix(strip, lattice: bool | None = None) -> np.ndarray:
         ``Σ_j S[i, j] = (x_i + L) - (L - x_i) = 2 x_i``; ``F S`` is antisymmetric up to the
         discretization error, exactly for constant elements on a uniform grid.
     """
-    return _assemble(strip, _sgn_moments, element_offsets(strip, lattice))
+    return _kernel_matrix(strip, _sgn_moments, lattice)
 
 
 def undeformed_gap(x, R_A: float, R_B: float = np.inf) -> np.ndarray:
@@ -446,26 +480,77 @@ def _coupling(strip, f, beta, Estar, coupling):
     ``‖FS + (FS)ᵀ‖/‖FS‖``.
     """
     S = sgn_kernel_matrix(strip)
-    FS = f[:, None] * S
-    nFS = np.linalg.norm(FS)
-    defect = float(np.linalg.norm(FS + FS.T) / nFS) if nFS > 0 else 0.0
-    return (-beta / Estar) * S, ((beta / Estar) * S if coupling == "full" else None), defect
+    defect = asymmetry(S, f, sign=-1.0)
+    S *= -beta / Estar                          # A_tn in place; A_nt = -A_tn exactly (rounding is odd)
+    return S, (np.negative(S) if coupling == "full" else None), defect
+
+
+#: Below this many nodes the reported ``min_eig_rel`` is a full eigenvalue computation (cheap);
+#: above it a Lanczos estimate on the Cholesky factor (``_lanczos_rel``).
+_EIG_DENSE_MAX = 400
+
+
+def _weighted_sym_upper(f, K) -> np.ndarray:
+    """A new array whose upper triangle is ``sym(F K)`` (the lower one is not needed by Cholesky):
+    row blocks, so the only ``n × n`` array made is the result (two copies of a matrix at the peak)."""
+    n = K.shape[0]
+    B = f[:, None] * K
+    for i0 in range(0, n, 256):
+        i1 = min(n, i0 + 256)
+        B[i0:i1, i0:] = 0.5 * (B[i0:i1, i0:] + B[i0:, i0:i1].T)
+    return B
+
+
+def _lanczos_rel(Lf) -> float:
+    """``λ_min/λ_max`` of ``B = L Lᵀ`` (``Lf`` the Fortran-ordered lower factor) by Lanczos (ARPACK,
+    to round-off): ``λ_max`` from products ``L(Lᵀx)``, ``λ_min = 1/λ_max(B⁻¹)`` from triangular
+    solves: ``O(n²)`` per iteration, no copy of the factor."""
+    import scipy.sparse.linalg as spla
+    n = Lf.shape[0]
+    trmv, trsv = scipy.linalg.blas.dtrmv, scipy.linalg.blas.dtrsv
+
+    def mul(x):
+        return trmv(Lf, trmv(Lf, np.ravel(x), trans=1, lower=1), lower=1)
+
+    def inv(x):
+        return trsv(Lf, trsv(Lf, np.ravel(x), lower=1), trans=1, lower=1)
+
+    top = spla.eigsh(spla.LinearOperator((n, n), matvec=mul, dtype=float), k=1, which="LA",
+                     tol=0, return_eigenvectors=False)[0]
+    low = 1.0 / spla.eigsh(spla.LinearOperator((n, n), matvec=inv, dtype=float), k=1, which="LA",
+                           tol=0, return_eigenvectors=False)[0]
+    return float(low / top)
 
 
 def _check_definite(f, K, d_ref, L):
-    """``(λ_min/max|λ|, d_min)`` of ``sym(F K)``; an :class:`InputError` on ``contact.reference_distance``
-    if it is not positive definite, with the smallest admissible ``d_ref`` (:func:`_threshold`)."""
+    """``(λ_min/max|λ|, d_min)`` of ``sym(F K)`` by an attempted Cholesky factorization (``O(n³/3)``,
+    no eigendecomposition); an :class:`InputError` on ``contact.reference_distance`` if it fails,
+    with the smallest admissible ``d_ref`` (:func:`_threshold`). ``d_min`` from the same factor:
+    ``d_ref exp(-1/(fᵀB⁻¹f))``; ``λ_min/λ_max`` exact below :data:`_EIG_DENSE_MAX` nodes, a Lanczos
+    estimate on the factor above."""
+    try:
+        # the transpose of the C-ordered upper triangle is a Fortran-ordered lower one: factorized
+        # in place (no third copy)
+        Lf = scipy.linalg.cholesky(_weighted_sym_upper(f, K).T, lower=True, overwrite_a=True,
+                                   check_finite=False)
+    except np.linalg.LinAlgError:
+        Lf = None
+    if Lf is not None and np.all(np.diag(Lf) > 0):
+        y = scipy.linalg.cho_solve((Lf, True), f, check_finite=False)
+        q = float(f @ y)
+        d_min = float(d_ref * np.exp(-1.0 / q)) if q != 0 else float("nan")
+        lam = min_eigenvalue(f, K) if K.shape[0] <= _EIG_DENSE_MAX else _lanczos_rel(Lf)
+        return lam, d_min
+    del Lf
     lam = min_eigenvalue(f, K)
     d_min = _threshold(f, K, d_ref)
-    if not lam > 0:
-        hint = (f"the smallest admissible value for this mesh is {d_min:.6g}"
-                if np.isfinite(d_min) else "no admissible value could be determined")
-        raise InputError(
-            "contact.reference_distance",
-            f"d_ref = {d_ref:.6g} makes the normal influence matrix indefinite "
-            f"(relative min eigenvalue {lam:.3e}); it must exceed L/2 = {L / 2:.6g} "
-            f"(continuous bound), {hint}; the default is the relative radius R")
-    return lam, d_min
+    hint = (f"the smallest admissible value for this mesh is {d_min:.6g}"
+            if np.isfinite(d_min) else "no admissible value could be determined")
+    raise InputError(
+        "contact.reference_distance",
+        f"d_ref = {d_ref:.6g} makes the normal influence matrix indefinite "
+        f"(relative min eigenvalue {lam:.3e}); it must exceed L/2 = {L / 2:.6g} "
+        f"(continuous bound), {hint}; the default is the relative radius R")
 
 
 def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: float = np.inf,
@@ -528,21 +613,21 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
     K = log_kernel_matrix(strip, d_ref)
     lam, d_min = _check_definite(f, K, d_ref, L)
 
-    Ann = (2.0 / (np.pi * Estar)) * K
-    Att = Ann.copy()
-    Ant = Atn = None
     info = {
         "d_ref": d_ref, "d_ref_min": d_min, "d_ref_min_continuous": 0.5 * L,
         "coupling": coupling, "beta": beta, "kappa": 2.0 * beta, "Estar": Estar,
         "R": R, "R_A": float(R_A), "R_B": float(R_B),
         "asymmetry_FA": asymmetry(K, f),
-        "asymmetry_A": float(np.linalg.norm(K - K.T) / np.linalg.norm(K)),
+        "asymmetry_A": asymmetry(K, np.ones(K.shape[0])),
         "min_eig_rel": lam,
         "gauss_points": GAUSS_POINTS, "far_field": FAR_FIELD,
     }
+    K *= 2.0 / (np.pi * Estar)                  # A_nn in place: the same products as (2/(πE*)) K
+    Ann = Att = K                               # one read-only array for both (A_tt = A_nn)
+    Ant = Atn = None
     if coupling in ("full", "goodman"):
         Atn, Ant, info["reciprocity_defect"] = _coupling(strip, f, beta, Estar, coupling)
-    for M in (Ann, Att, Ant, Atn, h):
+    for M in (Ann, Ant, Atn, h):
         if M is not None:
             M.setflags(write=False)
     return Influence(Ann=Ann, Att=Att, Ant=Ant, Atn=Atn, h=h, model="halfspace", info=info)

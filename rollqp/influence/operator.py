@@ -127,16 +127,29 @@ class Split:
     skew: np.ndarray
 
 
-def asymmetry(A, f) -> float:
+def asymmetry(A, f, sign: float = 1.0) -> float:
     """``‖FA − (FA)ᵀ‖_F / ‖FA‖_F`` with ``F = diag(f)``: how far the QP Hessian's source is from symmetric.
 
     ``A`` an operator or a matrix, ``f`` the weights (a vector, or ``diag(f)``). Zero for a zero ``A``.
+    ``sign = -1`` measures the defect from antisymmetry, ``‖FA + (FA)ᵀ‖_F / ‖FA‖_F``. Above 512
+    rows the norms are accumulated over row blocks (no ``n × n`` temporary).
     """
     f = np.asarray(f, dtype=float)
     f = np.diagonal(f) if f.ndim == 2 else f
-    FA = f[:, None] * np.asarray(A, dtype=float)
-    norm = np.linalg.norm(FA)
-    return float(np.linalg.norm(FA - FA.T) / norm) if norm > 0 else 0.0
+    M = np.asarray(A, dtype=float)
+    n = M.shape[0]
+    if n <= 512:
+        FA = f[:, None] * M
+        norm = np.linalg.norm(FA)
+        return float(np.linalg.norm(FA - sign * FA.T) / norm) if norm > 0 else 0.0
+    num = den = 0.0
+    for i0 in range(0, n, 256):
+        i1 = min(n, i0 + 256)
+        rows = f[i0:i1, None] * M[i0:i1]
+        cols = (f[:, None] * M[:, i0:i1]).T
+        num += float(np.sum((rows - sign * cols) ** 2))
+        den += float(np.sum(rows * rows))
+    return float(np.sqrt(num / den)) if den > 0 else 0.0
 
 
 def split(A, f: np.ndarray) -> Split:

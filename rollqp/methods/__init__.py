@@ -6,6 +6,7 @@
 ``qp-cvxpy``              convex QP, cvxpy textbook formulation (OSQP underneath)
 ``newton``                generalized Newton with line search (GNMls, paper §4)
 ``nt-newton``             normal–tangential alternation of Newton halves (paper §6.3)
+``mf-newton``             matrix-free generalized Newton, Krylov reduced systems (FFT products)
 ``qps-daqp``, …           convex QP through qpsolvers (optional extra ``qpsolvers``:
                           DAQP, quadprog, ProxQP, PIQP, HiGHS; :mod:`.qp_qpsolvers`)
 ========================  ==========================================================
@@ -34,6 +35,7 @@ _REGISTRY = {
     "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"),
     "newton": ("rollqp.methods.newton", "NewtonMethod", None),
     "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None),
+    "mf-newton": ("rollqp.methods.krylov", "KrylovNewton", None),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
     **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers")
        for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
@@ -147,3 +149,13 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
 def _Alternation():
     from .alternation import Alternation
     return Alternation
+
+
+def matrix_free(name: str) -> bool:
+    """Whether method ``name`` works with operator products only (its class's ``matrix_free``),
+    so that a scene may give it FFT operators (:mod:`rollqp.matrixfree`); False for a method whose
+    package is not installed."""
+    try:
+        return bool(getattr(method_class(name), "matrix_free", False))
+    except MissingBackendError:
+        return False

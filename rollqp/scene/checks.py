@@ -20,7 +20,8 @@ from ..errors import InputError
 from ..histories import Constant, Harmonic, parse_history
 from ..methods import check_name as check_method
 from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, COUPLINGS, EDGE_ELEMENTS,
-                     ELEMENT_TYPES, FORMULATION_TYPES, MAX_NODES, MAX_START_STEPS, MAX_STEPS, MODELS, STARTS,
+                     ELEMENT_TYPES, FORMULATION_TYPES, MAX_ELEMENTS, MAX_NODES, MAX_START_STEPS, MAX_STEPS,
+                     MODELS, OPERATOR_MODES, STARTS,
                      Body, Contact, Discretization, Load, SolverSettings)
 from .validate import choice, integer, number, string
 
@@ -111,8 +112,9 @@ def check_discretization(d: Any) -> Discretization:
     if not isinstance(d, Discretization):
         raise InputError("discretization", f"must be a Discretization, got {d!r}")
     return Discretization(
-        elements=integer("discretization.elements", d.elements, ">= 2 (and <= 20000)",
-                          lambda n: 2 <= n <= 20000),
+        elements=integer("discretization.elements", d.elements,
+                          f">= 2 (and <= 20000 on the dense path, {MAX_ELEMENTS} matrix-free)",
+                          lambda n: 2 <= n <= MAX_ELEMENTS),
         element=choice("discretization.element", d.element, ELEMENT_TYPES),
         zone=number("discretization.zone", d.zone, "> 1", lambda x: x > 1),
         step=number("discretization.step", d.step, "in (0, 8]", lambda x: 0 < x <= 8),
@@ -133,7 +135,9 @@ def check_solver(s: Any) -> SolverSettings:
         augmentation=None if s.augmentation is None else number(
             "solver.augmentation", s.augmentation,
             f"in [{AUGMENTATION_MIN:g}, {AUGMENTATION_MAX:g}] or absent (automatic)",
-            lambda x: AUGMENTATION_MIN <= x <= AUGMENTATION_MAX))
+            lambda x: AUGMENTATION_MIN <= x <= AUGMENTATION_MAX),
+        operator=None if getattr(s, "operator", None) is None else choice("solver.operator", s.operator,
+                                                                          OPERATOR_MODES))
 
 
 
@@ -229,14 +233,13 @@ def check_work(scene) -> None:
     """The work a scene asks for fits: nodes within :data:`MAX_NODES`, and the dense influence
     matrices and the result arrays within this machine's memory — refused before any work, with
     what they would need."""
+    from ..matrixfree import check_scene, memory_estimate
     n, K = scene.n_nodes, scene.n_steps
-    if n > MAX_NODES:
-        raise InputError("discretization.elements",
-                         f"{scene.discretization.elements} {scene.discretization.element} elements make {n} nodes; "
-                         f"the dense path takes at most {MAX_NODES}")
-    need, memory = scene.memory_estimate(), available_memory()
+    dense = check_scene(scene, MAX_NODES) == "dense"
+    need, memory = (scene.memory_estimate() if dense else memory_estimate(scene)), available_memory()
     if need > 0.8 * memory:
-        raise InputError("discretization.elements" if n * n * 8 * 6 > 0.5 * need else "discretization.distance",
+        per_node = n * n * 8 * 6 if dense else n * 8.0 * 200    # the operators' share of the need
+        raise InputError("discretization.elements" if per_node > 0.5 * need else "discretization.distance",
                          f"this scene needs about {need / 2**30:.3g} GiB ({n} nodes, {K + 1} states), more than "
                          f"80 % of this machine's {memory / 2**30:.3g} GiB: use fewer elements or a shorter distance")
 

@@ -32,6 +32,9 @@ AUGMENTATION_MIN, AUGMENTATION_MAX = 1e-6, 10.0
 
 #: largest number of nodes of a dense strip (its n × n influence matrices: 3.2 GB each at the limit)
 MAX_NODES = 20001
+#: largest number of elements (the dense path stops at MAX_NODES nodes; the matrix-free one here)
+MAX_ELEMENTS = 1_000_000
+OPERATOR_MODES = ("auto", "dense", "matrix-free")
 #: largest number of rolling steps of a scene (a result of 10^6 states of 81 nodes is 3 GB)
 MAX_STEPS = 1_000_000
 #: largest number of increments of a braked start
@@ -202,10 +205,15 @@ class SolverSettings:
         ``1/mean(diag Â)`` (normal) and ``Δq̂/mean(diag Â)`` (tangential), see
         :mod:`rollqp.methods.newton`. Ignored by the QP methods. The solution does not depend
         on ``r``, only the Newton path does.
+    operator : {"auto", "dense", "matrix-free"} or None
+        Influence operators as dense matrices or as FFT products on the uniform half-space strip
+        (docs/matrix-free.md); "auto" (or None, the default): matrix-free for the methods that
+        work with products only (``mf-newton``) from :data:`rollqp.matrixfree.THRESHOLD` nodes.
     """
 
     method: str = "newton"
     tolerance: float = 1e-10
     max_iterations: int | None = None
     augmentation: float | None = None
+    operator: str | None = None
 

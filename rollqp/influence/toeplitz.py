@@ -1,0 +1,310 @@
+r"""Half-space influence on a uniform strip as a (block-)Toeplitz product by FFT, never a matrix (docs/matrix-free.md).
+
+On the uniform strip of :class:`rollqp.strip.Strip` every collocation matrix of
+:mod:`rollqp.influence.halfspace` (eq. 25–30) has the form
+
+.. math::
+
+    M[i, j] = \sum_{a} \sum_{e:\ \mathrm{conn}[e, a] = j} P_a[i - r e - k_{min}],
+    \qquad \mathrm{conn}[e, a] = r e + a
+
+with ``r = 1`` (constant, linear) or ``2`` (quadratic), ``a`` the local node of an element and
+``P_a`` a generating vector of ``n - k_min = n + r(n_e - 1)`` values: the reference moments of
+the kernel at the ``O(n)`` distinct offsets times the half-length
+(:func:`~rollqp.influence.halfspace.element_offsets`). Constant elements give a Toeplitz
+matrix, linear ones a Toeplitz matrix with two boundary columns, quadratic ones a 1×2 block
+Toeplitz matrix (even and odd columns). Hence
+
+* ``M x = Σ_a P_a ∗ u_a`` with ``u_a[r e] = x[conn[e, a]]``: one real FFT of length
+  ``≈ 2n`` per local node and one inverse FFT (a non-periodic, exact linear convolution: the
+  circular wrap-around falls on indices that are not kept), ``O(n log n)`` time and ``O(n)``
+  memory; ``xᵀ M`` is the correlation, by the same transforms;
+* the dense matrix (:func:`assemble`) is built row block by row block from strided views of the
+  ``P_a``: the same products, added in the same order, as the general assembly, so the
+  matrices are bitwise those of the element-by-element path, at ``O(n)`` kernel evaluations.
+
+:class:`ToeplitzOperator` is an :class:`~rollqp.influence.operator.Operator` without a stored
+matrix (``@``, ``x @ A``, ``diagonal()``, ``dense()``, ``memo``); :func:`halfspace_operators`
+builds ``A_nn = A_tt`` and the coupling ``A_nt``, ``A_tn`` (eq. 26, 29) of a scene with it.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.fft
+from numpy.lib.stride_tricks import as_strided
+
+from ..errors import InputError
+from .operator import Operator
+
+__all__ = ["kernel_moments", "elementwise", "generators", "assemble", "ToeplitzOperator", "log_operator", "sgn_operator",
+           "halfspace_operators", "positive_definite_threshold"]
+
+#: Rows per block of the dense assembly (bounds its temporaries to a few MB).
+_ROWS = 256
+
+
+def kernel_moments(kernel: str):
+    """The reference moments of ``kernel`` (``"log"``: eq. 26's ``ln|ξ − ξ_i|``, ``"sgn"``: eq. 29's
+    ``sgn(ξ_i − ξ)``), the ``moments`` argument of :func:`generators` and :func:`elementwise`."""
+    from .halfspace import _log_moments, _sgn_moments
+    try:
+        return {"log": _log_moments, "sgn": _sgn_moments}[kernel]
+    except KeyError:
+        raise InputError("kernel", f"must be 'log' or 'sgn', got {kernel!r}") from None
+
+
+def elementwise(strip, moments) -> np.ndarray:
+    """The matrix of the general (node, element) gather on the lattice offsets: the reference
+    that :func:`assemble` reproduces bitwise (tests)."""
+    from .halfspace import _assemble, element_offsets
+    return _assemble(strip, moments, element_offsets(strip, True))
+
+
+def generators(strip, moments, lattice=None):
+    """``(P, r)``: the generating vectors ``P[a] = hl · (moments(values) @ coef.T)[:, a]`` of a lattice strip.
+
+    ``moments`` is ``halfspace._log_moments`` or ``_sgn_moments``, ``lattice`` the result of
+    :func:`~rollqp.influence.halfspace.lattice_offsets` (computed if ``None``); ``P`` has shape
+    ``(nen, n - k_min)`` with ``k_min = -r (n_e - 1)``. A strip that is not a uniform lattice is
+    an :class:`InputError` on ``strip``.
+    """
+    from .halfspace import lattice_offsets
+    lattice = lattice_offsets(strip) if lattice is None else lattice
+    if lattice is None:
+        raise InputError("strip", "nodes are not a uniform lattice (the FFT operator needs one)")
+    values, _, hl = lattice
+    conn = np.asarray(strip.connectivity)
+    ne, nen = conn.shape
+    r = int(conn[1, 0] - conn[0, 0]) if ne > 1 else 1
+    if not np.array_equal(conn, r * np.arange(ne)[:, None] + np.arange(nen)[None, :]):
+        raise InputError("strip", "the connectivity is not that of a uniform lattice")
+    coef = np.asarray(strip.coefficients, dtype=float)
+    local = moments(values) @ coef.T                          # (n_values, nen)
+    P = np.ascontiguousarray((local * hl).T)                   # products as in _assemble
+    return P, r
+
+
+def _views(P, r, n, ne):
+    """``V[a][i, e] = P[a][i - r e - k_min]`` as strided views (no copy)."""
+    kmin = -r * (ne - 1)
+    out = []
+    for a in range(P.shape[0]):
+        base = P[a, -kmin:]                                    # element i - k_min at e = 0
+        out.append(as_strided(base, shape=(n, ne), strides=(base.strides[0], -r * base.strides[0]),
+                              writeable=False))
+    return out
+
+
+def assemble(P, r, n, ne) -> np.ndarray:
+    """The dense ``M`` (C order) from the generating vectors: ``M[:, a + r e] += P_a[i - r e - k_min]``.
+
+    Row blocks of :data:`_ROWS`; for each local node ``a`` in order, the strided columns
+    ``a, a + r, …`` receive the strided view of ``P_a``: the operations of the general
+    assembly, so the result is bitwise the same (``O(n²)`` writes, no ``n × n`` temporary).
+    """
+    M = np.zeros((n, n))
+    views = _views(P, r, n, ne)
+    for i0 in range(0, n, _ROWS):
+        i1 = min(n, i0 + _ROWS)
+        for a, V in enumerate(views):
+            M[i0:i1, a:a + r * (ne - 1) + 1:r] += V[i0:i1]
+    return M
+
+
+class ToeplitzOperator(Operator):
+    """A read-only ``n × n`` (block-)Toeplitz influence operator applied by FFT (module docstring).
+
+    Parameters
+    ----------
+    P : ndarray, shape (nen, n - k_min)
+        Generating vectors (:func:`generators`), times ``scale``.
+    r : int
+        Node stride of the elements (1 or 2).
+    n, ne : int
+        Nodes and elements.
+    name : str
+        The scene key named in errors.
+    """
+
+    #: numpy defers ``x @ op`` to :meth:`__rmatmul__` (instead of converting the operator to an array)
+    __array_ufunc__ = None
+
+    def __init__(self, P, r: int, n: int, ne: int, name: str = "influence"):
+        P = np.array(P, dtype=float)
+        if not np.all(np.isfinite(P)):
+            raise InputError(name, "must be finite")
+        P.flags.writeable = False
+        self._P, self._r, self._n, self._ne = P, int(r), int(n), int(ne)
+        self._L = scipy.fft.next_fast_len(P.shape[1], real=True)
+        self._Phat = scipy.fft.rfft(P, n=self._L, axis=1)
+        self.name = name
+        self._memo = {}
+        self._m = None
+
+    # ------------------------------------------------------------------ the matrix interface
+    @property
+    def shape(self) -> tuple[int, int]:
+        return (self._n, self._n)
+
+    @property
+    def n(self) -> int:
+        return self._n
+
+    @property
+    def kmin(self) -> int:
+        return -self._r * (self._ne - 1)
+
+    def scaled(self, c: float, name: str | None = None) -> "ToeplitzOperator":
+        """``c`` times this operator (a new operator)."""
+        return ToeplitzOperator(c * self._P, self._r, self._n, self._ne, name or self.name)
+
+    def _gather(self, x):
+        """``u_a[r e] = x[conn[e, a]]`` for every local node ``a``: shape ``(nen, -k_min + 1)``."""
+        nen, r, ne = self._P.shape[0], self._r, self._ne
+        u = np.zeros((nen, r * (ne - 1) + 1) + x.shape[1:])
+        for a in range(nen):
+            u[a, ::r] = x[a:a + r * (ne - 1) + 1:r]
+        return u
+
+    def matvec(self, x):
+        """``M x`` (eq. 25, 28) by zero-padded FFT: exact linear convolution, ``O(n log n)``."""
+        x = np.asarray(x, dtype=float)
+        u = self._gather(x)
+        uh = scipy.fft.rfft(u, n=self._L, axis=1)
+        Phat = self._Phat if x.ndim == 1 else self._Phat[:, :, None]
+        y = scipy.fft.irfft((Phat * uh).sum(axis=0), n=self._L, axis=0)
+        return y[-self.kmin:-self.kmin + self._n]
+
+    def rmatvec(self, y):
+        """``yᵀ M`` (``Mᵀ y``): the correlation of ``y`` with each ``P_a``, gathered at the element nodes."""
+        y = np.asarray(y, dtype=float)
+        nen, r, ne, L = self._P.shape[0], self._r, self._ne, self._L
+        # c_a[m] = Σ_i P_a[i - m - k_min] y_i for m = r e: correlation via conj in Fourier space
+        yh = scipy.fft.rfft(y, n=L, axis=0)
+        Phat = self._Phat if y.ndim == 1 else self._Phat[:, :, None]
+        c = scipy.fft.irfft(np.conj(Phat) * yh[None], n=L, axis=1)
+        out = np.zeros(y.shape)
+        for a in range(nen):
+            # lag m + k_min of the circular correlation (m = r e; wrap-around hits y's zero padding)
+            idx = (r * np.arange(ne) + self.kmin) % L
+            out[a:a + r * (ne - 1) + 1:r] += c[a, idx]
+        return out
+
+    def dense(self) -> np.ndarray:
+        """The matrix, assembled once from the generating vectors (``O(n²)`` memory; kept)."""
+        if self._m is None:
+            m = assemble(self._P, self._r, self._n, self._ne)
+            m.flags.writeable = False
+            self._m = m
+        return self._m
+
+    def diagonal(self) -> np.ndarray:
+        """``M[i, i] = Σ_a P_a[i - (i - a) + ... ]``: one generating entry per local node."""
+        d = np.zeros(self._n)
+        for a in range(self._P.shape[0]):
+            cols = np.arange(a, a + self._r * (self._ne - 1) + 1, self._r)
+            d[cols] += self._P[a, cols - (cols - a) // self._r * self._r - self.kmin]
+        return d
+
+    def column(self, j: int) -> np.ndarray:
+        """Column ``j`` of the matrix (``O(n)``): for preconditioners."""
+        out = np.zeros(self._n)
+        for a in range(self._P.shape[0]):
+            if (j - a) % self._r == 0 and 0 <= (j - a) // self._r < self._ne:
+                e = (j - a) // self._r
+                out += self._P[a, np.arange(self._n) - self._r * e - self.kmin]
+        return out
+
+    def __matmul__(self, x):
+        return self.matvec(x)
+
+    def __rmatmul__(self, x):
+        return self.rmatvec(x)
+
+    def __array__(self, dtype=None, copy=None):
+        m = self.dense()
+        return m if dtype is None else m.astype(dtype, copy=False)
+
+    def __repr__(self) -> str:
+        return f"ToeplitzOperator({self.name!r}, n={self.n}, r={self._r})"
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held (generators and their transforms; the dense matrix if it was asked for)."""
+        return int(self._P.nbytes + self._Phat.nbytes + (0 if self._m is None else self._m.nbytes))
+
+
+def log_operator(strip, d_ref: float, scale: float = 1.0, name: str = "influence") -> ToeplitzOperator:
+    """``scale · K`` of :func:`~rollqp.influence.halfspace.log_kernel_matrix` as an FFT operator.
+
+    The rigid term ``ln(d_ref/hl) hl ∫N_a`` of every column (``K(d') = K(d) + ln(d'/d) e fᵀ``)
+    is folded into the generating vectors: each ``P_a`` gets the constant
+    ``hl ln(d_ref/hl) ∫_{-1}^{1} N_a dξ``.
+    """
+    from .halfspace import _log_moments
+    P, r = generators(strip, _log_moments)
+    hl = 0.5 * strip.element_length
+    coef = np.asarray(strip.coefficients, dtype=float)
+    w_ref = 2.0 * coef[:, 0] + 2.0 * coef[:, 2] / 3.0
+    G = -P + (hl * np.log(d_ref / hl) * w_ref)[:, None]
+    conn = np.asarray(strip.connectivity)
+    op = ToeplitzOperator(scale * G, r, strip.n, conn.shape[0], name)
+    op.strip = strip
+    op.coarsen = lambda ne: _coarse_log(strip, ne, d_ref, scale, name)
+    return op
+
+
+def _coarse_log(strip, ne: int, d_ref: float, scale: float, name: str):
+    """``(coarse strip, its log operator)``: the same kernel on ``ne`` elements of the same zone
+    (a coarse model of the same problem, for the cold start of :mod:`rollqp.methods.krylov`)."""
+    from ..strip import Strip
+    coarse = Strip(float(strip.half_width), int(ne), strip.element)
+    return coarse, log_operator(coarse, d_ref, scale, name)
+
+
+def sgn_operator(strip, scale: float = 1.0, name: str = "influence") -> ToeplitzOperator:
+    """``scale · S`` of :func:`~rollqp.influence.halfspace.sgn_kernel_matrix` as an FFT operator."""
+    from .halfspace import _sgn_moments
+    P, r = generators(strip, _sgn_moments)
+    return ToeplitzOperator(scale * P, r, strip.n, np.asarray(strip.connectivity).shape[0], name)
+
+
+def positive_definite_threshold(strip, rtol: float = 1e-10, maxiter: int | None = None) -> float:
+    """Smallest admissible ``d_ref`` of the discretization, matrix-free (cf. ``minimum_reference_distance``).
+
+    ``sym(F K(d)) = B + τ f fᵀ`` with ``B = sym(F K(4L))`` positive definite and
+    ``τ = ln(d/4L)``: positive definite exactly for ``d > 4L exp(-1/(fᵀB⁻¹f))``
+    (``halfspace._threshold``). ``B⁻¹f`` by conjugate gradients on FFT products.
+    """
+    import scipy.sparse.linalg as spla
+    L = float(strip.half_width)
+    d0 = 4.0 * L
+    K = log_operator(strip, d0)
+    f = np.asarray(strip.weights, dtype=float)
+    n = f.size
+
+    def mv(x):
+        return 0.5 * (f * K.matvec(x) + K.rmatvec(f * x))
+
+    op = spla.LinearOperator((n, n), matvec=mv, dtype=float)
+    y, info = spla.cg(op, f, rtol=rtol, atol=0.0, maxiter=maxiter or 20 * n)
+    if info != 0:
+        return float("nan")
+    q = float(f @ y)
+    return float(d0 * np.exp(-1.0 / q)) if q > 0 else float("nan")
+
+
+def halfspace_operators(strip, *, Estar: float, beta: float, d_ref: float, coupling: str):
+    """``(A_nn, A_tt, A_tn, A_nt)`` of :func:`~rollqp.influence.halfspace.halfspace_influence` as FFT operators.
+
+    ``A_nn = A_tt = (2/(πE*)) K``, ``A_nt = (β/E*) S`` (full coupling), ``A_tn = −(β/E*) S``
+    (full or Goodman); ``coupling`` already resolved (no ``"auto"``).
+    """
+    Ann = log_operator(strip, d_ref, 2.0 / (np.pi * Estar))
+    Atn = Ant = None
+    if coupling in ("full", "goodman"):
+        S = sgn_operator(strip)
+        Atn = S.scaled(-beta / Estar)
+        if coupling == "full":
+            Ant = S.scaled(beta / Estar)
+    return Ann, Ann, Atn, Ant

@@ -1,0 +1,183 @@
+r"""The matrix-free path of a scene: when it is taken, what it needs, and its operators (docs/matrix-free.md).
+
+A uniform half-space strip is modelled without stored matrices when its method works with
+products only (``mf-newton``) and it is large enough that FFT products beat dense ones
+(:data:`THRESHOLD`, measured by ``python benchmarks/matrix_free.py --threshold``), or when the
+scene asks for it (``solver.operator = "matrix-free"``). Then
+
+* the influence operators are :class:`~rollqp.influence.toeplitz.ToeplitzOperator`\ s
+  (``O(n)`` memory, ``O(n log n)`` products), checked positive definite without a matrix
+  (:func:`~rollqp.influence.toeplitz.positive_definite_threshold`);
+* the history and steady slip operators (eq. 37, 48; docs/formulation.md §9) are sparse
+  (``scipy.sparse``, at most three non-zeros a row) instead of dense ``n × n`` arrays;
+* the memory a run needs is ``O(n)`` per state (:func:`memory_estimate`), checked before any work.
+
+A method that needs the matrix (``newton``, ``nt-newton``, the QP backends) on a scene the dense
+path cannot hold is refused before any work, naming ``mf-newton`` (:func:`check_scene`).
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import scipy.sparse as sparse
+
+from .errors import InputError
+
+__all__ = ["MODES", "THRESHOLD", "mode", "memory_estimate", "check_scene", "sparse_history",
+           "sparse_steady", "build"]
+
+#: ``solver.operator``: ``"auto"`` (by :data:`THRESHOLD`), ``"dense"`` or ``"matrix-free"``.
+MODES = ("auto", "dense", "matrix-free")
+
+#: Nodes from which ``mf-newton`` on ``solver.operator = "auto"`` uses FFT products instead of
+#: dense ones, by element type. Measured (normal Hertz step, quadratic elements, medians, shared
+#: 2-core machine: ``python benchmarks/matrix_free.py --threshold``; docs/matrix-free.md): FFT
+#: products win already at 321 nodes (3.5×, 19× at 641), because only the FFT operator carries the
+#: circulant preconditioner; below 200 nodes the dense ``newton`` is the method to use anyway.
+#: Constant and linear elements take one or two transforms a product instead of three: the same
+#: threshold (not measured separately).
+THRESHOLD = {"constant": 200, "linear": 200, "quadratic": 200}
+
+#: Bytes per node of the matrix-free operators and solver work space (generators and their
+#: transforms, GMRES basis of 60 vectors, sparse history operators), measured at 131,073 nodes.
+BYTES_PER_NODE = 8 * 200
+
+
+def mode(scene) -> str:
+    """``"dense"`` or ``"matrix-free"``: the scene's ``solver.operator`` with ``"auto"`` resolved."""
+    asked = getattr(scene.solver, "operator", None) or "auto"
+    if asked != "auto":
+        return asked
+    from .methods import matrix_free
+    if (matrix_free(scene.solver.method) and scene.contact.model == "halfspace"
+            and scene.n_nodes >= THRESHOLD[scene.discretization.element]):
+        return "matrix-free"
+    return "dense"
+
+
+def memory_estimate(scene) -> float:
+    """Bytes a matrix-free run needs at its peak: ``O(n)`` operators and work space, and the
+    result's five per-state arrays (as :meth:`Scene.memory_estimate` counts them)."""
+    n, states = scene.n_nodes, scene.n_steps + 1
+    return float(BYTES_PER_NODE * n + 8.0 * 6 * states * n)
+
+
+def check_scene(scene, dense_max_nodes: int) -> str:
+    """The scene's operator mode, after refusing what cannot run (before any work).
+
+    Raises
+    ------
+    InputError
+        ``solver.operator`` = ``"matrix-free"`` with a method that needs the matrix or a model
+        other than the half-space; ``discretization.elements`` when a method that needs the matrix
+        is asked for more than ``dense_max_nodes`` nodes (naming ``mf-newton``).
+    """
+    from .methods import matrix_free
+    m = mode(scene)
+    method = scene.solver.method
+    if m == "matrix-free":
+        if not matrix_free(method):
+            raise InputError("solver.operator", f"'matrix-free' needs a method that works with products only "
+                                                f"(mf-newton); {method!r} needs the "
+                                                f"n × n matrix: use solver.method = 'mf-newton' or "
+                                                f"solver.operator = 'dense'")
+        if scene.contact.model != "halfspace":
+            raise InputError("solver.operator", f"'matrix-free' needs contact.model = 'halfspace' (a uniform "
+                                                f"strip's Toeplitz kernels), got {scene.contact.model!r}")
+    elif scene.n_nodes > dense_max_nodes:
+        gb = 8.0 * 6 * scene.n_nodes ** 2 / 2 ** 30
+        alt = ("solver.method = 'mf-newton' (matrix-free, O(n) memory)" if scene.contact.model == "halfspace"
+               else "fewer elements")
+        raise InputError("discretization.elements",
+                         f"{scene.discretization.elements} {scene.discretization.element} elements make "
+                         f"{scene.n_nodes} nodes; the dense path ({method!r} needs the n × n matrices, about "
+                         f"{gb:.3g} GiB) takes at most {dense_max_nodes} (20000 elements): use {alt}")
+    return m
+
+
+# ------------------------------------------------------------------------------ slip operators
+def _displacement(strip, points) -> sparse.csr_matrix:
+    """Sparse :meth:`~rollqp.strip.Strip.displacement_matrix` (same values, at most three per row)."""
+    pts = np.clip(np.atleast_1d(np.asarray(points, dtype=float)), strip.x[0], strip.x[-1])
+    n, m = strip.n, pts.size
+    rows = np.arange(m)
+    if strip.element == "constant":
+        j = np.clip(np.searchsorted(strip.x, pts, side="right") - 1, 0, n - 2)
+        lam = (pts - strip.x[j]) / (strip.x[j + 1] - strip.x[j])
+        return sparse.csr_matrix((np.concatenate([1.0 - lam, lam]), (np.concatenate([rows, rows]),
+                                  np.concatenate([j, j + 1]))), shape=(m, n))
+    ne, L, h = int(strip.n_elements), float(strip.half_width), 0.5 * strip.element_length
+    el = np.clip(np.floor((pts + L) / strip.element_length).astype(int), 0, ne - 1)
+    xi = (pts - 0.5 * (strip.edges[el] + strip.edges[el + 1])) / h
+    c = strip.coefficients
+    vals = c[None, :, 0] + c[None, :, 1] * xi[:, None] + c[None, :, 2] * xi[:, None] ** 2
+    nen = c.shape[0]
+    return sparse.csr_matrix((vals.ravel(), (np.repeat(rows, nen), strip.connectivity[el].ravel())),
+                             shape=(m, n))
+
+
+def _upwind(strip, direction: int) -> sparse.csr_matrix:
+    """Sparse :meth:`~rollqp.strip.Strip.upwind_difference` (eq. 20, 38–40)."""
+    n, hx = strip.n, np.diff(strip.x)
+    if direction < 0:
+        i = np.arange(n - 1)
+        r = np.concatenate([i, i, [n - 1, n - 1]])
+        c = np.concatenate([i, i + 1, [n - 2, n - 1]])
+        v = np.concatenate([-1.0 / hx, 1.0 / hx, [-1.0 / hx[-1], 1.0 / hx[-1]]])
+    else:
+        i = np.arange(1, n)
+        r = np.concatenate([i, i, [0, 0]])
+        c = np.concatenate([i - 1, i, [0, 1]])
+        v = np.concatenate([-1.0 / hx, 1.0 / hx, [-1.0 / hx[0], 1.0 / hx[0]]])
+    return sparse.csr_matrix((v, (r, c)), shape=(n, n))
+
+
+def sparse_history(strip, formulation: str, dq: float, direction: int) -> sparse.csr_matrix:
+    """Sparse :meth:`~rollqp.strip.Strip.history_operator`: ``c^{k-1} = -M w^{k-1}`` (eq. 37, 48)."""
+    if direction not in (-1, 1):
+        raise InputError("direction", f"must be -1 or +1, got {direction!r}")
+    if formulation == "material":
+        return _displacement(strip, strip.x - direction * float(dq))
+    eye = sparse.identity(strip.n, format="csr")
+    if formulation == "convective-local":
+        return (eye - float(dq) * direction * _upwind(strip, direction)).tocsr()
+    if formulation == "static":
+        return eye
+    raise InputError("formulation", f"must be one of material, convective-local, static; got {formulation!r}")
+
+
+def sparse_steady(strip, direction: int) -> sparse.csr_matrix:
+    """``d·D_up`` sparse: the steady-rolling slip ``s = ξ e + d·D_up w`` (docs/formulation.md §9)."""
+    return direction * _upwind(strip, direction)
+
+
+# ------------------------------------------------------------------------------ operators
+def build(scene, strip):
+    """``(A_nn, A_tt, A_tn, A_nt, h, info)`` of a matrix-free scene (half-space, eq. 25–30).
+
+    ``d_ref`` must exceed the discretization's threshold
+    (:func:`~rollqp.influence.toeplitz.positive_definite_threshold`), else an
+    :class:`InputError` on ``contact.reference_distance`` as on the dense path.
+    """
+    from .influence.halfspace import undeformed_gap
+    from .influence.toeplitz import halfspace_operators, positive_definite_threshold
+    t0 = time.perf_counter()
+    coupling = scene.coupling_level
+    d_ref = scene.reference_distance_value
+    L = float(strip.half_width)
+    d_min = positive_definite_threshold(strip)
+    if not d_ref > d_min:
+        raise InputError("contact.reference_distance",
+                         f"d_ref = {d_ref:.6g} makes the normal influence operator indefinite; it must exceed "
+                         f"L/2 = {L / 2:.6g} (continuous bound), the smallest admissible value for this mesh "
+                         f"is {d_min:.6g}; the default is the relative radius R")
+    Ann, Att, Atn, Ant = halfspace_operators(strip, Estar=scene.Estar, beta=scene.beta, d_ref=d_ref,
+                                             coupling=coupling)
+    h = undeformed_gap(strip.x, scene.A.radius, scene.B.radius)
+    h.setflags(write=False)
+    info = {"d_ref": d_ref, "d_ref_min": d_min, "d_ref_min_continuous": 0.5 * L, "coupling": coupling,
+            "beta": scene.beta, "kappa": 2.0 * scene.beta, "Estar": scene.Estar, "R": scene.R,
+            "R_A": float(scene.A.radius), "R_B": float(scene.B.radius), "operator_mode": "matrix-free",
+            "operator_seconds": time.perf_counter() - t0}
+    return Ann, Att, Atn, Ant, h, info
