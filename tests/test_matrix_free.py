@@ -179,3 +179,12 @@ def test_scene_operator_choice_and_refusals():
     big = base.replace(**{"solver.method": "mf-newton", "discretization.elements": 50_000,
                           "discretization.distance": 0.0})
     assert big.n_nodes == 100_001, "beyond the dense limit with a matrix-free method"
+
+
+def test_matrix_free_method_refuses_load_paths_up_front():
+    """mf-newton with load.rolled (stops, reversals) is refused before any work, naming the
+    dense alternative: its active-set iteration stalls at 2.4e-5 on the first static-shift step
+    of the built-in stop-reverse (step 97), a limitation stated rather than a late SolverError."""
+    import rollqp
+    with pytest.raises(rollqp.InputError, match="solver.method.*load.rolled.*'newton'"):
+        rollqp.load_scene("stop-reverse").replace(**{"solver.method": "mf-newton"})
