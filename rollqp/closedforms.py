@@ -371,6 +371,15 @@ def carter_stick_zone(a, ratio, direction):
     return (-a, -a + 2.0 * c) if d == 1 else (a - 2.0 * c, a)
 
 
+def _carter_arguments(a, mu, ratio, direction):
+    """Checked ``(a, μ, ratio, d)`` of Carter's solution and its stick half-width ``c = a√(1 − |ratio|)``."""
+    a = _positive("a", a)
+    mu = _nonnegative("mu", mu)
+    ratio = _ratio(ratio)
+    d = _direction(direction)
+    return a, mu, ratio, d, a * math.sqrt(1.0 - abs(ratio))
+
+
 def carter_traction(x, a, p0, mu, ratio, direction):
     """Carter's steady-rolling tangential traction (similar cylinders).
 
@@ -406,12 +415,8 @@ def carter_traction(x, a, p0, mu, ratio, direction):
     Carter (1926); Johnson (1985) Ch. 8, see ``SOURCES["carter_traction"]``.
     """
     x = _coords(x)
-    a = _positive("a", a)
+    a, mu, ratio, d, c = _carter_arguments(a, mu, ratio, direction)
     p0 = _nonnegative("p0", p0)
-    mu = _nonnegative("mu", mu)
-    ratio = _ratio(ratio)
-    d = _direction(direction)
-    c = a * math.sqrt(1.0 - abs(ratio))
     t = _semi_ellipse(x, 0.0, a) - (c / a) * _leading_semi_ellipse(x, a, c, d)
     return _out(math.copysign(1.0, ratio) * (ratio != 0.0) * mu * p0 * t)
 
@@ -842,12 +847,8 @@ def carter_slip(x, a, R, mu, ratio, direction):
     Ch. 8, see ``SOURCES["carter_slip"]``.
     """
     x = _coords(x)
-    a = _positive("a", a)
+    a, mu, ratio, d, c = _carter_arguments(a, mu, ratio, direction)
     R = _positive("R", R)
-    mu = _nonnegative("mu", mu)
-    ratio = _ratio(ratio)
-    d = _direction(direction)
-    c = a * math.sqrt(1.0 - abs(ratio))
     y = x - (-d * (a - c))
     sign_r = math.copysign(1.0, ratio) * (ratio != 0.0)
     s = -d * sign_r * (mu / R) * np.sign(y) * np.sqrt(np.maximum(y * y - c * c, 0.0))
