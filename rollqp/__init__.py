@@ -16,7 +16,8 @@ NormalStep, TangentialStep, Scales       step problems built from arrays
 StepSolution, Residuals, classify, compare
 solve_step                               solve one step with any method
 get_method, available_methods            the method registry
-closedforms                              Hertz, Cattaneo, Carter, creep law
+closedforms                              Hertz, Cattaneo, Carter, creep law, McEwen
+stresses                                 subsurface stresses of a state (rollqp.stresses module)
 """
 __version__ = "0.1.0"
 
@@ -31,6 +32,8 @@ from .scene import Scene, builtin_scenes, load_scene
 from .strip import Strip
 from .operators import SceneOperators
 from .march import StepRecord, march, run
+from . import energy, wear  # noqa: E402,F401  (register their result fields)
+from .stresses import stresses  # noqa: E402
 
 
 def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> StepSolution:
@@ -46,4 +49,4 @@ def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> S
 __all__ = ["load_scene", "builtin_scenes", "Scene", "march", "run", "StepRecord", "SceneOperators", "Result", "load_result", "Strip",
            "halfspace_influence", "Influence", "NormalStep", "TangentialStep", "Scales", "StepSolution",
            "Residuals", "classify", "compare", "solve_step", "get_method", "available_methods",
-           "closedforms", "InputError", "SolverError", "RollqpError", "MissingBackendError"]
+           "closedforms", "stresses", "InputError", "SolverError", "RollqpError", "MissingBackendError"]

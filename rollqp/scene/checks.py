@@ -59,7 +59,10 @@ def check_body(key: str, b: Any) -> Body:
     if shaft is not None:
         shaft = number(f"{key}.shaft_radius", shaft, f"in (0, radius = {radius!r}) or absent",
                         lambda x: 0.0 < x < radius)
-    return Body(radius, E, nu, shaft)
+    wear = b.wear
+    if wear is not None:  # Archard's k/H (docs/stresses.md §6)
+        wear = number(f"{key}.wear", wear, ">= 0 (k/H in 1/stress) or absent", lambda x: x >= 0)
+    return Body(radius, E, nu, shaft, wear)
 
 
 def check_contact(c: Any) -> Contact:

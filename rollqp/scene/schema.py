@@ -53,12 +53,16 @@ class Body:
     shaft_radius : float or None
         Inner (shaft) radius of the annular cylinder, in (0, radius); used by
         ``contact.model = "bem"`` only. None: not given.
+    wear : float or None
+        Archard's wear coefficient over hardness, k/H (1/stress, ``>= 0``): the worn depth rate is
+        ``(k/H)·p·|s|`` per unit rolled distance (docs/stresses.md §6). None: no wear modelled.
     """
 
     radius: float
     E: float
     nu: float
     shaft_radius: float | None = None
+    wear: float | None = None
 
     @property
     def G(self) -> float:
