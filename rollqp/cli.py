@@ -46,6 +46,8 @@ def _parser():
     r.add_argument("--plot", help="draw tractions, slip and creepage to this PNG file")
     r.add_argument("--method", choices=METHOD_NAMES, help="overrides [solver].method")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    r.add_argument("--stresses", action="store_true", help="report the peak subsurface von Mises and tau1 over "
+                   "the run, with place and state (docs/stresses.md)")
     r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
                    help="solve three steps again with qp-clarabel and qp-osqp and show the differences "
                         "(default: on for strips of at most 400 nodes run by a method other than those)")
@@ -229,7 +231,11 @@ def cmd_run(args) -> int:
     if args.plot:
         plot_result(res, scene, args.plot)
     if not args.quiet:
-        print(summary(res, scene, scene.solver.method, wall))
+        peaks = None
+        if getattr(args, "stresses", False):
+            from .stresses import stress_history
+            peaks = stress_history(result)
+        print(summary(res, scene, scene.solver.method, wall, peaks))
         if keep:
             from .crossval import spot_check
             t1 = time.perf_counter()

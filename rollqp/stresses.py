@@ -232,6 +232,12 @@ def _source(result) -> tuple[dict, object]:
             raise InputError("result", f"the result file holds no tractions (no key {key!r}): nothing to "
                                        "compute stresses from")
     meta = arrays.get("meta")
+    if isinstance(meta, (str, np.ndarray)):  # Result.arrays() keeps meta as its JSON text
+        import json
+        try:
+            meta = json.loads(str(meta))
+        except json.JSONDecodeError:
+            meta = None
     if not isinstance(meta, dict) or not isinstance(meta.get("scene"), dict):
         raise InputError("result", "the result holds no scene (meta['scene']): the strip cannot be rebuilt")
     return arrays, load_scene(meta["scene"])
