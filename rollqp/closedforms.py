@@ -600,7 +600,7 @@ HERTZ_MAX_SHEAR = (0.300283, 0.786151)
 
 def _mcewen_mn(x, z, a):
     """McEwen's m, n ≥ 0: m² = ½[√(A² + 4x²z²) + A], n² = ½[√(A² + 4x²z²) − A], A = a² − x² + z²;
-    m has the sign of z and n that of x (each product written without cancellation)."""
+    m ≥ 0 (z ≥ 0) and n has the sign of x (each product written without cancellation)."""
     A = a * a - x * x + z * z
     S = np.hypot(A, 2.0 * x * z)
     big = np.where(A >= 0, S + A, S - A)           # the larger of S ± A, no cancellation
@@ -608,7 +608,7 @@ def _mcewen_mn(x, z, a):
         other = np.where(big > 0, 2.0 * (x * z) ** 2 / big, 0.0)  # (S² − A²)/(2 big) = the smaller
     m2 = np.where(A >= 0, big / 2.0, other)
     n2 = np.where(A >= 0, other, big / 2.0)
-    return np.sign(z) * np.sqrt(m2), np.where(x < 0, -1.0, 1.0) * np.sqrt(n2)
+    return np.sqrt(m2), np.where(x < 0, -1.0, 1.0) * np.sqrt(n2)  # z >= 0: m >= 0 (its limit at z = 0 too)
 
 
 def mcewen_stresses(x, z, a, p0, mu=0.0):

@@ -4,7 +4,7 @@ Per unit axial length, in the scene's units, with rollqp's signs (docs/formulati
 A in +x, ``s`` the slip of A relative to B per unit rolled distance, friction opposing slip):
 
 * ``friction_power`` (K+1, n): the dissipation density ``−t·s ≥ 0`` per unit rolled distance
-  (force/length²; times the speed |V| it is the frictional power per unit area);
+  (force/length²; times the speed ``|V|`` it is the frictional power per unit area);
 * ``dissipation`` (K+1,): ``D = −∫ t s dx = −fᵀ(t∘s)`` (force/length: energy per unit rolled
   distance and unit axial length);
 * ``friction_work`` (K+1,): the step's frictional work ``D_k Δq`` (0 for the starting state; the
@@ -17,7 +17,7 @@ A in +x, ``s`` the slip of A relative to B per unit rolled distance, friction op
 
 The identities (derived in docs/stresses.md §5): from the slip ``s = ξ + d ∂w/∂x`` of steady
 rolling and ``w = A_tn p + A_tt t``, with ``∫ t ∂(A_tt t)/∂x dx = 0`` (the log kernel's derivative is
-odd) and ``∂(A_tn p)/∂x = −(2β/E*) p``,
+odd) and ``∂(A_tn p)/∂x = −(2β/E*) p``::
 
     D = −Q ξ + d (2β/E*) ∫ p t dx        (steady rolling; similar bodies: D = −Q ξ)
 
@@ -81,15 +81,15 @@ def _mu(scene) -> bool:
 
 
 for _f in (
-    Field("friction_power", "state", STRESS, "frictional dissipation density -t*s >= 0 per unit rolled distance "
+    Field("friction_power", "state", STRESS, "frictional dissipation density -t s >= 0 per unit rolled distance "
           "(times |V|: power per unit area); written when mu > 0", compute=friction_power, needed=_mu),
-    Field("dissipation", "step", FORCE, "frictional dissipation D = -integral(t s dx) per unit rolled distance; "
-          "written when mu > 0", compute=dissipation, needed=_mu),
-    Field("friction_work", "step", "force*length/length", "frictional work of the step, D*dq (0 for the starting "
+    Field("dissipation", "step", FORCE, "frictional dissipation D = -integral(t s dx) per unit rolled distance "
+          "(and axial length); written when mu > 0", compute=dissipation, needed=_mu),
+    Field("friction_work", "step", "force", "frictional work of the step per unit axial length, D dq (0 for the starting "
           "state); its cumulative sum is the accumulated work", compute=friction_work, needed=_mu),
-    Field("elastic_energy", "step", "force*length/length", "elastic energy of the contact tractions, "
+    Field("elastic_energy", "step", "force", "elastic energy of the contact tractions per unit axial length, "
           "1/2 p.F.Ann.p + p.F.Ant.t + 1/2 t.F.Att.t (relative to d_ref)", compute=elastic_energy),
-    Field("load_work", "step", "force*length/length", "work of the applied loads in the step, -Q xi dq + "
+    Field("load_work", "step", "force", "work of the applied loads in the step, -Q xi dq + "
           "mean(P) d(delta) (0 for the starting state)", compute=load_work),
 ):
     register(_f)

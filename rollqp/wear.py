@@ -11,7 +11,7 @@ state ``k`` has the surface coordinate ``σ = x_i − d·q_k`` (its position at 
 modulo the roller's circumference ``2πR``. :func:`profile` adds every step's ``wear_rate·Δq``
 at those coordinates (the traction shape functions interpolate between nodes), which gives the
 worn depth along each roller's surface. Both rollers move by the same ``Δq`` per step up to the
-creepage (|ξ| ≲ 1e-3), which is neglected here.
+creepage (``|ξ| ≲ 1e-3``), which is neglected here.
 """
 from __future__ import annotations
 

@@ -206,3 +206,22 @@ def test_wear_key_is_checked():
     with pytest.raises(InputError) as e:
         rollqp.load_scene("harmonic").replace(**{"bodies.A.wear": -1.0})
     assert e.value.key == "bodies.A.wear"
+
+
+def test_stresses_example():
+    """examples/stresses.py (docs/examples.md): computed Hertz field against McEwen, 40 QCE
+    (measured 9.0e-4 p0 on ±1.5 a × (0.05 a, 2 a], discretization §2), and its max τ1 (measured
+    0.30029 p0 at 0.7862 a; the depth grid step is 1e-4 a)."""
+    import importlib.util
+    from pathlib import Path
+    spec = importlib.util.spec_from_file_location("stresses_example",
+                                                  Path(__file__).parents[1] / "examples" / "stresses.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = mod.main([])
+    assert out["hertz_error"] < 2e-3
+    assert abs(out["hertz_tau"] - cf.HERTZ_MAX_SHEAR[0]) < 2e-5 and abs(out["hertz_depth"] - cf.HERTZ_MAX_SHEAR[1]) < 2e-4
+    h = out["history"]
+    # the 200 × 200 map of the last state and the 100 × 60 history agree to the grids' resolution
+    assert abs(h.peaks["von_mises"][-1, 0] / out["field"].maxima["von_mises"][0] - 1) < 5e-3
+    assert h.overall["von_mises"][0] == h.peaks["von_mises"][:, 0].max()
