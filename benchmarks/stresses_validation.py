@@ -117,8 +117,8 @@ def sec_surface():
         s = stress_components(strip, X.ravel(), Zi.ravel(), p, mu * p)
         return {k: v.reshape(X.shape) for k, v in invariants(s[0], s[1], s[2], 0.3).items()}
     rows = [[name, f"{surface_mu(closed, key):.3f}", f"{surface_mu(integrated, key):.3f}"]
-            for name, key in (("τ1 (in-plane max shear)", "tau1"), ("von Mises (ν = 0.3)", "von_mises"),
-                              ("Tresca (ν = 0.3)", "tresca"))]
+            for name, key in (("Tresca s1 − s3 (3D maximum shear, ν = 0.3)", "tresca"),
+                              ("von Mises (ν = 0.3)", "von_mises"), ("τ1 (in-plane maximum shear)", "tau1"))]
     return ("Friction coefficient μ of a sliding Hertz contact (t = μp) above which the maximum lies on the "
             "surface (bisection to 1e-3; grid 481 × 401, |x| ≤ 1.2 a, z ≤ a, first subsurface row 0.0025 a)\n\n"
             + table(["quantity", "McEwen (closed form)", "integrated, 80 QCE"], rows))

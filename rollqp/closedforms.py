@@ -588,8 +588,6 @@ _MCEWEN = ("E. McEwen, Stresses in elastic cylinders in contact along a generatr
            "(eq. 7.18, the traction q = mu p)")
 SOURCES["hertz_subsurface_stresses"] = _MCEWEN
 SOURCES["mcewen_stresses"] = _MCEWEN
-SOURCES["HERTZ_MAX_SHEAR"] = ("K. L. Johnson, Contact Mechanics, 1985, §4.2: the principal shear stress tau1 "
-                              "has its maximum 0.300 p0 on the axis at z = 0.78 a (frictionless line contact)")
 __all__ += ["mcewen_stresses", "hertz_subsurface_stresses", "HERTZ_MAX_SHEAR"]
 
 #: Frictionless 2D Hertz contact: the largest in-plane maximum shear τ1/p0 and its depth z/a
@@ -661,6 +659,20 @@ def mcewen_stresses(x, z, a, p0, mu=0.0):
 def hertz_subsurface_stresses(x, z, a, p0):
     """Frictionless 2D Hertz field: :func:`mcewen_stresses` with ``μ = 0``.
 
+    Parameters
+    ----------
+    x, z : float or array_like
+        Point (broadcast together); ``z >= 0`` is the depth into the body.
+    a, p0 : float
+        Hertz half-width ``> 0`` and peak pressure ``>= 0``.
+
+    Returns
+    -------
+    (sxx, szz, txz) : floats or ndarrays
+        Plane stresses, tension positive (frame and signs of :func:`mcewen_stresses`).
+
+    Notes
+    -----
     On the axis ``σxx = −p0[(1 + 2z²/a²)/√(1 + z²/a²) − 2z/a]``, ``σzz = −p0/√(1 + z²/a²)``; the
     in-plane maximum shear τ1 has its maximum :data:`HERTZ_MAX_SHEAR` = 0.300 p0 at z = 0.786 a
     (Johnson §4.2). Source: ``SOURCES["hertz_subsurface_stresses"]``.

@@ -225,3 +225,13 @@ def test_stresses_example():
     # the 200 × 200 map of the last state and the 100 × 60 history agree to the grids' resolution
     assert abs(h.peaks["von_mises"][-1, 0] / out["field"].maxima["von_mises"][0] - 1) < 5e-3
     assert h.overall["von_mises"][0] == h.peaks["von_mises"][:, 0].max()
+
+
+@pytest.mark.parametrize("key, below, above", [("tresca", 0.22, 0.27), ("von_mises", 0.24, 0.29)])
+def test_peak_reaches_the_surface(key, below, above):
+    """McEwen's field (ν = 0.3): the maximum of Tresca reaches the surface at μ = 0.247 (Johnson §7.2:
+    about 0.25), von Mises at 0.263 (docs/stresses.md §3, measured by bisection); ±0.025 either side."""
+    X, Z = np.meshgrid(np.linspace(-1.2, 1.2, 241), np.concatenate([[0.0], np.linspace(0.005, 1.0, 200)]))
+    for mu, surface in ((below, False), (above, True)):
+        v = invariants(*cf.mcewen_stresses(X, Z, 1.0, 1.0, mu), 0.3)[key]
+        assert (v[0].max() >= v[1:].max()) == surface, (key, mu)
