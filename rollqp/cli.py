@@ -413,6 +413,9 @@ def cmd_stresses(args) -> int:
         raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
     a, p0 = float(arrays["a_H"]), float(arrays["p0"])
     print(f"  state         {sf.step} (q = {sf.q / a:.4f} a_H), body {sf.body}, grid {nx} x {nz}")
+    if scene.contact.model == "bem":
+        print(f"  note          half-space field below the BEM tractions: error about a/(2R) p0 = "
+              f"{a / (2 * scene.R):.2g} p0 (docs/stresses.md §4)")
     for k, v in summary_rows(sf, p0, a):
         print(f"  {k:<20}  {v}")
     if args.out:

@@ -30,7 +30,7 @@ import numpy as np
 
 from .fields import FORCE, STRESS, Field, register
 
-__all__ = ["friction_power", "dissipation", "elastic_energy", "load_work", "balance", "steady_identity"]
+__all__ = ["friction_power", "dissipation", "elastic_energy", "load_work", "balance", "steady_identity", "power"]
 
 
 def _rolling(rec) -> bool:
@@ -113,3 +113,14 @@ def steady_identity(res: dict, k: int, direction: int) -> float:
     f = res["f"]
     return float(-res["Q"][k] * res["creepage"][k]
                  + direction * 2 * float(res["beta"]) / float(res["Estar"]) * f @ (res["pn"][k] * res["pt"][k]))
+
+
+def power(res: dict, speed: float) -> np.ndarray:
+    """Frictional power per unit axial length of each state at the rolling speed ``|V|`` (length/time):
+    ``D·|V|`` (force·length/time per length); the density is ``friction_power·|V|``."""
+    from .errors import InputError
+    if not (isinstance(speed, (int, float, np.floating)) and np.isfinite(speed) and speed >= 0):
+        raise InputError("speed", f"must be a finite number >= 0 (|V|, length/time), got {speed!r}")
+    if "dissipation" not in res:
+        raise InputError("result", "holds no 'dissipation' (a frictionless scene, or written before rollqp had it)")
+    return np.asarray(res["dissipation"], dtype=float) * float(speed)

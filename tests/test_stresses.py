@@ -235,3 +235,16 @@ def test_peak_reaches_the_surface(key, below, above):
     for mu, surface in ((below, False), (above, True)):
         v = invariants(*cf.mcewen_stresses(X, Z, 1.0, 1.0, mu), 0.3)[key]
         assert (v[0].max() >= v[1:].max()) == surface, (key, mu)
+
+
+def test_run_summary_shows_dissipation_and_peaks(tmp_path, capsys):
+    """``rollqp run --stresses``: the summary gains the dissipation and the peak von Mises with its place."""
+    assert main(["run", "cattaneo-carter", "--out", str(tmp_path / "r.npz"), "--stresses", "--no-cross-check"]) == 0
+    out = capsys.readouterr().out
+    assert "dissipation" in out and "peak von Mises" in out and "state" in out.split("peak von Mises")[1]
+    r = rollqp.load_result(tmp_path / "r.npz")
+    from rollqp.energy import power
+    assert np.allclose(power(r, 2000.0), 2000.0 * r["dissipation"])
+    with pytest.raises(InputError) as e:
+        power(r, -1.0)
+    assert e.value.key == "speed"
