@@ -33,7 +33,7 @@ from .strip import Strip
 from .operators import SceneOperators
 from .march import StepRecord, march, run
 from . import energy, wear  # noqa: E402,F401  (register their result fields)
-from .stresses import stresses  # noqa: E402
+from . import stresses  # noqa: E402,F401  (callable: rollqp.stresses(result, step, grid))
 
 
 def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> StepSolution:
