@@ -283,7 +283,7 @@ def variantstable(scene, var, ref, model):
     base = var["coupled Newton, default r"]
     for label, r in var.items():
         if r.get("ok", 0) == 0:
-            rows.append((label, "failed: " + r["failed"].split(": ", 2)[-1][:90], *["–"] * 8))
+            rows.append((label, "failed: " + r["failed"].split(": ", 2)[-1], *["–"] * 8))
             continue
         coupled = label.startswith("coupled")
         dp, dt = _diff(r, ref, scene)

@@ -388,7 +388,7 @@ def run_all(selected, stream=sys.stdout):
             print(_line(row, by[row.case]), file=stream, flush=True)
             print(f"{row.case:28s} {row.method:12s} {row.outcome:11s} it {row.iterations:4d} "
                   f"res {row.residual:9.2e} err {row.error:9.2e} cf {row.closed:9.2e} "
-                  f"{row.seconds:7.2f}s {'ok' if row.ok else 'FAIL'} {row.message[:90]}",
+                  f"{row.seconds:7.2f}s {'ok' if row.ok else 'FAIL'} {row.message}",
                   file=sys.stderr, flush=True)
     return rows
 

@@ -141,9 +141,10 @@ class Run:
 
 
 def short_error(exc) -> str:
-    """One line: the exception's type and the first line of its message."""
+    """One line: the exception's type and the first line of its message, whole (rollqp's errors
+    are one line by design; a cut message loses the step, the residual or the limit at its end)."""
     msg = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
-    return f"{type(exc).__name__}: {msg[:160]}"
+    return f"{type(exc).__name__}: {msg}"
 
 
 def timed_run(scene, method, label="", repeats=3, budget=2.0, keep=True) -> Run:

@@ -41,6 +41,9 @@ extensions = [
     "myst_parser",
     "sphinx.ext.autodoc",
     "sphinx.ext.mathjax",
+    # MathJax served from the build itself (docs/_build/html/_static/mathjax), not from a CDN:
+    # formulas render offline. The extension is ten lines around a copy of MathJax 3.
+    "sphinx-mathjax-offline",
     "sphinx.ext.viewcode",
     "numpydoc",
 ]
@@ -66,6 +69,9 @@ highlight_language = "text"
 
 html_theme = "alabaster"
 html_title = f"rollqp {release}"
+# wide tables scroll within the text column (docs/_static/rollqp.css)
+html_static_path = ["_static"]
+html_css_files = ["rollqp.css"]
 
 _CODE_LINK = re.compile(r"(?:^|/)rollqp/((?:[A-Za-z_][A-Za-z0-9_]*/)*[A-Za-z_][A-Za-z0-9_]*)\.py$")
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*")

@@ -1,4 +1,4 @@
-"""The ``rollqp`` command (SPEC.md, "Command line").
+"""The ``rollqp`` command (docs/scenes.md and docs/results.md: the command line, scene and result files).
 
     rollqp run SCENE [--out RESULT.npz] [--plot FIGURE.png] [--method METHOD] [--quiet]
     rollqp scenes
@@ -252,6 +252,8 @@ def _spot_steps(args, scene):
     if wanted is None:
         n = scene.discretization.elements * {"constant": 1, "linear": 1, "quadratic": 2}[scene.discretization.element] + 1
         wanted = not args.quiet and n <= SPOT_MAX_NODES and scene.solver.method not in SPOT_METHODS
+    if not isinstance(scene.contact.friction, float):  # step files hold one constant μ (a law: docs/friction.md)
+        wanted = False
     if not wanted or args.quiet:
         return {}, None
     from .stepfile import from_record

@@ -44,6 +44,7 @@ __all__ = [
     "carter_stick_zone",
     "carter_traction",
     "carter_creepage",
+    "carter_slip",
     "creep_force_ratio",
     "bentall_johnson_creepage",
     "BENTALL_JOHNSON_COEFFICIENT",
@@ -82,6 +83,7 @@ SOURCES: dict[str, str] = {
     "carter_stick_zone": _CARTER,
     "carter_traction": _CARTER,
     "carter_creepage": _CARTER,
+    "carter_slip": _CARTER,
     "creep_force_ratio": _CARTER + "; " + _KALKER,
     "bentall_johnson_creepage": _BENTALL,
     "lame_ring_displacement": _LAME,
@@ -579,6 +581,277 @@ def lame_ring_displacement(r, inner, outer, pressure, E, nu):
     A = -pressure / (2.0 * (lam + G) + 2.0 * G * inner ** 2 / outer ** 2)
     r = np.asarray(r, dtype=float)
     return _out(A * r - A * inner ** 2 / r)
+
+
+# --------------------------------------------------------------------------- issue 13: load paths and profiles
+_MINDLIN = ("R. D. Mindlin and H. Deresiewicz, Elastic spheres in contact under varying oblique forces, J. Appl. "
+            "Mech. 20, 327–344 (1953) (unloading and reloading as superpositions of Cattaneo solutions, with "
+            "the memory of the turning points); 2D form as in " + _JOHNSON + ", §7.2 (oscillating tangential "
+            "force; the 2D energy per cycle from the 2D tangential compliance of the stick zone)")
+_CIAVARELLA = ("M. Ciavarella, D. A. Hills and G. Monno, The influence of rounded edges on indentation by a flat "
+               "punch, Proc. IMechE C 212, 319–328 (1998) (2D flat punch with rounded corners); derived again "
+               "in docs/kinematics.md from the 2D inversion formula (" + _JOHNSON + ", §2.8, eq. 2.49)")
+SOURCES.update({"mindlin_turning_points": _MINDLIN, "mindlin_traction": _MINDLIN, "mindlin_dissipation": _MINDLIN,
+                "rounded_punch_load": _CIAVARELLA, "rounded_punch_half_width": _CIAVARELLA,
+                "rounded_punch_pressure": _CIAVARELLA})
+__all__ += ["mindlin_turning_points", "mindlin_traction", "mindlin_dissipation", "rounded_punch_load",
+            "rounded_punch_half_width", "rounded_punch_pressure"]
+
+
+def mindlin_turning_points(ratios) -> tuple[list, float]:
+    """The turning points a path of ``Q/(μP)`` values (from 0, at constant P) is remembered by.
+
+    Masing's memory rule for Mindlin–Deresiewicz: a reversal from ``r_m`` is forgotten, with the
+    one before it, once the load goes past ``r_{m−1}`` (the slip annulus of the earlier branch is
+    swept again); the first (virgin) turning point ``r_1`` is forgotten once the load passes
+    ``−r_1``. Source: ``SOURCES["mindlin_turning_points"]``.
+
+    Parameters
+    ----------
+    ratios : sequence of float
+        The path of ``Q/(μP)`` from 0, each ``|r| < 1``, piecewise linear between the values.
+
+    Returns
+    -------
+    (list of float, float)
+        The remembered turning points (``stack[0] = 0``) and the current value.
+    """
+    vals = _ratio_array(ratios).ravel()
+    stack, cur = [0.0], 0.0
+    for v in vals:
+        v = float(v)
+        if v == cur:
+            continue
+        if cur != stack[-1] and np.sign(v - cur) != np.sign(cur - stack[-1]):
+            stack.append(cur)
+        cur = v
+        while True:
+            m = len(stack) - 1
+            if m >= 2 and abs(cur - stack[m]) >= abs(stack[m] - stack[m - 1]):
+                del stack[-2:]
+            elif m == 1 and abs(cur - stack[1]) >= 2.0 * abs(stack[1]):
+                del stack[-1]
+            else:
+                break
+    return stack, cur
+
+
+def mindlin_traction(x, a, p0, mu, ratios):
+    """Tangential traction at constant P after the path of load ratios ``Q/(μP)`` (Mindlin–Deresiewicz).
+
+    Superposition of Cattaneo solutions ``t_C(x; r)`` (:func:`cattaneo_traction`) over the
+    remembered turning points ``0 = r_0, r_1, …, r_m`` and the current value ``r``
+    (:func:`mindlin_turning_points`):
+
+    ``t = t_C(r_1 − r_0) + Σ_{i≥2} 2·t_C((r_i − r_{i−1})/2) + 2·t_C((r − r_m)/2)``
+
+    (the first term with factor 1 and without halving when it is the virgin branch, ``m = 0``:
+    ``t = t_C(r)``). Unloading from ``r*`` to ``r``: ``t = t_C(r*) − 2 t_C((r* − r)/2)``; at
+    ``r = −r*``, ``t = −t_C(r*)``.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Coordinate along the strip.
+    a, p0 : float
+        Hertz half-width (> 0) and peak pressure (>= 0) of the constant normal load.
+    mu : float
+        Friction coefficient, >= 0.
+    ratios : sequence of float
+        The path of ``Q/(μP)`` from 0, each ``|r| < 1``; piecewise linear between the values
+        (its turning points among them). The last value is the current load.
+
+    Returns
+    -------
+    float or ndarray
+        ``t(x)`` on body A in +x.
+
+    Notes
+    -----
+    Similar materials (no normal–tangential coupling), P held constant while Q varies. Source:
+    ``SOURCES["mindlin_traction"]``.
+    """
+    stack, cur = mindlin_turning_points(ratios)
+    x = _coords(x)
+    nodes = stack + [cur]
+    t = np.zeros_like(x, dtype=float)
+    for i in range(1, len(nodes)):
+        dr = nodes[i] - nodes[i - 1]
+        if dr == 0.0:
+            continue
+        factor = 1.0 if i == 1 else 2.0
+        t = t + factor * cattaneo_traction(x, a, p0, mu, dr / factor)
+    return _out(np.asarray(t))
+
+
+def mindlin_dissipation(ratio, mu, P, Estar):
+    """Energy dissipated per cycle of ``Q`` between ``±ratio·μP`` at constant P (2D, similar bodies).
+
+    ``W = (4(μP)²/(πE*))·[(1 − r)ln(1 − r) + r − r²/2]``, ``r = |ratio|`` (≈ ``2(μP)² r³/(3πE*)``
+    for small r), per unit axial length. From the Masing loop ``W = 4[Q*u(Q*) − 2∫₀^{Q*} u dQ]``
+    of the Cattaneo displacement, whose part not linear in Q is ``(μP/(πE*))(1 − r)ln(1 − r)``
+    in 2D (the part linear in Q and the constant, which depend on the reference distance of the
+    2D half-space, do no work over a closed cycle; docs/kinematics.md). Source:
+    ``SOURCES["mindlin_dissipation"]``.
+
+    Parameters
+    ----------
+    ratio : float
+        Amplitude ``Q*/(μP)``, ``|ratio| < 1``.
+    mu, P, Estar : float
+        Friction coefficient (>= 0), normal load per unit length (> 0), contact modulus (> 0).
+
+    Returns
+    -------
+    float
+        Energy per cycle and unit axial length (force units).
+    """
+    r = abs(_ratio(ratio))
+    mu, P, Estar = _nonnegative("mu", mu), _positive("P", P), _positive("Estar", Estar)
+    g = (1.0 - r) * math.log1p(-r) + r - 0.5 * r * r
+    return 4.0 * (mu * P) ** 2 / (math.pi * Estar) * g
+
+
+def rounded_punch_load(a, b, R, Estar):
+    """Normal load of a flat punch of half-width ``b`` with edges rounded to radius ``R``, contact half-width ``a``.
+
+    Profile ``z = 0`` for ``|x| ≤ b``, ``(|x| − b)²/(2R)`` outside; for ``a > b``:
+    ``P = (E* a²/(4R))·(π − 2φ0 − sin 2φ0)``, ``sin φ0 = b/a`` (``b = 0``: Hertz). Source:
+    ``SOURCES["rounded_punch_load"]``.
+
+    Parameters
+    ----------
+    a, b : float
+        Contact half-width (> 0) and flat half-width (``0 <= b < a``).
+    R, Estar : float
+        Edge radius and contact modulus, > 0.
+
+    Returns
+    -------
+    float
+        P per unit axial length.
+    """
+    a, b = _positive("a", a), _nonnegative("b", b)
+    R, Estar = _positive("R", R), _positive("Estar", Estar)
+    if not b < a:
+        raise InputError("b", f"the flat half-width must be below the contact half-width a = {a!r}, got {b!r}")
+    phi0 = math.asin(b / a)
+    return Estar * a * a / (4.0 * R) * (math.pi - 2.0 * phi0 - math.sin(2.0 * phi0))
+
+
+def rounded_punch_half_width(P, b, R, Estar):
+    """Contact half-width ``a`` of the rounded punch under ``P`` (:func:`rounded_punch_load` inverted, bisection).
+
+    Source: ``SOURCES["rounded_punch_half_width"]``.
+
+    Parameters
+    ----------
+    P : float
+        Normal load per unit length, > 0.
+    b, R, Estar : float
+        Flat half-width (>= 0), edge radius and contact modulus (> 0).
+
+    Returns
+    -------
+    float
+        ``a > b``.
+    """
+    P = _positive("P", P)
+    lo, hi = max(_nonnegative("b", b), 0.0), max(2.0 * b, 1.0)
+    while rounded_punch_load(hi, b, R, Estar) < P:
+        hi *= 2.0
+    lo = b * (1 + 1e-15) + 1e-300
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if rounded_punch_load(mid, b, R, Estar) < P:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def rounded_punch_pressure(x, a, b, R, Estar):
+    """Pressure under the rounded punch (:func:`rounded_punch_load`) of contact half-width ``a``.
+
+    ``p(x) = (E*/(2πR))·[(π − 2φ0)√(a² − x²) − (x − b)·ln|(t0 − τ)/(1 − t0 τ)| + (x + b)·ln|(t0 + τ)/(1 + t0 τ)|]``
+    with ``t0 = tan(φ0/2)``, ``τ = tan(ψ/2)``, ``sin ψ = x/a``; zero for ``|x| ≥ a``; bounded
+    (no edge singularity), and Hertz's ``p0√(1 − x²/a²)`` for ``b = 0``. From
+    ``p = (E*/(2π))√(a² − x²)·PV∫ z'(s)/((s − x)√(a² − s²)) ds`` (docs/kinematics.md). Source:
+    ``SOURCES["rounded_punch_pressure"]``.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Coordinates along the strip.
+    a, b, R, Estar : float
+        As for :func:`rounded_punch_load`.
+
+    Returns
+    -------
+    float or ndarray
+        ``p(x) >= 0``, zero for ``|x| >= a``.
+    """
+    x = _coords(x)
+    a, b = _positive("a", a), _nonnegative("b", b)
+    R, Estar = _positive("R", R), _positive("Estar", Estar)
+    if not b < a:
+        raise InputError("b", f"the flat half-width must be below the contact half-width a = {a!r}, got {b!r}")
+    inside = np.abs(x) < a
+    xi = np.where(inside, x, 0.0)
+    phi0 = math.asin(b / a)
+    t0 = math.tan(0.5 * phi0)
+    tau = np.tan(0.5 * np.arcsin(xi / a))
+    with np.errstate(divide="ignore"):
+        l1 = np.log(np.abs((t0 - tau) / (1.0 - t0 * tau)))
+        l2 = np.log(np.abs((t0 + tau) / (1.0 + t0 * tau)))
+    term = (math.pi - 2.0 * phi0) * np.sqrt((a - xi) * (a + xi))
+    term = term - np.where(xi == b, 0.0, (xi - b) * l1) + np.where(xi == -b, 0.0, (xi + b) * l2)
+    return _out(np.where(inside, Estar / (2.0 * math.pi * R) * term, 0.0))
+
+
+def carter_slip(x, a, R, mu, ratio, direction):
+    """Carter's steady-rolling slip per unit rolled distance (similar cylinders).
+
+    ``s(x) = −d·sgn(ratio)·(μ/R)·sgn(y)·√(y² − c²)`` in the slip zone (``|x| < a``,
+    ``|y| > c`` with ``y = x − x_c``), ``s = 0`` in the stick zone ``|y| ≤ c``, and NaN
+    outside the contact (separated: no slip is defined). ``c = a√(1 − |ratio|)`` and
+    ``x_c = −d·(a − c)`` as in :func:`carter_traction`.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Positions (Eulerian, fixed to the contact).
+    a, R, mu, ratio, direction
+        As for :func:`carter_traction` and :func:`carter_creepage`.
+
+    Returns
+    -------
+    float or ndarray
+        ``s`` (dimensionless, as the result file's ``slip``), shape of ``x``. Its sign is
+        opposite to the traction's, ``t = −μp·sgn(s)`` (the friction law of
+        docs/formulation.md §5).
+
+    Notes
+    -----
+    Derivation in the project's convention (the same steps as :func:`carter_creepage`): the
+    steady slip is ``s = ξ + d·∂w/∂x`` with ``∂w/∂x = −(2/(πE*))·PV∫ t(s')/(x − s') ds'``.
+    With ``(1/π)·PV∫_{−c}^{c} √(c² − s²)/(y − s) ds = y − sgn(y)·√(y² − c²)·[|y| > c]``
+    and ``p0 = aE*/(2R)``, the two semi-ellipses of Carter's traction give
+    ``∂w/∂x = −sgn(ratio)·(μ/R)·[x_c + sgn(y)√(y² − c²)·[|y| > c]]``; the constant part
+    cancels ξ, what remains is the formula above. Source: Carter (1926); Johnson (1985)
+    Ch. 8, see ``SOURCES["carter_slip"]``.
+    """
+    x = _coords(x)
+    a = _positive("a", a)
+    R = _positive("R", R)
+    mu = _nonnegative("mu", mu)
+    ratio = _ratio(ratio)
+    d = _direction(direction)
+    c = a * math.sqrt(1.0 - abs(ratio))
+    y = x - (-d * (a - c))
+    sign_r = math.copysign(1.0, ratio) * (ratio != 0.0)
+    s = -d * sign_r * (mu / R) * np.sign(y) * np.sqrt(np.maximum(y * y - c * c, 0.0))
+    return _out(np.where(np.abs(x) < a, s, np.nan))
 
 
 # --------------------------------------------------------------------------- subsurface stresses

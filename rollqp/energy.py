@@ -48,9 +48,17 @@ def dissipation(rec, ops) -> float:
     return float(ops.f @ friction_power(rec, ops))
 
 
+def _dq(rec) -> float:
+    """The rolled length ``|Δq_k|`` of a rolling step (its own under ``load.rolled``), 0 otherwise."""
+    if rec.k == 0 or not _rolling(rec) or rec.problem is None:
+        return 0.0
+    return float(rec.problem.dq)
+
+
 def friction_work(rec, ops) -> float:
-    """The step's frictional work ``D Δq`` (rolling steps; 0 for the starting state)."""
-    return dissipation(rec, ops) * ops.scene.dq if _rolling(rec) and rec.k > 0 else 0.0
+    """The step's frictional work ``D Δq`` (rolling steps; 0 for the starting state and stops)."""
+    dq = _dq(rec)
+    return dissipation(rec, ops) * dq if dq else 0.0
 
 
 def elastic_energy(rec, ops) -> float:
@@ -66,10 +74,11 @@ def elastic_energy(rec, ops) -> float:
 
 def load_work(rec, ops) -> float:
     """``−Q ξ Δq + ½(P_k + P_{k−1})(δ_k − δ_{k−1})`` of a rolling step (0 for the starting state)."""
-    if rec.k == 0 or not _rolling(rec):
+    dq = _dq(rec)
+    if dq == 0.0:
         return 0.0
     st, pr = rec.state, rec.previous
-    W = -rec.Q * float(st.tsol.xi) * ops.scene.dq
+    W = -rec.Q * float(st.tsol.xi) * dq
     if pr is not None and pr.nsol is not None and st.nsol is not None and pr.p is not None:
         P0 = float(ops.f @ pr.p)
         W += 0.5 * (rec.P + P0) * (float(st.nsol.delta) - float(pr.nsol.delta))
@@ -77,7 +86,9 @@ def load_work(rec, ops) -> float:
 
 
 def _mu(scene) -> bool:
-    return scene.contact.friction > 0
+    """Friction somewhere (a Coulomb μ > 0 or a law of :mod:`rollqp.friction` that is not zero)."""
+    from .friction import largest
+    return largest(scene.contact.friction) > 0
 
 
 for _f in (

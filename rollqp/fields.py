@@ -50,7 +50,7 @@ class Field:
         ``needed(scene) -> bool``: whether a scene's result holds the field (model only what a
         scene needs); the core fields are always there.
     contract : bool
-        Part of the outer contract (SPEC: names and meanings never change).
+        Part of the outer contract (docs/results.md: names and meanings never change).
     """
 
     name: str
@@ -135,3 +135,29 @@ def markdown_table() -> str:
                 "package versions, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
                 "`rolling_start`) |")
     return "\n".join(rows)
+
+
+# ------------------------------------------------------------------------- kinematics (issue 13)
+def _with_rolled(scene) -> bool:
+    return scene.load.rolled is not None
+
+
+register(Field("time", "step", LENGTH, "time-like parameter tau of each state (load.rolled: q = q(tau) and the "
+                                       "loads are histories of tau; 0: the starting state)",
+               compute=lambda rec, ops: 0.0 if rec.tau is None else rec.tau, needed=_with_rolled))
+register(Field("direction", "step", "1", "direction of the material in the step (load.rolled): +1 or -1, "
+                                         "0 for a stop (a static shift step)", dtype="int64",
+               compute=lambda rec, ops: rec.direction if rec.k > 0 else int(ops.scene.load.direction),
+               needed=_with_rolled))
+
+
+def _friction_coefficient(rec, operators):
+    """``μ`` at the nodes of a step with a friction law (kept by the march in ``info["mu"]``)."""
+    sol = rec.solution
+    mu = None if sol is None else sol.info.get("mu")
+    return np.full(operators.n, float(operators.mu)) if mu is None else np.asarray(mu, dtype=float)
+
+
+register(Field("friction_coefficient", "state", "1",
+               "coefficient of friction mu at each node in the step (scenes with a friction law, docs/friction.md)",
+               compute=_friction_coefficient, needed=lambda scene: not isinstance(scene.contact.friction, float)))

@@ -21,7 +21,11 @@ benchmarks, post-processing — consumes the records; it needs no private call. 
     state until the tractions stop changing (phase ``"rolling"``).
 * **rolling steps** ``k = 1..K`` at ``q_k = k Δq`` (phase ``"rolling"``): the history vector
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
-  ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step.
+  ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step. With
+  ``load.rolled`` (:mod:`rollqp.kinematics`) the steps are ``τ_k``, the loads ``P(τ_k)``, …, each
+  step's ``M`` is that of its own ``|Δq_k|`` and direction (a reversal flips the shift and upwind
+  operators, eq. 32–40), and a stop (Δq_k = 0) is a static-shift step (phase ``"static-shift"``);
+  a profile that moves (:mod:`rollqp.profiles`) gives each step its own undeformed gap.
 * **contact lost** (``P(q) = 0``): an unloaded state (:func:`_unloaded`), nothing solved;
   **frictionless** (``μ = 0``): the normal half alone, ``t = 0`` (:func:`_frictionless`);
 * **gross sliding** (only with a prescribed creepage beyond the sliding creepage; a prescribed
@@ -35,6 +39,7 @@ coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
 """
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 from typing import Iterator
@@ -42,6 +47,7 @@ from typing import Iterator
 import numpy as np
 
 from .errors import InputError, SolverError
+from .kinematics import HistoryCache, plan
 from .operators import SceneOperators
 from .problem import StepSolution, classify
 from .result import Result
@@ -137,6 +143,10 @@ class StepRecord:
         0 separation, 1 stick, 2 slip.
     gross_sliding : bool
         Every contact node slips (possible only with a prescribed creepage).
+    tau : float or None
+        The time-like parameter τ_k (length units; :mod:`rollqp.kinematics`), None for the start.
+    direction : int
+        Direction of the material in the step (±1), 0 for a static shift.
     """
 
     k: int
@@ -153,6 +163,8 @@ class StepRecord:
     step_time: float
     nodes: np.ndarray = field(repr=False, default=None)
     gross_sliding: bool = False
+    tau: float | None = None
+    direction: int = 0
 
     @property
     def normal(self):
@@ -166,6 +178,9 @@ class _March:
 
     def __init__(self, scene: Scene, ops: SceneOperators, method):
         self.scene, self.ops, self.method = scene, ops, method
+        self.plan = plan(scene)
+        self.moving = ops.profiles_move
+        self.cache = HistoryCache(ops) if self.plan.rolled else None
         self.fixed = self._normal_fixed()
 
     # ------------------------------------------------------------ loads
@@ -184,39 +199,49 @@ class _March:
 
     def _normal_fixed(self) -> bool:
         """The normal step cannot change: no shear feedback (A_nt absent) and constant P."""
-        if self.ops.Ant is not None:
+        if self.ops.Ant is not None or self.moving:
             return False
-        qs = self.scene.q_steps
+        qs = self.scene.time_steps
         sc = self.scene
         P = sc.normal_load(qs) if sc.load.approach is None else sc.prescribed_approach(qs)
         return bool(np.all(P == P[0]))
 
     # ------------------------------------------------------------ one step
     def step(self, state: State, cnt: Counters, *, P, c, dq, Q=None, xi=None, normal_fixed=False,
-             steady=False, delta=None):
-        """One step (rolling, static shift or steady): ``(new state, problem, solution)``."""
+             steady=False, delta=None, h=None, q=0.0, transport=None):
+        """One step (rolling, static shift or steady): ``(new state, problem, solution)``.
+
+        ``h``: the gap of a moving profile (else the operators' own); ``q`` places a friction law
+        that varies along the surface; ``transport`` (the step's rolled distance, rolling steps
+        only) carries a friction memory with the material."""
         ops, meth = self.ops, self.method
         if P is not None and P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
             return _unloaded(ops, xi), None, None
-        if ops.mu == 0.0:
-            return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta)
+        if ops.frictionless:
+            return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
+        fr = None
+        if not isinstance(ops.friction, float):  # a law: this step's μ (Coulomb keeps the old path)
+            prev = None if state.tsol is None else state.tsol.info.get("mu")
+            fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
-            pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta)
+            pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta, h=h, friction=fr)
             sol = meth.solve(pb, warm=state.tsol)
             cnt.add_coupled(sol)
+            _keep_mu(pb, sol)
             return State(sol.p, sol.t, ops.w(sol.p, sol.t), sol, sol, None), pb, sol
         nsol, npb = state.nsol, state.normal
         if not normal_fixed or nsol is None:
             # goodman/off: the normal half does not see t (A_nt = 0); offset kept for generality
-            npb = ops.normal_step(P, state.t, delta=delta)
+            npb = ops.normal_step(P, state.t, delta=delta, h=h)
             nsol = meth.solve(npb, warm=state.nsol)
             cnt.add(nsol, "normal")
-        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady)
+        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady, friction=fr)
         tsol = meth.solve(pb, warm=state.tsol)
         cnt.add(tsol, "tangential")
+        _keep_mu(pb, tsol)
         return State(nsol.p, tsol.t, ops.w(nsol.p, tsol.t), nsol, tsol, npb), pb, tsol
 
-    def _frictionless(self, state, cnt, *, P, c, dq, xi=None, steady=False, delta=None):
+    def _frictionless(self, state, cnt, *, P, c, dq, xi=None, steady=False, delta=None, h=None):
         """A step at ``μ = 0``: ``t = 0`` (the bound ``μp`` is zero at every node), the normal half alone.
 
         The tangential problem is degenerate (every node on the kink ``|t| = μp = 0``, no node can
@@ -227,7 +252,7 @@ class _March:
         """
         ops = self.ops
         zero = np.zeros(ops.n)
-        npb = ops.normal_step(P, zero, delta=delta)
+        npb = ops.normal_step(P, zero, delta=delta, h=h)
         nsol = self.method.solve(npb, warm=state.nsol)
         cnt.add(nsol, "normal")
         xi = 0.0 if xi is None else float(xi)
@@ -239,7 +264,8 @@ class _March:
     def record(self, k, phase, q, state, previous, problem, sol, cnt, *, P, shift, t0) -> StepRecord:
         ops = self.ops
         tsol = state.tsol
-        nodes = classify(state.p, state.t, tsol.s, ops.mu, ops.scales)
+        mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s)
+        nodes = classify(state.p, state.t, tsol.s, mu, ops.scales)
         gross = bool(np.any(nodes == 2) and not np.any(nodes == 1))
         return StepRecord(k=k, phase=phase, q=float(q), P=float(ops.f @ state.p) if P is None else P,
                           Q=float(ops.f @ state.t), state=state, previous=previous, problem=problem, solution=sol, counters=cnt,
@@ -320,7 +346,7 @@ class _March:
         for _ in range(max_steps):
             previous = state
             state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                                            normal_fixed=self.fixed, delta=self.approach(0.0))
+                                            normal_fixed=self.fixed, delta=self.approach(0.0), transport=scene.dq)
             change = np.max(np.abs(state.t - previous.t)) / (max(ops.mu, 1e-300) * ops.scales.stress)
             if not self.fixed:
                 change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
@@ -332,16 +358,34 @@ class _March:
         return self.record(0, "rolling", 0.0, state, previous, problem, sol, cnt, P=P, shift=0.0, t0=t0)
 
     def rolling(self, k: int, q: float, state: State, M) -> StepRecord:
-        """Rolling step ``k`` at ``q``."""
-        scene = self.scene
+        """Step ``k`` of the plan (:mod:`rollqp.kinematics`): rolling by Δq_k in its direction, or a stop.
+
+        Without ``load.rolled``: a rolling step at ``q = k·Δq`` with the scene's ``M``. With it: the
+        loads at τ_k; a stop is a static shift (``c = −w^{k−1}``, ``Δ = a_H``, the rigid shift ξ·Δ
+        recorded in ``shift``), a rolling step uses ``M`` of its own ``|Δq_k|`` and direction.
+        """
+        scene, pl = self.scene, self.plan
         t0 = time.perf_counter()
-        P, Q, xi = self.loads(q)
+        tau = float(pl.tau[k])
+        P, Q, xi = self.loads(tau)
         cnt = Counters()
-        new, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                                      normal_fixed=self.fixed, delta=self.approach(q))
+        d = int(pl.d[k])
+        h = self.ops.gap(q) if self.moving else None
+        if d == 0:  # a stop: static shift under the loads of τ_k (§4.4)
+            c, dq, phase = -state.w, self.ops.scales.length, "static-shift"
+        elif pl.rolled:
+            c, dq, phase = -(self.cache.get(float(pl.dq[k]), d) @ state.w), float(pl.dq[k]), "rolling"
+        else:
+            c, dq, phase = -(M @ state.w), scene.dq, "rolling"
+        new, problem, sol = self.step(state, cnt, P=P, c=c, dq=dq, Q=Q, xi=xi,
+                                      normal_fixed=self.fixed, delta=self.approach(tau), h=h,
+                                      q=q, transport=dq if phase == "rolling" else None)
         if not self.fixed:
             self.ops.check_inside(new.p, k)
-        return self.record(k, "rolling", q, new, state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+        shift = new.tsol.xi * dq if d == 0 else 0.0
+        rec = self.record(k, phase, q, new, state, problem, sol, cnt, P=P, shift=shift, t0=t0)
+        rec.tau, rec.direction = tau, d
+        return rec
 
 
 def prepare(scene, method=None):
@@ -359,11 +403,14 @@ def prepare(scene, method=None):
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
+    from .friction import law_kind
     coupled = scene.coupling_level == "full"
+    kind = law_kind(scene.contact.friction)
     if method is None or isinstance(method, str):
-        meth = scene_method(scene.solver, coupled=coupled)
+        law = {} if kind == "constant" else {"friction": kind}  # Coulomb: the call as before
+        meth = scene_method(scene.solver, coupled=coupled, **law)
     else:
-        meth = compose(method, coupled, max_outer=scene.solver.max_iterations)
+        meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
     ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")
     meth.setup(ops)
     return scene, meth, ops
@@ -410,7 +457,7 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         yield start
         state, first = start.state, 1
     M = ops.history()
-    qs = scene.q_steps
+    qs = m.plan.q
     for k in range(first, qs.size):
         try:
             rec = m.rolling(k, float(qs[k]), state, M)
@@ -512,6 +559,13 @@ def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
 
 
 def _versions() -> dict:
+    return dict(_installed_versions())
+
+
+@functools.lru_cache(maxsize=1)
+def _installed_versions() -> tuple:
+    """The versions recorded in every result's meta, read once per process (importlib.metadata
+    scans sys.path: ~5 ms, more than the stepping of a small scene)."""
     import importlib.metadata as md
     out = {}
     for pkg in ("numpy", "scipy", "clarabel", "osqp", "cvxpy"):
@@ -519,7 +573,7 @@ def _versions() -> dict:
             out[pkg] = md.version(pkg)
         except md.PackageNotFoundError:
             out[pkg] = None
-    return out
+    return tuple(out.items())
 
 
 def _unloaded(ops: SceneOperators, xi=None) -> State:
@@ -539,3 +593,10 @@ def _unloaded(ops: SceneOperators, xi=None) -> State:
     tsol = StepSolution(t=zero, s=zero, xi=0.0 if xi is None else float(xi), method="unloaded",
                         status="unloaded")
     return State(zero, zero, zero, nsol, tsol, None)
+
+
+def _keep_mu(problem, sol) -> None:
+    """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
+    the result field ``friction_coefficient``); Coulomb steps are left as they were."""
+    if problem.law is not None or np.ndim(problem.mu) != 0:
+        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s), (problem.n,)).astype(float)

@@ -12,6 +12,7 @@ silent cast.
 from __future__ import annotations
 
 import os
+import struct
 import zipfile
 import zlib
 
@@ -79,9 +80,13 @@ def read_npz(path, arg: str) -> dict:
                 out[name] = value
     except InputError:
         raise
-    except (zipfile.BadZipFile, zlib.error, EOFError, OSError, ValueError, MemoryError) as exc:
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, zlib.error, EOFError, OSError, ValueError, MemoryError,
+            NotImplementedError, RuntimeError, KeyError, TypeError, struct.error) as exc:
+        # what zipfile and numpy raise on corrupt archives: bad headers, an unknown zip version or
+        # compression (NotImplementedError), an "encrypted" flag (RuntimeError), bad struct fields
+        first = (str(exc).splitlines() or [""])[0][:120]
         raise InputError(arg, f"{path!r} is not a readable .npz without pickles "
-                              f"({type(exc).__name__}: {str(exc)[:120]})") from exc
+                              f"({type(exc).__name__}: {first})") from exc
     return out
 
 

@@ -87,8 +87,36 @@ class SceneOperators:
         info["influence_seconds"] = time.perf_counter() - t0
         info["operator"] = "symmetrized" if symmetrized else "collocation"
         Atn, Ant = (None if M is None else Operator(M, "influence") for M in (infl.Atn, infl.Ant))
-        return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
-                   scales=Scales(scene.a_H, scene.p0, scene.Estar), symmetrized=symmetrized, info=info)
+        ops = cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
+                  scales=Scales(scene.a_H, scene.p0, scene.Estar), symmetrized=symmetrized, info=info)
+        if scene.A.profile is not None or scene.B.profile is not None:  # profiles (rollqp.profiles)
+            ops.h = ops.gap(float(scene.rolled_distance(0.0)))
+        return ops
+
+    # ------------------------------------------------------------ geometry
+    @property
+    def profiles_move(self) -> bool:
+        """A body's profile has a feature attached to its material: the gap changes as it rolls."""
+        return any(b.profile is not None and b.profile.moves for b in (self.scene.A, self.scene.B))
+
+    def gap(self, q: float) -> np.ndarray:
+        """Undeformed gap ``h = z_A(x) + z_B(x)`` after the rolled distance ``q`` (eq. 10; :mod:`rollqp.profiles`).
+
+        The material of both bodies has moved by ``d·q`` (``d`` = ``load.direction``); a scene of
+        two circles has the influence model's own gap (:attr:`h`), whatever ``q``.
+        """
+        sc = self.scene
+        if sc.A.profile is None and sc.B.profile is None:
+            return self.h
+        from .profiles import Profile
+        x, shift = self.strip.x, sc.load.direction * float(q)
+        h = 0.0
+        for body in (sc.A, sc.B):
+            prof = body.profile if body.profile is not None else Profile(body.radius)
+            h = h + prof.gap(x, shift)
+        h = np.asarray(h, dtype=float)
+        h.setflags(write=False)
+        return h
 
     @property
     def f(self) -> np.ndarray:
@@ -106,7 +134,27 @@ class SceneOperators:
 
     @property
     def mu(self) -> float:
+        """The reference coefficient (Coulomb's ``μ`` itself; :attr:`Contact.mu <rollqp.scene.Contact.mu>`)."""
+        return self.scene.contact.mu
+
+    @property
+    def friction(self):
+        """The scene's friction law (a number for Coulomb; :mod:`rollqp.friction`)."""
         return self.scene.contact.friction
+
+    @property
+    def frictionless(self) -> bool:
+        """``μ = 0`` everywhere, whatever the slip (the law's largest value is 0)."""
+        from .friction import largest
+        return largest(self.friction) == 0.0
+
+    def step_friction(self, q=0.0, dq=None, previous=None, steady=False):
+        """``(mu, law)`` of a step at the rolled distance ``q`` (:func:`rollqp.friction.bound.step_coefficient`):
+        the number ``μ`` and ``None`` for Coulomb — the step problems' old path, bitwise."""
+        from .friction.bound import step_coefficient
+        sc, a = self.scene, self.scales.length
+        return step_coefficient(self.friction, self.strip.x / a, q / a, sc.load.direction,
+                                dq_hat=None if dq is None else dq / a, previous=previous, steady=steady)
 
     # ------------------------------------------------------------ slip operators
     def history(self, formulation: str | None = None, dq: float | None = None,
@@ -137,23 +185,29 @@ class SceneOperators:
         return self._memo["steady"]
 
     # ------------------------------------------------------------ step problems
-    def normal_step(self, P, t=None, delta=None) -> NormalStep:
-        """The normal step (eq. 53): load ``P`` (or approach ``delta``), shear ``t`` fixed."""
+    def normal_step(self, P, t=None, delta=None, h=None) -> NormalStep:
+        """The normal step (eq. 53): load ``P`` (or approach ``delta``), shear ``t`` fixed; ``h``: the
+        undeformed gap of the step (default :attr:`h`; a moving profile's :meth:`gap`)."""
         offset = None if (self.Ant is None or t is None) else self.Ant @ t
-        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=P, delta=delta, offset=offset, scales=self.scales)
+        return NormalStep(A=self.Ann, f=self.f, h=self.h if h is None else h, P=P, delta=delta, offset=offset, scales=self.scales)
 
-    def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False) -> TangentialStep:
-        """The tangential step (eq. 61/62) at the pressure ``p``; ``steady``: the steady slip operators."""
+    def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False, friction=None) -> TangentialStep:
+        """The tangential step (eq. 61/62) at the pressure ``p``; ``steady``: the steady slip operators;
+        ``friction``: ``(mu, law)`` of the step (:meth:`step_friction`; default the scene's Coulomb ``μ``)."""
         Atn, Att = self.steady() if steady else (self.Atn, self.Att)
         if Atn is not None:
             c = c + Atn @ p
-        return TangentialStep(A=Att, f=self.f, p=p, mu=self.mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales)
+        mu, law = (self.mu, None) if friction is None else friction
+        return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
 
-    def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None) -> CoupledStep:
-        """The coupled step (docs/formulation.md §10); ``steady``: slip ``s = ξ e + d·D_up w``."""
+    def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None, h=None,
+                     friction=None) -> CoupledStep:
+        """The coupled step (docs/formulation.md §10); ``steady``: slip ``s = ξ e + d·D_up w``; ``h`` as
+        for :meth:`normal_step`; ``friction`` as for :meth:`tangential_step`."""
         Atn, Att = self.steady() if steady else (self.Atn, self.Att)
-        return CoupledStep(Ann=self.Ann, Att=Att, Ant=self.Ant, Atn=Atn, f=self.f, h=self.h, mu=self.mu,
-                           c=c, dq=dq, P=P, Q=Q, xi=xi, delta=delta, scales=self.scales)
+        mu, law = (self.mu, None) if friction is None else friction
+        return CoupledStep(Ann=self.Ann, Att=Att, Ant=self.Ant, Atn=Atn, f=self.f, h=self.h if h is None else h,
+                           mu=mu, c=c, dq=dq, P=P, Q=Q, xi=xi, delta=delta, scales=self.scales, law=law)
 
     def w(self, p, t) -> np.ndarray:
         """Relative tangential displacement ``w = A_tn p + A_tt t`` (eq. 28)."""

@@ -50,45 +50,90 @@ def snapshot_indices(q, a, wanted=(0.0, 0.25, 0.5, 1.0, 2.0)):
 
 
 def transient_figure(res: dict, scene, path: str, title: str | None = None) -> str:
-    """Save a three-panel figure: t/(μp0), slip, and creepage against q."""
+    """Save a three-panel figure: t/(μp0), slip and creepage against q, closed forms overlaid.
+
+    Slip and creepage are drawn as ``s·R/a_H`` and ``ξ·R/a_H`` in every figure of this module
+    (geometric scaling, the same for any μ). The braked starting state (a static shift, not a
+    rolling state) is left off the slip panel and out of the creepage panel's y-range.
+    """
     plt = pyplot()
     x, a, p0 = res["x"], float(res["a_H"]), float(res["p0"])
-    mu = scene.contact.friction or 1.0
+    mu = scene.contact.mu or 1.0
+    braked = scene.load.start == "braked"
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6), constrained_layout=True)
-    idx = snapshot_indices(res["q"], a)
-    colors = plt.cm.viridis(np.linspace(0, 0.9, len(idx)))
-    for c, k in zip(colors, idx):
-        lab = f"q = {res['q'][k] / a:.2f} a_H"
+    # a load path (load.rolled, rollqp.kinematics): states against the time-like τ, Carter in the last direction
+    clock, tname = (res["time"], "tau") if "time" in res else (res["q"], "q")
+    d = res["direction"][res["direction"] != 0] if "direction" in res else np.zeros(0)
+    direction = int(d[-1]) if d.size else scene.load.direction
+    idx = snapshot_indices(clock, a)
+    for c, k in zip(_colors(plt, len(idx)), idx):
+        lab = f"{tname} = {clock[k] / a:.2f} a_H"
         ax[0].plot(x / a, res["pt"][k] / (mu * p0), "-", color=c, lw=1.4, label=lab)
-        slip = np.where(res["state"][k] == 0, np.nan, res["slip"][k])  # no slip where separated
-        ax[1].plot(x / a, slip * scene.R / (mu * a), "-", color=c, lw=1.2, label=lab)
+        if not (k == 0 and braked):
+            slip = np.where(res["state"][k] == 0, np.nan, res["slip"][k])  # no slip where separated
+            ax[1].plot(x / a, slip * scene.R / a, "-", color=c, lw=1.2, label=lab)
     ax[0].plot(x / a, res["pn"][0] / p0, ":", color="0.5", lw=1, label="p/p0 (q = 0)")
+    ax[2].plot(clock / a, res["creepage"] * scene.R / a, "-", lw=1.2, label="rollqp")
     xf = np.linspace(-1, 1, 801) * a
-    if scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0:
+    closed = scene.coupling_level == "off" and scene.load.tangential is not None and isinstance(scene.contact.friction, float) and scene.contact.friction > 0
+    marks = []
+    if closed:
         P0, Q0 = float(res["P"][0]), float(res["Q"][0])
-        if scene.load.start == "braked" and abs(Q0) < mu * P0:
+        if braked and abs(Q0) < mu * P0:
             ax[0].plot(xf / a, cf.cattaneo_traction(xf, a, p0, mu, Q0 / (mu * P0)) / (mu * p0), "k--", lw=0.9,
                        label="Cattaneo")
         r1 = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
         if abs(r1) < 1:
-            ax[0].plot(xf / a, cf.carter_traction(xf, a, p0, mu, r1, scene.load.direction) / (mu * p0), "k-.",
-                       lw=0.9, label="Carter")
+            ax[0].plot(xf / a, cf.carter_traction(xf, a, p0, mu, r1, direction) / (mu * p0), "k-.", lw=0.9,
+                       label="Carter")
+            ax[1].plot(xf / a, cf.carter_slip(xf, a, scene.R, mu, r1, direction) * scene.R / a, "k-.", lw=0.9,
+                       label="Carter (steady)")
+            marks.append(cf.carter_creepage(a, scene.R, mu, r1) * scene.R / a)
+            ax[2].axhline(marks[-1], color="k", ls="-.", lw=0.9, label="Carter (steady)")
+    _creepage_limits(ax[2], res["creepage"] * scene.R / a, skip_first=braked, marks=marks)
     ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="tangential traction on body A")
-    ax[1].set(xlabel="x / a_H", ylabel="s R / (mu a_H)", title="slip (per unit rolled distance)")
-    ax[2].plot(res["q"] / a, res["creepage"] * scene.R / (mu * a), "-", lw=1.2, label="rollqp")
-    if scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction > 0:
-        r1 = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
-        if abs(r1) < 1:
-            ax[2].axhline(cf.carter_creepage(a, scene.R, mu, r1) * scene.R / (mu * a), color="k", ls="-.", lw=0.9,
-                          label="Carter (steady)")
-    ax[2].set(xlabel="q / a_H", ylabel="xi R / (mu a_H)", title="creepage")
+    note = " (q = 0 braked: no rolling slip)" if braked else ""
+    ax[1].set(xlabel="x / a_H", ylabel="s R / a_H", title="slip per unit rolled distance" + note)
+    ax[2].set(xlabel=f"{tname} / a_H", ylabel="xi R / a_H", title="creepage")
     for axis in ax:
         axis.grid(alpha=0.3)
-        axis.legend(fontsize=7)
+        axis.legend(fontsize=7, loc="best")
     fig.suptitle(title or f"{scene.name}: {scene.description}", fontsize=10)
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def _creepage_limits(ax, values, skip_first: bool, marks=()) -> None:
+    """y-range of a creepage panel from the rolling states (and the lines already drawn).
+
+    A braked start's state 0 is a static shift whose "creepage" is the rigid shift per unit
+    length, often far outside the rolling range: it is left off the range and, when off scale,
+    named in a note in the panel. ``marks``: the closed-form levels drawn, kept in range.
+    """
+    v = np.asarray(values, dtype=float)
+    rolling = v[1:] if skip_first and v.size > 1 else v
+    pool = np.concatenate([rolling[np.isfinite(rolling)], np.asarray(marks, dtype=float).ravel()])
+    if pool.size == 0:
+        return
+    lo, hi = float(pool.min()), float(pool.max())
+    pad = 0.08 * (hi - lo) if hi > lo else 0.1 * max(abs(hi), 1e-12)
+    ax.set_ylim(lo - pad, hi + pad)
+    if skip_first and v.size > 1 and not (lo - pad <= v[0] <= hi + pad):
+        ax.text(0.01, 0.02, f"q = 0 (braked, static shift): {v[0]:.3g}, off scale", transform=ax.transAxes,
+                fontsize=7, color="0.3", va="bottom")
+
+
+#: ``|Q|/P`` below which a state counts as free rolling: the load condition ∫t = Q is met to the
+#: solver tolerance (nondimensional residual 1e-10), so a prescribed Q = 0 is stored as ~1e-15 P;
+#: 1e-8 leaves room and is far below any applied traction.
+FREE_ROLLING_RATIO = 1e-8
+
+
+def _free_rolling(res) -> bool:
+    """True if no tangential load acts at any step (the Bentall–Johnson μ → 0 limit applies)."""
+    scale = np.maximum(np.abs(np.asarray(res["P"], dtype=float)), 1e-300)
+    return bool(np.all(np.abs(np.asarray(res["Q"], dtype=float)) <= FREE_ROLLING_RATIO * scale))
 
 
 # =========================================================================== dissimilar bodies
@@ -119,13 +164,14 @@ class _Info:
         meta = _meta(res)
         sd = meta.get("scene", {})
         if scene is not None:
-            self.mu = float(scene.contact.friction)
+            self.mu = float(scene.contact.mu)
             self.name, self.description = scene.name, scene.description
             self.start, self.direction = scene.load.start, int(scene.load.direction)
             self.normal = float(scene.load.normal)
             self.coupling = scene.coupling_level
         else:
-            self.mu = float(sd.get("contact", {}).get("friction", 1.0))
+            fr = sd.get("contact", {}).get("friction", 1.0)
+            self.mu = float(fr) if not isinstance(fr, dict) else float(fr.get("mu", fr.get("static", max(fr.get("values", [1.0])))))
             self.name, self.description = sd.get("name", "result"), sd.get("description", "")
             self.start = sd.get("load", {}).get("start", "braked")
             self.direction = int(sd.get("load", {}).get("direction", -int(res.get("leading_edge", 1))))
@@ -206,7 +252,9 @@ def select_states(q, a, at=None, n: int = 5, settled: float | None = None) -> li
 
 
 def _colors(plt, m):
-    return plt.cm.viridis(np.linspace(0.0, 0.88, max(m, 1)))
+    """Snapshot colours from light (first state) to dark (last): the final state, usually the
+    one read, gets viridis' darkest end rather than its near-invisible yellow."""
+    return plt.cm.viridis(np.linspace(0.8, 0.0, max(m, 1)))
 
 
 def _contact_span(res, a, pad=0.15):
@@ -257,7 +305,7 @@ def draw_snapshots(axes, res, scene=None, at=None, n: int = 5) -> list[int]:
         axt.plot(x, -bound, ":", color=c, lw=0.9)
         if not (k == 0 and info.static_start):
             slip = np.where(st == 0, np.nan, res["slip"][k])  # no slip where separated
-            axs.plot(x, slip * info.R / (mu * a), "-", color=c, lw=1.2, label=lab)
+            axs.plot(x, slip * info.R / a, "-", color=c, lw=1.2, label=lab)
         for code in (0, 1, 2):
             m = st == code
             if m.any():
@@ -272,7 +320,7 @@ def draw_snapshots(axes, res, scene=None, at=None, n: int = 5) -> list[int]:
     axp.set(xlabel="x / a_H", ylabel="p / p0", title="contact pressure")
     axt.set(xlabel="x / a_H", ylabel="t / (mu p0)", title="tangential traction on body A (dotted: ±mu p)")
     note = " (q = 0 braked: no rolling slip)" if (0 in idx and info.static_start) else ""
-    axs.set(xlabel="x / a_H", ylabel="s R / (mu a_H)", title="slip of A relative to B" + note)
+    axs.set(xlabel="x / a_H", ylabel="s R / a_H", title="slip of A relative to B" + note)
     axz.set(xlabel="x / a_H", title="node state", ylim=(-0.6, len(idx) - 0.4))
     axz.set_yticks([])
     axz.invert_yaxis()
@@ -284,7 +332,7 @@ def draw_snapshots(axes, res, scene=None, at=None, n: int = 5) -> list[int]:
                  ha="right" if lead > 0 else "left", va="bottom", color="0.3")
     for axis in (axp, axt, axs):
         if axis.get_legend_handles_labels()[0]:
-            axis.legend(fontsize=7)
+            axis.legend(fontsize=7, loc="best", framealpha=0.85)
     return idx
 
 
@@ -314,8 +362,9 @@ def draw_zone_map(ax, res, scene=None):
     lead = -info.direction
     ax.text(0.99, 0.98 if lead > 0 else 0.02, "leading edge", transform=ax.transAxes, ha="right",
             va="top" if lead > 0 else "bottom", fontsize=7, color="0.2")
+    # outside the axes: the image fills them, any legend inside would hide states
     ax.legend(handles=[Patch(color=STATE_COLORS[c], label=STATE_NAMES[c]) for c in (1, 2, 0)],
-              fontsize=7, loc="upper left", ncol=3, framealpha=0.8)
+              fontsize=7, loc="upper left", bbox_to_anchor=(1.005, 1.0), borderaxespad=0.0)
 
 
 def draw_history(ax, res, scene=None):
@@ -326,9 +375,15 @@ def draw_history(ax, res, scene=None):
     a, R = info.a, info.R
     q = res["q"] / a
     ax.plot(q, res["creepage"] * R / a, "-", color="C0", lw=1.3, label="creepage xi R/a_H")
-    if info.kappa != 0 and abs(info.kappa) <= 1:
+    marks = []
+    if info.kappa != 0 and abs(info.kappa) <= 1 and _free_rolling(res):
         bj = _cf.bentall_johnson_creepage(info.kappa, a, R) * np.sign(info.kappa) * info.direction
         ax.axhline(bj * R / a, color="C0", ls="--", lw=0.9, label="Bentall-Johnson, mu -> 0")
+        marks = [bj * R / a]
+    elif info.kappa != 0:
+        ax.text(0.01, 0.98, "Bentall-Johnson (free rolling) not drawn: Q != 0", transform=ax.transAxes,
+                fontsize=7, color="0.3", va="top")
+    _creepage_limits(ax, res["creepage"] * R / a, skip_first=info.static_start, marks=marks)
     ax.set(xlabel="q / a_H", ylabel="xi R / a_H", title="creepage and loads")
     ax.grid(alpha=0.3)
     P = res["P"] / info.normal
@@ -459,17 +514,23 @@ def comparison_figure(results: dict, scene=None, path=None, at=None, n: int = 4,
             ax[0].plot(x, r["pn"][k] / p0, ls, color=c, lw=1.3, label=lab)
             ax[1].plot(x, r["pt"][k] / (mu * p0), ls, color=c, lw=1.3, label=lab)
         ax[2].plot(r["q"] / a, r["creepage"] * info.R / a, ls, color="C0", lw=1.3, label=label)
-    if info.kappa != 0 and abs(info.kappa) <= 1:
-        from . import closedforms as _cf
-        bj = _cf.bentall_johnson_creepage(info.kappa, a, info.R) * np.sign(info.kappa) * info.direction
-        ax[2].axhline(bj * info.R / a, color="k", ls=":", lw=0.9, label="Bentall-Johnson, mu -> 0")
+    marks = []
+    if info.kappa != 0 and abs(info.kappa) <= 1 and all(_free_rolling(r) for _, r in items):
+        bj = cf.bentall_johnson_creepage(info.kappa, a, info.R) * np.sign(info.kappa) * info.direction
+        marks.append(bj * info.R / a)
+        ax[2].axhline(marks[-1], color="k", ls=":", lw=0.9, label="Bentall-Johnson, mu -> 0")
+    elif info.kappa != 0:
+        ax[2].text(0.01, 0.98, "Bentall-Johnson (free rolling) not drawn: Q != 0", transform=ax[2].transAxes,
+                   fontsize=7, color="0.3", va="top")
+    _creepage_limits(ax[2], np.concatenate([r["creepage"][1:] for _, r in items]) * info.R / a, skip_first=False,
+                     marks=marks)
     x0, x1 = _contact_span(first, a)
     ax[0].set(xlabel="x / a_H", ylabel="p / p0", title="contact pressure", xlim=(x0, x1))
     ax[1].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="tangential traction on body A", xlim=(x0, x1))
     ax[2].set(xlabel="q / a_H", ylabel="xi R / a_H", title="creepage")
     for axis in ax:
         axis.grid(alpha=0.3)
-        axis.legend(fontsize=6)
+        axis.legend(fontsize=6, loc="best")
     fig.suptitle(title or f"{info.name}: " + " vs ".join(k for k, _ in items), fontsize=9)
     return _finish(fig, plt, path)
 

@@ -42,7 +42,7 @@ import numpy as np
 from .errors import InputError
 from .influence.operator import Operator, as_operator, asymmetry, split  # noqa: F401 - re-exported
 
-# Node states in result files (SPEC.md): 0 separation, 1 stick, 2 slip.
+# Node states in result files (docs/results.md): 0 separation, 1 stick, 2 slip.
 SEPARATION, STICK, SLIP = 0, 1, 2
 
 
@@ -87,12 +87,60 @@ class Scales:
         return self.length * self.stress
 
 
+#: Largest magnitude of any number given to a step problem. rollqp forms products of up to four
+#: of them (the QP objective pᵀ F A p, fᵀp, A·p): with every factor ≤ 1e60 these stay below
+#: 1e240 · n, far from float64's 1.8e308, while any physical input in any units is far below
+#: it (stresses ~1e11 Pa, compliances ~1e-12).
+MAX_MAGNITUDE = 1e60
+
+
+def _real(name, v) -> np.ndarray:
+    """``v`` as a float array; an InputError naming ``name`` unless it holds real, finite numbers
+    within ±:data:`MAX_MAGNITUDE` (booleans, complex numbers, strings, objects and ragged lists
+    are refused, never cast)."""
+    if type(v) is np.ndarray and v.dtype == np.float64:  # the common case: no copy, two numpy calls
+        a = v
+    else:
+        try:
+            a = np.asarray(v)
+        except (ValueError, TypeError) as exc:
+            raise InputError(name, f"must hold real numbers ({exc})") from None
+        if a.dtype.kind not in "iuf":
+            raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
+        a = a.astype(float)
+    if a.size:
+        big = np.max(np.abs(a))
+        if not big <= MAX_MAGNITUDE:  # NaN compares false: one test for both
+            if not np.all(np.isfinite(a)):
+                raise InputError(name, "must be finite")
+            raise InputError(name, f"values must be within ±{MAX_MAGNITUDE:g} (beyond, the products of the step "
+                                   f"problem overflow; rescale, e.g. with Scales), got {big:.3g}")
+    return a
+
+
+def _scalar(name, v):
+    """``v`` as a float, or ``None``; an InputError naming ``name`` unless it is one real number."""
+    if v is None:
+        return None
+    if isinstance(v, (float, int)) and not isinstance(v, bool):  # the common case, without numpy
+        x = float(v)
+        if abs(x) <= MAX_MAGNITUDE:
+            return x
+    a = _real(name, v)
+    if a.ndim != 0:
+        raise InputError(name, f"must be a real number, got an array of shape {a.shape}")
+    return float(a)
+
+
+def _set_scalars(step, names) -> None:
+    for name in names:
+        object.__setattr__(step, name, _scalar(name, getattr(step, name)))
+
+
 def _vec(name, v, n):
-    a = np.asarray(v, dtype=float)
+    a = _real(name, v)  # real and finite
     if a.shape != (n,):
         raise InputError(name, f"must have shape ({n},), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise InputError(name, "must be finite")
     return a
 
 
@@ -116,19 +164,37 @@ def _check_arrays(step, operators=(), vectors=(), optional=()) -> int:
     ``None``) in place; return ``n``."""
     n = _set_weights(step)
     for name in operators:
-        if getattr(step, name) is not None or name in ("A", "Ann", "Att"):
-            object.__setattr__(step, name, as_operator(getattr(step, name), name, n))
+        value = getattr(step, name)
+        if value is not None or name in ("A", "Ann", "Att"):
+            if not isinstance(value, Operator):
+                value = _real(name, value)
+            object.__setattr__(step, name, as_operator(value, name, n))
     for name in vectors + optional:
         if getattr(step, name) is not None or name in vectors:
             object.__setattr__(step, name, _vec(name, getattr(step, name), n))
     return n
 
 
+def _per_node(mu) -> bool:
+    """``mu`` is given per node (a sequence or an array of dimension >= 1), not one number."""
+    return isinstance(mu, (list, tuple, np.ndarray)) and not (isinstance(mu, np.ndarray) and mu.ndim == 0)
+
+
 def _check_friction(step) -> None:
-    """``μ`` finite and ``>= 0``, ``Δq`` finite and ``> 0``."""
-    if not (np.isfinite(step.mu) and step.mu >= 0):
-        raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {step.mu!r}")
-    if not (np.isfinite(step.dq) and step.dq > 0):
+    """``μ`` finite and ``>= 0`` (a number, or one per node: :mod:`rollqp.friction`), ``Δq`` finite and ``> 0``."""
+    if not _per_node(step.mu):
+        if step.mu is None or not (np.isfinite(step.mu) and step.mu >= 0):
+            raise InputError("mu", f"the coefficient of friction must be finite and >= 0, got {step.mu!r}")
+    else:
+        mu = _vec("mu", step.mu, step.f.size)
+        if np.any(mu < 0):
+            raise InputError("mu", f"the coefficients of friction must all be >= 0, got min {float(mu.min())!r}")
+        object.__setattr__(step, "mu", mu)
+    law = getattr(step, "law", None)
+    if law is not None and not (callable(getattr(law, "mu", None)) and callable(getattr(law, "dmu", None))):
+        raise InputError("law", f"must be a slip-dependent bound with mu(s) and dmu(s) (rollqp.friction.SlipBound), "
+                                f"got {type(law).__name__}")
+    if step.dq is None or not (np.isfinite(step.dq) and step.dq > 0):
         raise InputError("dq", f"the step must be a finite number > 0, got {step.dq!r}")
 
 
@@ -226,6 +292,7 @@ class NormalStep:
 
     def __post_init__(self):
         _check_arrays(self, ("A",), ("h",), ("offset",))
+        _set_scalars(self, ("P", "delta"))
         _exactly_one(("P", "delta"), (self.P, self.delta))
         if self.delta is not None and not np.isfinite(self.delta):
             raise InputError("delta", f"the prescribed approach must be finite, got {self.delta!r}")
@@ -337,10 +404,12 @@ class TangentialStep:
     Q: float | None = None        # load row (eq. 67) …
     xi: float | None = None       # … or the creepage prescribed
     scales: Scales = field(default_factory=Scales)
+    law: object = None            # slip-dependent bound μ(s) (rollqp.friction.SlipBound); None: μ fixed
     kind = "tangential"
 
     def __post_init__(self):
         _check_arrays(self, ("A",), ("p", "c"))
+        _set_scalars(self, ("dq", "Q", "xi") + (() if _per_node(self.mu) else ("mu",)))  # μ per node: _check_friction
         _check_friction(self)
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
         if self.xi is not None and not np.isfinite(self.xi):
@@ -359,8 +428,22 @@ class TangentialStep:
 
     @property
     def bound(self) -> np.ndarray:
-        """``μ·max(p̄, 0)``."""
+        """``μ·max(p̄, 0)`` (with a slip-dependent ``law``: at zero slip, the static bound)."""
+        if self.law is not None:
+            return self.law.mu(np.zeros(self.n)) * np.maximum(self.p, 0.0)
         return self.mu * np.maximum(self.p, 0.0)
+
+    def bound_at(self, s) -> np.ndarray:
+        """The bound at the slip ``s``: ``μ(s)·max(p̄, 0)`` (``law``), else :attr:`bound`."""
+        return self.bound if self.law is None else self.law.mu(s) * np.maximum(self.p, 0.0)
+
+    def coefficient(self, s=None):
+        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""
+        return self.mu if self.law is None or s is None else self.law.mu(s)
+
+    def frozen(self, s) -> "TangentialStep":
+        """The same step with the bound frozen at the slip ``s`` (``μ = law.mu(s)`` per node): a convex QP."""
+        return self.replace(mu=self.law.mu(s), law=None)
 
     def replace(self, **kw) -> "TangentialStep":
         return dataclasses.replace(self, **kw)
@@ -389,7 +472,7 @@ class TangentialStep:
         """rollqp's residuals of ``(t, ξ)``: ``‖t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)‖∞`` (eq. 60), load row (eq. 67)."""
         sc = self.scales
         s = self.slip(t, xi)
-        th, sh, bh = t / sc.stress, s / sc.slip, self.bound / sc.stress
+        th, sh, bh = t / sc.stress, s / sc.slip, self.bound_at(s) / sc.stress
         fr = friction_residual(th, sh, bh)
         load = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
         return Residuals(friction=float(np.max(np.abs(fr))), load_tangential=abs(float(load)))
@@ -483,10 +566,12 @@ class CoupledStep:
     Q: float | None = None        # tangential load row …
     xi: float | None = None       # … or the creepage prescribed
     scales: Scales = field(default_factory=Scales)
+    law: object = None            # slip-dependent bound μ(s) (rollqp.friction.SlipBound); None: μ fixed
     kind = "coupled"
 
     def __post_init__(self):
         _check_arrays(self, ("Ann", "Att", "Ant", "Atn"), ("h", "c"))
+        _set_scalars(self, ("dq", "P", "delta", "Q", "xi") + (() if _per_node(self.mu) else ("mu",)))
         _check_friction(self)
         _exactly_one(("P", "delta"), (self.P, self.delta))
         _exactly_one(("Q", "xi"), (self.Q, self.xi))
@@ -496,9 +581,11 @@ class CoupledStep:
             v = getattr(self, name)
             if v is not None and not np.isfinite(v):
                 raise InputError(name, f"must be finite, got {v!r}")
-        if self.Q is not None and self.P is not None and not abs(self.Q) < self.mu * self.P:
+        mu_max = self.mu if np.ndim(self.mu) == 0 and self.law is None else float(
+            np.max(self.mu if self.law is None else self.law.mu(np.zeros(self.n))))
+        if self.Q is not None and self.P is not None and not abs(self.Q) < mu_max * self.P:
             raise InputError("Q", f"|Q| = {abs(self.Q):.6g} must be below the sliding limit "
-                                  f"mu P = {self.mu * self.P:.6g} for a solution with stick")
+                                  f"mu P = {mu_max * self.P:.6g} for a solution with stick")
 
     @property
     def n(self) -> int:
@@ -529,7 +616,11 @@ class CoupledStep:
         """The tangential step with the pressure ``p`` fixed (eq. 61/62): bound ``μ p⁺``."""
         c = self.c if self.Atn is None else self.c + self.Atn @ p
         return TangentialStep(A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q,
-                              xi=self.xi, scales=self.scales)
+                              xi=self.xi, scales=self.scales, law=self.law)
+
+    def coefficient(self, s=None):
+        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""
+        return self.mu if self.law is None or s is None else self.law.mu(s)
 
     def residuals(self, p, t, delta, xi) -> "Residuals":
         """rollqp's residuals of the coupled step: Signorini, friction (bound ``μp⁺``), loads (eq. 70–71)."""
@@ -537,7 +628,7 @@ class CoupledStep:
         g, s = self.gap(p, t, delta), self.slip(p, t, xi)
         sig = np.minimum(p / sc.stress, g / sc.displacement)
         th, sh = t / sc.stress, s / sc.slip
-        bh = self.mu * np.maximum(p, 0.0) / sc.stress
+        bh = self.coefficient(s) * np.maximum(p, 0.0) / sc.stress
         fr = friction_residual(th, sh, bh)
         ln = 0.0 if self.P is None else (self.f @ p - self.P) / sc.force
         lt = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force

@@ -26,7 +26,9 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     if scene.coupling_level != "off" or scene.contact.model != "halfspace":
         return out
     x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
-    mu, lead = scene.contact.friction, int(res["leading_edge"])
+    mu, lead = scene.contact.mu, int(res["leading_edge"])
+    if not isinstance(scene.contact.friction, float):  # a friction law: no closed form to compare with
+        mu = 0.0
     P0 = float(res["P"][0])
     a0 = cf.hertz_half_width(P0, R, scene.Estar)
     p00 = cf.hertz_peak_pressure(P0, a0)
@@ -42,18 +44,38 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     q = res["q"]
     qa = q[-1] / a
     tail = q >= q[-1] - 3 * a
-    if qa >= 3 and np.ptp(res["P"][tail]) == 0 and np.ptp(res["Q"][tail]) <= 1e-12 * abs(res["Q"][-1]) + 1e-300:
+    direction = scene.load.direction
+    if scene.load.rolled is not None:  # a load path (rollqp.kinematics): the last 3 a_H rolled one way
+        rolled, tail, direction = _rolled_tail(scene, 3 * a)
+    else:
+        rolled = q[-1]
+    if rolled / a >= 3 * (1 - 1e-12) and np.ptp(res["P"][tail]) == 0 and np.ptp(res["Q"][tail]) <= 1e-12 * abs(res["Q"][-1]) + 1e-300:
         P1 = float(res["P"][-1])
         a1 = cf.hertz_half_width(P1, R, scene.Estar)
         p01 = cf.hertz_peak_pressure(P1, a1)
         r1 = float(res["Q"][-1]) / (mu * P1)
-        e = res["pt"][-1] - cf.carter_traction(x, a1, p01, mu, r1, scene.load.direction)
+        e = res["pt"][-1] - cf.carter_traction(x, a1, p01, mu, r1, direction)
         out.append(("carter", rms_in_contact(x, a1, e) / (mu * p0), f"rms(pt - Carter)/(mu p0) at q = {qa:.2f} a_H"))
         xi = cf.carter_creepage(a1, R, mu, r1)
         if xi != 0:
             out.append(("creepage", abs(float(res["creepage"][-1]) / xi - 1),
                         f"|xi/xi_Carter - 1| at q = {qa:.2f} a_H ({float(res['creepage'][-1]):.4e} vs {xi:.4e})"))
     return out
+
+
+def _rolled_tail(scene, need: float):
+    """``(distance, mask, direction)``: how far the last steps of a load path rolled without stopping or
+    reversing (up to ``need``), which states they are, and their direction (:mod:`rollqp.kinematics`)."""
+    from .kinematics import plan
+    pl = plan(scene)
+    d, k, dist = pl.final_direction, pl.d.size - 1, 0.0
+    mask = np.zeros(pl.d.size, dtype=bool)
+    mask[-1] = True
+    while k > 0 and pl.d[k] == d and dist < need:
+        dist += float(pl.dq[k])
+        k -= 1
+        mask[k] = True
+    return dist, mask, d
 
 
 def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:

@@ -252,7 +252,8 @@ def load_result(path, arg: str = "RESULT.npz") -> dict:
 
     The file is read without trusting it (:func:`rollqp.npzfile.read_npz`); each key that
     :mod:`rollqp.fields` documents must have its shape (``(K+1, n)``, ``(K+1,)``, ``(n,)`` or
-    ``()``) and hold real numbers; other keys are kept as they are.
+    ``()``) and hold real numbers; every key of the outer contract (``Field.contract``) must be
+    there; other keys are kept as they are.
 
     Raises
     ------
@@ -268,6 +269,10 @@ def load_result(path, arg: str = "RESULT.npz") -> dict:
     if n < 1 or K1 < 1:
         raise InputError(arg, f"keys 'x' and 'q' must be non-empty 1-D arrays, got shapes {np.shape(z['x'])}, "
                               f"{np.shape(z['q'])}")
+    missing = [key for key, f in FIELDS.items() if f.contract and key not in z]
+    if missing:  # the contract's keys are in every result file rollqp writes
+        raise InputError(arg, f"{os.fspath(path)!r} is not a complete rollqp result file (no key {missing[0]!r}"
+                              + (f" and {len(missing) - 1} more)" if len(missing) > 1 else ")"))
     shapes = {"state": (K1, n), "step": (K1,), "node": (n,), "scalar": ()}
     out = {}
     for key, value in z.items():

@@ -9,7 +9,7 @@ documented in ``docs/stepfiles.md``. :func:`check_step` evaluates a candidate so
 rollqp's own residuals (docs/formulation.md §5; paper eq. 51–60, 67), compares it with rollqp's
 Newton and QP solutions, and says which condition fails at which nodes.
 
-**Step numbering** follows the result file's ``q`` index (SPEC.md): step ``K >= 1`` is the
+**Step numbering** follows the result file's ``q`` index (docs/results.md): step ``K >= 1`` is the
 rolling step whose solution is state ``K`` (``q = K Δq``), solved from state ``K − 1``; step
 ``0`` is the starting state's last solve (the last static-shift increment of a braked start,
 or the steady-rolling solve / last marching step of a rolling start).
@@ -93,6 +93,9 @@ def from_record(scene, ops, method, rec) -> "StepFile":
 def _from_record(scene, ops, k, method, rec):
     n = ops.n
     problem, sol = rec.problem, rec.solution
+    if getattr(problem, "law", None) is not None or np.ndim(problem.mu) != 0:
+        raise InputError("contact.friction", "a step file holds one constant coefficient of friction; this scene's "
+                                             "friction law (docs/friction.md) cannot be exported")
     if problem.kind == "coupled":
         pb = problem
         ref = sol

@@ -7,7 +7,8 @@ depth grows by ``dh = (k/H)·p·|s|·dq`` at a material point under pressure ``p
 
 The material kinematics are the scene's (docs/formulation.md §1–2): a material point moves
 through the contact with direction ``d`` by ``Δq`` per step, so the point at node ``x_i`` in
-state ``k`` has the surface coordinate ``σ = x_i − d·q_k`` (its position at ``q = 0``), taken
+state ``k`` has the surface coordinate ``σ = x_i − Σ_j d_j Δq_j`` (its position at ``q = 0``; the
+directions of ``load.rolled`` when the result holds them), taken
 modulo the roller's circumference ``2πR``. :func:`profile` adds every step's ``wear_rate·Δq``
 at those coordinates (the traction shape functions interpolate between nodes), which gives the
 worn depth along each roller's surface. Both rollers move by the same ``Δq`` per step up to the
@@ -70,17 +71,22 @@ def profile(result, body: str = "A", coefficient=None, resolution: int = 4):
         raise InputError("coefficient", f"must be a finite number >= 0 (k/H), got {coefficient!r}")
     d = scene.discretization
     strip = Strip(scene.half_width, d.elements, d.element)
-    q, direction, dq = np.asarray(arrays["q"], dtype=float), scene.load.direction, scene.dq
+    q = np.asarray(arrays["q"], dtype=float)
+    # the material's signed travel: Σ d_k Δq_k (per-step directions of load.rolled, else load.direction)
+    d = np.asarray(arrays["direction"], dtype=float) if "direction" in arrays else \
+        np.full(q.size, float(scene.load.direction))
+    dqs = np.abs(np.diff(q, prepend=q[0]))                  # |Δq_k|: q falls when load.rolled reverses
+    travel = np.cumsum(d * dqs)
     rate = (coefficient * np.asarray(arrays["pn"]) * np.abs(arrays["slip"])) if coefficient is not None \
         else np.asarray(arrays[key])
-    rolling = q > 0  # the starting state is not a step of rolling
     L, h = scene.half_width, strip.spacing / resolution
-    sigma = np.arange(-L - q.max(), L + q.max() + h / 2, h)
+    reach = np.abs(travel).max()
+    sigma = np.arange(-L - reach, L + reach + h / 2, h)
     depth = np.zeros_like(sigma)
-    for k in np.flatnonzero(rolling):
-        x = sigma + direction * q[k]                            # where each material point is at q_k
+    for k in np.flatnonzero((dqs > 0) & (d != 0)):            # rolling steps (not the start, not stops)
+        x = sigma + travel[k]                                   # where each material point is at q_k
         inside = np.abs(x) <= L
-        depth[inside] += strip.traction_matrix(x[inside]) @ rate[k] * dq
+        depth[inside] += strip.traction_matrix(x[inside]) @ rate[k] * dqs[k]
     circ = 2 * np.pi * mat.radius
     if sigma.max() - sigma.min() > circ:  # more than one turn: fold the surface onto one circumference
         s = np.mod(sigma, circ)

@@ -347,3 +347,12 @@ def test_halfspace_scene_never_builds_bem(monkeypatch):
     monkeypatch.setattr(bem, "contact_compliance", boom)
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"solver.method": "newton", "discretization.distance": 0.5})
     rollqp.run(sc)
+
+
+def test_a_contact_too_small_for_the_bem_mesh_is_refused():
+    """load.normal = 1e-30 makes a_H/R ~ 1e-19: the BEM nodes would coincide in floating point
+    (found by tests/test_fuzz.py, seed scene-10183, as a divide-by-zero in the assembly). The
+    scene is refused up front, naming contact.model and the half-space alternative."""
+    scene = rollqp.load_scene("cattaneo-carter")
+    with pytest.raises(rollqp.InputError, match="contact.model.*use model = 'halfspace'"):
+        scene.replace(**{"contact.model": "bem", "load.normal": 1e-30})

@@ -388,3 +388,36 @@ def test_every_function_is_documented_and_cited():
         assert "Parameters" in doc and "Returns" in doc, f"{name} needs a numpydoc docstring"
         assert "SOURCES" in doc, f"{name}'s docstring must point to its citation"
         assert cf.SOURCES[name].strip(), f"{name} has an empty citation"
+
+
+def test_carter_slip_vanishes_in_the_stick_zone_and_opposes_the_traction():
+    """carter_slip: zero in Carter's stick zone, NaN outside the contact, of the sign opposite
+    to the traction in the slip zone (t = −μp·sgn(s)), continuous at the stick edge, mirrored
+    with the direction, and equal to ξ + d·∂w/∂x computed from the traction by quadrature."""
+    a, R, mu = 1.3, 80.0, 0.25
+    x = np.linspace(-1.2 * a, 1.2 * a, 2401)
+    for ratio in (0.3, -0.75):
+        for d in (1, -1):
+            s = cf.carter_slip(x, a, R, mu, ratio, d)
+            t = cf.carter_traction(x, a, 1.0, mu, ratio, d)
+            lo, hi = cf.carter_stick_zone(a, ratio, d)
+            inside = np.abs(x) < a
+            assert np.all(np.isnan(s[~inside]))
+            stick = (x > lo + 1e-12) & (x < hi - 1e-12)
+            assert np.all(s[stick] == 0.0)
+            slip = inside & ~((x >= lo) & (x <= hi))
+            assert np.all(np.sign(s[slip]) == -np.sign(t[slip])), "slip must oppose the traction"
+            assert np.allclose(cf.carter_slip(-x, a, R, mu, ratio, -d), s, equal_nan=True)
+    # d·∂w/∂x by the Hilbert transform of the traction, evaluated numerically (midpoint rule on a
+    # fine grid, the singular point excluded symmetrically: error O(h log h) ≈ 1e-3 relative)
+    ratio, d = 0.6, 1
+    E_star = 1.0
+    p0 = a * E_star / (2 * R)
+    h = a / 20000
+    s_nodes = np.arange(-a + h / 2, a, h)
+    t_nodes = cf.carter_traction(s_nodes, a, p0, mu, ratio, d)
+    xi = cf.carter_creepage(a, R, mu, ratio)
+    for xq in (0.55 * a, 0.8 * a, 0.95 * a):  # in the trailing slip zone for d = +1
+        xq = s_nodes[np.argmin(np.abs(s_nodes - xq))] + h / 2  # between two nodes
+        dwdx = -(2 / (np.pi * E_star)) * np.sum(t_nodes / (xq - s_nodes)) * h
+        assert cf.carter_slip(xq, a, R, mu, ratio, d) == pytest.approx(xi + d * dwdx, abs=2e-3 * mu * a / R)

@@ -54,6 +54,7 @@ def _script_options(script):
     out = io.StringIO()
     with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(out):
         mp.setattr("sys.argv", [str(script), "--help"])
+        mp.syspath_prepend(str(script.parent))   # as `python benchmarks/x.py` does (harness.py beside it)
         with pytest.raises(SystemExit):
             runpy.run_path(str(script), run_name="__main__")
     return set(re.findall(r"--[a-z][a-z-]*", out.getvalue()))
@@ -174,3 +175,19 @@ def test_readme_snippet_runs():
     diff = rollqp.compare(scope["a"], scope["b"], mu=scope["mu"], scales=scope["scales"])
     # constant elements: F·A exactly symmetric, both backends solve the same QP to 5e-9 (conftest.BACKENDS)
     assert diff["t"] <= 1e-8 and scope["a"].residual <= 1e-8, out.getvalue()
+
+
+def test_every_cited_formulation_section_exists():
+    """Code, docs, tests, examples and benchmarks cite the equations as ``docs/formulation.md §N``
+    (the one source; issue 11): every cited N must be a numbered section of that page."""
+    page = (ROOT / "docs" / "formulation.md").read_text(encoding="utf-8")
+    sections = set(re.findall(r"^## (\d+)\. ", page, flags=re.M))
+    cited = {}
+    for folder in ("rollqp", "docs", "tests", "examples", "benchmarks"):
+        for path in sorted((ROOT / folder).rglob("*")):
+            if path.suffix not in (".py", ".md") or "_build" in path.parts:
+                continue
+            for n in re.findall(r"formulation\.md ?§ ?(\d+)", path.read_text(encoding="utf-8")):
+                cited.setdefault(n, path.relative_to(ROOT))
+    missing = {n: str(p) for n, p in cited.items() if n not in sections}
+    assert cited and not missing, f"cited sections that docs/formulation.md does not have: {missing}"

@@ -216,3 +216,21 @@ def test_examples_are_documented(name):
     text = (EXAMPLES / name).read_text(encoding="utf-8")
     assert text.startswith('"""') and "Run it::" in text, f"{name} starts with a docstring saying how to run it"
     assert 'if __name__ == "__main__":' in text, f"{name} is a script"
+
+
+@pytest.mark.slow
+def test_gallery_load_paths(tmp_path, capsys):
+    """examples/load_paths.py (docs/kinematics.md), run as its command runs it: the stop keeps the state
+    to round-off, the reversal ends at the mirrored Carter state, the fretting cycle follows
+    Mindlin–Deresiewicz and its energy the 2D closed form, the dent raises the pressure; figures drawn."""
+    ns = runpy.run_path(str(EXAMPLES / "load_paths.py"), run_name="load_paths")
+    sr, fr, dn = ns["main"](["--figures", str(tmp_path)])
+    assert sr[2]["stop_change"] < 1e-9                     # round-off (solver tolerance 1e-10)
+    assert sr[2]["carter_mirrored"] < 0.0065               # Carter's discretization error, 0.0064
+    assert fr[2]["turning"] < 0.0051 and fr[2]["worst"] < 0.017   # measured 0.0050, 0.0160 (docs/kinematics.md)
+    assert abs(fr[2]["W_halfspace"] / fr[2]["W_closed"] - 1) < 2e-3   # measured 6e-4 (trapezoids, step 1)
+    assert abs(fr[2]["W_bem"] / fr[2]["W_closed"] - 1) < 1.5e-2       # finite rollers, measured 0.6 %
+    assert dn[3]["peak"] > 1.5
+    assert "stop-reverse" in capsys.readouterr().out
+    for name in ("stop-reverse.png", "fretting.png", "dent.png"):
+        assert (tmp_path / name).stat().st_size > 10_000

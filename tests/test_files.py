@@ -113,3 +113,16 @@ def test_result_files_are_checked(tmp_path):
             load_result(_write(tmp_path / "bad.npz", dict(res, **{key: value})))
     with pytest.raises(InputError, match="not a rollqp result file"):
         load_result(_write(tmp_path / "other.npz", {"a": np.zeros(3)}))
+
+
+def test_unknown_zip_version_is_a_one_line_error(step_file, tmp_path):
+    """A flipped bit in a member's 'version needed' field makes zipfile raise
+    NotImplementedError (found by tests/test_fuzz.py, seed file-30205): an InputError here."""
+    path, _ = step_file
+    data = bytearray(path.read_bytes())
+    k = data.find(b"PK\x01\x02")  # first central-directory entry; bytes 6–7: version needed to extract
+    data[k + 6] = 109  # version 10.9
+    bad = tmp_path / "version.npz"
+    bad.write_bytes(bytes(data))
+    with pytest.raises(InputError, match="not a readable .npz"):
+        StepFile.load(bad)

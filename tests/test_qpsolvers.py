@@ -72,3 +72,20 @@ def test_cli_run_with_a_qpsolvers_backend(tmp_path, monkeypatch, capsys):
     assert cli.main(["run", str(path), "--method", name, "--out", "r.npz"]) == 0
     assert name in capsys.readouterr().out, "the summary names the method"
     assert (tmp_path / "r.npz").is_file()
+
+
+@pytest.mark.skipif("qps-highs" not in INSTALLED, reason="HiGHS not installed")
+def test_highs_banner_stays_off_stdout(tmp_path):
+    """HiGHS prints its banner on the C-level stdout when a process builds its first solver
+    object; rollqp routes it to stderr, so the summary (and anything piped from it) starts
+    with rollqp's own table. A real process: the banner is written below Python's sys.stdout."""
+    import subprocess
+    import sys
+    scene = tmp_path / "short.toml"
+    scene.write_text(load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.1}).to_toml())
+    out = subprocess.run([sys.executable, "-m", "rollqp.cli", "run", str(scene), "--method", "qps-highs",
+                          "--no-cross-check", "--out", str(tmp_path / "r.npz")],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "HiGHS" not in out.stdout, out.stdout[:300]
+    assert out.stdout.lstrip().startswith("scene"), out.stdout[:300]

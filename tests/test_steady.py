@@ -263,3 +263,26 @@ def test_rolling_start_failure_is_step_0():
     with pytest.raises(_r.SolverError) as info:
         _r.run(scene)
     assert info.value.step == 0, f"labelled state 0: {info.value}"
+
+
+def test_direct_steady_slip_matches_carter_slip():
+    """The steady slip against Carter's (``closedforms.carter_slip``) on 40, 80, 160 QCE.
+
+    Measured rms error over the contact, in units of μa/R (the slip's scale: the edge value is
+    1.38 μa/R at Q/(μP) = 0.75): 1.91e-2, 9.96e-3, 5.16e-3 — first order (0.94, 0.95), as the
+    tractions (docs/validation.md §5: square-root kink at the stick–slip boundary). The maximum
+    error sits at that boundary and falls as √Le (7.5e-2, 5.2e-2, 3.7e-2). Bounds: ≤ 2.5e-2 on
+    40 QCE (the measured error with room for solver tolerance), and each refinement at most
+    0.6 × the previous (first order gives 0.5; a slip of the wrong sign or zone fails at once).
+    """
+    errors = []
+    for n in (40, 80, 160):
+        scene = similar(**{"discretization.elements": n, "load.start": "rolling", "discretization.distance": 0.0})
+        r = rollqp.run(scene, method="newton")
+        x, a, R, mu = np.asarray(r["x"]), scene.a_H, scene.R, scene.contact.friction
+        exact = cf.carter_slip(x, a, R, mu, RATIO, scene.load.direction)
+        diff = np.nan_to_num(np.asarray(r["slip"][0]) - exact)  # NaN outside the contact
+        errors.append(rms_in_contact(x, a, diff) / (mu * a / R))
+    assert errors[0] <= 2.5e-2, f"steady slip rms error {errors[0]:.3e} μa/R on 40 QCE"
+    for coarse, fine in zip(errors, errors[1:]):
+        assert fine <= 0.6 * coarse, f"slip error {coarse:.2e} → {fine:.2e}: not first order"

@@ -99,7 +99,7 @@ def get_method(name: str, **settings) -> Method:
         raise InputError(name, f"invalid settings {sorted(settings)}: {exc}") from None
 
 
-def scene_method(settings, coupled: bool = False, **options) -> Method:
+def scene_method(settings, coupled: bool = False, friction: str = "constant", **options) -> Method:
     """The method a scene runs with: ``settings.method`` built from the scene's solver settings.
 
     Parameters
@@ -110,15 +110,31 @@ def scene_method(settings, coupled: bool = False, **options) -> Method:
         The scene's steps are coupled (full coupling): a method that does not declare
         ``"coupled"`` is wrapped in the N–T alternation (paper §6.3), with
         ``settings.max_iterations`` outer iterations.
+    friction : {"constant", "spatial", "slip"}
+        The kind of the scene's friction law (:func:`rollqp.friction.law_kind`); see :func:`compose`.
     **options
         Method-specific settings (an unknown one is an :class:`InputError`).
     """
     method = method_class(settings.method).from_settings(settings, **options)
-    return compose(method, coupled, max_outer=settings.max_iterations)
+    return compose(method, coupled, max_outer=settings.max_iterations, friction=friction)
 
 
-def compose(method: Method, coupled: bool, max_outer: int | None = None) -> Method:
-    """``method``, or the N–T alternation around it when ``coupled`` and it does not solve coupled steps."""
+def compose(method: Method, coupled: bool, max_outer: int | None = None, friction: str = "constant") -> Method:
+    """``method``, or the N–T alternation around it when ``coupled`` and it does not solve coupled steps.
+
+    With a slip-dependent friction law (``friction = "slip"``) a method that does not declare
+    ``slip_dependent`` runs inside the fixed point on the bound
+    (:class:`~rollqp.friction.fixedpoint.BoundFixedPoint`: each iteration one of its QPs). A method
+    whose coupled step takes a constant coefficient only (``newton``) refuses a law on a coupled
+    scene up front, naming the alternatives.
+    """
+    if friction != "constant" and coupled and "coupled" in method.solves and not isinstance(method, _Alternation()):
+        raise InputError("solver.method", f"method {method.name!r} solves coupled steps with a constant friction "
+                                          f"coefficient only; with a {friction} friction law on a coupled scene use "
+                                          "'nt-newton' (Newton halves in the N–T alternation) or a qp-* method")
+    if friction == "slip" and not getattr(method, "slip_dependent", False):
+        from ..friction.fixedpoint import BoundFixedPoint
+        method = BoundFixedPoint(method)
     if coupled and "coupled" not in method.solves:
         if not {"normal", "tangential"} <= method.solves:
             raise InputError("solver.method", f"method {method.name!r} solves neither coupled steps nor both "
@@ -126,3 +142,8 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None) -> Meth
         from .alternation import Alternation
         return Alternation(method, max_outer=max_outer)
     return method
+
+
+def _Alternation():
+    from .alternation import Alternation
+    return Alternation

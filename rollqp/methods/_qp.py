@@ -112,6 +112,10 @@ class QPMethod:
     def solve(self, problem, warm: StepSolution | None = None) -> StepSolution:
         """Solve a normal or tangential step; raise :class:`SolverError` short of solved."""
         check_kind(self, problem)
+        if getattr(problem, "law", None) is not None:
+            raise InputError("problem", f"method {self.name!r} solves steps with a fixed friction bound; this one depends on "
+                                        "the slip: use rollqp.friction.fixedpoint.BoundFixedPoint around it (scenes do) "
+                                        "or method 'newton'")
         t0 = time.perf_counter()
         sp = problem.A.split(problem.f)
         check_convex(sp.sym, problem.f)

@@ -86,6 +86,8 @@ class Alternation:
         self.name = getattr(inner, "name", "alternation")
         self.operator = getattr(inner, "operator", "exact")
         self.tolerance = inner.tolerance
+        #: the halves' own capability (rollqp.methods.compose): a slip-dependent bound reaches them unchanged
+        self.slip_dependent = bool(getattr(inner, "slip_dependent", False))
 
     def setup(self, operators) -> None:
         """A new scene: the inner method's set-up."""

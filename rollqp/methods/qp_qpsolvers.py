@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import functools
 import importlib
+import os
 import time
 
 import numpy as np
@@ -90,8 +91,10 @@ def _settings(solver: str, tolerance: float, max_iterations) -> dict:
             s["max_iter"] = int(max_iterations)
         return s
     if solver == "highs":
+        # output_flag/log_to_console off: HiGHS otherwise prints its banner and log to stdout,
+        # into rollqp's summary (rollqp's own SolverError says what went wrong)
         return dict(primal_feasibility_tolerance=1e-2 * tolerance, dual_feasibility_tolerance=1e-2 * tolerance,
-                    qp_regularization_value=0.0)
+                    qp_regularization_value=0.0, output_flag=False, log_to_console=False)
     return {}  # quadprog: a direct dual active-set method without tolerances
 
 
@@ -131,6 +134,8 @@ class QpsolversQP(QPMethod):
         super().__init__(tolerance, residual_limit, max_iterations, operator, **options)
         import qpsolvers
         self._qpsolvers = qpsolvers
+        if self.solver == "highs":
+            _highs_banner_to_stderr()
 
     def _problem(self, form):
         n, up, lo, fx = constraint_rows(form)
@@ -171,6 +176,32 @@ class QpsolversQP(QPMethod):
         iters = _iterations(sol.extras)
         return x, y, "solved" if ok else "not found", iters, spent, {"solver": self.solver, "built": True,
                                                                       "iterations_reported": iters > 0}
+
+
+@functools.lru_cache(maxsize=None)
+def _highs_banner_to_stderr() -> None:
+    """Build the process's first HiGHS object with the C-level stdout pointed at stderr.
+
+    HiGHS prints its banner (version and licence) on stdout when the first ``Highs`` object of
+    a process is built, before any option can silence it; it would land in rollqp's summary
+    and in anything piped from it. The banner goes to stderr instead, once per process; later
+    objects print nothing (their log is off by ``output_flag``).
+    """
+    import ctypes
+    import sys
+    import highspy
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        os.dup2(2, 1)
+        highspy.Highs()
+        try:
+            ctypes.CDLL(None).fflush(None)  # the banner sits in C's stdout buffer until flushed
+        except (OSError, AttributeError):  # pragma: no cover - no C library to flush (non-POSIX)
+            pass
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def _available(solver: str, package: str) -> bool:

@@ -62,13 +62,16 @@ def check_body(key: str, b: Any) -> Body:
     wear = b.wear
     if wear is not None:  # Archard's k/H (docs/stresses.md §6)
         wear = number(f"{key}.wear", wear, ">= 0 (k/H in 1/stress) or absent", lambda x: x >= 0)
-    return Body(radius, E, nu, shaft, wear)
+    from ..profiles import parse_profile
+    profile = parse_profile(b.profile, f"{key}.profile", radius)
+    return Body(radius, E, nu, shaft, None if profile.is_circle else profile, wear)
 
 
 def check_contact(c: Any) -> Contact:
     if not isinstance(c, Contact):
         raise InputError("contact", f"must be a Contact, got {c!r}")
-    mu = number("contact.friction", c.friction, f">= 0 (and <= {MAX_FRICTION:g})", lambda x: 0 <= x <= MAX_FRICTION)
+    from ..friction import parse_friction
+    mu = parse_friction(c.friction)  # a number (Coulomb, as before) or a law record
     model = choice("contact.model", c.model, MODELS)
     coupling = choice("contact.coupling", c.coupling, COUPLINGS)
     d = c.reference_distance
@@ -103,7 +106,8 @@ def check_load(ld: Any) -> Load:
     if approach is not None and nh != Constant(1.0):
         raise InputError("load.approach", "give at most one of load.normal_history and load.approach "
                                           "(with a prescribed approach the normal load is an unknown)")
-    return Load(normal, nh, tang, creep, start, int(direction), steps, approach)
+    rolled = None if ld.rolled is None else parse_history(ld.rolled, "load.rolled")
+    return Load(normal, nh, tang, creep, start, int(direction), steps, approach, rolled)
 
 
 def check_discretization(d: Any) -> Discretization:
@@ -147,6 +151,29 @@ def check_whole(scene) -> None:
     check_zone(scene)
     check_tangential(scene)
     check_sampling(scene)
+    check_kinematics(scene)
+    check_friction(scene)
+
+
+def check_kinematics(scene) -> None:
+    """``load.rolled``: every step's ``|Δq|`` within the step limits (``discretization.step``'s range, the
+    convective-local CFL bound), and each body's profile against the strip and the run
+    (:func:`rollqp.profiles.check_cover`)."""
+    from ..kinematics import plan
+    from ..profiles import check_cover
+    pl = plan(scene)
+    if pl.rolled and pl.dq.size > 1:
+        disc = scene.discretization
+        limit = 8.0 if disc.formulation == "material" else CONVECTIVE_STEP_MAX[disc.element]
+        big = float(np.max(pl.dq)) / scene.element_length
+        if big > limit * (1 + 1e-12):
+            k = int(np.argmax(pl.dq))
+            raise InputError("load.rolled", f"|Δq| must stay in [0, {limit:g}] Le per step with formulation = "
+                                            f"{disc.formulation!r}, but step {k} (τ = {pl.tau[k] / scene.a_H:.6g} a_H) "
+                                            f"rolls {big:.6g} Le: use a smaller discretization.step")
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
+        if body.profile is not None:
+            check_cover(body.profile, f"{key}.profile", scene.half_width, pl.shift_range(), scene.contact.model)
 
 
 def check_derived(scene) -> None:
@@ -248,7 +275,7 @@ def check_tangential(scene) -> None:
     if tang is None:
         return
     tmin, tmax = tang.extremes(q_end)
-    if scene.contact.friction == 0.0:
+    if scene.contact.mu == 0.0:
         if tmin != 0.0 or tmax != 0.0:
             raise InputError("load.tangential",
                              "must be 0 when contact.friction = 0 (it is Q/(mu P̄) and "
@@ -257,7 +284,7 @@ def check_tangential(scene) -> None:
     nmin, _ = load.normal_history.extremes(q_end)
     if nmin > 0 and max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
         return
-    q = np.unique(np.concatenate((scene.q_steps / scene.a_H, load.normal_history.critical_points(q_end),
+    q = np.unique(np.concatenate((scene.time_steps / scene.a_H, load.normal_history.critical_points(q_end),
                                   tang.critical_points(q_end))))
     Qr, Pr = np.abs(np.asarray(tang(q), dtype=float)), np.asarray(load.normal_history(q), dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):  # P = 0 (contact lost): Q must be 0 too
@@ -289,10 +316,24 @@ def check_sampling(scene) -> None:
                              f"smaller discretization.step")
 
 
+#: Smallest strip element length over the smaller radius for ``model = "bem"``: the BEM nodes are
+#: points ``R (cos θ, sin θ)`` and its collocation integrals need their separations resolved far
+#: above round-off (1e-7 R is 1e9 ulps of R). Contacts this small are half-space contacts: the
+#: BEM's departure from the half-space is of order a/R (docs/bem.md).
+MIN_BEM_ELEMENT_RATIO = 1e-7
+
+
 def check_bem(scene) -> None:
-    """``model = "bem"``: both shafts given, and the strip shorter than half a circumference."""
+    """``model = "bem"``: both shafts given, the strip shorter than half a circumference, its
+    elements resolvable on the circles."""
     if scene.contact.model != "bem":
         return
+    smaller = min(scene.A.radius, scene.B.radius)
+    if not scene.element_length >= MIN_BEM_ELEMENT_RATIO * smaller:
+        raise InputError("contact.model", f"'bem' needs strip elements of at least {MIN_BEM_ELEMENT_RATIO:g} × the "
+                                          f"smaller radius, got {scene.element_length:.3g} on radius {smaller:g} "
+                                          f"(a_H/R = {scene.a_H / scene.R:.3g}); a contact this small is a half-space "
+                                          f"contact: use model = 'halfspace'")
     for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
         if body.shaft_radius is None:
             raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' (the "
@@ -323,3 +364,15 @@ def check_convective_step(scene) -> None:
                          f"{disc.element} elements (Δq at most the node spacing: the upwind "
                          f"transport is unstable beyond it, docs/stability.md), got {disc.step!r}; "
                          f"use a smaller step or formulation = 'material'")
+
+
+def check_friction(scene) -> None:
+    """A friction law varying along the surface meets the strip during the run (:mod:`rollqp.friction`)."""
+    law = scene.contact.friction
+    if not isinstance(law, float) and scene.load.rolled is not None:
+        # the laws place their μ(x) and transport their memory with the scene's one direction and
+        # q = direction·τ; stops and reversals (load.rolled) are not wired into them yet
+        raise InputError("contact.friction", "a friction law cannot be combined with load.rolled yet (stops and "
+                                             "reversals); use a constant coefficient, or roll one way")
+    if hasattr(law, "check_strip"):
+        law.check_strip(scene.half_width / scene.a_H, scene.q_end / scene.a_H, scene.load.direction)

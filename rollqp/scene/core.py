@@ -18,7 +18,7 @@ __all__ = ["Scene"]
 
 @dataclass(frozen=True)
 class Scene(Derived):
-    """A validated rolling-contact problem (SPEC.md, "Scene file").
+    """A validated rolling-contact problem (docs/scenes.md).
 
     Construction validates every field and the scene as a whole and normalizes the values
     (numbers to float, history tables to :class:`~rollqp.histories.History`); the parts

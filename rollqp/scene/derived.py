@@ -115,9 +115,23 @@ class Derived:
         return int(r) if abs(r - ratio) <= 1e-9 * ratio else int(math.ceil(ratio))
 
     @property
-    def q_steps(self) -> np.ndarray:
-        """Rolled distances q_k = k·Δq, k = 0 … K, shape (K + 1,), length units."""
+    def time_steps(self) -> np.ndarray:
+        """The time-like parameter τ_k = k·Δq, k = 0 … K, shape (K + 1,), length units: the argument of
+        the load histories (the rolled distance itself without ``load.rolled``)."""
         return np.arange(self.n_steps + 1) * self.dq
+
+    @property
+    def q_steps(self) -> np.ndarray:
+        """Rolled distances q_k, k = 0 … K, shape (K + 1,), length units: k·Δq, or q(τ_k) with
+        ``load.rolled`` (:mod:`rollqp.kinematics`)."""
+        tau = self.time_steps
+        return tau if self.load.rolled is None else self.rolled_distance(tau)
+
+    def rolled_distance(self, tau):
+        """q(τ) = a_H·rolled(τ/a_H) (length units); τ itself without ``load.rolled``."""
+        if self.load.rolled is None:
+            return np.asarray(tau, dtype=float)
+        return self.a_H * np.asarray(self.load.rolled(np.asarray(tau, dtype=float) / self.a_H), dtype=float)
 
     @property
     def n_nodes(self) -> int:
@@ -150,7 +164,7 @@ class Derived:
     def tangential_load(self, q):
         """Tangential load on body A, Q(q) = μ·P̄·tangential(q/a_H), at the rolled distance ``q``
         (length units); an :class:`~rollqp.errors.InputError` if the scene prescribes the creepage."""
-        return self.contact.friction * self.load.normal * self._history("tangential", "creepage", q)
+        return self.contact.mu * self.load.normal * self._history("tangential", "creepage", q)
 
     def prescribed_creepage(self, q):
         """Prescribed creepage ξ(q) = creepage(q/a_H) at the rolled distance ``q`` (length units);

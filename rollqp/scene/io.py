@@ -47,6 +47,9 @@ def part_dict(obj) -> dict:
 
 def plain(v: Any) -> Any:
     """Plain (TOML/JSON) form of a value: histories and parts become dicts."""
+    from ..profiles import Profile
+    if isinstance(v, Profile):
+        return v.to_dict()
     if isinstance(v, History) or dataclasses.is_dataclass(v) and not isinstance(v, type):
         return part_dict(v)
     if isinstance(v, np.generic):
@@ -108,6 +111,19 @@ def _table(d: dict, key: str, cls: type) -> dict:
     return dict(d)
 
 
+def _body(d: Any, key: str, source: str) -> Body:
+    """``[bodies.X]``, its ``profile`` read with the scene file's folder (:func:`rollqp.profiles.parse_profile`)."""
+    from ..profiles import parse_profile
+    t = _table(d, key, Body)
+    if "profile" in t:
+        folder = os.path.dirname(os.path.abspath(source)) if os.path.isfile(source) else None
+        radius = t.get("radius")
+        if not (isinstance(radius, (int, float)) and not isinstance(radius, bool) and radius > 0):
+            raise InputError(f"{key}.radius", f"must be a number > 0, got {radius!r}")
+        t["profile"] = parse_profile(t["profile"], f"{key}.profile", float(radius), folder)
+    return Body(**t)
+
+
 def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene") -> Scene:
     """Build and validate a scene from its nested dict (the parsed TOML).
 
@@ -143,8 +159,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
         if k not in bodies:
             raise InputError(f"bodies.{k}", f"missing required table [bodies.{k}] "
                                             "(needs radius, E, nu)")
-    A = Body(**_table(bodies["A"], "bodies.A", Body))
-    B = Body(**_table(bodies["B"], "bodies.B", Body))
+    A, B = (_body(bodies[k], f"bodies.{k}", source) for k in ("A", "B"))
     parts = {}
     for k, cls in _SECTIONS.items():
         if k in d or k in ("contact", "load"):
@@ -155,7 +170,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     if "normal_history" in ld:
         ld["normal_history"] = parse_history(ld["normal_history"], "load.normal_history",
                                              constant_default=1.0)
-    for k in ("tangential", "creepage", "approach"):
+    for k in ("tangential", "creepage", "approach", "rolled"):
         if k in ld:
             ld[k] = parse_history(ld[k], f"load.{k}")
     return Scene(name=d.get("name", default_name), description=d.get("description", ""),

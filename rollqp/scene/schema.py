@@ -53,6 +53,9 @@ class Body:
     shaft_radius : float or None
         Inner (shaft) radius of the annular cylinder, in (0, radius); used by
         ``contact.model = "bem"`` only. None: not given.
+    profile : Profile or None
+        The body's undeformed shape (:mod:`rollqp.profiles`: a contact-frame table, flats,
+        defects, material tables); None: the circle of ``radius``.
     wear : float or None
         Archard's wear coefficient over hardness, k/H (1/stress, ``>= 0``): the worn depth rate is
         ``(k/H)·p·|s|`` per unit rolled distance (docs/stresses.md §6). None: no wear modelled.
@@ -62,6 +65,7 @@ class Body:
     E: float
     nu: float
     shaft_radius: float | None = None
+    profile: object = None
     wear: float | None = None
 
     @property
@@ -76,8 +80,9 @@ class Contact:
 
     Parameters
     ----------
-    friction : float
-        Coulomb coefficient μ, finite and ``>= 0``.
+    friction : float or friction law
+        Coulomb coefficient μ, finite and ``>= 0``; or a law of :mod:`rollqp.friction`
+        (``[contact.friction]`` table: a patch, a table μ(x), a slip-velocity law).
     model : {"halfspace", "bem"}
         Half-space influence (docs/formulation.md §3) or true geometry by BEM (docs/bem.md).
     coupling : {"auto", "full", "goodman", "off"}
@@ -96,6 +101,12 @@ class Contact:
     reference_distance: float | None = None
     bem_outer_elements: int | None = None
     bem_inner_elements: int | None = None
+
+    @property
+    def mu(self) -> float:
+        """The reference coefficient (the number itself for Coulomb; :func:`rollqp.friction.reference`):
+        ``load.tangential`` is ``Q/(μ P̄)`` with it."""
+        return self.friction if isinstance(self.friction, float) else float(self.friction.reference)
 
 
 @dataclass(frozen=True)
@@ -125,6 +136,11 @@ class Load:
         of the normal load (the normal-side analogue of ``creepage``); ``normal`` stays the
         reference load P̄ of a_H, p0 and the zone. Meaningful with ``contact.model = "bem"``
         (rigid shafts); on the half-space δ depends on ``reference_distance`` (docs/bem.md).
+    rolled : History or None
+        Kinematics as a history (:mod:`rollqp.kinematics`): the rolled distance
+        q(τ) = a_H·rolled(τ/a_H) of the time-like parameter τ, which then steps by Δτ = step·Le
+        up to ``distance`` and is the argument of every load history. Increasing q rolls in
+        ``direction``, decreasing q reverses, a constant q stops (static shift steps). None: τ = q.
     """
 
     normal: float                                # P̄, the reference load
@@ -135,6 +151,7 @@ class Load:
     direction: int = -1                          # d = sgn(V)
     start_steps: int = 1
     approach: History | None = None              # δ(q) instead of P(q)
+    rolled: History | None = None                # q(τ)/a_H (None: τ = q)
 
 
 @dataclass(frozen=True)

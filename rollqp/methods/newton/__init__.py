@@ -87,6 +87,7 @@ from . import linear
 from .coupled import solve_coupled
 from .linear import CoupledFactors, ReducedSystem, coupled_system, coupled_vectors
 from .ncp import NormalNCP, TangentialNCP, coupled_cases, coupled_jacobian, coupled_labels, coupled_phi
+from .slip import solve_slip
 from .uncoupled import solve_uncoupled, tangential_by_creepage
 
 __all__ = ["NewtonMethod"]
@@ -123,6 +124,9 @@ class NewtonMethod:
 
     name = "newton"
     solves = frozenset({"normal", "tangential", "coupled", "steady"})
+    #: Solves steps whose friction bound depends on the slip (:mod:`.slip`); the others are wrapped in
+    #: the fixed point on the bound (:class:`rollqp.friction.fixedpoint.BoundFixedPoint`).
+    slip_dependent = True
     operator = "exact"  # the collocation operator itself, not F⁻¹ sym(F A)
     #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
     #: (:class:`~.linear.CoupledFactors`); ``False`` solves a new reduced system every iteration
@@ -171,7 +175,13 @@ class NewtonMethod:
         """Solve a normal, tangential or coupled step; raise :class:`SolverError` short of the tolerance."""
         t0 = time.perf_counter()
         if problem.kind == "coupled":
+            if getattr(problem, "law", None) is not None or np.ndim(problem.mu) != 0:
+                raise InputError("solver.method", "newton's coupled step takes a constant friction coefficient "
+                                                  "only; for a friction law on a coupled scene use 'nt-newton' "
+                                                  "(Newton halves in the N–T alternation) or a qp-* method")
             return solve_coupled(self, problem, warm, t0)
+        if problem.kind == "tangential" and getattr(problem, "law", None) is not None:
+            return self._solve_slip(problem, warm, t0)
         if problem.kind not in ("normal", "tangential"):
             raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
                                         f"not {problem.kind!r}")
@@ -182,6 +192,25 @@ class NewtonMethod:
                 raise
             sol = tangential_by_creepage(self, problem, warm, t0, err)
         return self.checked(sol)
+
+    def _solve_slip(self, problem, warm, t0):
+        """A slip-dependent tangential step (:mod:`.slip`): from the warm start; if that fails, once from zero
+        shear (``info["restarts"]``); with ``Q`` prescribed and both failing, by the creepage search
+        (:func:`~.uncoupled.tangential_by_creepage`, the ξ-prescribed solves being slip-dependent too)."""
+        try:
+            return self.checked(solve_slip(self, problem, warm, t0))
+        except SolverError as err:
+            first = err
+        try:
+            if warm is None:
+                raise first
+            sol = self.checked(solve_slip(self, problem, None, t0))  # the warm start's branch lost
+            sol.info["restarts"] = 1
+            return sol
+        except SolverError as err:
+            if problem.Q is None:
+                raise
+            return self.checked(tangential_by_creepage(self, problem, warm, t0, err))
 
     def augmentation(self, problem) -> float:
         """The nondimensional ``r`` used for ``problem`` (package docstring)."""

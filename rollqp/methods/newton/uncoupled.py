@@ -254,7 +254,11 @@ def tangential_by_creepage(meth, pb, warm, t0, err):
     if at_root is None:
         raise err
     try:
-        sol = solve_tangential(meth, pb, at_root, t0)
+        if pb.law is not None:  # a slip-dependent bound (rollqp.methods.newton.slip)
+            from .slip import solve_slip
+            sol = solve_slip(meth, pb, at_root, t0)
+        else:
+            sol = solve_tangential(meth, pb, at_root, t0)
     except (SolverError, Stalled):
         sol = pb.solution(at_root.t, at_root.xi)
         if not sol.residual <= meth.tolerance:
@@ -277,7 +281,11 @@ class _CreepageSearch:
 
     def solve_at(self, xh):
         sc = self.pb.scales
-        return solve_uncoupled(self.meth, self.pb.replace(Q=None, xi=xh * sc.slip), self.sol, self.t0)
+        sub = self.pb.replace(Q=None, xi=xh * sc.slip)
+        if sub.law is not None:  # a slip-dependent bound (rollqp.methods.newton.slip)
+            from .slip import solve_slip
+            return self.meth.checked(solve_slip(self.meth, sub, self.sol, self.t0))
+        return solve_uncoupled(self.meth, sub, self.sol, self.t0)
 
     def F(self, xh):
         self.evals += 1
@@ -292,7 +300,7 @@ class _CreepageSearch:
         pb, sc, warm = self.pb, self.pb.scales, self.sol
         x0 = warm.xi / sc.slip if warm is not None and warm.xi is not None else 0.0
         f0 = self.F(x0)
-        h = 2.0 * pb.mu * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
+        h = 2.0 * (pb.mu if np.ndim(pb.mu) == 0 else float(np.max(pb.mu))) * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
         lo = hi = x0
         flo = fhi = f0
         for _ in range(80):  # widen both ways until F changes sign

@@ -1,0 +1,111 @@
+"""Friction laws: convergence slopes, marching against the direct steady solve, Newton against the fixed point.
+
+Prints the Markdown tables of docs/friction.md ("Convergence and cross-checks")::
+
+    python benchmarks/friction_study.py                 # all sections (about 1–2 min on a shared 2-core machine)
+    python benchmarks/friction_study.py --only slope    # one section: slope, falling, march, fixedpoint
+
+Sections:
+
+* ``slope``      static = kinetic (the slip-dependent Newton path) against Carter's closed-form creepage,
+                 Q = 0.5 μP prescribed, direct steady solve, constant elements 23 … 368 on CONTACT's ±4.6 mm;
+* ``falling``    the falling law's steady Q at ξ = −1e-3 as the mesh doubles (no closed form: successive
+                 differences and their observed order);
+* ``march``      a fine-mesh marching run (Q prescribed on the rising branch) against the direct steady solve;
+* ``fixedpoint`` Newton against the fixed point on the bound around qp-clarabel, step by step (V = 450 mm/s).
+"""
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+from harness import table  # (pins BLAS first)
+
+from rollqp import closedforms as cf
+from rollqp.friction.cases import VELDEP, veldep_scene
+from rollqp.friction.fixedpoint import BoundFixedPoint
+from rollqp.march import march, prepare, run
+from rollqp.methods import get_method
+
+MESHES = (23, 46, 92, 184, 368)
+
+
+def slope_section():
+    """static = kinetic = 0.3: |ξ/ξ_Carter − 1| as the mesh doubles (the law's path against a closed form)."""
+    rows, errs = [], []
+    for n in MESHES:
+        sc = veldep_scene(elements=n, static=0.3, kinetic=0.3, tangential=0.5)
+        t0 = time.perf_counter()
+        xi = float(run(sc, "newton").arrays()["creepage"][-1])
+        ref = cf.carter_creepage(sc.a_H, sc.R, 0.3, 0.5)
+        errs.append(abs(xi / ref - 1))
+        order = "" if len(errs) < 2 else f"{np.log2(errs[-2] / errs[-1]):.2f}"
+        rows.append([n, f"{xi:.8e}", f"{ref:.8e}", f"{errs[-1]:.2e}", order, f"{time.perf_counter() - t0:.2f}"])
+    return table(["elements", "ξ (law path)", "ξ Carter", "|ξ/ξ_C − 1|", "order", "s"], rows)
+
+
+def falling_section():
+    rows, vals = [], []
+    for n in MESHES:
+        r = run(veldep_scene(elements=n), "newton").arrays()
+        vals.append(r["Q"][-1] / (0.3 * VELDEP["FN"]))
+        d = "" if len(vals) < 2 else f"{abs(vals[-1] - vals[-2]):.2e}"
+        order = "" if len(vals) < 3 else f"{np.log2(abs(vals[-2] - vals[-3]) / abs(vals[-1] - vals[-2])):.2f}"
+        rows.append([n, f"{vals[-1]:.6f}", d, order])
+    return table(["elements", "Q/(μ_s P), ξ = −0.9999e-3", "|change|", "order"], rows)
+
+
+def march_section():
+    """Marched to the end against the direct steady solve: V = 45 m/s with the creepage prescribed (2D: the
+    transient at prescribed ξ relaxes over tens of a_H, the uniform part of w changing with Q) and
+    V = 4.5 m/s with the force prescribed on a fine mesh."""
+    cases = [dict(elements=92, speed=45000.0, distance=40.0, creepage=VELDEP["CKSI"], tangential=None),
+             dict(elements=92, speed=4500.0, distance=10.0, creepage=None, tangential=0.5)]
+    rows = []
+    for c in cases:
+        sc = veldep_scene(elements=c["elements"], tangential=c["tangential"],
+                          **({} if c["creepage"] is None else {"creepage": c["creepage"]})).replace(
+            **{"contact.friction.rolling_speed": c["speed"]})
+        key = "creepage" if c["tangential"] is not None else "Q"
+        steady = float(run(sc, "newton").arrays()[key][-1])
+        t0 = time.perf_counter()
+        r = run(sc.replace(**{"load.start": "braked", "discretization.distance": c["distance"]}), "newton").arrays()
+        v = r[key]
+        rows.append([f"{c['speed']:g}", "ξ" if key == "Q" else "Q", c["elements"], f"{c['distance']:g}", key,
+                     f"{v[-1]:.8e}", f"{steady:.8e}", f"{abs(v[-1] / steady - 1):.2e}", f"{abs(v[-1] / v[-2] - 1):.1e}",
+                     f"{time.perf_counter() - t0:.1f}"])
+    return table(["V [mm/s]", "prescribed", "elements", "distance [a_H]", "compared", "marched", "direct steady",
+                  "relative difference", "last step's change", "s"], rows)
+
+
+def fixedpoint_section(elements=92, distance=2.0, speed=450.0):
+    sc = veldep_scene(elements=elements, start="braked", distance=distance).replace(
+        **{"contact.friction.rolling_speed": speed})
+    fp = BoundFixedPoint(get_method("qp-clarabel", tolerance=1e-10))
+    fp.setup(prepare(sc, "qp-clarabel")[2])
+    worst, its = 0.0, []
+    for rec in march(sc, "newton"):
+        if rec.k > 0:
+            sol = fp.solve(rec.problem, warm=rec.previous.tsol)
+            worst = max(worst, float(np.max(np.abs(sol.t - rec.solution.t))) / (0.3 * sc.p0))
+            its.append(sol.info["bound_iterations"])
+    return table(["V [mm/s]", "elements", "steps", "max |Δt| / (μ_s p0)", "QPs per step (median, max)"],
+                 [[f"{speed:g}", elements, len(its), f"{worst:.1e}", f"{np.median(its):g}, {max(its)}"]])
+
+
+SECTIONS = {"slope": slope_section, "falling": falling_section, "march": march_section,
+            "fixedpoint": fixedpoint_section}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="+", choices=list(SECTIONS), help="sections to run (default all)")
+    args = ap.parse_args(argv)
+    for name in args.only or SECTIONS:
+        print(f"\n### {name}\n")
+        print(SECTIONS[name]())
+
+
+if __name__ == "__main__":
+    main()

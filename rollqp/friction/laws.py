@@ -1,0 +1,226 @@
+r"""The friction laws: what the coefficient ``μ`` of the bound ``|t| <= μ p`` depends on (docs/friction.md).
+
+Three families, each a small frozen record whose fields are the keys of ``[contact.friction]``:
+
+* :class:`Coulomb` — one constant ``μ`` (``contact.friction = 0.3`` is this law);
+* :class:`Patch`, :class:`Table` — ``μ(x)`` varying along the surface, fixed in the contact
+  frame (``frame = "fixed"``) or carried by a body's material through the contact
+  (``frame = "material"``: the material point at ``x`` at rolled distance ``q`` was at
+  ``x − d q`` at ``q = 0``, ``d = load.direction``);
+* :class:`SlipVelocity` — ``μ(v)`` of the slip velocity ``v = V |s|`` (``V`` the rolling speed,
+  ``s`` the slip per unit rolled distance), CONTACT's forms with ``Δμ = static − kinetic`` and a
+  characteristic velocity ``v_h``:
+
+  ===============  ============================================================
+  ``linear``       ``μ = μ_k + Δμ max(0, 1 − v/v_h)``
+  ``rational``     ``μ = μ_k + Δμ / (1 + v/v_h)``
+  ``exponential``  ``μ = μ_k + Δμ exp(−v/v_h)``
+  ``plateau``      ``μ = μ_k + Δμ exp(−max(0, v − v_p)/v_h)`` (flat up to ``v_p``)
+  ===============  ============================================================
+
+  with an optional memory length ``L``: the coefficient of a material point relaxes towards
+  ``μ(v)`` over the rolled distance ``L`` (implicit Euler per step, :mod:`.bound`).
+
+Positions and lengths are in units of ``a_H`` (like the histories' ``q/a_H``); velocities in the
+scene's own length/time units. Every law validates its keys (an :class:`~rollqp.errors.InputError`
+naming ``contact.friction.<key>`` and the range) at construction.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..scene.validate import choice, number, real_sequence
+
+__all__ = ["MAX_FRICTION", "Coulomb", "Patch", "Table", "SlipVelocity", "VELOCITY_FORMS", "FRAMES"]
+
+#: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
+MAX_FRICTION = 1e6
+FRAMES = ("fixed", "material")
+VELOCITY_FORMS = ("linear", "rational", "exponential", "plateau")
+KEY = "contact.friction"
+
+
+def _mu(name, v):
+    return number(f"{KEY}.{name}", v, f">= 0 (and <= {MAX_FRICTION:g})", lambda x: 0 <= x <= MAX_FRICTION)
+
+
+@dataclass(frozen=True)
+class Coulomb:
+    """Constant Coulomb coefficient ``μ`` (paper eq. 57–60)."""
+
+    mu: float
+    law: str = "coulomb"
+    kind = "constant"
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", _mu("mu", self.mu))
+
+    @property
+    def reference(self) -> float:
+        """The ``μ`` of ``load.tangential = Q/(μ P̄)`` and of the reports."""
+        return self.mu
+
+    @property
+    def largest(self) -> float:
+        return self.mu
+
+
+class _Spatial:
+    """Shared part of the laws varying along the surface: the frame and ``μ`` at the nodes."""
+
+    kind = "spatial"
+
+    def _check_frame(self):
+        object.__setattr__(self, "frame", choice(f"{KEY}.frame", self.frame, FRAMES))
+
+    def positions(self, x_hat, q_hat, direction):
+        """Where the nodes ``x̂`` are in the law's own coordinate (``a_H`` units) at ``q̂``."""
+        return x_hat - direction * q_hat if self.frame == "material" else x_hat
+
+    def coefficient(self, x_hat, q_hat, direction) -> np.ndarray:
+        """``μ`` at the nodes ``x̂`` (``a_H`` units) at the rolled distance ``q̂``."""
+        return self.profile(self.positions(np.asarray(x_hat, dtype=float), q_hat, direction))
+
+    def span(self):
+        """``(lo, hi)``: the part of the law's coordinate where μ differs from the outside value."""
+        raise NotImplementedError
+
+    def check_strip(self, half_width_hat, q_end_hat, direction):
+        """The varying part meets the strip ``[−L̂, L̂]`` at some ``q̂ ∈ [0, q̂_end]``, else an InputError."""
+        lo, hi = self.span()
+        if self.frame == "material":  # the strip in the law's coordinate sweeps x − d q
+            a, b = sorted((-direction * q_end_hat, 0.0))
+            slo, shi = -half_width_hat + a, half_width_hat + b
+        else:
+            slo, shi = -half_width_hat, half_width_hat
+        if not (hi > slo and lo < shi):
+            name = "start" if isinstance(self, Patch) else "x"
+            raise InputError(f"{KEY}.{name}", f"the {self.law} [{lo:.6g}, {hi:.6g}] a_H lies outside the strip "
+                                              f"(it must meet [{slo:.6g}, {shi:.6g}] a_H, the potential contact zone "
+                                              f"{'swept by the material over the run' if self.frame == 'material' else ''})")
+
+
+@dataclass(frozen=True)
+class Patch(_Spatial):
+    """``μ = inside`` on ``[start, end]`` (``a_H`` units), ``mu`` elsewhere."""
+
+    mu: float
+    inside: float
+    start: float
+    end: float
+    frame: str = "fixed"
+    law: str = "patch"
+
+    def __post_init__(self):
+        object.__setattr__(self, "mu", _mu("mu", self.mu))
+        object.__setattr__(self, "inside", _mu("inside", self.inside))
+        s = number(f"{KEY}.start", self.start, "finite (a_H units)", lambda x: True)
+        e = number(f"{KEY}.end", self.end, f"> start = {s!r} (a_H units)", lambda x: x > s)
+        object.__setattr__(self, "start", s)
+        object.__setattr__(self, "end", e)
+        self._check_frame()
+
+    reference = property(lambda self: self.mu, doc="The outside value (``load.tangential = Q/(μ P̄)``).")
+    largest = property(lambda self: max(self.mu, self.inside))
+
+    def profile(self, xi):
+        return np.where((xi >= self.start) & (xi <= self.end), self.inside, self.mu)
+
+    def span(self):
+        return self.start, self.end
+
+
+@dataclass(frozen=True)
+class Table(_Spatial):
+    """``μ(x)`` interpolated linearly in the table ``(x, values)`` (``a_H`` units), constant beyond its ends."""
+
+    x: tuple
+    values: tuple
+    frame: str = "fixed"
+    law: str = "table"
+
+    def __post_init__(self):
+        x = real_sequence(f"{KEY}.x", self.x, 100_000)
+        v = real_sequence(f"{KEY}.values", self.values, 100_000)
+        if len(x) < 2 or len(v) != len(x):
+            raise InputError(f"{KEY}.values", f"must have as many entries as {KEY}.x (at least 2), got {len(v)} and {len(x)}")
+        if any(b <= a for a, b in zip(x, x[1:])):
+            raise InputError(f"{KEY}.x", "must be strictly increasing")
+        for i, m in enumerate(v):
+            _mu(f"values[{i}]", m)
+        object.__setattr__(self, "x", x)
+        object.__setattr__(self, "values", v)
+        self._check_frame()
+
+    reference = property(lambda self: max(self.values), doc="The largest tabulated value.")
+    largest = property(lambda self: max(self.values))
+
+    def profile(self, xi):
+        return np.interp(xi, self.x, self.values)
+
+    def span(self):
+        return self.x[0], self.x[-1]
+
+
+@dataclass(frozen=True)
+class SlipVelocity:
+    """``μ(v)``, ``v = V |s|`` (module docstring): ``static``, ``kinetic``, ``velocity`` ``v_h``, ``plateau``
+    ``v_p`` (form ``plateau`` only), ``rolling_speed`` ``V`` (required), ``memory`` ``L`` (``a_H`` units, 0: none)."""
+
+    law: str
+    static: float
+    kinetic: float
+    velocity: float
+    rolling_speed: float | None = None
+    plateau: float | None = None
+    memory: float = 0.0
+    kind = "slip"
+
+    def __post_init__(self):
+        choice(f"{KEY}.law", self.law, VELOCITY_FORMS)
+        st, kin = _mu("static", self.static), _mu("kinetic", self.kinetic)
+        if not st >= kin:
+            raise InputError(f"{KEY}.static", f"must be >= kinetic = {kin!r} (a falling law), got {st!r}")
+        put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 - frozen dataclass
+        put("static", st)
+        put("kinetic", kin)
+        put("velocity", number(f"{KEY}.velocity", self.velocity, "> 0 (slip velocity, length/time)", lambda x: x > 0))
+        if self.rolling_speed is None:
+            raise InputError(f"{KEY}.rolling_speed", f"is required by the slip-velocity law {self.law!r} "
+                                                     "(the rolling speed V > 0, length/time: v_slip = V |s|)")
+        put("rolling_speed", number(f"{KEY}.rolling_speed", self.rolling_speed, "> 0 (length/time)", lambda x: x > 0))
+        if self.law == "plateau":
+            if self.plateau is None:
+                raise InputError(f"{KEY}.plateau", "is required by law 'plateau' (the velocity up to which μ = static, >= 0)")
+            put("plateau", number(f"{KEY}.plateau", self.plateau, ">= 0 (length/time)", lambda x: x >= 0))
+        elif self.plateau is not None:
+            raise InputError(f"{KEY}.plateau", f"belongs to law 'plateau' only, not {self.law!r}")
+        put("memory", number(f"{KEY}.memory", self.memory, ">= 0 (a_H units; 0: no memory)", lambda x: x >= 0))
+
+    reference = property(lambda self: self.static, doc="The static value (``load.tangential = Q/(μ_s P̄)``).")
+    largest = property(lambda self: self.static)
+
+    def steady(self, v):
+        """``(μ(v), dμ/dv)`` for slip velocities ``v >= 0`` (module docstring's forms)."""
+        v = np.asarray(v, dtype=float)
+        dm, vh = self.static - self.kinetic, self.velocity
+        if self.law == "linear":
+            inside = v < vh
+            return self.kinetic + dm * np.where(inside, 1.0 - v / vh, 0.0), np.where(inside, -dm / vh, 0.0)
+        if self.law == "rational":
+            u = 1.0 + v / vh
+            return self.kinetic + dm / u, -dm / (vh * u * u)
+        if self.law == "exponential":
+            e = np.exp(-v / vh)
+            return self.kinetic + dm * e, -dm * e / vh
+        over = v > self.plateau
+        e = np.exp(-np.maximum(0.0, v - self.plateau) / vh)
+        return self.kinetic + dm * e, np.where(over, -dm * e / vh, 0.0)
+
+    def weight(self, dq_hat) -> float:
+        """The memory's weight ``w = L/(L + Δq)`` of the previous coefficient (0 without memory)."""
+        return 0.0 if self.memory == 0.0 else self.memory / (self.memory + dq_hat)
+
