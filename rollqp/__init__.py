@@ -16,8 +16,9 @@ NormalStep, TangentialStep, Scales       step problems built from arrays
 StepSolution, Residuals, classify, compare
 solve_step                               solve one step with any method
 get_method, available_methods            the method registry
-closedforms                              Hertz, Cattaneo, Carter, creep law
 open_result                              a result file as an xarray Dataset (extra ``sweep``)
+closedforms                              Hertz, Cattaneo, Carter, creep law, McEwen
+stresses                                 subsurface stresses of a state (rollqp.stresses module)
 """
 __version__ = "0.1.0"
 
@@ -32,6 +33,8 @@ from .scene import Scene, builtin_scenes, load_scene
 from .strip import Strip
 from .operators import SceneOperators
 from .march import StepRecord, march, run
+from . import energy, wear  # noqa: E402,F401  (register their result fields)
+from . import stresses  # noqa: E402,F401  (callable: rollqp.stresses(result, step, grid))
 
 
 def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> StepSolution:
@@ -54,4 +57,4 @@ def open_result(path):
 __all__ = ["open_result", "load_scene", "builtin_scenes", "Scene", "march", "run", "StepRecord", "SceneOperators", "Result", "load_result", "Strip",
            "halfspace_influence", "Influence", "NormalStep", "TangentialStep", "Scales", "StepSolution",
            "Residuals", "classify", "compare", "solve_step", "get_method", "available_methods",
-           "closedforms", "InputError", "SolverError", "RollqpError", "MissingBackendError"]
+           "closedforms", "stresses", "InputError", "SolverError", "RollqpError", "MissingBackendError"]

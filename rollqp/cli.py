@@ -9,6 +9,7 @@
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
+    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first).
@@ -47,6 +48,8 @@ def _parser():
     r.add_argument("--plot", help="draw tractions, slip and creepage to this PNG file")
     r.add_argument("--method", choices=METHOD_NAMES, help="overrides [solver].method")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
+    r.add_argument("--stresses", action="store_true", help="report the peak subsurface von Mises and tau1 over "
+                   "the run, with place and state (docs/stresses.md)")
     r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
                    help="solve three steps again with qp-clarabel and qp-osqp and show the differences "
                         "(default: on for strips of at most 400 nodes run by a method other than those)")
@@ -68,6 +71,7 @@ def _parser():
     x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
     x.add_argument("--step", type=int, default=None, help="step K (default 1)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
+    _stresses_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
                        "(docs/performance.md; 'rollqp bench --help' for the options)")
     b.add_argument("bench_args", nargs=argparse.REMAINDER)
@@ -230,7 +234,11 @@ def cmd_run(args) -> int:
     if args.plot:
         plot_result(res, scene, args.plot)
     if not args.quiet:
-        print(summary(res, scene, scene.solver.method, wall))
+        peaks = None
+        if getattr(args, "stresses", False):
+            from .stresses import stress_history
+            peaks = stress_history(result)
+        print(summary(res, scene, scene.solver.method, wall, peaks))
         if keep:
             from .crossval import spot_check
             t1 = time.perf_counter()
@@ -433,7 +441,8 @@ def main(argv=None) -> int:
     try:
         return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
                 "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
-                "sweep": cmd_sweep, "creep-curve": cmd_creep_curve}[args.command](args)
+                "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
+                "stresses": cmd_stresses}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
@@ -449,6 +458,52 @@ def main(argv=None) -> int:
     finally:
         if limiter is not None:
             limiter.unregister() if hasattr(limiter, "unregister") else None
+
+
+# ----------------------------------------------------------------------------- stresses (issue 12)
+def _stresses_parser(sub):
+    t = sub.add_parser("stresses", help="subsurface stresses of one state of a result file (docs/stresses.md)")
+    t.add_argument("result", metavar="RESULT.npz")
+    t.add_argument("--step", type=int, required=True, help="the stored state K (0 = the starting state; "
+                   "negative counts from the end)")
+    t.add_argument("--plot", help="contour maps of von Mises and tau1 with the stick/slip zones (PNG)")
+    t.add_argument("--out", help="stress file (.npz): x, z, every stress quantity, the maxima")
+    t.add_argument("--body", default="A", choices=("A", "B"), help="body A (traction t) or B (-t)")
+    t.add_argument("--grid", default="200,200", help="NX,NZ points on ±WIDTH a_H and depths (0, DEPTH a_H]")
+    t.add_argument("--width", type=float, default=1.5, help="half-width of the grid in a_H (default 1.5)")
+    t.add_argument("--depth", type=float, default=2.0, help="depth of the grid in a_H (default 2)")
+
+
+def cmd_stresses(args) -> int:
+    from .errors import InputError
+    from .result import check_output, load_result
+    from .stresses import _source, default_grid, plot_field, save_field, stresses, summary_rows
+    try:
+        nx, nz = (int(v) for v in args.grid.split(","))
+    except ValueError:
+        raise InputError("--grid", f"must be NX,NZ (two integers), got {args.grid!r}") from None
+    if args.out:
+        check_output(args.out, "stress file", "--out")
+    _check_plot(args.plot)
+    names = {"nx": "--grid", "nz": "--grid", "width": "--width", "depth": "--depth", "step": "--step",
+             "result": "RESULT.npz"}
+    try:
+        arrays, scene = _source(load_result(args.result, "RESULT.npz"))
+        sf = stresses(arrays, args.step, default_grid(scene, nx, nz, args.width, args.depth), body=args.body)
+    except InputError as err:
+        raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
+    a, p0 = float(arrays["a_H"]), float(arrays["p0"])
+    print(f"  state         {sf.step} (q = {sf.q / a:.4f} a_H), body {sf.body}, grid {nx} x {nz}")
+    if scene.contact.model == "bem":
+        print(f"  note          half-space field below the BEM tractions: error about a/(2R) p0 = "
+              f"{a / (2 * scene.R):.2g} p0 (docs/stresses.md §4)")
+    for k, v in summary_rows(sf, p0, a):
+        print(f"  {k:<20}  {v}")
+    if args.out:
+        print(f"  stress file   {save_field(sf, args.out)}")
+    if args.plot:
+        print(f"  figure        {plot_field(sf, arrays, args.plot, p0, a)}")
+    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

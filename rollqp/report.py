@@ -78,8 +78,9 @@ def _rolled_tail(scene, need: float):
     return dist, mask, d
 
 
-def summary(res: dict, scene, method: str, wall: float) -> str:
-    """The table ``rollqp run`` prints."""
+def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
+    """The table ``rollqp run`` prints; ``stresses`` (a :class:`rollqp.stresses.StressHistory`, from
+    ``rollqp run --stresses``) adds the peak von Mises and τ1 over the run with their place and state."""
     K = len(res["q"]) - 1
     rows = [("scene", f"{scene.name} ({scene.source})"),
             ("method", method),
@@ -94,6 +95,7 @@ def summary(res: dict, scene, method: str, wall: float) -> str:
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _bem_rows(res, scene)
+    rows += energy_rows(res, scene, stresses)
     for name, val, what in closed_form_errors(res, scene):
         rows.append((f"error: {name}", f"{val:.4f}  {what}"))
     w = max(len(r[0]) for r in rows)
@@ -116,3 +118,21 @@ def _bem_rows(res: dict, scene) -> list[tuple[str, str]]:
                              f"(|F A_nt|/|F A_nn| = {m.get('coupling_size', float('nan')):.2e})"),
             ("BEM asymmetry", f"|FA - (FA)^T|/|FA| = {m.get('asymmetry_FA', float('nan')):.2e} (A_nn), "
                               f"{m.get('asymmetry_FAtt', float('nan')):.2e} (A_tt); operator {m.get('operator')}")]
+
+
+def energy_rows(res: dict, scene, stresses=None) -> list[tuple[str, str]]:
+    """Dissipation (docs/stresses.md §5) and, if computed, the peak subsurface stresses (§3)."""
+    rows = []
+    if "dissipation" in res:
+        unit = float(res["a_H"]) * float(res["p0"])  # force/length, the load unit
+        Wf = float(np.sum(res["friction_work"]))
+        rows.append(("dissipation", f"{float(res['dissipation'][-1]):.6g} per unit rolled distance at the end "
+                                    f"({float(res['dissipation'][-1]) / unit:.4g} a_H p0); friction work "
+                                    f"{Wf:.6g} accumulated over the rolling steps"))
+    if stresses is not None:
+        a, p0 = float(res["a_H"]), float(res["p0"])
+        for key, label in (("von_mises", "peak von Mises"), ("tau1", "peak tau1")):
+            v, x, z, k = stresses.overall[key]
+            rows.append((label, f"{v / p0:.4f} p0 at x = {x / a:.4f} a_H, z = {z / a:.4f} a_H, state {k} "
+                                f"(body {stresses.body}, grid {stresses.x.size} x {stresses.z.size})"))
+    return rows

@@ -211,7 +211,7 @@ def test_one_qp_is_not_the_contact_step(monkeypatch, capsys):
 
 
 @pytest.mark.parametrize("name", ["own_arrays.py", "cattaneo_carter.py", "cattaneo.py", "carter.py", "ramp.py",
-                                  "goodman_bentall.py", "harmonic.py", "one_qp.py"])
+                                  "goodman_bentall.py", "harmonic.py", "one_qp.py", "wear.py", "stresses.py"])
 def test_examples_are_documented(name):
     text = (EXAMPLES / name).read_text(encoding="utf-8")
     assert text.startswith('"""') and "Run it::" in text, f"{name} starts with a docstring saying how to run it"

@@ -60,9 +60,12 @@ def check_body(key: str, b: Any) -> Body:
     if shaft is not None:
         shaft = number(f"{key}.shaft_radius", shaft, f"in (0, radius = {radius!r}) or absent",
                         lambda x: 0.0 < x < radius)
+    wear = b.wear
+    if wear is not None:  # Archard's k/H (docs/stresses.md §6)
+        wear = number(f"{key}.wear", wear, ">= 0 (k/H in 1/stress) or absent", lambda x: x >= 0)
     from ..profiles import parse_profile
     profile = parse_profile(b.profile, f"{key}.profile", radius)
-    return Body(radius, E, nu, shaft, None if profile.is_circle else profile)
+    return Body(radius, E, nu, shaft, None if profile.is_circle else profile, wear)
 
 
 def check_contact(c: Any) -> Contact:

@@ -59,6 +59,9 @@ class Body:
     profile : Profile or None
         The body's undeformed shape (:mod:`rollqp.profiles`: a contact-frame table, flats,
         defects, material tables); None: the circle of ``radius``.
+    wear : float or None
+        Archard's wear coefficient over hardness, k/H (1/stress, ``>= 0``): the worn depth rate is
+        ``(k/H)·p·|s|`` per unit rolled distance (docs/stresses.md §6). None: no wear modelled.
     """
 
     radius: float
@@ -66,6 +69,7 @@ class Body:
     nu: float
     shaft_radius: float | None = None
     profile: object = None
+    wear: float | None = None
 
     @property
     def G(self) -> float:

@@ -1,0 +1,137 @@
+"""Energy and frictional dissipation of each state: result fields and the balance (docs/stresses.md §5).
+
+Per unit axial length, in the scene's units, with rollqp's signs (docs/formulation.md §1: ``t`` on
+A in +x, ``s`` the slip of A relative to B per unit rolled distance, friction opposing slip):
+
+* ``friction_power`` (K+1, n): the dissipation density ``−t·s ≥ 0`` per unit rolled distance
+  (force/length²; times the speed ``|V|`` it is the frictional power per unit area);
+* ``dissipation`` (K+1,): ``D = −∫ t s dx = −fᵀ(t∘s)`` (force/length: energy per unit rolled
+  distance and unit axial length);
+* ``friction_work`` (K+1,): the step's frictional work ``D_k Δq`` (0 for the starting state; the
+  accumulated work is its cumulative sum, :func:`balance`);
+* ``elastic_energy`` (K+1,): ``U = ½ pᵀF A_nn p + pᵀF A_nt t + ½ tᵀF A_tt t``, the work of the
+  contact tractions on the two bodies, relative to the reference distance ``d_ref`` of the 2D
+  half-space (docs/formulation.md §3: ``U`` changes by ``c(P² + Q²)/2`` with ``d_ref``);
+* ``load_work`` (K+1,): the step's work of the applied loads through the rigid motions,
+  ``−Q ξ Δq + P̄ Δδ`` (``P̄`` the mean of the step's two normal loads; 0 for the starting state).
+
+The identities (derived in docs/stresses.md §5): from the slip ``s = ξ + d ∂w/∂x`` of steady
+rolling and ``w = A_tn p + A_tt t``, with ``∫ t ∂(A_tt t)/∂x dx = 0`` (the log kernel's derivative is
+odd) and ``∂(A_tn p)/∂x = −(2β/E*) p``::
+
+    D = −Q ξ + d (2β/E*) ∫ p t dx        (steady rolling; similar bodies: D = −Q ξ)
+
+and in a transient, step by step, ``friction_work = load_work − ΔU`` up to O(Δq²) and the
+discretization error (similar bodies; with β ≠ 0 the term ``d (2β/E*) ∫ p t dx Δq`` is added).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .fields import FORCE, STRESS, Field, register
+
+__all__ = ["friction_power", "dissipation", "elastic_energy", "load_work", "balance", "steady_identity", "power"]
+
+
+def _rolling(rec) -> bool:
+    return rec.phase == "rolling"
+
+
+def friction_power(rec, ops) -> np.ndarray:
+    """``−t·s`` at the nodes: dissipation per unit area and unit rolled distance (≥ 0 up to the
+    solver tolerance; the starting state of a braked start: per a_H of static shift)."""
+    return -rec.state.t * rec.state.tsol.s
+
+
+def dissipation(rec, ops) -> float:
+    """``D = −fᵀ(t∘s)``: frictional dissipation per unit rolled distance (and axial length)."""
+    return float(ops.f @ friction_power(rec, ops))
+
+
+def _dq(rec) -> float:
+    """The rolled length ``|Δq_k|`` of a rolling step (its own under ``load.rolled``), 0 otherwise."""
+    if rec.k == 0 or not _rolling(rec) or rec.problem is None:
+        return 0.0
+    return float(rec.problem.dq)
+
+
+def friction_work(rec, ops) -> float:
+    """The step's frictional work ``D Δq`` (rolling steps; 0 for the starting state and stops)."""
+    dq = _dq(rec)
+    return dissipation(rec, ops) * dq if dq else 0.0
+
+
+def elastic_energy(rec, ops) -> float:
+    """``U = ½ pᵀF A_nn p + pᵀF A_nt t + ½ tᵀF A_tt t`` (relative to ``d_ref``)."""
+    p, t, f = rec.state.p, rec.state.t, ops.f
+    if p is None:
+        return 0.0
+    U = 0.5 * float((f * p) @ (ops.Ann @ p)) + 0.5 * float((f * t) @ (ops.Att @ t))
+    if ops.Ant is not None:
+        U += float((f * p) @ (ops.Ant @ t))
+    return U
+
+
+def load_work(rec, ops) -> float:
+    """``−Q ξ Δq + ½(P_k + P_{k−1})(δ_k − δ_{k−1})`` of a rolling step (0 for the starting state)."""
+    dq = _dq(rec)
+    if dq == 0.0:
+        return 0.0
+    st, pr = rec.state, rec.previous
+    W = -rec.Q * float(st.tsol.xi) * dq
+    if pr is not None and pr.nsol is not None and st.nsol is not None and pr.p is not None:
+        P0 = float(ops.f @ pr.p)
+        W += 0.5 * (rec.P + P0) * (float(st.nsol.delta) - float(pr.nsol.delta))
+    return W
+
+
+def _mu(scene) -> bool:
+    """Friction somewhere (a Coulomb μ > 0 or a law of :mod:`rollqp.friction` that is not zero)."""
+    from .friction import largest
+    return largest(scene.contact.friction) > 0
+
+
+for _f in (
+    Field("friction_power", "state", STRESS, "frictional dissipation density -t s >= 0 per unit rolled distance "
+          "(times |V|: power per unit area); written when mu > 0", compute=friction_power, needed=_mu),
+    Field("dissipation", "step", FORCE, "frictional dissipation D = -integral(t s dx) per unit rolled distance "
+          "(and axial length); written when mu > 0", compute=dissipation, needed=_mu),
+    Field("friction_work", "step", "force", "frictional work of the step per unit axial length, D dq (0 for the starting "
+          "state); its cumulative sum is the accumulated work", compute=friction_work, needed=_mu),
+    Field("elastic_energy", "step", "force", "elastic energy of the contact tractions per unit axial length, "
+          "1/2 p.F.Ann.p + p.F.Ant.t + 1/2 t.F.Att.t (relative to d_ref)", compute=elastic_energy),
+    Field("load_work", "step", "force", "work of the applied loads in the step, -Q xi dq + "
+          "mean(P) d(delta) (0 for the starting state)", compute=load_work),
+):
+    register(_f)
+
+
+def balance(res: dict) -> dict:
+    """Accumulated frictional work, load work and elastic energy change of a result (arrays).
+
+    Returns ``friction_work``, ``load_work`` (cumulative sums), ``delta_U`` (``U_k − U_0``) and
+    ``residual = load_work − delta_U − friction_work`` (all shape (K+1,)).
+    """
+    Wf = np.cumsum(res["friction_work"]) if "friction_work" in res else np.zeros(len(res["q"]))
+    Wl = np.cumsum(res["load_work"])
+    dU = np.asarray(res["elastic_energy"]) - float(res["elastic_energy"][0])
+    return dict(friction_work=Wf, load_work=Wl, delta_U=dU, residual=Wl - dU - Wf)
+
+
+def steady_identity(res: dict, k: int, direction: int) -> float:
+    """Right-hand side of the steady identity ``D = −Q ξ + d (2β/E*) ∫ p t dx`` at state ``k``
+    (nodal quadrature with the strip's weights reconstructed from ``x``: pass ``f`` in ``res``)."""
+    f = res["f"]
+    return float(-res["Q"][k] * res["creepage"][k]
+                 + direction * 2 * float(res["beta"]) / float(res["Estar"]) * f @ (res["pn"][k] * res["pt"][k]))
+
+
+def power(res: dict, speed: float) -> np.ndarray:
+    """Frictional power per unit axial length of each state at the rolling speed ``|V|`` (length/time):
+    ``D·|V|`` (force·length/time per length); the density is ``friction_power·|V|``."""
+    from .errors import InputError
+    if not (isinstance(speed, (int, float, np.floating)) and np.isfinite(speed) and speed >= 0):
+        raise InputError("speed", f"must be a finite number >= 0 (|V|, length/time), got {speed!r}")
+    if "dissipation" not in res:
+        raise InputError("result", "holds no 'dissipation' (a frictionless scene, or written before rollqp had it)")
+    return np.asarray(res["dissipation"], dtype=float) * float(speed)
