@@ -55,11 +55,17 @@ def clarabel_rows(form):
     I = sp.identity(n, format="csr")
     blocks = [sp.csr_matrix(form.a[None, :])] if form.a is not None else []
     blocks += [I[fx], I[up], -I[lo]]
+    cones = (("ZeroConeT", int(form.a is not None) + fx.size), ("NonnegativeConeT", up.size + lo.size))
+    return sp.vstack(blocks, format="csc"), clarabel_rhs(form, (up, lo, fx)), cones
+
+
+def clarabel_rhs(form, rows=None) -> np.ndarray:
+    """The right-hand side ``b`` of :func:`clarabel_rows` alone (what a re-solve updates: the
+    sparse rows stay those of the solver object's structure). ``rows``: ``(up, lo, fx)`` if known."""
+    up, lo, fx = constraint_rows(form)[1:] if rows is None else rows
     b = [[form.b]] if form.a is not None else []
     b += [form.lower[fx], form.upper[up], -form.lower[lo]]
-    b = np.concatenate([np.atleast_1d(np.asarray(v, dtype=float)) for v in b])
-    cones = (("ZeroConeT", int(form.a is not None) + fx.size), ("NonnegativeConeT", up.size + lo.size))
-    return sp.vstack(blocks, format="csc"), b, cones
+    return np.concatenate([np.atleast_1d(np.asarray(v, dtype=float)) for v in b])
 
 
 def clarabel_settings(tolerance: float) -> dict:
@@ -97,7 +103,7 @@ class ClarabelQP(QPMethod):
         solver, fresh = self._solver_for(form, source, self._build)
         setup = time.perf_counter() - t0 if fresh else 0.0
         if not fresh:
-            solver.update(q=form.q, b=clarabel_rows(form)[1])
+            solver.update(q=form.q, b=clarabel_rhs(form))
         t1 = time.perf_counter()
         sol = solver.solve()
         solve_wall = time.perf_counter() - t1
