@@ -7,6 +7,7 @@ and peak pressure are :func:`rollqp.closedforms.hertz_half_width` and
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -18,7 +19,12 @@ __all__ = ["Derived"]
 
 
 class Derived:
-    """Derived quantities of a scene (module docstring); the scene's units throughout."""
+    """Derived quantities of a scene (module docstring); the scene's units throughout.
+
+    The scalars a step reads (E*, R, β, a_H, p0, L, Le, Δq) are computed once per scene and kept
+    (``functools.cached_property``: a Scene is immutable, and its checks read them only after
+    every field is normalized); a small run reads them thousands of times.
+    """
 
     @property
     def q_end(self) -> float:
@@ -38,18 +44,18 @@ class Derived:
                 DEFAULT_INNER if c.bem_inner_elements is None else c.bem_inner_elements)
 
     # ------------------------------------------------------------------ derived quantities
-    @property
+    @functools.cached_property
     def Estar(self) -> float:
         """Contact modulus E*, 1/E* = (1 − ν_A²)/E_A + (1 − ν_B²)/E_B (plane strain)."""
         A, B = self.A, self.B
         return 1.0 / ((1.0 - A.nu ** 2) / A.E + (1.0 - B.nu ** 2) / B.E)
 
-    @property
+    @functools.cached_property
     def R(self) -> float:
         """Relative radius R, 1/R = 1/R_A + 1/R_B."""
         return 1.0 / (1.0 / self.A.radius + 1.0 / self.B.radius)
 
-    @property
+    @functools.cached_property
     def beta(self) -> float:
         """Dundurs' parameter (docs/formulation.md §3).
 
@@ -66,13 +72,13 @@ class Derived:
         """κ = 2β: the paper's "constant" (eq. 92), Bentall–Johnson's κ."""
         return 2.0 * self.beta
 
-    @property
+    @functools.cached_property
     def a_H(self) -> float:
         """Hertz half-width for the reference load P̄: a_H = sqrt(4 P̄ R / (π E*))."""
         from ..closedforms import hertz_half_width
         return hertz_half_width(self.load.normal, self.R, self.Estar)
 
-    @property
+    @functools.cached_property
     def p0(self) -> float:
         """Hertz peak pressure for P̄: p0 = 2 P̄ / (π a_H) = a_H E* / (2R)."""
         from ..closedforms import hertz_peak_pressure
@@ -91,17 +97,17 @@ class Derived:
         """Sign of x where material enters the contact, −d (docs/formulation.md §1)."""
         return -self.load.direction
 
-    @property
+    @functools.cached_property
     def half_width(self) -> float:
         """Half-width of the potential contact zone, L = zone·a_H."""
         return self.discretization.zone * self.a_H
 
-    @property
+    @functools.cached_property
     def element_length(self) -> float:
         """Element length Le = 2L / elements."""
         return 2.0 * self.half_width / self.discretization.elements
 
-    @property
+    @functools.cached_property
     def dq(self) -> float:
         """Rolled distance per step, Δq = step·Le (length units)."""
         return self.discretization.step * self.element_length
