@@ -20,7 +20,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-import scipy.sparse as sparse
 
 from .errors import InputError
 
@@ -104,6 +103,7 @@ def check_scene(scene, dense_max_nodes: int) -> str:
 # ------------------------------------------------------------------------------ slip operators
 def _displacement(strip, points) -> sparse.csr_matrix:
     """Sparse :meth:`~rollqp.strip.Strip.displacement_matrix` (same values, at most three per row)."""
+    from scipy import sparse  # at first use: `import rollqp` stays free of scipy.sparse
     pts = np.clip(np.atleast_1d(np.asarray(points, dtype=float)), strip.x[0], strip.x[-1])
     n, m = strip.n, pts.size
     rows = np.arange(m)
@@ -124,6 +124,7 @@ def _displacement(strip, points) -> sparse.csr_matrix:
 
 def _upwind(strip, direction: int) -> sparse.csr_matrix:
     """Sparse :meth:`~rollqp.strip.Strip.upwind_difference` (eq. 20, 38–40)."""
+    from scipy import sparse  # at first use: `import rollqp` stays free of scipy.sparse
     n, hx = strip.n, np.diff(strip.x)
     if direction < 0:
         i = np.arange(n - 1)
@@ -140,6 +141,7 @@ def _upwind(strip, direction: int) -> sparse.csr_matrix:
 
 def sparse_history(strip, formulation: str, dq: float, direction: int) -> sparse.csr_matrix:
     """Sparse :meth:`~rollqp.strip.Strip.history_operator`: ``c^{k-1} = -M w^{k-1}`` (eq. 37, 48)."""
+    from scipy import sparse  # at first use: `import rollqp` stays free of scipy.sparse
     if direction not in (-1, 1):
         raise InputError("direction", f"must be -1 or +1, got {direction!r}")
     if formulation == "material":

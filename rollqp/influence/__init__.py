@@ -6,8 +6,15 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from .bem import bem_influence
 from .halfspace import Influence, halfspace_influence, min_eigenvalue
+
+
+def bem_influence(strip, **kw) -> Influence:
+    """The BEM influence (:func:`rollqp.influence.bem.bem_influence`), imported when a scene asks for
+    it: the BEM module and scipy.linalg stay out of ``import rollqp`` (half-space scenes never
+    load them)."""
+    from .bem import bem_influence as build
+    return build(strip, **kw)
 
 __all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence"]
 

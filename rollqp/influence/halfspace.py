@@ -80,7 +80,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg
 
 from ..errors import InputError
 from ..scene.validate import positive_real
@@ -393,6 +392,7 @@ def _threshold(f, K, d_ref):
     det(B)(1 + τ fᵀB⁻¹f)`` vanishes only at ``τ* = -1/(fᵀB⁻¹f)``, and the matrix is positive
     definite exactly for ``τ > τ*``. Returns ``nan`` when ``B`` is singular.
     """
+    import scipy.linalg  # here, not at import: `import rollqp` stays free of scipy.linalg
     FK = f[:, None] * K
     B = 0.5 * (FK + FK.T)
     try:
@@ -507,6 +507,7 @@ def _lanczos_rel(Lf) -> float:
     solves: ``O(n²)`` per iteration, no copy of the factor."""
     import scipy.sparse.linalg as spla
     n = Lf.shape[0]
+    import scipy.linalg  # here, not at import: `import rollqp` stays free of scipy.linalg
     trmv, trsv = scipy.linalg.blas.dtrmv, scipy.linalg.blas.dtrsv
 
     def mul(x):
@@ -528,6 +529,7 @@ def _check_definite(f, K, d_ref, L):
     with the smallest admissible ``d_ref`` (:func:`_threshold`). ``d_min`` from the same factor:
     ``d_ref exp(-1/(fᵀB⁻¹f))``; ``λ_min/λ_max`` exact below :data:`_EIG_DENSE_MAX` nodes, a Lanczos
     estimate on the factor above."""
+    import scipy.linalg  # here, not at import: `import rollqp` stays free of scipy.linalg
     try:
         # the transpose of the C-ordered upper triangle is a Fortran-ordered lower one: factorized
         # in place (no third copy)
