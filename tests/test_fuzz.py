@@ -240,17 +240,19 @@ def _run_scene_file(path, case):
         return "ran"
 
 
-def _scene_ids(n, offset=0):
-    return [pytest.param(offset + k, id=f"scene-{offset + k}") for k in range(n)]
+def _seeds(family, offset=0, slow=False):
+    """The seeds of a family's cases (FAST or SLOW count), each with its id ``family-seed``."""
+    n = (SLOW if slow else FAST)[family]
+    return [pytest.param(offset + k, id=f"{family}-{offset + k}") for k in range(n)]
 
 
-@pytest.mark.parametrize("seed", _scene_ids(FAST["scene"]))
+@pytest.mark.parametrize("seed", _seeds("scene"))
 def test_fuzzed_scene(seed, bases, tmp_path):
     _scene_property(seed, bases, tmp_path)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", _scene_ids(SLOW["scene"], offset=10_000))
+@pytest.mark.parametrize("seed", _seeds("scene", 10_000, slow=True))
 def test_fuzzed_scene_slow(seed, bases, tmp_path):
     _scene_property(seed, bases, tmp_path)
 
@@ -303,13 +305,13 @@ def _cli_property(seed, bases, tmp_path):
         assert out.stderr.count("\n") == 1 and out.stderr.startswith("rollqp: "), f"{case}: {out.stderr!r}"
 
 
-@pytest.mark.parametrize("seed", [pytest.param(k, id=f"cli-{k}") for k in range(FAST["cli"])])
+@pytest.mark.parametrize("seed", _seeds("cli"))
 def test_fuzzed_cli(seed, bases, tmp_path):
     _cli_property(seed, bases, tmp_path)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [pytest.param(20_000 + k, id=f"cli-{20_000 + k}") for k in range(SLOW["cli"])])
+@pytest.mark.parametrize("seed", _seeds("cli", 20_000, slow=True))
 def test_fuzzed_cli_slow(seed, bases, tmp_path):
     _cli_property(seed, bases, tmp_path)
 
@@ -444,13 +446,13 @@ def _file_property(seed, files, tmp_path):
             one_line(err, case)
 
 
-@pytest.mark.parametrize("seed", [pytest.param(k, id=f"file-{k}") for k in range(FAST["file"])])
+@pytest.mark.parametrize("seed", _seeds("file"))
 def test_fuzzed_file(seed, files, tmp_path):
     _file_property(seed, files, tmp_path)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [pytest.param(30_000 + k, id=f"file-{30_000 + k}") for k in range(SLOW["file"])])
+@pytest.mark.parametrize("seed", _seeds("file", 30_000, slow=True))
 def test_fuzzed_file_slow(seed, files, tmp_path):
     _file_property(seed, files, tmp_path)
 
@@ -498,13 +500,13 @@ def _api_property(seed, capfd):
     assert out.out == "" and out.err == "", f"{case}: printed {out}"
 
 
-@pytest.mark.parametrize("seed", [pytest.param(k, id=f"api-{k}") for k in range(FAST["api"])])
+@pytest.mark.parametrize("seed", _seeds("api"))
 def test_fuzzed_api(seed, capfd):
     _api_property(seed, capfd)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", [pytest.param(40_000 + k, id=f"api-{40_000 + k}") for k in range(SLOW["api"])])
+@pytest.mark.parametrize("seed", _seeds("api", 40_000, slow=True))
 def test_fuzzed_api_slow(seed, capfd):
     _api_property(seed, capfd)
 
