@@ -16,6 +16,7 @@ from scipy.integrate import quad
 from rollqp.errors import InputError
 from rollqp.influence import MODELS, Influence, build_influence, halfspace_influence, min_eigenvalue
 from rollqp.influence import halfspace as hs
+from rollqp.influence import toeplitz as tp
 from rollqp.strip import ELEMENTS, Strip
 
 # Tolerance table: one place, each with its reason.
@@ -455,3 +456,40 @@ def test_large_strip_builds():
     print(f"halfspace_influence, 1281 nodes: {elapsed:.2f} s")
     assert inf.Ann.shape == (1281, 1281) and inf.info["min_eig_rel"] > 0, "1281-node build"
     assert np.all(np.isfinite(inf.Ann)) and np.all(np.isfinite(inf.Ant)), "finite matrices"
+
+
+def _above_cap(element):
+    """The smallest uniform strip of ``element`` decided matrix-free (just above ``CHOLESKY_MAX`` nodes)."""
+    per = {"constant": 1, "linear": 1, "quadratic": 2}[element]
+    return _strip(element, (hs.CHOLESKY_MAX + per) // per)
+
+
+@pytest.mark.parametrize("element", ["constant", "quadratic"])
+def test_large_uniform_strip_is_decided_matrix_free_and_sharp(element):
+    """Above CHOLESKY_MAX nodes a uniform strip's definiteness is the rank-one threshold by FFT
+    products (no factorization): d_ref 0.1 % above the threshold builds, 0.1 % below it is the
+    one-line InputError naming contact.reference_distance with the admissible value."""
+    strip = _above_cap(element)
+    assert strip.n > hs.CHOLESKY_MAX
+    d = tp.positive_definite_threshold(strip)
+    inf = halfspace_influence(strip, Estar=1.0, beta=0.0, R_A=2 * R_REL, R_B=2 * R_REL, d_ref=1.001 * d)
+    # the threshold by CG to rtol 1e-10: the same number the check reports
+    assert inf.info["d_ref_min"] == pytest.approx(d, rel=1e-8) and np.isnan(inf.info["min_eig_rel"])
+    with pytest.raises(InputError, match=r"smallest admissible value for this mesh is") as exc:
+        halfspace_influence(strip, Estar=1.0, beta=0.0, R_A=2 * R_REL, R_B=2 * R_REL, d_ref=0.999 * d)
+    assert exc.value.key == "contact.reference_distance"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("element", ["constant", "linear", "quadratic"])
+def test_rank_one_premise_holds_at_the_cholesky_cap(element):
+    """The matrix-free check's premise, B = sym(F K(4L)) positive definite, by Cholesky on the
+    largest strip still factorized (CHOLESKY_MAX nodes), and the two thresholds agree (CG rtol 1e-10)."""
+    per = {"constant": 1, "linear": 1, "quadratic": 2}[element]
+    strip = _strip(element, (hs.CHOLESKY_MAX - 1) // per)
+    assert strip.n <= hs.CHOLESKY_MAX
+    L = float(strip.half_width)
+    f = np.asarray(strip.weights, dtype=float)
+    FK = f[:, None] * hs.log_kernel_matrix(strip, 4 * L)
+    np.linalg.cholesky(0.5 * (FK + FK.T))          # raises if B is not positive definite
+    assert tp.positive_definite_threshold(strip) == pytest.approx(hs.minimum_reference_distance(strip), rel=1e-8)

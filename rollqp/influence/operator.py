@@ -143,12 +143,15 @@ def asymmetry(A, f, sign: float = 1.0) -> float:
         norm = np.linalg.norm(FA)
         return float(np.linalg.norm(FA - sign * FA.T) / norm) if norm > 0 else 0.0
     num = den = 0.0
-    for i0 in range(0, n, 256):
-        i1 = min(n, i0 + 256)
+    b = 256
+    for i0 in range(0, n, b):
+        i1 = min(n, i0 + b)
         rows = f[i0:i1, None] * M[i0:i1]
-        cols = (f[:, None] * M[:, i0:i1]).T
-        num += float(np.sum((rows - sign * cols) ** 2))
-        den += float(np.sum(rows * rows))
+        den += float(np.einsum("ij,ij->", rows, rows))
+        for j0 in range(i0, n, b):   # the pair of blocks (i, j) and (j, i), each read along its rows
+            j1 = min(n, j0 + b)
+            d = rows[:, j0:j1] - sign * (f[j0:j1, None] * M[j0:j1, i0:i1]).T
+            num += float(np.einsum("ij,ij->", d, d)) * (1.0 if j0 == i0 else 2.0)
     return float(np.sqrt(num / den)) if den > 0 else 0.0
 
 
