@@ -357,6 +357,12 @@ class _March:
                               f"(last change {change:.2e} mu p0)", method=self.method.name, step=0)
         return self.record(0, "rolling", 0.0, state, previous, problem, sol, cnt, P=P, shift=0.0, t0=t0)
 
+    def _transport(self, k: int, dq: float) -> float:
+        """The step's signed rolled distance ``q_k − q_{k−1}`` (a load path rolls back with ``Δq < 0``),
+        which carries a friction law's memory with the material; ``dq`` itself without ``load.rolled``."""
+        pl = self.plan
+        return float(pl.q[k] - pl.q[k - 1]) if pl.rolled else dq
+
     def rolling(self, k: int, q: float, state: State, M) -> StepRecord:
         """Step ``k`` of the plan (:mod:`rollqp.kinematics`): rolling by Δq_k in its direction, or a stop.
 
@@ -379,7 +385,7 @@ class _March:
             c, dq, phase = -(M @ state.w), scene.dq, "rolling"
         new, problem, sol = self.step(state, cnt, P=P, c=c, dq=dq, Q=Q, xi=xi,
                                       normal_fixed=self.fixed, delta=self.approach(tau), h=h,
-                                      q=q, transport=dq if phase == "rolling" else None)
+                                      q=q, transport=self._transport(k, dq) if phase == "rolling" else None)
         if not self.fixed:
             self.ops.check_inside(new.p, k)
         shift = new.tsol.xi * dq if d == 0 else 0.0

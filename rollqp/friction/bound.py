@@ -51,6 +51,15 @@ class SlipBound:
         return self.law.rolling_speed * np.abs(np.asarray(s, dtype=float))
 
 
+def _at_nodes(points, x_hat):
+    """``points`` with those within round-off (1e-9 of a node spacing) of the strip's end nodes put on them:
+    material that was at an end node keeps its memory instead of being taken for material entering
+    the strip (a step of exactly a node spacing lands there up to the last bit of ``Δq``)."""
+    tol = 1e-9 * float(np.min(np.diff(x_hat))) if x_hat.size > 1 else 0.0
+    points = np.where(np.abs(points - x_hat[0]) <= tol, x_hat[0], points)
+    return np.where(np.abs(points - x_hat[-1]) <= tol, x_hat[-1], points)
+
+
 def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None, steady=False):
     """What one step problem takes as ``mu`` (and ``law``): ``(mu, law)``.
 
@@ -65,8 +74,9 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
     direction : int
         ``d = load.direction``.
     dq_hat : float or None
-        The step's rolled distance in ``a_H`` units (rolling steps; ``None``: no transport of the
-        memory, a static shift or a steady state).
+        The step's signed rolled distance ``q_k − q_{k−1}`` in ``a_H`` units (negative when a load
+        path rolls back; rolling steps; ``None``: no transport of the memory, a static shift or a
+        steady state).
     previous : (n,) array or None
         The coefficient at the nodes after the previous step (memory).
     steady : bool
@@ -86,7 +96,8 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
                                                     "memory = 0")
     if previous is None:
         previous = np.full(x_hat.shape, float(static))
-    if dq_hat is not None:  # the material now at x was at x − d Δq
-        previous = np.interp(x_hat - direction * dq_hat, x_hat, previous, left=float(static), right=float(static))
+    if dq_hat is not None:  # the material now at x was at x − d Δq (Δq signed: a reversal brings it back)
+        previous = np.interp(_at_nodes(x_hat - direction * dq_hat, x_hat), x_hat, previous,
+                             left=float(static), right=float(static))
     w = law.weight(dq_hat if dq_hat is not None else 1.0)
     return float(static), SlipBound(law, w, np.asarray(previous, dtype=float))

@@ -89,10 +89,15 @@ class _Spatial:
         raise NotImplementedError
 
     def check_strip(self, half_width_hat, q_end_hat, direction):
-        """The varying part meets the strip ``[−L̂, L̂]`` at some ``q̂ ∈ [0, q̂_end]``, else an InputError."""
+        """The varying part meets the strip ``[−L̂, L̂]`` at some rolled distance of the run, else an InputError.
+
+        ``q_end_hat``: the last rolled distance (the run covers ``[0, q̂_end]``), or ``(q̂_lo, q̂_hi)``,
+        the range a load path (``load.rolled``: stops and reversals) covers."""
         lo, hi = self.span()
+        q_lo, q_hi = (0.0, q_end_hat) if np.ndim(q_end_hat) == 0 else (min(q_end_hat), max(q_end_hat))
         if self.frame == "material":  # the strip in the law's coordinate sweeps x − d q
-            a, b = sorted((-direction * q_end_hat, 0.0))
+            a, b = sorted((-direction * q_lo, -direction * q_hi))
+            a, b = min(a, 0.0), max(b, 0.0)
             slo, shi = -half_width_hat + a, half_width_hat + b
         else:
             slo, shi = -half_width_hat, half_width_hat
@@ -221,6 +226,6 @@ class SlipVelocity:
         return self.kinetic + dm * e, np.where(over, -dm * e / vh, 0.0)
 
     def weight(self, dq_hat) -> float:
-        """The memory's weight ``w = L/(L + Δq)`` of the previous coefficient (0 without memory)."""
-        return 0.0 if self.memory == 0.0 else self.memory / (self.memory + dq_hat)
+        """The memory's weight ``w = L/(L + |Δq|)`` of the previous coefficient (0 without memory)."""
+        return 0.0 if self.memory == 0.0 else self.memory / (self.memory + abs(dq_hat))
 

@@ -372,10 +372,10 @@ def check_convective_step(scene) -> None:
 def check_friction(scene) -> None:
     """A friction law varying along the surface meets the strip during the run (:mod:`rollqp.friction`)."""
     law = scene.contact.friction
-    if not isinstance(law, float) and scene.load.rolled is not None:
-        # the laws place their μ(x) and transport their memory with the scene's one direction and
-        # q = direction·τ; stops and reversals (load.rolled) are not wired into them yet
-        raise InputError("contact.friction", "a friction law cannot be combined with load.rolled yet (stops and "
-                                             "reversals); use a constant coefficient, or roll one way")
     if hasattr(law, "check_strip"):
-        law.check_strip(scene.half_width / scene.a_H, scene.q_end / scene.a_H, scene.load.direction)
+        q = scene.q_end / scene.a_H
+        if scene.load.rolled is not None:  # a load path: the range of q it covers (stops, reversals)
+            from ..kinematics import plan
+            qs = plan(scene).q / scene.a_H
+            q = (float(qs.min()), float(qs.max()))
+        law.check_strip(scene.half_width / scene.a_H, q, scene.load.direction)
