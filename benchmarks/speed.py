@@ -1,0 +1,164 @@
+"""The speed targets of issues 16 and 18 in one run: each target, what it requires, what this machine measures.
+
+One command writes the table into docs/performance.md (between ``<!-- bench:speed -->`` markers)::
+
+    python benchmarks/speed.py                # print the table (about 3 minutes on 2 idle cores)
+    python benchmarks/speed.py --docs         # and write it into docs/performance.md
+    python benchmarks/speed.py --full         # also the 2,561-node cattaneo-carter run (minutes)
+
+Every figure is a median over repeated runs in this one process or in fresh child processes
+(where the target is a whole process: ``import rollqp``, a CLI run, an assembly's peak memory),
+BLAS pinned to one thread; ratios compare numbers of this run only. No test times anything:
+this script is where speed is measured.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from harness import machine_table, pin_threads, table, write_sections  # noqa: E402
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def _child(code: str, *args, repeats=1) -> list:
+    """The last stdout line of ``python -c code args`` as JSON, ``repeats`` fresh processes."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               MPLBACKEND="Agg")
+    out = []
+    for _ in range(repeats):
+        r = subprocess.run([sys.executable, "-c", code, *map(str, args)], env=env, cwd=ROOT,
+                           capture_output=True, text=True, check=True)
+        out.append(json.loads(r.stdout.strip().splitlines()[-1]))
+    return out
+
+
+def import_time(repeats=7) -> float:
+    """Median seconds of ``import rollqp`` in a fresh interpreter (the interpreter's own start excluded)."""
+    code = "import json, time; t = time.perf_counter(); import rollqp; print(json.dumps(time.perf_counter() - t))"
+    return float(np.median(_child(code, repeats=repeats)))
+
+
+#: The ``rollqp`` command of this interpreter's environment (its console script), else the same entry point.
+_SCRIPT = Path(sys.executable).with_name("rollqp")
+_ROLLQP = ([str(_SCRIPT)] if _SCRIPT.exists()
+           else [sys.executable, "-c", "import sys; from rollqp.cli import main; sys.exit(main())"])
+
+
+def cli_time(repeats=5, scene="cattaneo-carter", method="newton") -> float:
+    """Median wall seconds of the whole process ``rollqp run SCENE --method M --out F`` (interpreter start,
+    imports, the run, the summary and the result file)."""
+    times = []
+    with tempfile.TemporaryDirectory() as tmp:
+        env = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+                   MPLBACKEND="Agg")
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            subprocess.run([*_ROLLQP, "run", scene, "--method", method, "--out", os.path.join(tmp, "r.npz")],
+                           env=env, cwd=tmp, check=True, capture_output=True)
+            times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def newton_step_ratio(repeats=5) -> dict:
+    """§6.1.1 (81 nodes): the median Newton rolling step against three dense ``n × n`` products."""
+    import timeit
+
+    import rollqp
+    scene = rollqp.load_scene("cattaneo-carter")
+    steps = []
+    for _ in range(repeats):
+        a = rollqp.run(scene, method="newton").arrays()
+        steps.append(float(np.median(a["step_time"][1:])))
+    n = int(a["x"].size)
+    rng = np.random.default_rng(0)
+    A, x = rng.standard_normal((n, n)), rng.standard_normal(n)
+    number = 20000
+    product = min(timeit.repeat(lambda: A @ x, number=number, repeat=7)) / number
+    step = float(np.median(steps))
+    return {"n": n, "step": step, "product": product, "ratio": step / (3.0 * product)}
+
+
+_ASSEMBLY = r"""
+import json, resource, sys, time
+import scipy.fft, scipy.linalg, scipy.sparse.linalg  # imported before timing: a process's one-time cost
+from rollqp.strip import Strip
+from rollqp.influence import halfspace_influence
+n = int(sys.argv[1])
+s = Strip(1.25, (n - 1) // 2, "quadratic")
+t0 = time.perf_counter()
+halfspace_influence(s, Estar=1.0, beta=0.0, R_A=20.0, R_B=40.0)
+print(json.dumps({"seconds": time.perf_counter() - t0,
+                  "peak": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 / (8.0 * s.n * s.n)}))
+"""
+
+
+def assembly(nodes=5121, repeats=3) -> dict:
+    """Half-space assembly of ``nodes`` quadratic nodes in a fresh process: median seconds, peak RSS in matrices."""
+    runs = _child(_ASSEMBLY, nodes, repeats=repeats)
+    return {"seconds": float(np.median([r["seconds"] for r in runs])),
+            "peak": float(np.median([r["peak"] for r in runs]))}
+
+
+def cattaneo_carter_fine(elements=1280) -> dict:
+    """The §6.1.1 transient on ``elements`` quadratic elements with ``newton``: the whole ``rollqp.run`` call."""
+    import rollqp
+    scene = rollqp.load_scene("cattaneo-carter").replace(**{"discretization.elements": elements})
+    t0 = time.perf_counter()
+    a = rollqp.run(scene, method="newton").arrays()
+    return {"nodes": int(a["x"].size), "steps": len(a["q"]) - 1, "seconds": time.perf_counter() - t0,
+            "stepping": float(a["step_time"].sum())}
+
+
+def rows(full: bool, log) -> list:
+    out = []
+
+    def add(issue, target, required, measured, met):
+        out.append((issue, target, required, measured, "met" if met else "**not met**"))
+        log(f"{target}: {measured}")
+
+    t = import_time()
+    add("18", "`import rollqp` (fresh interpreter)", "≤ 0.3 s", f"{t:.2f} s", t <= 0.3)
+    t = cli_time()
+    add("18", "`rollqp run cattaneo-carter --method newton`, whole process", "≤ 0.6 s", f"{t:.2f} s", t <= 0.6)
+    r = newton_step_ratio()
+    add("18", f"§6.1.1 Newton rolling step / three dense products (n = {r['n']})", "≤ 20",
+        f"{r['ratio']:.1f} ({1e3 * r['step']:.3f} ms / 3 × {1e6 * r['product']:.2f} µs)", r["ratio"] <= 20)
+    r = assembly()
+    add("18", "half-space assembly, 5,121 nodes (peak memory in matrices)", "≤ 1 s, ≤ 2 matrices",
+        f"{r['seconds']:.2f} s, {r['peak']:.2f}", r["seconds"] <= 1.0 and r["peak"] <= 2.0)
+    if full:
+        r = cattaneo_carter_fine()
+        add("18", f"cattaneo-carter, {r['nodes']} nodes, {r['steps']} steps, `newton`", "≤ 60 s",
+            f"{r['seconds']:.1f} s (Σ step_time {r['stepping']:.1f} s)", r["seconds"] <= 60)
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--docs", action="store_true", help="write the table into docs/performance.md")
+    ap.add_argument("--full", action="store_true", help="also the 2,561-node cattaneo-carter run")
+    args = ap.parse_args(argv)
+    pin_threads()
+    command = "python benchmarks/speed.py" + (" --full" if args.full else "") + (" --docs" if args.docs else "")
+    print(machine_table(command) + "\n", flush=True)
+    res = rows(args.full, lambda m: print(f"  {m}", file=sys.stderr, flush=True))
+    body = table(["issue", "target", "required", "measured", ""], res)
+    print(body)
+    if args.docs:
+        doc = ROOT / "docs" / "performance.md"
+        write_sections(doc, {"speed": machine_table(command) + "\n\n" + body})
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
