@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from harness import machine_table, pin_threads, table, write_sections  # noqa: E402
+from harness import fit_exponent, machine_table, pin_threads, table, write_sections  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -119,6 +119,29 @@ def cattaneo_carter_fine(elements=1280) -> dict:
             "stepping": float(a["step_time"].sum())}
 
 
+def matrix_free_sizes(sizes=(2561, 10001, 40001, 131073)) -> dict:
+    """``benchmarks/matrix_free.py``'s normal Hertz problem (cold) and rolling step (tangential half) with
+    ``mf-newton`` on FFT products, one fresh process per size (medians of 3 solves; 1 at 131,073)."""
+    from matrix_free import measure
+    return {n: measure(n, "fft", 3 if n < 100000 else 1) for n in sizes}
+
+
+def rows_matrix_free(add) -> None:
+    r = matrix_free_sizes()
+    n1, nb = r[10001], r[131073]
+    add("16", "normal problem, 10,001 nodes, `mf-newton` (rms error vs Hertz)", "≤ 0.5 s",
+        f"{n1['normal']:.3f} s ({n1['err']:.1e})", n1["normal"] <= 0.5)
+    add("16", "normal problem, 131,073 nodes (peak memory)", "≤ 30 s, ≤ 1 GB",
+        f"{nb['normal']:.1f} s, {nb['peak_bytes'] / 2 ** 20:.0f} MiB", nb["normal"] <= 30 and nb["peak_bytes"] <= 2 ** 30)
+    ns = sorted(r)
+    e = fit_exponent(ns, [r[n]["normal"] for n in ns], n_min=2561)
+    each = ", ".join(f"{r[n]['normal']:.3g} s" for n in ns)
+    add("16", f"normal problem cost exponent, {ns[0]:,}–{ns[-1]:,} nodes ({each})",
+        "≤ 1.3", f"{e:.2f}", e <= 1.3)
+    add("16", "rolling step (Carter state, tangential half), 10,001 nodes", "≤ 1 s", f"{n1['roll']:.3f} s",
+        n1["roll"] <= 1.0)
+
+
 def rows(full: bool, log) -> list:
     out = []
 
@@ -136,6 +159,7 @@ def rows(full: bool, log) -> list:
     r = assembly()
     add("18", "half-space assembly, 5,121 nodes (peak memory in matrices)", "≤ 1 s, ≤ 2 matrices",
         f"{r['seconds']:.2f} s, {r['peak']:.2f}", r["seconds"] <= 1.0 and r["peak"] <= 2.0)
+    rows_matrix_free(add)
     if full:
         r = cattaneo_carter_fine()
         add("18", f"cattaneo-carter, {r['nodes']} nodes, {r['steps']} steps, `newton`", "≤ 60 s",
