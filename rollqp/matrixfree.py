@@ -69,17 +69,12 @@ def check_scene(scene, dense_max_nodes: int) -> str:
     ------
     InputError
         ``solver.operator`` = ``"matrix-free"`` with a method that needs the matrix or a model
-        other than the half-space; ``solver.method`` = a matrix-free method with ``load.rolled``; ``discretization.elements`` when a method that needs the matrix
+        other than the half-space; ``discretization.elements`` when a method that needs the matrix
         is asked for more than ``dense_max_nodes`` nodes (naming ``mf-newton``).
     """
     from .methods import matrix_free
     m = mode(scene)
     method = scene.solver.method
-    if matrix_free(method) and getattr(scene.load, "rolled", None) is not None:
-        # measured on the built-in stop-reverse: the active-set iteration stalls at 2.4e-5 on the
-        # first static-shift step of the stop (step 97); not yet investigated
-        raise InputError("solver.method", f"{method!r} does not take load.rolled (stops and reversals) yet: use "
-                                          f"'newton' (dense) for load paths")
     if m == "matrix-free":
         if not matrix_free(method):
             raise InputError("solver.operator", f"'matrix-free' needs a method that works with products only "
