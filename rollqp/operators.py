@@ -201,6 +201,8 @@ class SceneOperators:
         With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt t)/dq``
         is then the steady-rolling slip ``ξ e + d·D_up w`` (docs/formulation.md §4, §9).
         """
+        if "steady" not in self._memo and self.matrix_free:   # products, no matrix (rollqp.matrixfree)
+            self._memo["steady"] = matrixfree.steady_operators(self)
         if "steady" not in self._memo:
             T = self.scales.length * self.strip.steady_operator(self.scene.load.direction)
             Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")
