@@ -206,7 +206,7 @@ class SteadyOperator(Operator):
 
 
 def steady_operators(ops):
-    """``(Δ·d·D_up·A_tn or None, Δ·d·D_up·A_tt)`` of a matrix-free scene as :class:`SteadyOperator`\ s
+    """``(Δ·d·D_up·A_tn or None, Δ·d·D_up·A_tt)`` of a matrix-free scene as :class:`SteadyOperator` objects
     (``Δ = a_H``; the dense path's :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`)."""
     T = sparse_steady(ops.strip, ops.scene.load.direction)
     delta = ops.scales.length
