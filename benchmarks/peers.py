@@ -12,7 +12,8 @@ E* = 1; rms pressure error against Hertz over the contact |x| < a, relative to p
   ``M`` times the strip, on a grid of rollqp's node spacing (``M (n − 1)`` points). Their error
   has a periodic-image part that falls only with ``M`` (about ``M⁻²``), so each is run at
   ``M = 8`` and at the smallest ``M`` of 8, 16, 32, … whose error is at most rollqp's at that
-  ``n`` ("equal achieved accuracy"; given up above ``--max-grid`` points).
+  ``n`` ("equal achieved accuracy"; given up above ``--max-grid`` points, or when the error stops
+  falling: the peer's discretization error on that spacing is above rollqp's).
 
 Medians of ``--repeats`` solves (one above 2^18 grid points), BLAS/OpenMP pinned to one
 thread; a peer that is not installed is skipped (``pip install rollqp[bench]``)::
@@ -90,17 +91,21 @@ def median_solve(solve, n, M, repeats):
 
 
 def matched(solve, n, target, repeats, max_grid):
-    """``(M, seconds, error)`` at the smallest M = 8, 16, … with error <= target, or the last one tried
-    with ``M = None`` when the grid would exceed ``max_grid`` points first."""
+    """``(M, seconds, error, why)`` at the smallest M = 8, 16, … with error <= target; else ``M = None``
+    with the last error and why the search stopped: the grid would exceed ``max_grid`` points, or
+    the error no longer falls (less than 20 % from M to 2M: the peer's own discretization error at
+    this spacing is reached, above rollqp's)."""
     M, last = 8, None
     while M * (n - 1) <= max_grid:
         t, e = median_solve(solve, n, M, 1)
-        last = (M, t, e)
         if e <= target:
             t, e = median_solve(solve, n, M, repeats)
-            return M, t, e
+            return M, t, e, ""
+        if last is not None and e > 0.8 * last[2]:
+            return None, t, e, f"plateau from M = {last[0]}"
+        last = (M, t, e)
         M *= 2
-    return None, *(last[1:] if last else (float("nan"), float("nan")))
+    return None, *(last[1:] if last else (float("nan"), float("nan"))), "grid limit"
 
 
 def _fmt(s):
@@ -132,10 +137,10 @@ def main(argv=None):
         row = [n, _fmt(r.get("normal")), f"{r['err']:.1e}" if "err" in r else r.get("error", "")]
         for name, solve in peers.items():
             t8, e8 = median_solve(solve, n, 8, args.repeats) if 8 * (n - 1) <= args.max_grid else (None, None)
-            M, tm_, em = matched(solve, n, r.get("err", 0.0), args.repeats, args.max_grid)
+            M, tm_, em, why = matched(solve, n, r.get("err", 0.0), args.repeats, args.max_grid)
             row += [_fmt(t8), "–" if e8 is None else f"{e8:.1e}",
-                    f"{_fmt(tm_)} ({em:.1e})" if M else f"not reached ({em:.1e} at the largest grid)",
-                    M or f"> {args.max_grid // (n - 1)}",
+                    f"{_fmt(tm_)} ({em:.1e})" if M else f"not reached: {em:.1e}, {why}",
+                    M or "–",
                     f"{tm_ / r['normal']:.1f}×" if M and "normal" in r else "–"]
         rows.append(row)
         print(table(header, rows[-1:]), flush=True)
