@@ -22,9 +22,10 @@ import time
 import numpy as np
 
 from .errors import InputError
+from .influence.operator import Operator
 
 __all__ = ["MODES", "THRESHOLD", "mode", "memory_estimate", "check_scene", "sparse_history",
-           "sparse_steady", "build"]
+           "sparse_steady", "SteadyOperator", "steady_operators", "build"]
 
 #: ``solver.operator``: ``"auto"`` (by :data:`THRESHOLD`), ``"dense"`` or ``"matrix-free"``.
 MODES = ("auto", "dense", "matrix-free")
@@ -69,17 +70,12 @@ def check_scene(scene, dense_max_nodes: int) -> str:
     ------
     InputError
         ``solver.operator`` = ``"matrix-free"`` with a method that needs the matrix or a model
-        other than the half-space; ``solver.method`` = a matrix-free method with ``load.rolled``; ``discretization.elements`` when a method that needs the matrix
+        other than the half-space; ``discretization.elements`` when a method that needs the matrix
         is asked for more than ``dense_max_nodes`` nodes (naming ``mf-newton``).
     """
     from .methods import matrix_free
     m = mode(scene)
     method = scene.solver.method
-    if matrix_free(method) and getattr(scene.load, "rolled", None) is not None:
-        # measured on the built-in stop-reverse: the active-set iteration stalls at 2.4e-5 on the
-        # first static-shift step of the stop (step 97); not yet investigated
-        raise InputError("solver.method", f"{method!r} does not take load.rolled (stops and reversals) yet: use "
-                                          f"'newton' (dense) for load paths")
     if m == "matrix-free":
         if not matrix_free(method):
             raise InputError("solver.operator", f"'matrix-free' needs a method that works with products only "
@@ -157,6 +153,65 @@ def sparse_history(strip, formulation: str, dq: float, direction: int) -> sparse
 def sparse_steady(strip, direction: int) -> sparse.csr_matrix:
     """``d·D_up`` sparse: the steady-rolling slip ``s = ξ e + d·D_up w`` (docs/formulation.md §9)."""
     return direction * _upwind(strip, direction)
+
+
+class SteadyOperator(Operator):
+    """``c·T·A``: a sparse slip operator ``T`` times an FFT influence operator ``A``, never a matrix.
+
+    The steady slip operators ``Δ·d·D_up·A_tt`` and ``Δ·d·D_up·A_tn`` (eq. 48; docs/formulation.md
+    §9) of a matrix-free scene: products ``O(n log n)``, memory ``O(n)``; the operator interface
+    of :class:`~rollqp.influence.operator.Operator` (``@``, ``x @ A``, ``diagonal()``,
+    ``column(j)``, ``dense()``, ``memo``) so that step problems and ``mf-newton`` take it unchanged
+    (the column gives ``mf-newton`` its circulant preconditioner).
+    """
+
+    __array_ufunc__ = None      # ``x @ op`` goes to __rmatmul__
+
+    def __init__(self, T, A, c: float = 1.0, name: str = "steady"):
+        self.T, self.A, self.c, self.name = T.tocsr(), A, float(c), name
+        self._memo = {}
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.A.shape
+
+    @property
+    def n(self) -> int:
+        return self.A.shape[0]
+
+    def __matmul__(self, x):
+        return self.c * (self.T @ (self.A @ x))
+
+    def __rmatmul__(self, y):
+        return (self.c * (self.T.T @ y)) @ self.A
+
+    def diagonal(self) -> np.ndarray:
+        """``c Σ_k T[i, k] A[k, i]`` from ``T``'s non-zeros and ``A.entries`` (``O(n)``)."""
+        coo = self.T.tocoo()
+        vals = coo.data * self.A.entries(coo.col, coo.row)
+        return self.c * np.bincount(coo.row, weights=vals, minlength=self.n)
+
+    def column(self, j: int) -> np.ndarray:
+        return self.c * (self.T @ self.A.column(j))
+
+    def dense(self) -> np.ndarray:
+        return self.c * (self.T @ self.A.dense())
+
+    def __array__(self, dtype=None, copy=None):
+        m = self.dense()
+        return m if dtype is None else m.astype(dtype, copy=False)
+
+    def __repr__(self) -> str:
+        return f"SteadyOperator({self.name!r}, n={self.n})"
+
+
+def steady_operators(ops):
+    """``(Δ·d·D_up·A_tn or None, Δ·d·D_up·A_tt)`` of a matrix-free scene as :class:`SteadyOperator` objects
+    (``Δ = a_H``; the dense path's :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`)."""
+    T = sparse_steady(ops.strip, ops.scene.load.direction)
+    delta = ops.scales.length
+    Atn = None if ops.Atn is None else SteadyOperator(T, ops.Atn, delta, "steady A_tn")
+    return Atn, SteadyOperator(T, ops.Att, delta, "steady A_tt")
 
 
 # ------------------------------------------------------------------------------ operators

@@ -69,7 +69,7 @@ class SceneOperators:
         d = scene.discretization
         strip = Strip(scene.half_width, d.elements, d.element)
         if matrixfree.mode(scene) == "matrix-free":
-            return cls._build_matrix_free(scene, strip)
+            return cls._build_matrix_free(scene, strip).with_profiles()
         t0 = time.perf_counter()
         kw = {}
         if scene.contact.model == "bem":  # true geometry: the rollers and their BEM meshes
@@ -92,9 +92,13 @@ class SceneOperators:
         Atn, Ant = (None if M is None else Operator(M, "influence") for M in (infl.Atn, infl.Ant))
         ops = cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
                   scales=Scales(scene.a_H, scene.p0, scene.Estar), symmetrized=symmetrized, info=info)
-        if scene.A.profile is not None or scene.B.profile is not None:  # profiles (rollqp.profiles)
-            ops.h = ops.gap(float(scene.rolled_distance(0.0)))
-        return ops
+        return ops.with_profiles()
+
+    def with_profiles(self) -> "SceneOperators":
+        """This object with :attr:`h` the profiles' gap at q(0) (:mod:`rollqp.profiles`; dense or matrix-free)."""
+        if self.scene.A.profile is not None or self.scene.B.profile is not None:
+            self.h = self.gap(float(self.scene.rolled_distance(0.0)))
+        return self
 
     # ------------------------------------------------------------ geometry
     @property
@@ -197,6 +201,8 @@ class SceneOperators:
         With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt t)/dq``
         is then the steady-rolling slip ``ξ e + d·D_up w`` (docs/formulation.md §4, §9).
         """
+        if "steady" not in self._memo and self.matrix_free:   # products, no matrix (rollqp.matrixfree)
+            self._memo["steady"] = matrixfree.steady_operators(self)
         if "steady" not in self._memo:
             T = self.scales.length * self.strip.steady_operator(self.scene.load.direction)
             Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")

@@ -5,7 +5,7 @@ import pytest
 
 from rollqp import cli, load_scene
 from rollqp.crossval import report
-from rollqp.methods import available_methods
+from rollqp.methods import available_methods, get_method
 
 FAST = [m for m in ("qp-osqp", "nt-newton", "qps-daqp", "qps-quadprog") if m in available_methods()]
 
@@ -59,6 +59,7 @@ def test_docs_tables(name, step, coupled):
         # uncoupled: every backend solves the same collocation step (measured ≤ 1.5e-11);
         # coupled: the alternations stop at the coupled residual 1e-10 (measured 1e-9 from Newton)
         assert max(r.dp, r.dt) <= (1e-8 if coupled else 1e-10), r.method
-        if coupled and r.method != "newton":
+        # (a method with its own coupled_limit, mf-newton's 0.01 tol, stops its alternation later)
+        if coupled and r.method != "newton" and getattr(get_method(r.method), "coupled_limit", None) is None:
             outer.add(r.iterations.split()[0])
-    assert len(outer) <= 1, f"all alternations take the same outer iterations: {outer}"
+    assert len(outer) <= 1, f"all alternations at the same limit take the same outer iterations: {outer}"

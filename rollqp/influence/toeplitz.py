@@ -215,6 +215,16 @@ class ToeplitzOperator(Operator):
                 out += self._P[a, np.arange(self._n) - self._r * e - self.kmin]
         return out
 
+    def entries(self, i, j) -> np.ndarray:
+        """``M[i, j]`` for index arrays ``i``, ``j`` (``O(len)``): for the diagonal of products."""
+        i, j = np.asarray(i, dtype=int), np.asarray(j, dtype=int)
+        out = np.zeros(np.broadcast(i, j).shape)
+        for a in range(self._P.shape[0]):
+            e = (j - a) // self._r
+            ok = ((j - a) % self._r == 0) & (e >= 0) & (e < self._ne)
+            out += np.where(ok, self._P[a, np.where(ok, i - self._r * e - self.kmin, 0)], 0.0)
+        return out
+
     def __matmul__(self, x):
         return self.matvec(x)
 

@@ -142,7 +142,7 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
             raise InputError("solver.method", f"method {method.name!r} solves neither coupled steps nor both "
                                               "halves of them")
         from .alternation import Alternation
-        return Alternation(method, max_outer=max_outer)
+        return Alternation(method, max_outer=max_outer, limit=getattr(method, "coupled_limit", None))
     return method
 
 

@@ -39,8 +39,26 @@ from .base import check_kind, check_options
 __all__ = ["KrylovNewton"]
 
 PRECONDITIONERS = ("circulant", "none")
-#: Relative GMRES tolerance of the reduced solves while the node sets still change.
+#: Relative GMRES tolerance of the reduced solves while the node sets still change: LOOSE, and
+#: at most ``m^-LOOSE_EXPONENT`` on ``m`` nodes. The error of the solution can be the residual
+#: times the condition number (``∝ m`` for the log kernel), and the set decisions at a contact
+#: edge need it below the edge node's pressure (``∝ m^-1/2``): at 1e-6 the normal step at
+#: 131,073 nodes took 14 set iterations and 36 s (loose solves moving 63 edge nodes the wrong
+#: way), at m^-1.5 (2.9e-8) 5 and 12 s; below ~10,000 nodes the bound is above 1e-6 (no change).
 LOOSE = 1e-6
+LOOSE_EXPONENT = 1.5
+#: The N–T alternation around ``mf-newton`` stops at this times the tolerance. It stops at a coupled
+#: residual whose distance to the solution grows with its contraction rate: at the factor 1 the
+#: states differed from the dense coupled ``newton`` by up to 2.2e-10 μp0 (harmonic, 1 a_H) and
+#: 1.1e-10 (linear elements, dissimilar); at 0.1 and 0.01 by 4.0e-12 (harmonic), for 20 % more
+#: outer iterations: 0.01 leaves a margin on both.
+COUPLED_FACTOR = 1e-2
+#: Loose set iterations without a smaller residual after which the reduced systems are solved
+#: exactly: inexact solves can flip nodes that are at the bound with zero slip (after a stop)
+#: at random, never repeating a set (measured: the built-in stop-reverse on a dense operator).
+STALL = 3
+#: Dead band of the stick/slip switches, relative to the tolerance (:func:`_next_friction_sets`).
+DEADBAND = 1e-3
 #: Nodes from which a cold normal step starts from a coarse solution, and the coarsening factor.
 COARSE_MIN, COARSE_FACTOR = 2000, 4
 
@@ -70,6 +88,8 @@ class _Reduced:
         if self.idx.size == 0:
             return np.zeros(0)
         nb = float(np.linalg.norm(b))
+        if rtol > 0.0:                                        # loose: at most m^-1.5 (LOOSE_EXPONENT)
+            rtol = min(rtol, float(self.idx.size) ** -LOOSE_EXPONENT)
         atol = max(atol, rtol * nb, 1e-15 * nb)               # never below round-off of b
         x, info = spla.gmres(self.op, b, x0=x0, rtol=0.0, atol=atol, restart=min(60, self.idx.size),
                              maxiter=max(50, self.idx.size), M=self.M)
@@ -102,8 +122,11 @@ def chan_symbol(A, scale):
         t_pos, t_neg = col[hi], col[lo]
         c = ((m - k) * t_pos + k * np.roll(t_neg[::-1], 1)) / m
         lam = scipy.fft.rfft(c)
-        lam = np.where(np.real(lam) > 0, np.real(lam), np.max(np.real(lam)))
-        return lam
+        if np.max(np.abs(lam.imag)) <= 1e-12 * np.max(np.abs(lam)):
+            lam = lam.real                      # a symmetric Toeplitz part: a real spectrum
+        # eigenvalues with a non-positive real part (the ω = 0 mode of the steady operator
+        # d·D_up·A, whose symbol vanishes there) replaced by the largest real part
+        return np.where(np.real(lam) > 0, lam, np.max(np.real(lam)))
 
     return symbol
 
@@ -122,10 +145,16 @@ class KrylovNewton:
     """
 
     name = "mf-newton"
-    solves = frozenset({"normal", "tangential"})
+    solves = frozenset({"normal", "tangential", "steady"})
     operator = "exact"
     #: works with operator products only (``A @ x``, ``x @ A``, ``diagonal()``): no stored matrix
     matrix_free = True
+
+    @property
+    def coupled_limit(self) -> float:
+        """The coupled residual at which the N–T alternation around this method stops
+        (:func:`rollqp.methods.compose`): :data:`COUPLED_FACTOR` times the tolerance."""
+        return COUPLED_FACTOR * self.tolerance
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, preconditioner: str = "circulant"):
         if preconditioner not in PRECONDITIONERS:
@@ -164,20 +193,25 @@ class KrylovNewton:
         """Iterate ``active → (solution, next sets)`` until the sets repeat and the residual is met.
 
         While the sets change the reduced systems are solved loosely (relative
-        :data:`LOOSE`); once they repeat, to ``‖r‖₂ <= 10⁻² tol`` (tightened by 10⁻² until
+        :data:`LOOSE`); once they repeat (or cycle, or :data:`STALL` iterations bring no smaller
+        residual), to ``‖r‖₂ <= 10⁻² tol`` (tightened by 10⁻² until
         rollqp's residual is met): an inexact Newton method with exact final iterations.
         """
         seen, atol, rtol = set(), 1e-4 * self.tolerance, LOOSE
+        best, stalled = np.inf, 0
         for it in range(1, self.max_iterations + 1):
             sol, nxt, key = iterate(active, atol, rtol)
             settled = np.array_equal(nxt, active)
+            if rtol != 0.0:                       # loose phase: count iterations without progress
+                stalled = 0 if sol.residual < best else stalled + 1
+                best = min(best, sol.residual)
             if settled and rtol == 0.0:
                 if sol.residual <= self.tolerance:
                     return sol, it
                 if atol < 1e-6 * self.tolerance:
                     break
                 atol *= 1e-2                      # the sets are right: solve them more exactly
-            elif settled or (key in seen and rtol != 0.0):
+            elif settled or (rtol != 0.0 and (key in seen or stalled >= STALL)):
                 rtol, seen = 0.0, set()           # found (or cycling on inexact solves): solve exactly
             seen.add(key)
             active = nxt
@@ -272,7 +306,7 @@ class KrylovNewton:
             t = tJ.copy()
             t[idx] = xi * u + v
             sol = pb.solution(t * sc.stress, xi * sc.slip, method=self.name)
-            nxt = _next_friction_sets(act, t, sol.s / sc.slip, bh)
+            nxt = _next_friction_sets(act, t, sol.s / sc.slip, bh, DEADBAND * self.tolerance)
             if pb.Q is not None and not np.any(nxt == 2):    # a load row needs one sticking node
                 y = np.abs(t - r * sol.s / sc.slip)
                 nxt[np.argmin(np.where(bh > 0, y / np.where(bh > 0, bh, 1), np.inf))] = 2
@@ -282,21 +316,25 @@ class KrylovNewton:
         return _with(sol, it)
 
 
-def _next_friction_sets(act, t, s, b):
+def _next_friction_sets(act, t, s, b, eps=0.0):
     """The next stick/slip sets of the tangential iteration (eq. 57–60).
 
-    A sticking node whose shear exceeds the bound slips in the direction of its shear; a
-    slipping node (``t = σ b``) whose slip does not oppose it (``σ s > 0``) sticks; the others
-    keep their state. This is the ``r → 0⁺`` limit of ``Proj(t − r s)``: unlike a finite ``r``
-    it never moves a node from one bound straight to the other, which made the iteration
-    oscillate and diverge after long steps (Δq = 8 Le at 2,001 nodes).
+    A sticking node whose shear exceeds the bound by more than ``eps`` slips in the direction of
+    its shear; a slipping node (``t = σ b``) whose slip does not oppose it (``σ s > eps``) sticks;
+    the others keep their state. This is the ``r → 0⁺`` limit of ``Proj(t − r s)``: unlike a
+    finite ``r`` it never moves a node from one bound straight to the other, which made the
+    iteration oscillate and diverge after long steps (Δq = 8 Le at 2,001 nodes). The dead band
+    ``eps`` (nondimensional, far below the tolerance: a node left in it adds at most ``eps`` to
+    the friction residual of eq. 60) keeps round-off from flipping nodes that are both at the
+    bound and at zero slip, as after a stop (static shift under constant loads: ``ŝ = 0`` up to
+    round-off at every node), where it made 11–22 set iterations a step.
     """
     nxt = act.copy()
     stick = act == 2
-    over = stick & (np.abs(t) > b)
+    over = stick & (np.abs(t) > b + eps)
     nxt[over] = np.sign(t[over])
     slip = (act == 1) | (act == -1)
-    nxt[slip & (act * s > 0)] = 2
+    nxt[slip & (act * s > eps)] = 2
     nxt[b <= 0] = 0
     return nxt.astype(np.int8)
 
