@@ -247,7 +247,7 @@ class NewtonMethod:
         else:
             r = self.r if self.r is not None else dqh / scale
             last, t_scale = np.ones(pb.n), dqh  # ∂(r ŝ)/∂ξ̂ = r, ∂(r ŝ)/∂t̂ = r Â/Δq̂
-        sys_ = ReducedSystem(pb.A, pb.f, Ahat, fhat, r, last, t_scale)
+        sys_ = ReducedSystem(pb.A, pb.f, Ahat, fhat, r, last, t_scale, unit=sc.modulus / sc.length / sc.stress)
         self._keep(self._systems, key, sys_)
         return sys_
 

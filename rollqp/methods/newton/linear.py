@@ -21,7 +21,50 @@ from ...errors import InputError
 from .ncp import slip_rows
 
 __all__ = ["ReducedSystem", "CoupledSystem", "coupled_system", "coupled_vectors", "CoupledFactors",
-           "direct_coupled_direction"]
+           "direct_coupled_direction", "runs", "partial_product", "PARTIAL_MIN"]
+
+#: From this many nodes the iteration multiplies only the blocks of ``K`` it needs
+#: (:func:`partial_product`); below, one dense product is cheaper than the bookkeeping.
+PARTIAL_MIN = 320
+#: Indices closer than this are one run (a block with a few needless zeros costs less than
+#: another BLAS call).
+RUN_GAP = 32
+#: More blocks than this: one dense product instead.
+MAX_BLOCKS = 12
+
+
+def runs(idx: np.ndarray, gap: int = RUN_GAP) -> list:
+    """The sorted indices ``idx`` as ``(start, stop)`` runs, gaps up to ``gap`` bridged."""
+    if idx.size == 0:
+        return []
+    brk = np.flatnonzero(np.diff(idx) > gap)
+    starts = idx[np.concatenate(([0], brk + 1))]
+    stops = idx[np.concatenate((brk, [idx.size - 1]))] + 1
+    return list(zip(starts.tolist(), stops.tolist()))
+
+
+def partial_product(K: np.ndarray, rows: np.ndarray, v: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """``(K @ v)[rows]`` for ``v`` zero outside the sorted indices ``cols``, by blocks of ``K`` (views, no copies).
+
+    The node sets of a contact step (the stick zone, the slip zones, the contact) are a few runs
+    of consecutive nodes, so the product costs ``|rows|·|cols|`` instead of ``n²``; a set in more
+    than :data:`MAX_BLOCKS` blocks takes the dense product.
+    """
+    out = np.zeros(rows.size)
+    if rows.size == 0 or cols.size == 0:
+        return out
+    rr, cr = runs(rows), runs(cols)
+    if len(rr) * len(cr) > MAX_BLOCKS:
+        return (K @ v)[rows]
+    i0 = 0
+    for a, b in rr:
+        acc = K[a:b, cr[0][0]:cr[0][1]] @ v[cr[0][0]:cr[0][1]]
+        for c0, c1 in cr[1:]:
+            acc += K[a:b, c0:c1] @ v[c0:c1]
+        i1 = i0 + int(np.searchsorted(rows[i0:], b))
+        out[i0:i1] = acc[rows[i0:i1] - a]
+        i0 = i1
+    return out
 
 
 class ReducedSystem:
@@ -35,7 +78,8 @@ class ReducedSystem:
     few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "_base", "factorizations", "updates")
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "unit", "partial", "last", "_base", "factorizations",
+                 "updates")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
     #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
@@ -44,7 +88,7 @@ class ReducedSystem:
     #: Below this many free nodes a new factorization is cheaper than the bordered solve.
     UPDATE_MIN_SIZE = 64
 
-    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale):
+    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale, unit=1.0):
         n = fhat.size
         self.A, self.f, self.Ahat, self.fhat, self.r = A, f, Ahat, fhat, r
         K = np.empty((n, n + 1))
@@ -52,6 +96,11 @@ class ReducedSystem:
         K[:, n] = r * last_column
         self.K = K
         self.K_nl = np.ascontiguousarray(K[:, :n])
+        #: ``K_nl x̂ = unit · (A x)`` for a traction ``x`` in the problem's units (``x̂ = x/p0``)
+        self.unit = (r / t_scale) * unit
+        self.partial = n >= PARTIAL_MIN
+        #: ``(x, A x)`` of the last solution: the next step, warm-started from ``x``, needs no new product
+        self.last = None
         self._base = {}  # with_load -> (mask, free, position of each node in free or -1, lu, piv)
         self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
         self.updates = 0  # directions solved by a Schur complement on an older factorization
@@ -145,12 +194,7 @@ class ReducedSystem:
         pinned = np.flatnonzero(~m)
         d[pinned] = -phi[pinned]
         known = np.flatnonzero(~m & ~m0)  # pinned now and not in the factored set
-        if known.size:
-            e = np.zeros(K.shape[1])
-            e[known] = d[known]
-            Ke = K @ e
-        else:
-            Ke = np.zeros(n)
+        Ke = self._known_product(K, d, known, free0, added)
         nf0 = free0.size
         r0 = np.empty(nf0 + with_load)
         r0[:nf0] = -phi[free0] - Ke[free0]
@@ -167,6 +211,21 @@ class ReducedSystem:
                 d[n] = u0[nf0]
             return d
         return self._bordered(K, phi, d, u0, Ke, base, added, released, with_load)
+
+    def _known_product(self, K, d, known, free0, added):
+        """``K e`` with ``e = d`` on the ``known`` nodes and 0 elsewhere, on the rows the solve reads
+        (``free0`` and ``added``; the others are left 0)."""
+        n = self.fhat.size
+        if known.size == 0:
+            return np.zeros(n)
+        e = np.zeros(K.shape[1])
+        e[known] = d[known]
+        if not self.partial:
+            return K @ e
+        Ke = np.zeros(n)
+        rows = np.union1d(free0, added)
+        Ke[rows] = partial_product(K, rows, e, known[e[known] != 0.0])
+        return Ke
 
     def _bordered(self, K, phi, d, u0, Ke, base, added, released, with_load):
         """The direction on the factors of another free set, bordered by the rows and columns of
