@@ -141,7 +141,7 @@ class ReducedSystem:
         pos = np.full(n, -1)
         pos[free] = np.arange(nf)
         self.factorizations += 1
-        return m.copy(), free, pos, lu, piv, {}
+        return m.copy(), free, pos, lu, piv, _Store(nf + with_load)
 
     def direction(self, mask, phi, with_load):
         r"""The Newton direction ``d``: ``J d = −Φ`` solved on the free nodes (eq. 80).
@@ -175,7 +175,7 @@ class ReducedSystem:
         m = mask[:n]
         base = self._base.get(with_load)
         if base is not None:
-            m0, free0, pos0, lu, piv, cols = base
+            m0, free0, pos0, lu, piv, store = base
             released = np.flatnonzero(m0 & ~m)
             added = np.flatnonzero(m & ~m0)
             k = released.size + added.size
@@ -187,7 +187,7 @@ class ReducedSystem:
             if base is None:
                 return None
             self._base[with_load] = base
-            m0, free0, pos0, lu, piv, cols = base
+            m0, free0, pos0, lu, piv, store = base
             released = added = np.empty(0, dtype=int)
             k = 0
         d = np.empty(K.shape[1])
@@ -202,15 +202,15 @@ class ReducedSystem:
             r0[nf0] = -phi[n] - self.fhat[known] @ d[known]
         if r0.size == 0 and k == 0:
             return d
+        if k:
+            return self._bordered(K, phi, d, r0, Ke, base, added, released, with_load)
         u0, info = dgetrs(lu, piv, r0)
         if info != 0:
             return None
-        if k == 0:
-            d[free0] = u0[:nf0]
-            if with_load:
-                d[n] = u0[nf0]
-            return d
-        return self._bordered(K, phi, d, u0, Ke, base, added, released, with_load)
+        d[free0] = u0[:nf0]
+        if with_load:
+            d[n] = u0[nf0]
+        return d
 
     def _known_product(self, K, d, known, free0, added):
         """``K e`` with ``e = d`` on the ``known`` nodes and 0 elsewhere, on the rows the solve reads
@@ -227,43 +227,54 @@ class ReducedSystem:
         Ke[rows] = partial_product(K, rows, e, known[e[known] != 0.0])
         return Ke
 
-    def _bordered(self, K, phi, d, u0, Ke, base, added, released, with_load):
+    def _bordered(self, K, phi, d, r0, Ke, base, added, released, with_load):
         """The direction on the factors of another free set, bordered by the rows and columns of
-        the ``added`` and ``released`` nodes (:meth:`direction`); ``None`` if singular."""
+        the ``added`` and ``released`` nodes (:meth:`direction`; ``r0`` its right-hand side on the
+        factored set); ``None`` if singular."""
         n = self.fhat.size
-        m0, free0, pos0, lu, piv, cols = base
+        m0, free0, pos0, lu, piv, store = base
         nf0 = free0.size
         k = released.size + added.size
         # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z.
-        # The columns of Z are kept per node (``cols``): as the set drifts away from the factored
-        # one, each step adds a node or two, and only their columns cost triangular solves.
+        # The columns of Z, the rows C of the added nodes and their products C Z are kept per node
+        # (``store``): as the set drifts away from the factored one, each step adds a node or two,
+        # and only theirs cost triangular solves and products. The solve for u0 = M0⁻¹ r0 takes the
+        # new columns along (one pass over the factors).
         na = added.size
         keys = added.tolist() + [-1 - i for i in released.tolist()]
-        missing = [c for c in keys if c not in cols]
+        missing = [c for c in keys if c not in store.cslot]
+        W = np.zeros((nf0 + with_load, 1 + len(missing)), order="F")
+        W[:, 0] = r0
         if missing:
-            order = [c for c in missing if c >= 0] + [c for c in missing if c < 0]  # W's columns
-            W = np.zeros((nf0 + with_load, len(missing)), order="F")
-            ma = np.array([c for c in order if c >= 0], dtype=int)
-            mr = np.array([-1 - c for c in order if c < 0], dtype=int)
-            W[:nf0, :ma.size] = K[np.ix_(free0, ma)]
+            ma = np.array([c for c in missing if c >= 0], dtype=int)
+            mr = np.array([-1 - c for c in missing if c < 0], dtype=int)
+            order = ma.tolist() + [-1 - i for i in mr.tolist()]  # W's columns
+            W[:nf0, 1:1 + ma.size] = K[np.ix_(free0, ma)]
             if with_load:
-                W[nf0, :ma.size] = self.fhat[ma]
-            W[pos0[mr], ma.size + np.arange(mr.size)] = 1.0
-            Zm, info = dgetrs(lu, piv, W)
-            if info != 0:
-                return None
-            for j, c in enumerate(order):
-                cols[c] = Zm[:, j]
-        Z = np.column_stack([cols[c] for c in keys])
+                W[nf0, 1:1 + ma.size] = self.fhat[ma]
+            W[pos0[mr], 1 + ma.size + np.arange(mr.size)] = 1.0
+        X, info = dgetrs(lu, piv, W)
+        if info != 0:
+            return None
+        u0 = X[:, 0]
+        if missing:
+            store.add_columns(order, X[:, 1:])
+        new_rows = [a for a in added.tolist() if a not in store.rslot]
+        if new_rows:
+            rows = np.empty((len(new_rows), nf0 + with_load))
+            rows[:, :nf0] = K[np.ix_(new_rows, free0)]
+            if with_load:
+                rows[:, nf0] = K[new_rows, n]
+            store.add_rows(new_rows, rows)
+        cs = [store.cslot[c] for c in keys]
+        rs = [store.rslot[a] for a in added.tolist()]
+        Z = store.Z[:, cs]
         S = np.empty((k, k))
-        Ca = K[np.ix_(added, free0)]
-        S[:na] = -(Ca @ Z[:nf0])
-        if with_load:
-            S[:na] -= np.outer(K[added, n], Z[nf0])
+        S[:na] = -store.products(rs, cs)
         S[na:] = -Z[pos0[released]]
         S[:na, :na] += K[np.ix_(added, added)]
         Cu0 = np.empty(k)
-        Cu0[:na] = Ca @ u0[:nf0] + (K[added, n] * u0[nf0] if with_load else 0.0)
+        Cu0[:na] = store.R[rs] @ u0
         Cu0[na:] = u0[pos0[released]]
         rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu0
         try:
@@ -278,6 +289,61 @@ class ReducedSystem:
             d[n] = u[nf0]
         self.updates += 1
         return d
+
+
+class _Store:
+    """What the bordered solves of one factorization keep (:meth:`ReducedSystem._bordered`): the columns
+    ``Z_c = M0⁻¹ w_c`` per key (an added node ``a >= 0``, a released node ``−1 − i``), the rows
+    ``C_a = [K_{a,F0}, k_a]`` of the added nodes, and their products ``G = C Z``, each computed once."""
+
+    def __init__(self, m):
+        self.m = m
+        self.cslot, self.rslot = {}, {}
+        self.Z = np.empty((m, 16), order="F")
+        self.R = np.empty((16, m))
+        self.G = np.empty((16, 16))
+        self.filled = np.zeros(16, dtype=int)  # per row slot: the column slots of G computed
+
+    def add_columns(self, keys, X):
+        c0 = len(self.cslot)
+        if c0 + len(keys) > self.Z.shape[1]:
+            cap = 2 * (c0 + len(keys))
+            Z = np.empty((self.m, cap), order="F")
+            Z[:, :c0] = self.Z[:, :c0]
+            self.Z = Z
+            G = np.empty((self.G.shape[0], cap))
+            G[:, :c0] = self.G[:, :c0]
+            self.G = G
+        self.Z[:, c0:c0 + len(keys)] = X
+        for j, c in enumerate(keys):
+            self.cslot[c] = c0 + j
+
+    def add_rows(self, nodes, rows):
+        r0 = len(self.rslot)
+        if r0 + len(nodes) > self.R.shape[0]:
+            cap = 2 * (r0 + len(nodes))
+            R = np.empty((cap, self.m))
+            R[:r0] = self.R[:r0]
+            self.R = R
+            G = np.empty((cap, self.G.shape[1]))
+            G[:r0] = self.G[:r0]
+            self.G = G
+            self.filled = np.concatenate([self.filled, np.zeros(cap - self.filled.size, dtype=int)])
+        self.R[r0:r0 + len(nodes)] = rows
+        self.filled[r0:r0 + len(nodes)] = 0
+        for j, a in enumerate(nodes):
+            self.rslot[a] = r0 + j
+
+    def products(self, rs, cs):
+        """``G[rs][:, cs] = C Z``, the missing entries computed first."""
+        nc = len(self.cslot)
+        rs = np.asarray(rs, dtype=int)
+        lag = rs[self.filled[rs] < nc]
+        if lag.size:
+            c0 = int(self.filled[lag].min())
+            self.G[np.ix_(lag, np.arange(c0, nc))] = self.R[lag] @ self.Z[:, c0:nc]
+            self.filled[lag] = nc
+        return self.G[np.ix_(rs, cs)]
 
 
 
