@@ -223,7 +223,7 @@ class ReducedSystem:
         if not self.partial:
             return K @ e
         Ke = np.zeros(n)
-        rows = np.union1d(free0, added)
+        rows = np.sort(np.concatenate((free0, added)))  # disjoint: added is outside the factored set
         Ke[rows] = partial_product(K, rows, e, known[e[known] != 0.0])
         return Ke
 

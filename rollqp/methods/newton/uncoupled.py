@@ -165,6 +165,7 @@ class _Iterate:
         self.K = sys_.matrices(self.with_load)
         self.k0 = k0
         self.needs = getattr(ncp, "needs", None)
+        self.all_rows = np.arange(self.n)
         self.z = z
         self.x = z[:self.n]
         if start is None:
@@ -181,8 +182,11 @@ class _Iterate:
 
     def refresh(self):
         """``y`` and ``Φ`` from a new product ``A x`` of the iterate."""
-        self.xphys = self.z[:self.n] * self.pb.scales.stress
-        self.Ax = self.pb.A @ self.xphys
+        x = self.xphys = self.z[:self.n] * self.pb.scales.stress
+        if self.sys.partial:  # the columns where x ≠ 0 (the contact: a zero traction outside it)
+            self.Ax = partial_product(self.pb.A.dense(), self.all_rows, x, np.flatnonzero(x))
+        else:
+            self.Ax = self.pb.A @ x
         self._y_from_product()
 
     def _y_from_product(self):
@@ -198,7 +202,7 @@ class _Iterate:
         self.z = z
         self.x = z[:self.n]
         self.since += 1
-        if self.since >= REFRESH_EVERY:
+        if self.since >= REFRESH_EVERY or not self.sys.partial:  # small n: a product costs less than carrying y
             self.refresh()
             return
         self.y = self.y + alpha * Kd
