@@ -182,6 +182,7 @@ class _March:
         self.moving = ops.profiles_move
         self.cache = HistoryCache(ops) if self.plan.rolled else None
         self.fixed = self._normal_fixed()
+        self.frictionless = ops.frictionless  # the scene's law: the same at every step
 
     # ------------------------------------------------------------ loads
     def loads(self, q):
@@ -217,7 +218,7 @@ class _March:
         ops, meth = self.ops, self.method
         if P is not None and P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
             return _unloaded(ops, xi), None, None
-        if ops.frictionless:
+        if self.frictionless:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
         if not isinstance(ops.friction, float):  # a law: this step's μ (Coulomb keeps the old path)
