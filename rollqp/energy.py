@@ -62,14 +62,45 @@ def friction_work(rec, ops) -> float:
 
 
 def elastic_energy(rec, ops) -> float:
-    """``U = ½ pᵀF A_nn p + pᵀF A_nt t + ½ tᵀF A_tt t`` (relative to ``d_ref``)."""
-    p, t, f = rec.state.p, rec.state.t, ops.f
-    if p is None:
+    """``U = ½ pᵀF A_nn p + pᵀF A_nt t + ½ tᵀF A_tt t`` (relative to ``d_ref``).
+
+    From the displacements the step already has, not from new ``n × n`` products: ``A_nn p + A_nt t
+    = g − h + δ`` (eq. 25, 30: the gap of the state) and, without ``A_tn``, ``A_tt t = w`` (eq. 28);
+    with coupling the terms ``A_nt t`` and ``A_tt t`` are multiplied out.
+    """
+    st = rec.state
+    p, t, f = st.p, st.t, ops.f
+    if p is None or (not np.any(p) and not np.any(t)):
         return 0.0
-    U = 0.5 * float((f * p) @ (ops.Ann @ p)) + 0.5 * float((f * t) @ (ops.Att @ t))
-    if ops.Ant is not None:
-        U += float((f * p) @ (ops.Ant @ t))
+    G, coupled = _normal_displacement(rec)
+    if G is None:  # no gap of the state to read it from
+        U = 0.5 * float((f * p) @ (ops.Ann @ p)) + 0.5 * float((f * t) @ (ops.Att @ t))
+        if ops.Ant is not None:
+            U += float((f * p) @ (ops.Ant @ t))
+        return U
+    U = 0.5 * float((f * p) @ G)  # ½ pᵀF A_nn p, or ½ pᵀF (A_nn p + A_nt t) (coupled)
+    if ops.Ant is not None and np.any(t):
+        U += (0.5 if coupled else 1.0) * float((f * p) @ (ops.Ant @ t))
+    if np.any(t):
+        At = st.w if ops.Atn is None else ops.Att @ t
+        U += 0.5 * float((f * t) @ At)
     return U
+
+
+def _normal_displacement(rec):
+    """``(G, coupled)`` from the state's gap ``g``, approach ``δ`` and the undeformed gap of its problem:
+    ``G = A_nn p = g − h − o + δ`` of a normal half (``coupled`` False; eq. 53, ``o`` its fixed offset),
+    ``G = A_nn p + A_nt t = g − h + δ`` of a coupled step (eq. 25, 30); ``(None, False)`` where the
+    record does not hold them."""
+    st = rec.state
+    nsol = st.nsol
+    if nsol is None or nsol.g is None or nsol.delta is None or st.w is None:
+        return None, False
+    if st.normal is not None:
+        return nsol.g - st.normal.h_total + nsol.delta, False
+    if rec.problem is not None and rec.problem.kind == "coupled":
+        return nsol.g - rec.problem.h + nsol.delta, True
+    return None, False
 
 
 def load_work(rec, ops) -> float:

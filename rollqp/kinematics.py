@@ -87,12 +87,13 @@ class HistoryCache:
         self.ops, self.rtol, self.size = ops, rtol, size
         self.items: list = []
 
-    def get(self, dq: float, d: int) -> np.ndarray:
+    def get(self, dq: float, d: int):
         for i, (dq0, d0, M) in enumerate(self.items):
             if d0 == d and abs(dq - dq0) <= self.rtol * dq0:
                 self.items.append(self.items.pop(i))
                 return M
-        M = self.ops.strip.history_operator(self.ops.scene.discretization.formulation, dq, d)
+        from .strip import RowSparse  # at most three non-zeros a row: O(n) products
+        M = RowSparse.from_dense(self.ops.strip.history_operator(self.ops.scene.discretization.formulation, dq, d))
         self.items.append((dq, d, M))
         if len(self.items) > self.size:
             self.items.pop(0)

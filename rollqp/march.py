@@ -182,6 +182,7 @@ class _March:
         self.moving = ops.profiles_move
         self.cache = HistoryCache(ops) if self.plan.rolled else None
         self.fixed = self._normal_fixed()
+        self.frictionless = ops.frictionless  # the scene's law: the same at every step
 
     # ------------------------------------------------------------ loads
     def loads(self, q):
@@ -217,7 +218,7 @@ class _March:
         ops, meth = self.ops, self.method
         if P is not None and P <= 0.0:  # contact lost (the scene allows P = 0 only with Q = 0)
             return _unloaded(ops, xi), None, None
-        if ops.frictionless:
+        if self.frictionless:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
         if not isinstance(ops.friction, float):  # a law: this step's μ (Coulomb keeps the old path)
@@ -239,7 +240,7 @@ class _March:
         tsol = meth.solve(pb, warm=state.tsol)
         cnt.add(tsol, "tangential")
         _keep_mu(pb, tsol)
-        return State(nsol.p, tsol.t, ops.w(nsol.p, tsol.t), nsol, tsol, npb), pb, tsol
+        return State(nsol.p, tsol.t, ops.w(nsol.p, tsol.t, _product(tsol, pb, ops.Att)), nsol, tsol, npb), pb, tsol
 
     def _frictionless(self, state, cnt, *, P, c, dq, xi=None, steady=False, delta=None, h=None):
         """A step at ``μ = 0``: ``t = 0`` (the bound ``μp`` is zero at every node), the normal half alone.
@@ -413,8 +414,7 @@ def prepare(scene, method=None):
     coupled = scene.coupling_level == "full"
     kind = law_kind(scene.contact.friction)
     if method is None or isinstance(method, str):
-        law = {} if kind == "constant" else {"friction": kind}  # Coulomb: the call as before
-        meth = scene_method(scene.solver, coupled=coupled, **law)
+        meth = scene_method(scene.solver, coupled=coupled, friction=kind)
     else:
         meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
     ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")
@@ -599,6 +599,16 @@ def _unloaded(ops: SceneOperators, xi=None) -> State:
     tsol = StepSolution(t=zero, s=zero, xi=0.0 if xi is None else float(xi), method="unloaded",
                         status="unloaded")
     return State(zero, zero, zero, nsol, tsol, None)
+
+
+def _product(sol, problem, A):
+    """``A t`` of the tangential solution ``sol``, if its method handed it back (``info["At"]``, a pair
+    ``(t, A t)``) for this very operator ``A`` (not a steady slip operator), else None."""
+    got = sol.info.get("At")
+    if got is None or problem.A is not A:
+        return None
+    t, At = got
+    return At if (t is sol.t or np.array_equal(t, sol.t)) else None
 
 
 def _keep_mu(problem, sol) -> None:

@@ -21,7 +21,7 @@ from .errors import InputError
 from .influence import build_influence
 from .influence.operator import Operator, asymmetry
 from .problem import CoupledStep, NormalStep, Scales, TangentialStep
-from .strip import Strip
+from .strip import RowSparse, Strip
 
 __all__ = ["SceneOperators"]
 
@@ -180,8 +180,11 @@ class SceneOperators:
 
     # ------------------------------------------------------------ slip operators
     def history(self, formulation: str | None = None, dq: float | None = None,
-                direction: int | None = None) -> np.ndarray:
+                direction: int | None = None):
         """``M`` with the history vector ``c^{k−1} = −M w^{k−1}`` (eq. 37, 48), built once per argument set.
+
+        At most three non-zeros a row, stored so (:class:`~rollqp.strip.RowSparse`; ``scipy.sparse``
+        on the matrix-free path): a product costs ``O(n)``, not the dense ``O(n²)``.
 
         The defaults are the scene's own: ``discretization.formulation``, ``Δq`` and ``load.direction``.
         """
@@ -192,7 +195,7 @@ class SceneOperators:
         key = ("history", formulation, float(dq), int(direction))
         if key not in self._memo:
             self._memo[key] = (matrixfree.sparse_history(self.strip, formulation, dq, direction) if self.matrix_free
-                               else self.strip.history_operator(formulation, dq, direction))
+                               else RowSparse.from_dense(self.strip.history_operator(formulation, dq, direction)))
         return self._memo[key]
 
     def steady(self) -> tuple[Operator | None, Operator]:
@@ -234,9 +237,9 @@ class SceneOperators:
         return CoupledStep(Ann=self.Ann, Att=Att, Ant=self.Ant, Atn=Atn, f=self.f, h=self.h if h is None else h,
                            mu=mu, c=c, dq=dq, P=P, Q=Q, xi=xi, delta=delta, scales=self.scales, law=law)
 
-    def w(self, p, t) -> np.ndarray:
-        """Relative tangential displacement ``w = A_tn p + A_tt t`` (eq. 28)."""
-        out = self.Att @ t
+    def w(self, p, t, At=None) -> np.ndarray:
+        """Relative tangential displacement ``w = A_tn p + A_tt t`` (eq. 28); ``At``: ``A_tt t`` if known."""
+        out = self.Att @ t if At is None else At
         return out if self.Atn is None else out + self.Atn @ p
 
     def check_inside(self, p, step: int):

@@ -310,9 +310,9 @@ class NormalStep:
     def h_total(self) -> np.ndarray:
         return self.h if self.offset is None else self.h + self.offset
 
-    def gap(self, p, delta) -> np.ndarray:
-        """``g = h + o − δ e + A p`` (eq. 25, 30)."""
-        return self.h_total - delta + self.A @ p
+    def gap(self, p, delta, Ap=None) -> np.ndarray:
+        """``g = h + o − δ e + A p`` (eq. 25, 30); ``Ap``: the product ``A p`` if already computed."""
+        return self.h_total - delta + (self.A @ p if Ap is None else Ap)
 
     def symmetrized(self) -> "NormalStep":
         """The same problem with ``A`` replaced by ``F⁻¹ sym(F A)`` (what a QP solves)."""
@@ -330,10 +330,11 @@ class NormalStep:
         """``sol``'s pressure and approach re-evaluated on this problem (rollqp's residuals)."""
         return self.solution(sol.p, sol.delta)
 
-    def residuals(self, p, delta) -> "Residuals":
-        """rollqp's residuals of ``(p, δ)``: ``‖min(p̂, ĝ)‖∞`` (eq. 51–52), load row (eq. 67)."""
+    def residuals(self, p, delta, g=None) -> "Residuals":
+        """rollqp's residuals of ``(p, δ)``: ``‖min(p̂, ĝ)‖∞`` (eq. 51–52), load row (eq. 67); ``g``: its gap
+        if already computed."""
         sc = self.scales
-        g = self.gap(p, delta)
+        g = self.gap(p, delta) if g is None else g
         sig = np.minimum(p / sc.stress, g / sc.displacement)
         load = 0.0 if self.P is None else (self.f @ p - self.P) / sc.force
         return Residuals(signorini=float(np.max(np.abs(sig))), load_normal=abs(float(load)))
@@ -366,10 +367,11 @@ class NormalStep:
         delta = self.delta if self.delta is not None else -form.unscaled_multiplier(y) * sc.displacement
         return self.solution(p, delta, **meta)
 
-    def solution(self, p, delta, **meta) -> "StepSolution":
+    def solution(self, p, delta, Ap=None, **meta) -> "StepSolution":
+        """``(p, δ)`` with its gap and residuals (``Ap``: the product ``A p`` if the caller has it)."""
         p = np.asarray(p, dtype=float)
-        return StepSolution(p=p, g=self.gap(p, delta), delta=float(delta), residuals=self.residuals(p, delta),
-                            **meta)
+        g = self.gap(p, delta, Ap)
+        return StepSolution(p=p, g=g, delta=float(delta), residuals=self.residuals(p, delta, g), **meta)
 
 
 @dataclass(frozen=True)
@@ -448,9 +450,9 @@ class TangentialStep:
     def replace(self, **kw) -> "TangentialStep":
         return dataclasses.replace(self, **kw)
 
-    def slip(self, t, xi) -> np.ndarray:
-        """``s = ξ e + (c + A t)/Δq`` (eq. 36, 47)."""
-        return xi + (self.c + self.A @ t) / self.dq
+    def slip(self, t, xi, At=None) -> np.ndarray:
+        """``s = ξ e + (c + A t)/Δq`` (eq. 36, 47); ``At``: the product ``A t`` if already computed."""
+        return xi + (self.c + (self.A @ t if At is None else At)) / self.dq
 
     def symmetrized(self) -> "TangentialStep":
         """The same problem with ``A`` replaced by ``F⁻¹ sym(F A)`` (what a QP solves)."""
@@ -468,10 +470,11 @@ class TangentialStep:
         """``sol``'s traction and creepage re-evaluated on this problem (rollqp's residuals)."""
         return self.solution(sol.t, sol.xi)
 
-    def residuals(self, t, xi) -> "Residuals":
-        """rollqp's residuals of ``(t, ξ)``: ``‖t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)‖∞`` (eq. 60), load row (eq. 67)."""
+    def residuals(self, t, xi, s=None) -> "Residuals":
+        """rollqp's residuals of ``(t, ξ)``: ``‖t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)‖∞`` (eq. 60), load row (eq. 67);
+        ``s``: its slip if already computed."""
         sc = self.scales
-        s = self.slip(t, xi)
+        s = self.slip(t, xi) if s is None else s
         th, sh, bh = t / sc.stress, s / sc.slip, self.bound_at(s) / sc.stress
         fr = friction_residual(th, sh, bh)
         load = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
@@ -508,10 +511,11 @@ class TangentialStep:
         xi = self.xi if self.xi is not None else form.unscaled_multiplier(y) * sc.slip
         return self.solution(t, xi, **meta)
 
-    def solution(self, t, xi, **meta) -> "StepSolution":
+    def solution(self, t, xi, At=None, **meta) -> "StepSolution":
+        """``(t, ξ)`` with its slip and residuals (``At``: the product ``A t`` if the caller has it)."""
         t = np.asarray(t, dtype=float)
-        return StepSolution(t=t, s=self.slip(t, xi), xi=float(xi), p=self.p,
-                            residuals=self.residuals(t, xi), **meta)
+        s = self.slip(t, xi, At)
+        return StepSolution(t=t, s=s, xi=float(xi), p=self.p, residuals=self.residuals(t, xi, s), **meta)
 
 
 @dataclass(frozen=True)
@@ -622,10 +626,12 @@ class CoupledStep:
         """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""
         return self.mu if self.law is None or s is None else self.law.mu(s)
 
-    def residuals(self, p, t, delta, xi) -> "Residuals":
-        """rollqp's residuals of the coupled step: Signorini, friction (bound ``μp⁺``), loads (eq. 70–71)."""
+    def residuals(self, p, t, delta, xi, g=None, s=None) -> "Residuals":
+        """rollqp's residuals of the coupled step: Signorini, friction (bound ``μp⁺``), loads (eq. 70–71);
+        ``g``, ``s``: its gap and slip if already computed."""
         sc = self.scales
-        g, s = self.gap(p, t, delta), self.slip(p, t, xi)
+        g = self.gap(p, t, delta) if g is None else g
+        s = self.slip(p, t, xi) if s is None else s
         sig = np.minimum(p / sc.stress, g / sc.displacement)
         th, sh = t / sc.stress, s / sc.slip
         bh = self.coefficient(s) * np.maximum(p, 0.0) / sc.stress
@@ -639,8 +645,9 @@ class CoupledStep:
         p, t = np.asarray(p, dtype=float), np.asarray(t, dtype=float)
         delta = self.delta if self.delta is not None else float(delta)
         xi = self.xi if self.xi is not None else float(xi)
-        return StepSolution(p=p, t=t, g=self.gap(p, t, delta), s=self.slip(p, t, xi), delta=float(delta),
-                            xi=float(xi), residuals=self.residuals(p, t, delta, xi), **meta)
+        g, s = self.gap(p, t, delta), self.slip(p, t, xi)
+        return StepSolution(p=p, t=t, g=g, s=s, delta=float(delta), xi=float(xi),
+                            residuals=self.residuals(p, t, delta, xi, g, s), **meta)
 
 
 # ---------------------------------------------------------------------------- solutions

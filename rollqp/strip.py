@@ -217,6 +217,65 @@ class Strip:
         return _direction(direction) * self.upwind_difference(direction)
 
 
+class RowSparse:
+    """A matrix with at most ``k`` non-zeros a row, stored as ``cols``, ``vals`` of shape ``(n, k)``.
+
+    The slip operators of a strip (the history operator ``M`` of eq. 37, 48, the upwind
+    difference of eq. 38–40) have two or three non-zeros a row: stored so, their product costs
+    ``O(n k)`` instead of a dense ``O(n²)`` one, with the same non-zero values (a padded entry
+    has the value 0 and adds nothing). Only ``@`` (with a vector or an ``n × m`` matrix),
+    ``shape``, :meth:`dense` and ``np.asarray`` are provided.
+    """
+
+    __slots__ = ("cols", "vals", "shape")
+
+    def __init__(self, cols: np.ndarray, vals: np.ndarray, shape: tuple[int, int]):
+        self.cols, self.vals, self.shape = cols, vals, (int(shape[0]), int(shape[1]))
+        for a in (self.cols, self.vals):
+            a.setflags(write=False)
+
+    @classmethod
+    def from_dense(cls, M) -> "RowSparse":
+        """The non-zeros of the dense matrix ``M``, row by row in column order."""
+        M = np.asarray(M, dtype=float)
+        rows, cols = np.nonzero(M)
+        counts = np.bincount(rows, minlength=M.shape[0])
+        k = max(int(counts.max(initial=0)), 1)
+        start = np.concatenate(([0], np.cumsum(counts)[:-1]))
+        slot = np.arange(rows.size) - start[rows]
+        C = np.zeros((M.shape[0], k), dtype=np.intp)
+        V = np.zeros((M.shape[0], k))
+        C[rows, slot], V[rows, slot] = cols, M[rows, cols]
+        return cls(C, V, M.shape)
+
+    def __matmul__(self, w):
+        w = np.asarray(w, dtype=float)
+        cols, vals = self.cols, self.vals
+        if w.ndim == 1:
+            out = vals[:, 0] * w[cols[:, 0]]
+            for j in range(1, cols.shape[1]):
+                out += vals[:, j] * w[cols[:, j]]
+            return out
+        out = vals[:, 0, None] * w[cols[:, 0]]
+        for j in range(1, cols.shape[1]):
+            out += vals[:, j, None] * w[cols[:, j]]
+        return out
+
+    def dense(self) -> np.ndarray:
+        """The ``n × m`` matrix."""
+        M = np.zeros(self.shape)
+        r = np.repeat(np.arange(self.shape[0]), self.cols.shape[1])
+        np.add.at(M, (r, self.cols.ravel()), self.vals.ravel())
+        return M
+
+    def __array__(self, dtype=None, copy=None):
+        M = self.dense()
+        return M if dtype is None else M.astype(dtype, copy=False)
+
+    def __repr__(self) -> str:
+        return f"RowSparse(shape={self.shape}, per_row={self.cols.shape[1]})"
+
+
 def _direction(d) -> int:
     if d not in (-1, 1):
         raise InputError("direction", f"must be -1 or +1, got {d!r}")

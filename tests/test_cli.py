@@ -183,7 +183,7 @@ def test_injected_failure_exits_3_and_writes_partial(tmp_path, capsys, monkeypat
                     raise rollqp.SolverError("injected", method=self.name, status="test")
             return self.inner.solve(problem, warm=warm)
 
-    monkeypatch.setattr(rollqp.methods, "scene_method", lambda settings, coupled=False: Failing(real(settings, coupled)))
+    monkeypatch.setattr(rollqp.methods, "scene_method", lambda settings, coupled=False, **kw: Failing(real(settings, coupled, **kw)))
     out = tmp_path / "p.npz"
     assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 3, "exit 3 on a solver failure"
     err = capsys.readouterr().err

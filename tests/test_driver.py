@@ -168,8 +168,8 @@ def counting(monkeypatch):
     def install(fail_at_tangential=None):
         real = rollqp.methods.scene_method
 
-        def make(settings, coupled=False):
-            m = Counting(real(settings, coupled), fail_at_tangential)
+        def make(settings, coupled=False, **kw):
+            m = Counting(real(settings, coupled, **kw), fail_at_tangential)
             made.append(m)
             return m
         monkeypatch.setattr(rollqp.methods, "scene_method", make)

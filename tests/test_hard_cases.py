@@ -147,7 +147,7 @@ def failing_method(monkeypatch):
     import rollqp.methods
     make = rollqp.methods.scene_method
     monkeypatch.setattr(rollqp.methods, "scene_method",
-                        lambda settings, coupled=False: _FailingAt(make(settings, coupled), 5))
+                        lambda settings, coupled=False, **kw: _FailingAt(make(settings, coupled, **kw), 5))
 
 
 def test_driver_failure_names_the_step_and_keeps_completed_states(failing_method):

@@ -30,7 +30,6 @@ builds ``A_nn = A_tt`` and the coupling ``A_nt``, ``A_tn`` (eq. 26, 29) of a sce
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft
 from numpy.lib.stride_tricks import as_strided
 
 from ..errors import InputError
@@ -135,6 +134,7 @@ class ToeplitzOperator(Operator):
             raise InputError(name, "must be finite")
         P.flags.writeable = False
         self._P, self._r, self._n, self._ne = P, int(r), int(n), int(ne)
+        import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
         self._L = scipy.fft.next_fast_len(P.shape[1], real=True)
         self._Phat = scipy.fft.rfft(P, n=self._L, axis=1)
         self.name = name
@@ -170,6 +170,7 @@ class ToeplitzOperator(Operator):
         """``M x`` (eq. 25, 28) by zero-padded FFT: exact linear convolution, ``O(n log n)``."""
         x = np.asarray(x, dtype=float)
         u = self._gather(x)
+        import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
         uh = scipy.fft.rfft(u, n=self._L, axis=1)
         Phat = self._Phat if x.ndim == 1 else self._Phat[:, :, None]
         y = scipy.fft.irfft((Phat * uh).sum(axis=0), n=self._L, axis=0)
@@ -180,6 +181,7 @@ class ToeplitzOperator(Operator):
         y = np.asarray(y, dtype=float)
         nen, r, ne, L = self._P.shape[0], self._r, self._ne, self._L
         # c_a[m] = Σ_i P_a[i - m - k_min] y_i for m = r e: correlation via conj in Fourier space
+        import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
         yh = scipy.fft.rfft(y, n=L, axis=0)
         Phat = self._Phat if y.ndim == 1 else self._Phat[:, :, None]
         c = scipy.fft.irfft(np.conj(Phat) * yh[None], n=L, axis=1)

@@ -21,7 +21,50 @@ from ...errors import InputError
 from .ncp import slip_rows
 
 __all__ = ["ReducedSystem", "CoupledSystem", "coupled_system", "coupled_vectors", "CoupledFactors",
-           "direct_coupled_direction"]
+           "direct_coupled_direction", "runs", "partial_product", "PARTIAL_MIN"]
+
+#: From this many nodes the iteration multiplies only the blocks of ``K`` it needs
+#: (:func:`partial_product`); below, one dense product is cheaper than the bookkeeping.
+PARTIAL_MIN = 320
+#: Indices closer than this are one run (a block with a few needless zeros costs less than
+#: another BLAS call).
+RUN_GAP = 32
+#: More blocks than this: one dense product instead.
+MAX_BLOCKS = 12
+
+
+def runs(idx: np.ndarray, gap: int = RUN_GAP) -> list:
+    """The sorted indices ``idx`` as ``(start, stop)`` runs, gaps up to ``gap`` bridged."""
+    if idx.size == 0:
+        return []
+    brk = np.flatnonzero(np.diff(idx) > gap)
+    starts = idx[np.concatenate(([0], brk + 1))]
+    stops = idx[np.concatenate((brk, [idx.size - 1]))] + 1
+    return list(zip(starts.tolist(), stops.tolist()))
+
+
+def partial_product(K: np.ndarray, rows: np.ndarray, v: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """``(K @ v)[rows]`` for ``v`` zero outside the sorted indices ``cols``, by blocks of ``K`` (views, no copies).
+
+    The node sets of a contact step (the stick zone, the slip zones, the contact) are a few runs
+    of consecutive nodes, so the product costs ``|rows|·|cols|`` instead of ``n²``; a set in more
+    than :data:`MAX_BLOCKS` blocks takes the dense product.
+    """
+    out = np.zeros(rows.size)
+    if rows.size == 0 or cols.size == 0:
+        return out
+    rr, cr = runs(rows), runs(cols)
+    if len(rr) * len(cr) > MAX_BLOCKS:
+        return (K @ v)[rows]
+    i0 = 0
+    for a, b in rr:
+        acc = K[a:b, cr[0][0]:cr[0][1]] @ v[cr[0][0]:cr[0][1]]
+        for c0, c1 in cr[1:]:
+            acc += K[a:b, c0:c1] @ v[c0:c1]
+        i1 = i0 + int(np.searchsorted(rows[i0:], b))
+        out[i0:i1] = acc[rows[i0:i1] - a]
+        i0 = i1
+    return out
 
 
 class ReducedSystem:
@@ -35,7 +78,8 @@ class ReducedSystem:
     few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "_base", "factorizations", "updates")
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "unit", "partial", "last", "_base", "factorizations",
+                 "updates")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
     #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
@@ -44,7 +88,7 @@ class ReducedSystem:
     #: Below this many free nodes a new factorization is cheaper than the bordered solve.
     UPDATE_MIN_SIZE = 64
 
-    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale):
+    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale, unit=1.0):
         n = fhat.size
         self.A, self.f, self.Ahat, self.fhat, self.r = A, f, Ahat, fhat, r
         K = np.empty((n, n + 1))
@@ -52,6 +96,11 @@ class ReducedSystem:
         K[:, n] = r * last_column
         self.K = K
         self.K_nl = np.ascontiguousarray(K[:, :n])
+        #: ``K_nl x̂ = unit · (A x)`` for a traction ``x`` in the problem's units (``x̂ = x/p0``)
+        self.unit = (r / t_scale) * unit
+        self.partial = n >= PARTIAL_MIN
+        #: ``(x, A x)`` of the last solution: the next step, warm-started from ``x``, needs no new product
+        self.last = None
         self._base = {}  # with_load -> (mask, free, position of each node in free or -1, lu, piv)
         self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
         self.updates = 0  # directions solved by a Schur complement on an older factorization
@@ -92,7 +141,7 @@ class ReducedSystem:
         pos = np.full(n, -1)
         pos[free] = np.arange(nf)
         self.factorizations += 1
-        return m.copy(), free, pos, lu, piv, {}
+        return m.copy(), free, pos, lu, piv, _Store(nf + with_load)
 
     def direction(self, mask, phi, with_load):
         r"""The Newton direction ``d``: ``J d = −Φ`` solved on the free nodes (eq. 80).
@@ -126,7 +175,7 @@ class ReducedSystem:
         m = mask[:n]
         base = self._base.get(with_load)
         if base is not None:
-            m0, free0, pos0, lu, piv, cols = base
+            m0, free0, pos0, lu, piv, store = base
             released = np.flatnonzero(m0 & ~m)
             added = np.flatnonzero(m & ~m0)
             k = released.size + added.size
@@ -138,19 +187,14 @@ class ReducedSystem:
             if base is None:
                 return None
             self._base[with_load] = base
-            m0, free0, pos0, lu, piv, cols = base
+            m0, free0, pos0, lu, piv, store = base
             released = added = np.empty(0, dtype=int)
             k = 0
         d = np.empty(K.shape[1])
         pinned = np.flatnonzero(~m)
         d[pinned] = -phi[pinned]
         known = np.flatnonzero(~m & ~m0)  # pinned now and not in the factored set
-        if known.size:
-            e = np.zeros(K.shape[1])
-            e[known] = d[known]
-            Ke = K @ e
-        else:
-            Ke = np.zeros(n)
+        Ke = self._known_product(K, d, known, free0, added)
         nf0 = free0.size
         r0 = np.empty(nf0 + with_load)
         r0[:nf0] = -phi[free0] - Ke[free0]
@@ -158,53 +202,79 @@ class ReducedSystem:
             r0[nf0] = -phi[n] - self.fhat[known] @ d[known]
         if r0.size == 0 and k == 0:
             return d
+        if k:
+            return self._bordered(K, phi, d, r0, Ke, base, added, released, with_load)
         u0, info = dgetrs(lu, piv, r0)
         if info != 0:
             return None
-        if k == 0:
-            d[free0] = u0[:nf0]
-            if with_load:
-                d[n] = u0[nf0]
-            return d
-        return self._bordered(K, phi, d, u0, Ke, base, added, released, with_load)
+        d[free0] = u0[:nf0]
+        if with_load:
+            d[n] = u0[nf0]
+        return d
 
-    def _bordered(self, K, phi, d, u0, Ke, base, added, released, with_load):
-        """The direction on the factors of another free set, bordered by the rows and columns of
-        the ``added`` and ``released`` nodes (:meth:`direction`); ``None`` if singular."""
+    def _known_product(self, K, d, known, free0, added):
+        """``K e`` with ``e = d`` on the ``known`` nodes and 0 elsewhere, on the rows the solve reads
+        (``free0`` and ``added``; the others are left 0)."""
         n = self.fhat.size
-        m0, free0, pos0, lu, piv, cols = base
+        if known.size == 0:
+            return np.zeros(n)
+        e = np.zeros(K.shape[1])
+        e[known] = d[known]
+        if not self.partial:
+            return K @ e
+        Ke = np.zeros(n)
+        rows = np.sort(np.concatenate((free0, added)))  # disjoint: added is outside the factored set
+        Ke[rows] = partial_product(K, rows, e, known[e[known] != 0.0])
+        return Ke
+
+    def _bordered(self, K, phi, d, r0, Ke, base, added, released, with_load):
+        """The direction on the factors of another free set, bordered by the rows and columns of
+        the ``added`` and ``released`` nodes (:meth:`direction`; ``r0`` its right-hand side on the
+        factored set); ``None`` if singular."""
+        n = self.fhat.size
+        m0, free0, pos0, lu, piv, store = base
         nf0 = free0.size
         k = released.size + added.size
         # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z.
-        # The columns of Z are kept per node (``cols``): as the set drifts away from the factored
-        # one, each step adds a node or two, and only their columns cost triangular solves.
+        # The columns of Z, the rows C of the added nodes and their products C Z are kept per node
+        # (``store``): as the set drifts away from the factored one, each step adds a node or two,
+        # and only theirs cost triangular solves and products. The solve for u0 = M0⁻¹ r0 takes the
+        # new columns along (one pass over the factors).
         na = added.size
         keys = added.tolist() + [-1 - i for i in released.tolist()]
-        missing = [c for c in keys if c not in cols]
+        missing = [c for c in keys if c not in store.cslot]
+        W = np.zeros((nf0 + with_load, 1 + len(missing)), order="F")
+        W[:, 0] = r0
         if missing:
-            order = [c for c in missing if c >= 0] + [c for c in missing if c < 0]  # W's columns
-            W = np.zeros((nf0 + with_load, len(missing)), order="F")
-            ma = np.array([c for c in order if c >= 0], dtype=int)
-            mr = np.array([-1 - c for c in order if c < 0], dtype=int)
-            W[:nf0, :ma.size] = K[np.ix_(free0, ma)]
+            ma = np.array([c for c in missing if c >= 0], dtype=int)
+            mr = np.array([-1 - c for c in missing if c < 0], dtype=int)
+            order = ma.tolist() + [-1 - i for i in mr.tolist()]  # W's columns
+            W[:nf0, 1:1 + ma.size] = K[np.ix_(free0, ma)]
             if with_load:
-                W[nf0, :ma.size] = self.fhat[ma]
-            W[pos0[mr], ma.size + np.arange(mr.size)] = 1.0
-            Zm, info = dgetrs(lu, piv, W)
-            if info != 0:
-                return None
-            for j, c in enumerate(order):
-                cols[c] = Zm[:, j]
-        Z = np.column_stack([cols[c] for c in keys])
+                W[nf0, 1:1 + ma.size] = self.fhat[ma]
+            W[pos0[mr], 1 + ma.size + np.arange(mr.size)] = 1.0
+        X, info = dgetrs(lu, piv, W)
+        if info != 0:
+            return None
+        u0 = X[:, 0]
+        if missing:
+            store.add_columns(order, X[:, 1:])
+        new_rows = [a for a in added.tolist() if a not in store.rslot]
+        if new_rows:
+            rows = np.empty((len(new_rows), nf0 + with_load))
+            rows[:, :nf0] = K[np.ix_(new_rows, free0)]
+            if with_load:
+                rows[:, nf0] = K[new_rows, n]
+            store.add_rows(new_rows, rows)
+        cs = [store.cslot[c] for c in keys]
+        rs = [store.rslot[a] for a in added.tolist()]
+        Z = store.Z[:, cs]
         S = np.empty((k, k))
-        Ca = K[np.ix_(added, free0)]
-        S[:na] = -(Ca @ Z[:nf0])
-        if with_load:
-            S[:na] -= np.outer(K[added, n], Z[nf0])
+        S[:na] = -store.products(rs, cs)
         S[na:] = -Z[pos0[released]]
         S[:na, :na] += K[np.ix_(added, added)]
         Cu0 = np.empty(k)
-        Cu0[:na] = Ca @ u0[:nf0] + (K[added, n] * u0[nf0] if with_load else 0.0)
+        Cu0[:na] = store.R[rs] @ u0
         Cu0[na:] = u0[pos0[released]]
         rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu0
         try:
@@ -219,6 +289,61 @@ class ReducedSystem:
             d[n] = u[nf0]
         self.updates += 1
         return d
+
+
+class _Store:
+    """What the bordered solves of one factorization keep (:meth:`ReducedSystem._bordered`): the columns
+    ``Z_c = M0⁻¹ w_c`` per key (an added node ``a >= 0``, a released node ``−1 − i``), the rows
+    ``C_a = [K_{a,F0}, k_a]`` of the added nodes, and their products ``G = C Z``, each computed once."""
+
+    def __init__(self, m):
+        self.m = m
+        self.cslot, self.rslot = {}, {}
+        self.Z = np.empty((m, 16), order="F")
+        self.R = np.empty((16, m))
+        self.G = np.empty((16, 16))
+        self.filled = np.zeros(16, dtype=int)  # per row slot: the column slots of G computed
+
+    def add_columns(self, keys, X):
+        c0 = len(self.cslot)
+        if c0 + len(keys) > self.Z.shape[1]:
+            cap = 2 * (c0 + len(keys))
+            Z = np.empty((self.m, cap), order="F")
+            Z[:, :c0] = self.Z[:, :c0]
+            self.Z = Z
+            G = np.empty((self.G.shape[0], cap))
+            G[:, :c0] = self.G[:, :c0]
+            self.G = G
+        self.Z[:, c0:c0 + len(keys)] = X
+        for j, c in enumerate(keys):
+            self.cslot[c] = c0 + j
+
+    def add_rows(self, nodes, rows):
+        r0 = len(self.rslot)
+        if r0 + len(nodes) > self.R.shape[0]:
+            cap = 2 * (r0 + len(nodes))
+            R = np.empty((cap, self.m))
+            R[:r0] = self.R[:r0]
+            self.R = R
+            G = np.empty((cap, self.G.shape[1]))
+            G[:r0] = self.G[:r0]
+            self.G = G
+            self.filled = np.concatenate([self.filled, np.zeros(cap - self.filled.size, dtype=int)])
+        self.R[r0:r0 + len(nodes)] = rows
+        self.filled[r0:r0 + len(nodes)] = 0
+        for j, a in enumerate(nodes):
+            self.rslot[a] = r0 + j
+
+    def products(self, rs, cs):
+        """``G[rs][:, cs] = C Z``, the missing entries computed first."""
+        nc = len(self.cslot)
+        rs = np.asarray(rs, dtype=int)
+        lag = rs[self.filled[rs] < nc]
+        if lag.size:
+            c0 = int(self.filled[lag].min())
+            self.G[np.ix_(lag, np.arange(c0, nc))] = self.R[lag] @ self.Z[:, c0:nc]
+            self.filled[lag] = nc
+        return self.G[np.ix_(rs, cs)]
 
 
 

@@ -30,6 +30,8 @@ class NormalNCP:
     """The normal rows ``min(p̂, r ĝ)`` (eq. 51–53, cases eq. 82–84)."""
 
     kind = "normal"
+    #: Rows whose ``y`` enters ``Φ``: all (``None``).
+    needs = None
 
     def phi(self, x, y):
         """``Φ_i = min(p̂_i, r ĝ_i)`` (eq. 52)."""
@@ -57,6 +59,8 @@ class TangentialNCP:
     def __init__(self, b):
         self.b = b
         self.sep = b <= 0.0
+        #: Rows whose ``y`` enters ``Φ``: a zero bound gives ``Φ_i = t̂_i`` whatever ``r ŝ_i`` (eq. 85).
+        self.needs = ~self.sep
 
     def phi(self, x, y):
         """``Φ_i = t̂_i − Proj_[−b_i, b_i](t̂_i − r ŝ_i)`` (eq. 60)."""

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import SolverError
+from .linear import partial_product
 from .ncp import NormalNCP, TangentialNCP
 
 __all__ = ["ALPHA_MIN", "Stalled", "not_converged", "solve_uncoupled", "solve_normal", "solve_tangential",
@@ -94,11 +95,13 @@ def solve_normal(meth, pb, warm, t0):
     dhat_fixed = None if with_load else pb.delta / u0
     z, start = _normal_start(pb, sys_, warm)
     k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
-    z, it, info = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm")
-    p = z[:n] * sc.stress
+    known = _known_product(sys_, warm.p if start == "warm" else None)
+    z, it, info, p, Ap = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
     delta = z[n] * u0 if with_load else pb.delta
     info["start"] = start
-    return meth.finish(pb.solution(p, delta), it, info, t0)
+    sol = pb.solution(p, delta, Ap=Ap)
+    sys_.last = (sol.p, Ap)
+    return meth.finish(sol, it, info, t0)
 
 
 def solve_tangential(meth, pb, warm, t0):
@@ -120,28 +123,56 @@ def solve_tangential(meth, pb, warm, t0):
             xi0 = warm.xi / sc.slip
     z = np.append(t, xi0) if with_load else t.copy()
     k0 = r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
-    z, it, info = iterate(meth, pb, sys_, z, k0, Qhat, TangentialNCP(b), start == "warm")
-    tt = z[:n] * sc.stress
+    known = _known_product(sys_, warm.t if start == "warm" else None)
+    z, it, info, tt, At = iterate(meth, pb, sys_, z, k0, Qhat, TangentialNCP(b), start == "warm", known)
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
-    return meth.finish(pb.solution(tt, xi), it, info, t0)
+    sol = pb.solution(tt, xi, At=At)
+    sys_.last = (sol.t, At)
+    info["At"] = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
+    return meth.finish(sol, it, info, t0)
+
+
+def _known_product(sys_, x):
+    """``(x, A x)`` if the system's last solution was the traction ``x`` (the warm start), else None."""
+    last = sys_.last
+    if x is None or last is None or not (last[0] is x or np.array_equal(last[0], x)):
+        return None
+    return last
 
 
 # ------------------------------------------------------------------------------ the iteration
-class _Iterate:
-    """The state of one GNMls iteration (Steps 2–7): the iterate, ``y = K z + k0``, ``Φ`` and the counts."""
+#: Iterations between two products ``A x`` of the iterate: in between ``y`` is carried along
+#: (``y ← y + α K d``), which bounds the drift of its round-off.
+REFRESH_EVERY = 16
 
-    def __init__(self, meth, pb, sys_, z, k0, load, ncp):
+
+class _Iterate:
+    """The state of one GNMls iteration (Steps 2–7): the iterate, ``y = K z + k0``, ``Φ`` and the counts.
+
+    ``y`` is linear in ``z``: it is evaluated from a product ``A x`` of the traction (``x`` in the
+    problem's units, ``Ax`` its product; the last step's, if the iteration starts from it), then
+    carried along each step by ``α K d`` (:meth:`Kd`). The stopping test is passed only on a
+    ``y`` evaluated from a product of the iterate itself (:meth:`refresh`), whose ``A x`` the
+    step's solution then reuses.
+    """
+
+    def __init__(self, meth, pb, sys_, z, k0, load, ncp, start=None):
         self.meth, self.pb, self.sys, self.ncp = meth, pb, sys_, ncp
         self.n = pb.n
         self.load = load
         self.with_load = load is not None
         self.K = sys_.matrices(self.with_load)
         self.k0 = k0
+        self.needs = getattr(ncp, "needs", None)
+        self.all_rows = np.arange(self.n)
         self.z = z
         self.x = z[:self.n]
-        self.y = self.K @ z + k0
-        self.phi = self.residual(self.x, self.y)
+        if start is None:
+            self.refresh()
+        else:  # the traction of the last step and its product A x
+            self.xphys, self.Ax = start
+            self._y_from_product()
         self.history, self.merits, self.steps = [], [], []
         self.backtracks = self.nonmono = self.shifts = 0
 
@@ -149,11 +180,50 @@ class _Iterate:
         ph = self.ncp.phi(x, y)
         return np.append(ph, self.sys.fhat @ x - self.load) if self.with_load else ph
 
-    def update(self, z):
+    def refresh(self):
+        """``y`` and ``Φ`` from a new product ``A x`` of the iterate."""
+        x = self.xphys = self.z[:self.n] * self.pb.scales.stress
+        if self.sys.partial:  # the columns where x ≠ 0 (the contact: a zero traction outside it)
+            self.Ax = partial_product(self.pb.A.dense(), self.all_rows, x, np.flatnonzero(x))
+        else:
+            self.Ax = self.pb.A @ x
+        self._y_from_product()
+
+    def _y_from_product(self):
+        y = self.sys.unit * self.Ax + self.k0
+        if self.with_load:
+            y += self.K[:, self.n] * self.z[self.n]
+        self.y = y
+        self.fresh, self.since = True, 0
+        self.phi = self.residual(self.x, self.y)
+
+    def update(self, z, alpha, Kd):
+        """The iterate ``z`` reached by the step ``α d``, with ``K d`` (:meth:`Kd`)."""
         self.z = z
         self.x = z[:self.n]
-        self.y = self.K @ z + self.k0  # fresh, not accumulated: no drift of the linear part
+        self.since += 1
+        if self.since >= REFRESH_EVERY or not self.sys.partial:  # small n: a product costs less than carrying y
+            self.refresh()
+            return
+        self.y = self.y + alpha * Kd
+        self.fresh = False
         self.phi = self.residual(self.x, self.y)
+
+    def Kd(self, d, mask):
+        """``K d`` on the rows ``Φ`` reads. On the free rows (``mask``) the Newton equations give it,
+        ``K_F d = −Φ_F``; the others are multiplied by the blocks of ``K`` they need (the columns
+        where ``d ≠ 0``); rows whose ``y`` does not enter ``Φ`` (a zero friction bound) are left 0."""
+        sys_ = self.sys
+        if not sys_.partial:
+            return self.K @ d
+        n = self.n
+        F = mask[:n]
+        Kd = np.zeros(n)
+        Kd[F] = -self.phi[:n][F]
+        rows = ~F if self.needs is None else ~F & self.needs
+        rows = np.flatnonzero(rows)
+        Kd[rows] = partial_product(self.K, rows, d, np.flatnonzero(d))
+        return Kd
 
     def rows(self, mask):
         """The node rows of the pseudo-Jacobian (eq. 80–90) in ``mask``; a degenerate iterate (no
@@ -166,20 +236,22 @@ class _Iterate:
             except SolverError as err:
                 raise SolverError(err.message, method=self.meth.name, status=err.status) from None
             self.z[n] += dy / self.K[j, n]
-            self.y = self.K @ self.z + self.k0
-            self.phi = self.residual(self.x, self.y)
+            if self.fresh:  # only δ̂/ξ̂ moved: y from the same product
+                self._y_from_product()
+            else:
+                self.y = self.y + self.K[:, n] * (dy / self.K[j, n])
+                self.phi = self.residual(self.x, self.y)
             m = ncp.mask(self.x, self.y)
             m[j] = True
             self.shifts += 1
         mask[:n] = m
 
-    def line_search(self, d, warm):
+    def line_search(self, d, Kd, warm):
         """Armijo (eq. 75–78, ``s = 1``): ``α = ρ^m``, the first with ``θ(z + αd) <= (1 − 2σα) θ(z)``;
         below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start)."""
         meth = self.meth
         rho, two_sigma = meth.rho, 2.0 * meth.sigma
         dx = d[:self.n]
-        Kd = self.K @ d
         theta = self.merits[-1]
         alpha = 1.0
         while True:
@@ -195,20 +267,24 @@ class _Iterate:
                 return 1.0
 
 
-def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False):
+def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     """GNMls Steps 2–7 on ``Φ(z) = [φ(x, y); f̂ᵀx − load]`` with ``y = K z + k0``.
 
     ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z);
-    ``ncp`` gives ``φ`` and its node cases (:class:`~.ncp.NormalNCP`, :class:`~.ncp.TangentialNCP`).
-    Returns ``(z, iterations, info)``.
+    ``ncp`` gives ``φ`` and its node cases (:class:`~.ncp.NormalNCP`, :class:`~.ncp.TangentialNCP`);
+    ``start``: ``(x, A x)`` of the start in the problem's units, if the product is known.
+    Returns ``(z, iterations, info, x, A x)``, ``x`` the solution's traction in the problem's units.
     """
     n, r = pb.n, sys_.r
-    st = _Iterate(meth, pb, sys_, z, k0, load, ncp)
+    st = _Iterate(meth, pb, sys_, z, k0, load, ncp, start)
     stop = meth.tolerance * min(1.0, r)
     mask = np.ones(n + 1 if st.with_load else n, dtype=bool)  # last entry: load row (always the JK row)
     it = 0
     while True:
         nrm = float(np.max(np.abs(st.phi)))
+        if nrm <= stop and not st.fresh:  # converged on the carried y: test on the iterate's own product
+            st.refresh()
+            nrm = float(np.max(np.abs(st.phi)))
         st.history.append(nrm)
         st.merits.append(0.5 * float(st.phi @ st.phi))
         if nrm <= stop:
@@ -221,13 +297,14 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False):
         if d is None or not np.all(np.isfinite(d)):
             raise SolverError(f"the {pb.kind} Newton matrix is singular",
                               method=meth.name, status="singular", iterations=it, residual=nrm)
-        alpha = st.line_search(d, warm)
+        Kd = st.Kd(d, mask)
+        alpha = st.line_search(d, Kd, warm)
         st.steps.append(alpha)
-        st.update(st.z + alpha * d)  # eq. 79
+        st.update(st.z + alpha * d, alpha, Kd)  # eq. 79
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
-    return st.z, it, info
+    return st.z, it, info, st.xphys, st.Ax
 
 
 # ------------------------------------------------------------------------------ the creepage search
