@@ -343,6 +343,9 @@ class _March:
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
         change = np.inf
         state = start.state
+        sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
+        if sweeps is not None:
+            sweeps(True)
         for _ in range(max_steps):
             previous = state
             state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
@@ -351,8 +354,12 @@ class _March:
             if not self.fixed:
                 change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
             if change < STEADY_TOL:
+                if sweeps is not None and sweeps(False):
+                    continue  # then full steps (converged alternation) until steady again
                 break
         else:
+            if sweeps is not None:
+                sweeps(False)
             raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
                               f"(last change {change:.2e} mu p0)", method=self.method.name, step=0)
         return self.record(0, "rolling", 0.0, state, previous, problem, sol, cnt, P=P, shift=0.0, t0=t0)
