@@ -17,7 +17,11 @@ Sections (``--only`` names):
                20 … 320) at μ = 1e-4, and a dense sweep of constant meshes;
 * ``friction`` |ξ|/ξ_BJ against μ = 1e-4 … 0.3, both couplings;
 * ``signs``    A ↔ B and d = ±1: the signs of β, ξ and t;
-* ``newton``   where the Newton direct steady solve fails (free rolling at μ = 1e-4).
+* ``newton``   where the Newton direct steady solve fails (free rolling at μ = 1e-4);
+* ``start``    the coupled rolling start with the QP methods (issue 18): CONTACT's grid, μ = 0.05,
+               full coupling; time against ``newton``'s direct steady solve, the answer against it,
+               and the ways to reach the steady state that were measured (one N–T sweep per marching
+               step, Anderson acceleration, the splitting of the steady operator).
 
 The problem (CONTACT's examples/bentall.inp, Vollebregt & Kalker): R_A = R_B = 50 mm (R = 25 mm),
 aluminium body 1 = rollqp's A (G = 23000, ν = 0.31), steel body 2 = B (G = 82000, ν = 0.28),
@@ -41,6 +45,7 @@ from harness import table  # (pins BLAS first)
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.errors import SolverError
+from rollqp.methods.alternation import Alternation
 
 # CONTACT's bentall case (materials, load, grid), one copy with tests/test_bentall.py
 from rollqp.refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
@@ -244,8 +249,118 @@ def section_newton():
         print(f"\nTypical message: `{str(last)[:160]}…`\n")
 
 
+# =========================================================================== the coupled rolling start
+class FullAlternation(Alternation):
+    """The N–T alternation converged at every marching step of the rolling start (rollqp before issue 18)."""
+
+    single_sweeps = None  # rollqp.march then never switches to one sweep per step
+
+
+def _timed_run(s, method):
+    c0, t0 = time.process_time(), time.perf_counter()
+    r = rollqp.run(s, method=method)
+    return r, time.process_time() - c0, time.perf_counter() - t0
+
+
+def _sweeps(r):
+    """N–T sweeps of the rolling start (``iterations`` of state 0: the alternation's outer iterations; each
+    sweep is two QPs here, the constant elements' F·A being symmetric)."""
+    return int(r.arrays()["iterations"][0])
+
+
+def _distance(r, ref, s):
+    a, b = r.arrays(), ref.arrays()
+    dp = np.max(np.abs(a["pn"][0] - b["pn"][0])) / s.p0
+    dt = np.max(np.abs(a["pt"][0] - b["pt"][0])) / (s.contact.friction * s.p0)
+    return max(dp, dt), abs(float(a["creepage"][0]) / float(b["creepage"][0]) - 1)
+
+
+def steady_map(s, name):
+    """``G(t)``: one N–T sweep of a marching step from the shear ``t`` (history from ``w(p, t)``), and the
+    braked starting state; public API only (rollqp.march.prepare, SceneOperators)."""
+    from rollqp.march import prepare
+    _, meth, ops = prepare(s.replace(**{"load.start": "braked", "discretization.distance": 0.0}), name)
+    start = next(rollqp.march(s.replace(**{"load.start": "braked", "discretization.distance": 0.0}), name))
+    inner, M, P = meth.inner, ops.history(), float(s.normal_load(0.0))
+    warm, count = {"n": start.state.nsol, "t": start.state.tsol}, [0]
+
+    def G(t):
+        pb = ops.coupled_step(P, np.zeros(ops.n), s.dq, Q=0.0)
+        nsol = inner.solve(pb.normal_half(t), warm=warm["n"])
+        pb = ops.coupled_step(P, -(M @ ops.w(nsol.p, t)), s.dq, Q=0.0)
+        tsol = inner.solve(pb.tangential_half(nsol.p), warm=warm["t"])
+        warm["n"], warm["t"] = nsol, tsol
+        count[0] += 2
+        return tsol.t
+
+    return G, start.state.t, ops, count
+
+
+def anderson(G, x, scale, memory, budget, tol=1e-10):
+    """Anderson acceleration (type II, Walker & Ni 2011) of ``x = G(x)``: ``(evaluations, best residual)``."""
+    dX, dF, prev, best = [], [], None, np.inf
+    for k in range(budget):
+        gx = G(x)
+        f = gx - x
+        r = float(np.max(np.abs(f))) / scale
+        best = min(best, r)
+        if r < tol:
+            return k + 1, best
+        if prev is not None and memory:
+            dX.append(gx - prev[0])
+            dF.append(f - prev[1])
+            del dX[:-memory], dF[:-memory]
+        prev = (gx, f)
+        if dF:
+            gamma = np.linalg.lstsq(np.array(dF).T, f, rcond=None)[0]
+            x = gx - np.array(dX).T @ gamma
+        else:
+            x = gx
+    return budget, best
+
+
+def section_start():
+    s = contact_grid(0.05, "full")
+    print("#### The coupled rolling start with the QP methods (CONTACT's grid, 216 constant elements, μ = 0.05, "
+          "full coupling)\n")
+    print("`newton` solves the steady problem directly; the QP methods march the transient at constant loads "
+          "until max|Δt| per step < 1e-8 μp0 (rollqp.march's rolling start). Since issue 18 the march makes one "
+          "N–T sweep per step and ends with converged steps; `full alternation` converges the alternation at every "
+          "step (before). Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete "
+          "state: constant elements, Δq = Le). CPU seconds, one process; the machine may be loaded.\n")
+    ref, cpu_ref, wall_ref = _timed_run(s, "newton")
+    rows = [["`newton` (direct steady solve)", f"{cpu_ref:.2f}", f"{wall_ref:.2f}", "1", "–", "0", "0"]]
+    cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, full alternation", FullAlternation(
+        rollqp.methods.get_method("qp-osqp", tolerance=s.solver.tolerance))), ("`qp-clarabel`", "qp-clarabel")]
+    for label, method in cases:
+        r, cpu, wall = _timed_run(s, method)
+        dist, dxi = _distance(r, ref, s)
+        rows.append([label, f"{cpu:.2f}", f"{wall:.2f}", f"{cpu / cpu_ref:.0f}", _sweeps(r), f"{dist:.1e}",
+                     f"{dxi:.1e}"])
+    print(table(["method", "CPU [s]", "wall [s]", "CPU / newton", "N–T sweeps (state 0)", "distance from newton",
+                 "|ξ/ξ_newton − 1|"], rows))
+    print()
+    G, t0, ops, count = steady_map(s, "qp-osqp")
+    scale = s.contact.friction * s.p0
+    rows = []
+    for memory in (0, 10, 60):
+        count[0] = 0
+        evals, best = anderson(G, t0.copy(), scale, memory, budget=400)
+        rows.append([memory, evals, count[0], f"{best:.1e}"])
+    print("Anderson acceleration of the marching map (one N–T sweep of a step as a function of the shear; "
+          "memory 0 is the plain march), `qp-osqp`, from the braked state, at most 400 evaluations:\n")
+    print(table(["memory", "evaluations", "QPs", "smallest max|G(t) − t|/(μp0) reached"], rows))
+    Atn, Att = ops.steady()
+    FA = ops.f[:, None] * Att.dense()
+    lam = np.linalg.eigvalsh(0.5 * (FA + FA.T))
+    print(f"\nThe steady slip operator's weighted symmetric part sym(F·d·D_up·A_tt) has eigenvalues from "
+          f"{lam[0] / lam[-1]:+.2f}·λ_max to λ_max: indefinite, so no convex QP has it as Hessian and the "
+          f"symmetric–skew splitting cannot be applied to the steady problem.\n")
+
+
 SECTIONS = {"contact": section_contact, "mesh": section_mesh, "limit": section_limit,
-            "friction": section_friction, "signs": section_signs, "newton": section_newton}
+            "friction": section_friction, "signs": section_signs, "newton": section_newton,
+            "start": section_start}
 
 
 def main(argv=None):
