@@ -341,8 +341,10 @@ class _March:
         cnt = Counters()
         M = ops.history()
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
+        from .methods.steady_start import accelerated_start
         change = np.inf
-        state = start.state
+        state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
+                                  delta=self.approach(0.0), tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
         sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
         if sweeps is not None:
             sweeps(True)
