@@ -250,8 +250,14 @@ def section_newton():
 
 
 # =========================================================================== the coupled rolling start
-class FullAlternation(Alternation):
-    """The N–T alternation converged at every marching step of the rolling start (rollqp before issue 18)."""
+class PlainMarch(Alternation):
+    """The rolling start without Anderson acceleration: one N–T sweep per marching step, then converged steps."""
+
+    accelerated_start = False
+
+
+class FullAlternation(PlainMarch):
+    """The plain march with the alternation converged at every step (rollqp before issue 18)."""
 
     single_sweeps = None  # rollqp.march then never switches to one sweep per step
 
@@ -262,12 +268,6 @@ def _timed_run(s, method):
     return r, time.process_time() - c0, time.perf_counter() - t0
 
 
-def _sweeps(r):
-    """N–T sweeps of the rolling start (``iterations`` of state 0: the alternation's outer iterations; each
-    sweep is two QPs here, the constant elements' F·A being symmetric)."""
-    return int(r.arrays()["iterations"][0])
-
-
 def _distance(r, ref, s):
     a, b = r.arrays(), ref.arrays()
     dp = np.max(np.abs(a["pn"][0] - b["pn"][0])) / s.p0
@@ -275,81 +275,61 @@ def _distance(r, ref, s):
     return max(dp, dt), abs(float(a["creepage"][0]) / float(b["creepage"][0]) - 1)
 
 
-def steady_map(s, name):
-    """``G(t)``: one N–T sweep of a marching step from the shear ``t`` (history from ``w(p, t)``), and the
-    braked starting state; public API only (rollqp.march.prepare, SceneOperators)."""
+def start_map(s, name):
+    """The marching map ``G`` of the QP rolling start (rollqp.methods.steady_start.sweep_map) from the braked
+    state of ``s``, with ``name``'s QP backend; ``(G, braked shear, operators, QP counter)``."""
     from rollqp.march import prepare
-    _, meth, ops = prepare(s.replace(**{"load.start": "braked", "discretization.distance": 0.0}), name)
-    start = next(rollqp.march(s.replace(**{"load.start": "braked", "discretization.distance": 0.0}), name))
-    inner, M, P = meth.inner, ops.history(), float(s.normal_load(0.0))
-    warm, count = {"n": start.state.nsol, "t": start.state.tsol}, [0]
+    from rollqp.methods.steady_start import sweep_map
+    braked = s.replace(**{"load.start": "braked", "discretization.distance": 0.0})
+    _, meth, ops = prepare(braked, name)
+    state = next(rollqp.march(braked, name)).state
+    G0 = sweep_map(meth, ops, state, P=float(s.normal_load(0.0)), Q=0.0, xi=None, dq=s.dq, M=ops.history())
+    count = [0]
 
     def G(t):
-        pb = ops.coupled_step(P, np.zeros(ops.n), s.dq, Q=0.0)
-        nsol = inner.solve(pb.normal_half(t), warm=warm["n"])
-        pb = ops.coupled_step(P, -(M @ ops.w(nsol.p, t)), s.dq, Q=0.0)
-        tsol = inner.solve(pb.tangential_half(nsol.p), warm=warm["t"])
-        warm["n"], warm["t"] = nsol, tsol
         count[0] += 2
-        return tsol.t
+        return G0(t)
 
-    return G, start.state.t, ops, count
-
-
-def anderson(G, x, scale, memory, budget, tol=1e-10):
-    """Anderson acceleration (type II, Walker & Ni 2011) of ``x = G(x)``: ``(evaluations, best residual)``."""
-    dX, dF, prev, best = [], [], None, np.inf
-    for k in range(budget):
-        gx = G(x)
-        f = gx - x
-        r = float(np.max(np.abs(f))) / scale
-        best = min(best, r)
-        if r < tol:
-            return k + 1, best
-        if prev is not None and memory:
-            dX.append(gx - prev[0])
-            dF.append(f - prev[1])
-            del dX[:-memory], dF[:-memory]
-        prev = (gx, f)
-        if dF:
-            gamma = np.linalg.lstsq(np.array(dF).T, f, rcond=None)[0]
-            x = gx - np.array(dX).T @ gamma
-        else:
-            x = gx
-    return budget, best
+    return G, state.t, ops, count
 
 
 def section_start():
     s = contact_grid(0.05, "full")
     print("#### The coupled rolling start with the QP methods (CONTACT's grid, 216 constant elements, μ = 0.05, "
           "full coupling)\n")
-    print("`newton` solves the steady problem directly; the QP methods march the transient at constant loads "
-          "until max|Δt| per step < 1e-8 μp0 (rollqp.march's rolling start). Since issue 18 the march makes one "
-          "N–T sweep per step and ends with converged steps; `full alternation` converges the alternation at every "
-          "step (before). Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete "
-          "state: constant elements, Δq = Le). CPU seconds, one process; the machine may be loaded.\n")
+    print("`newton` solves the steady problem directly; the QP methods reach it by marching (rollqp.march's "
+          "rolling start): the march map (one N–T sweep of a step of Δq = Le as a function of the shear) iterated "
+          "with Anderson acceleration (rollqp.methods.steady_start), then marching steps with the alternation "
+          "converged until max|Δt| per step < 1e-8 μp0. `plain march`: without Anderson (one sweep per step, then "
+          "converged steps); `full alternation`: the alternation converged at every step (rollqp before issue 18). "
+          "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
+          "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
     ref, cpu_ref, wall_ref = _timed_run(s, "newton")
     rows = [["`newton` (direct steady solve)", f"{cpu_ref:.2f}", f"{wall_ref:.2f}", "1", "–", "0", "0"]]
-    cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, full alternation", FullAlternation(
-        rollqp.methods.get_method("qp-osqp", tolerance=s.solver.tolerance))), ("`qp-clarabel`", "qp-clarabel")]
+    qp = lambda cls, name="qp-osqp": cls(rollqp.methods.get_method(name, tolerance=s.solver.tolerance))  # noqa: E731
+    cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, plain march", qp(PlainMarch)),
+             ("`qp-osqp`, full alternation (before)", qp(FullAlternation)), ("`qp-clarabel`", "qp-clarabel")]
     for label, method in cases:
         r, cpu, wall = _timed_run(s, method)
         dist, dxi = _distance(r, ref, s)
-        rows.append([label, f"{cpu:.2f}", f"{wall:.2f}", f"{cpu / cpu_ref:.0f}", _sweeps(r), f"{dist:.1e}",
-                     f"{dxi:.1e}"])
+        rows.append([label, f"{cpu:.2f}", f"{wall:.2f}", f"{cpu / cpu_ref:.0f}", int(r.arrays()["iterations"][0]),
+                     f"{dist:.1e}", f"{dxi:.1e}"])
     print(table(["method", "CPU [s]", "wall [s]", "CPU / newton", "N–T sweeps (state 0)", "distance from newton",
                  "|ξ/ξ_newton − 1|"], rows))
     print()
-    G, t0, ops, count = steady_map(s, "qp-osqp")
-    scale = s.contact.friction * s.p0
+    from rollqp.methods.steady_start import fixed_point
+    G, t0, ops, count = start_map(s, "qp-osqp")
     rows = []
-    for memory in (0, 10, 60):
+    for memory, start in ((0, None), (10, 0.1), (60, 1.0), (150, 1.0), (150, 0.1), (150, 0.01), (300, 0.1)):
         count[0] = 0
-        evals, best = anderson(G, t0.copy(), scale, memory, budget=400)
-        rows.append([memory, evals, count[0], f"{best:.1e}"])
-    print("Anderson acceleration of the marching map (one N–T sweep of a step as a function of the shear; "
-          "memory 0 is the plain march), `qp-osqp`, from the braked state, at most 400 evaluations:\n")
-    print(table(["memory", "evaluations", "QPs", "smallest max|G(t) − t|/(μp0) reached"], rows))
+        _, evals, best = fixed_point(G, t0.copy(), s.contact.friction * s.p0, target=1e-10, memory=memory,
+                                     anderson_from=start if start is not None else 1.0, patience=800,
+                                     max_evaluations=800)
+        rows.append([memory or "0 (plain)", "–" if start is None else f"{start:g}", evals, count[0], f"{best:.1e}"])
+    print("Anderson acceleration of the march map, `qp-osqp`, from the braked state: memory (differences kept), "
+          "residual max|G(t) − t|/(μp0) below which it extrapolates, map evaluations to 1e-10 (at most 800), and "
+          "the smallest residual reached:\n")
+    print(table(["memory", "from residual", "evaluations", "QPs", "smallest residual"], rows))
     Atn, Att = ops.steady()
     FA = ops.f[:, None] * Att.dense()
     lam = np.linalg.eigvalsh(0.5 * (FA + FA.T))

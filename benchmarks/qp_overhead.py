@@ -10,10 +10,12 @@ On the built-in scene ``cattaneo-carter`` (the paper's §6.1.1: 40 quadratic ele
 rolling step of ``rollqp.march`` is timed as the march makes it (loads, history vector, the step
 problem, the QPs, rollqp's residuals, ``w``; as :func:`harness.step_records` does), and beside it the wall
 time spent inside the solver's own ``solve()`` calls during that step (``info["solve_call_time"]``
-of the step's solution; a rollqp without that key is measured by timing ``osqp.OSQP.solve``, and
+and ``info["solve_call_cpu"]`` of the step's solution; a rollqp without that key is measured by timing ``osqp.OSQP.solve``, and
 for Clarabel by its ``solver_time``, which there is the wall time of ``solve()``). The share
 outside the solver is ``1 − solve calls / step``: median over the steps, then over the repeats, in
-which the backends alternate (``harness.interleaved``). Prints a markdown table.
+which the backends alternate (``harness.interleaved``), in CPU time (``time.process_time``, which a
+loaded machine does not inflate; the solvers run on one thread) and in wall time. Prints a
+markdown table.
 """
 from __future__ import annotations
 
@@ -31,22 +33,23 @@ SCENE = "cattaneo-carter"
 
 
 class OsqpCallTimer:
-    """Wall time inside ``osqp.OSQP.solve`` while active (for a rollqp that does not report it)."""
+    """Wall and CPU time inside ``osqp.OSQP.solve`` while active (for a rollqp that does not report them)."""
 
     def __init__(self):
         import osqp
-        self.cls, self.total = osqp.OSQP, 0.0
+        self.cls, self.wall, self.cpu = osqp.OSQP, 0.0, 0.0
         self.original = self.cls.solve
 
     def __enter__(self):
         original = self.original
 
         def timed(obj, *args, **kw):
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             try:
                 return original(obj, *args, **kw)
             finally:
-                self.total += time.perf_counter() - t0
+                self.wall += time.perf_counter() - t0
+                self.cpu += time.process_time() - c0
 
         self.cls.solve = timed
         return self
@@ -55,12 +58,13 @@ class OsqpCallTimer:
         self.cls.solve = self.original
 
 
-def call_time(sol, name, timer, before):
-    """Wall time in the solver's solve calls during one step (module docstring)."""
-    t = sol.info.get("solve_call_time")
-    if t is not None:
-        return float(t)
-    return timer.total - before if name == "qp-osqp" else float(sol.solver_time)
+def call_times(sol, name, timer, before):
+    """(wall, CPU) time in the solver's solve calls during one step (module docstring)."""
+    if "solve_call_time" in sol.info:
+        return float(sol.info["solve_call_time"]), float(sol.info["solve_call_cpu"])
+    if name == "qp-osqp":
+        return timer.wall - before[0], timer.cpu - before[1]
+    return float(sol.solver_time), float(sol.solver_time)
 
 
 def measure(name):
@@ -72,18 +76,21 @@ def measure(name):
         records = rollqp.march(scene, method=method)
         next(records)  # the starting state
         while True:
-            before = timer.total
+            before = (timer.wall, timer.cpu)
             t0, c0 = time.perf_counter(), time.process_time()
             rec = next(records, None)
             wall, cpu = time.perf_counter() - t0, time.process_time() - c0
             if rec is None:
                 break
             sol = rec.solution
-            calls = call_time(sol, name, timer, before)
-            rows.append((wall, cpu, calls, 1.0 - calls / wall, sol.info["qp_solves"], sol.residual))
+            calls, calls_cpu = call_times(sol, name, timer, before)
+            rows.append((wall, cpu, calls, calls_cpu, sol.info["qp_solves"], sol.residual))
     a = np.array(rows)
     return dict(step=float(np.median(a[:, 0])), cpu=float(np.median(a[:, 1])), calls=float(np.median(a[:, 2])),
-                outside=float(np.median(a[:, 3])), total_outside=float(1.0 - a[:, 2].sum() / a[:, 0].sum()),
+                calls_cpu=float(np.median(a[:, 3])), outside=float(np.median(1.0 - a[:, 2] / a[:, 0])),
+                outside_cpu=float(np.median(1.0 - a[:, 3] / np.maximum(a[:, 1], 1e-300))),
+                total_outside=float(1.0 - a[:, 2].sum() / a[:, 0].sum()),
+                total_outside_cpu=float(1.0 - a[:, 3].sum() / a[:, 1].sum()),
                 qps=float(np.median(a[:, 4])), all_qps=int(a[:, 4].sum()), steps=len(rows),
                 residual=float(a[:, 5].max()))
 
@@ -99,19 +106,22 @@ def main(argv=None) -> int:
     print()
     runs = interleaved(args.repeats, {b: b for b in backends}, measure)
     rows = []
+    keys = ("step", "cpu", "calls", "calls_cpu", "outside", "outside_cpu", "total_outside", "total_outside_cpu", "qps")
     for name in backends:
         rs = runs[name]
-        med = {k: float(np.median([r[k] for r in rs])) for k in ("step", "cpu", "calls", "outside", "total_outside",
-                                                                  "qps")}
-        rows.append((f"`{name}`", ms(med["step"]), ms(med["cpu"]), ms(med["calls"]), f"{med['qps']:.0f}",
+        med = {k: float(np.median([r[k] for r in rs])) for k in keys}
+        rows.append((f"`{name}`", ms(med["step"]), ms(med["cpu"]), ms(med["calls"]), ms(med["calls_cpu"]),
+                     f"{med['qps']:.0f}", f"{100 * med['outside_cpu']:.1f} %", f"{100 * med['total_outside_cpu']:.1f} %",
                      f"{100 * med['outside']:.1f} %", f"{100 * med['total_outside']:.1f} %",
                      f"{rs[0]['all_qps']}", f"{max(r['residual'] for r in rs):.1e}"))
     print(f"### The QP paths' overhead on `{SCENE}` (§6.1.1, 81 nodes)\n")
     print(f"{runs[backends[0]][0]['steps']} rolling steps per march; medians over the steps, then over "
           f"{args.repeats} repeat(s), the backends alternating. Times in ms. \"outside\": 1 − (time in the "
-          f"solver's solve calls)/(step wall time), per step (median) and over the whole march (Σ/Σ).\n")
-    print(table(["backend", "step wall", "step CPU", "in solve calls", "QPs per step", "outside, median step",
-                 "outside, whole march", "QPs in the march", "max residual"], rows))
+          f"solver's solve calls)/(the step's time), per step (median) and over the whole march (Σ/Σ), in CPU "
+          f"time (what a loaded machine does not inflate) and in wall time.\n")
+    print(table(["backend", "step wall", "step CPU", "in solve calls (wall)", "in solve calls (CPU)", "QPs per step",
+                 "outside, median step (CPU)", "outside, whole march (CPU)", "outside, median step (wall)",
+                 "outside, whole march (wall)", "QPs in the march", "max residual"], rows))
     return 0
 
 

@@ -61,8 +61,9 @@ class QPMethod:
     the backend's calls: data update, solve, retries), ``setups`` (solver objects built),
     ``retried`` (QPs solved again after a failed polish), ``splitting_changes`` (max change of
     ``x/p0`` from QP to QP: its ratios are the splitting's contraction), ``asymmetry``, ``operator``,
-    ``solve_call_time`` (wall time inside the solver's own solve calls, summed over the QPs; NaN for a
-    backend that does not report it: what rollqp adds to a step is the rest).
+    ``solve_call_time`` and ``solve_call_cpu`` (wall and CPU time inside the solver's own solve calls,
+    summed over the QPs; NaN for a backend that does not report them: what rollqp adds to a step is
+    the rest).
 
     One solver object is kept per constraint structure (:meth:`structure_key`) with the Hessian
     it was built for, recognized by its source (the Hessian array of the operator's memo,
@@ -147,7 +148,8 @@ class QPMethod:
         final.info.update(info)
         final.info.update(asymmetry=sp.asymmetry, operator="exact" if (exact or sp.asymmetry == 0) else "symmetrized",
                           qp_solves=stats["outer"], backend_time=stats["backend"], setups=stats["setups"],
-                          retried=stats["retried"], splitting_changes=stats["changes"], solve_call_time=stats["calls"])
+                          retried=stats["retried"], splitting_changes=stats["changes"], solve_call_time=stats["calls"],
+                          solve_call_cpu=stats["calls_cpu"])
         if not final.residual <= self.residual_limit:
             raise SolverError(f"the {problem.kind} QP solution's residual is above {self.residual_limit:.1e}",
                               method=self.name, status=status, residual=final.residual, iterations=stats["iterations"])
@@ -163,7 +165,8 @@ class QPMethod:
         """
         stress = problem.scales.stress
         q0, source = form.q, form.H  # the Hessian (from the operator's memo) identifies the solver object
-        stats = dict(iterations=0, solver_time=0.0, outer=0, backend=0.0, setups=0, retried=0, changes=[], calls=0.0)
+        stats = dict(iterations=0, solver_time=0.0, outer=0, backend=0.0, setups=0, retried=0, changes=[], calls=0.0,
+                     calls_cpu=0.0)
         change = np.inf
         x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
         while True:
@@ -175,6 +178,7 @@ class QPMethod:
             x, y, status, it, st, info = self._solve_form(form, x0, source)
             stats["backend"] += time.perf_counter() - tb
             stats["calls"] += float(info.get("solve_call_time", np.nan))
+            stats["calls_cpu"] += float(info.get("solve_call_cpu", np.nan))
             stats["setups"] += int(bool(info.get("built", False)))
             stats["retried"] += int(info.get("tries", 1) > 1)
             stats["iterations"] += int(it)

@@ -45,17 +45,18 @@ PATIENCE = 200
 
 def applies(method, ops) -> bool:
     """Whether :func:`accelerated_start` handles this method and scene: a QP backend (or the N–T
-    alternation of one) with Coulomb friction (a fixed μ), friction, and a fixed profile."""
+    alternation of one) whose ``accelerated_start`` attribute is not False (benchmarks switch it off to
+    measure the plain march), with Coulomb friction (a fixed μ), friction, and a fixed profile."""
     inner = method.inner if isinstance(method, Alternation) else method
-    return (isinstance(inner, QPMethod) and isinstance(ops.friction, float) and not ops.frictionless
+    return (isinstance(inner, QPMethod) and getattr(method, "accelerated_start", True) and isinstance(ops.friction, float) and not ops.frictionless
             and not ops.profiles_move and ops.coupled == isinstance(method, Alternation))
 
 
-def sweep_map(method, ops, state, counters, *, P, Q, xi, dq, M, delta=None):
+def sweep_map(method, ops, state, counters=None, *, P, Q, xi, dq, M, delta=None):
     """``G(t) -> (t_new, nsol, tsol)``: one marching step from the shear ``t`` (module docstring), each
     half warm-started from the previous evaluation (first from ``state``); its solves are counted in
-    ``counters`` (rollqp.march's ``Counters`` of the starting state: a coupled evaluation is one N–T
-    outer iteration, as in the alternation)."""
+    ``counters`` if given (rollqp.march's ``Counters`` of the starting state: a coupled evaluation is
+    one N–T outer iteration, as in the alternation)."""
     inner = method.inner if isinstance(method, Alternation) else method
     warm = {"n": state.nsol, "t": state.tsol}
     zero = np.zeros(ops.n)
@@ -72,7 +73,9 @@ def sweep_map(method, ops, state, counters, *, P, Q, xi, dq, M, delta=None):
             half = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi)
         tsol = inner.solve(half, warm=warm["t"])
         warm["n"], warm["t"] = nsol, tsol
-        if ops.coupled:  # a sweep's coupled residual is not the alternation's: not counted (as in the march)
+        if counters is None:
+            pass
+        elif ops.coupled:  # a sweep's coupled residual is not the alternation's: not counted (as in the march)
             counters.iterations += 1
             counters.inner_normal += nsol.iterations
             counters.inner_tangential += tsol.iterations
@@ -141,26 +144,40 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
     if not applies(method, ops):
         return state
     G = sweep_map(method, ops, state, counters, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
-    scale = ops.mu * ops.scales.stress
-    acc = Anderson(min(MEMORY, ops.n), ops.n)
-    x = np.asarray(state.t, dtype=float)
-    best, since = (np.inf, None), 0
-    for _ in range(max_evaluations):
-        gx, nsol, tsol = G(x)
+    best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
+                             max_evaluations=max_evaluations)
+    return state if best is None else _state(ops, state, best, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
+
+
+def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FROM, patience=PATIENCE,
+                max_evaluations=1000):
+    """Iterate ``x ← G(x)`` with Anderson acceleration below ``anderson_from`` (module docstring).
+
+    ``G(x)`` returns ``(G(x), *extra)``; the residual is ``max|G(x) − x|/scale``. Returns ``(best,
+    evaluations, best residual)`` with ``best = (x, G(x), *extra)`` of the smallest residual (None if
+    none was finite). ``memory = 0``: the plain iteration.
+    """
+    x = np.asarray(x, dtype=float)
+    acc = Anderson(min(memory, x.size), x.size) if memory else None
+    best, best_r, since, k = None, np.inf, 0, 0
+    while k < max_evaluations:
+        k += 1
+        gx, *extra = G(x)
         r = float(np.abs(gx - x).max()) / scale
         if not np.isfinite(r):
             break
-        since = 0 if r < 0.9 * best[0] else since + 1
-        if r < best[0]:
-            best = (r, (x, gx, nsol, tsol))
-        if r <= TARGET * tol or since >= PATIENCE:
+        since = 0 if r < 0.9 * best_r else since + 1
+        if r < best_r:
+            best, best_r = (x, gx, *extra), r
+        if r <= target or since >= patience:
             break
-        if r > ANDERSON_FROM or r > 1e3 * best[0]:  # far from steady, or the extrapolation went astray
-            acc.reset()
+        if acc is None or r > anderson_from or r > 1e3 * best_r:  # far from steady, or the extrapolation went astray
+            if acc is not None:
+                acc.reset()
             x = gx
         else:
             x = acc.next(x, gx)
-    return state if best[1] is None else _state(ops, state, best[1], P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
+    return best, k, best_r
 
 
 def _state(ops, start, best, *, P, Q, xi, dq, M, delta):
