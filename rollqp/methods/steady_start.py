@@ -8,13 +8,13 @@ with that shear (paper eq. 53), the history ``c = −M w(p, t)`` (eq. 37, 48), t
 at the new pressure (eq. 61/62) — one N–T sweep (paper §6.3), two QPs. The steady state is its
 fixed point, and the plain march ``t ← G(t)`` converges to it only linearly and slowly: a
 disturbance is carried through the stick zone by the rolling and decays by about 10× per 100
-steps of ``Δq = Le`` on the Bentall–Johnson coupled start (216 constant elements; 780 steps).
+steps of ``Δq = Le`` on the Bentall–Johnson coupled start (216 constant elements; 750 steps).
 
 :func:`accelerated_start` iterates the same map with Anderson acceleration (type II; Walker & Ni,
 SIAM J. Numer. Anal. 49 (2011); the extrapolation of the last ``m`` differences that minimizes
 the linearized residual): plain steps while the residual ``max|G(t) − t|/(μp0)`` is above
 :data:`ANDERSON_FROM` (far from steady the stick and slip zones still move, the map is not
-affine, and extrapolating across those kinks diverged), then Anderson with :data:`MEMORY`
+affine, and extrapolating across those kinks costs evaluations: :data:`ANDERSON_FROM`), then Anderson with :data:`MEMORY`
 differences. Every iterate it returns is a map's *output*, i.e. QP answers (each state solved
 by the QP backend); the march then continues with its own steps (N–T alternation converged)
 until a step changes ``t`` by less than its tolerance, so the state it keeps is a marching step
@@ -28,12 +28,14 @@ from ._qp import QPMethod
 from .alternation import Alternation
 
 #: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this. Measured on the
-#: Bentall–Johnson coupled start (216 constant elements, μ = 0.05, memory 150): map evaluations to
-#: 1e-11 from 1 (Anderson from the first step): 483; 1e-1: 327; 1e-2: 353; 1e-3: 387; plain: ~790.
+#: Bentall–Johnson coupled start (216 constant elements, μ = 0.05, memory 150; ``python
+#: benchmarks/bentall.py --only start``): map evaluations to 1e-10 from 1 (Anderson from the first
+#: step): 452; from 1e-1: 316; from 1e-2: 350; plain iteration: not within 800 (5e-9 after 800).
 ANDERSON_FROM = 0.1
 #: Differences kept (at most the number of nodes). The slow part of the march is transport through
-#: the stick zone (many modes near the unit circle): measured memory 10: no gain over the plain
-#: march; 60: diverged; 150: 327 evaluations; 300: 484.
+#: the stick zone (many modes near the unit circle): measured (same benchmark) memory 10 from 1e-1:
+#: 1.4e-7 after 800 evaluations, no better than the plain march; 60 from 1: 616; 150 from 1e-1: 316;
+#: 300 from 1e-1: 333.
 MEMORY = 150
 #: The fixed-point iteration stops at this fraction of the march's own tolerance (its verification
 #: steps then change ``t`` by far less than that tolerance), …
