@@ -17,7 +17,11 @@ Sections (``--only`` names):
                20 … 320) at μ = 1e-4, and a dense sweep of constant meshes;
 * ``friction`` |ξ|/ξ_BJ against μ = 1e-4 … 0.3, both couplings;
 * ``signs``    A ↔ B and d = ±1: the signs of β, ξ and t;
-* ``newton``   where the Newton direct steady solve fails (free rolling at μ = 1e-4).
+* ``newton``   where the Newton direct steady solve fails (free rolling at μ = 1e-4);
+* ``start``    the coupled rolling start with the QP methods (issue 18): CONTACT's grid, μ = 0.05,
+               full coupling; time against ``newton``'s direct steady solve, the answer against it,
+               and the ways to reach the steady state that were measured (one N–T sweep per marching
+               step, Anderson acceleration, the splitting of the steady operator).
 
 The problem (CONTACT's examples/bentall.inp, Vollebregt & Kalker): R_A = R_B = 50 mm (R = 25 mm),
 aluminium body 1 = rollqp's A (G = 23000, ν = 0.31), steel body 2 = B (G = 82000, ν = 0.28),
@@ -41,6 +45,7 @@ from harness import table  # (pins BLAS first)
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.errors import SolverError
+from rollqp.methods.alternation import Alternation
 
 # CONTACT's bentall case (materials, load, grid), one copy with tests/test_bentall.py
 from rollqp.refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
@@ -244,8 +249,98 @@ def section_newton():
         print(f"\nTypical message: `{str(last)[:160]}…`\n")
 
 
+# =========================================================================== the coupled rolling start
+class PlainMarch(Alternation):
+    """The rolling start without Anderson acceleration: one N–T sweep per marching step, then converged steps."""
+
+    accelerated_start = False
+
+
+class FullAlternation(PlainMarch):
+    """The plain march with the alternation converged at every step (rollqp before issue 18)."""
+
+    single_sweeps = None  # rollqp.march then never switches to one sweep per step
+
+
+def _timed_run(s, method):
+    c0, t0 = time.process_time(), time.perf_counter()
+    r = rollqp.run(s, method=method)
+    return r, time.process_time() - c0, time.perf_counter() - t0
+
+
+def _distance(r, ref, s):
+    a, b = r.arrays(), ref.arrays()
+    dp = np.max(np.abs(a["pn"][0] - b["pn"][0])) / s.p0
+    dt = np.max(np.abs(a["pt"][0] - b["pt"][0])) / (s.contact.friction * s.p0)
+    return max(dp, dt), abs(float(a["creepage"][0]) / float(b["creepage"][0]) - 1)
+
+
+def start_map(s, name):
+    """The marching map ``G`` of the QP rolling start (rollqp.methods.steady_start.sweep_map) from the braked
+    state of ``s``, with ``name``'s QP backend; ``(G, braked shear, operators, QP counter)``."""
+    from rollqp.march import prepare
+    from rollqp.methods.steady_start import sweep_map
+    braked = s.replace(**{"load.start": "braked", "discretization.distance": 0.0})
+    _, meth, ops = prepare(braked, name)
+    state = next(rollqp.march(braked, name)).state
+    G0 = sweep_map(meth, ops, state, P=float(s.normal_load(0.0)), Q=0.0, xi=None, dq=s.dq, M=ops.history())
+    count = [0]
+
+    def G(t):
+        count[0] += 2
+        return G0(t)
+
+    return G, state.t, ops, count
+
+
+def section_start():
+    s = contact_grid(0.05, "full")
+    print("#### The coupled rolling start with the QP methods (CONTACT's grid, 216 constant elements, μ = 0.05, "
+          "full coupling)\n")
+    print("`newton` solves the steady problem directly; the QP methods reach it by marching (rollqp.march's "
+          "rolling start): the march map (one N–T sweep of a step of Δq = Le as a function of the shear) iterated "
+          "with Anderson acceleration (rollqp.methods.steady_start), then marching steps with the alternation "
+          "converged until max|Δt| per step < 1e-8 μp0. `plain march`: without Anderson (one sweep per step, then "
+          "converged steps); `full alternation`: the alternation converged at every step (rollqp before issue 18). "
+          "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
+          "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
+    ref, cpu_ref, wall_ref = _timed_run(s, "newton")
+    rows = [["`newton` (direct steady solve)", f"{cpu_ref:.2f}", f"{wall_ref:.2f}", "1", "–", "0", "0"]]
+    qp = lambda cls, name="qp-osqp": cls(rollqp.methods.get_method(name, tolerance=s.solver.tolerance))  # noqa: E731
+    cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, plain march", qp(PlainMarch)),
+             ("`qp-osqp`, full alternation (before)", qp(FullAlternation)), ("`qp-clarabel`", "qp-clarabel")]
+    for label, method in cases:
+        r, cpu, wall = _timed_run(s, method)
+        dist, dxi = _distance(r, ref, s)
+        rows.append([label, f"{cpu:.2f}", f"{wall:.2f}", f"{cpu / cpu_ref:.0f}", int(r.arrays()["iterations"][0]),
+                     f"{dist:.1e}", f"{dxi:.1e}"])
+    print(table(["method", "CPU [s]", "wall [s]", "CPU / newton", "N–T sweeps (state 0)", "distance from newton",
+                 "|ξ/ξ_newton − 1|"], rows))
+    print()
+    from rollqp.methods.steady_start import fixed_point
+    G, t0, ops, count = start_map(s, "qp-osqp")
+    rows = []
+    for memory, start in ((0, None), (10, 0.1), (60, 1.0), (150, 1.0), (150, 0.1), (150, 0.01), (300, 0.1)):
+        count[0] = 0
+        _, evals, best = fixed_point(G, t0.copy(), s.contact.friction * s.p0, target=1e-10, memory=memory,
+                                     anderson_from=start if start is not None else 1.0, patience=800,
+                                     max_evaluations=800)
+        rows.append([memory or "0 (plain)", "–" if start is None else f"{start:g}", evals, count[0], f"{best:.1e}"])
+    print("Anderson acceleration of the march map, `qp-osqp`, from the braked state: memory (differences kept), "
+          "residual max|G(t) − t|/(μp0) below which it extrapolates, map evaluations to 1e-10 (at most 800), and "
+          "the smallest residual reached:\n")
+    print(table(["memory", "from residual", "evaluations", "QPs", "smallest residual"], rows))
+    Atn, Att = ops.steady()
+    FA = ops.f[:, None] * Att.dense()
+    lam = np.linalg.eigvalsh(0.5 * (FA + FA.T))
+    print(f"\nThe steady slip operator's weighted symmetric part sym(F·d·D_up·A_tt) has eigenvalues from "
+          f"{lam[0] / lam[-1]:+.2f}·λ_max to λ_max: indefinite, so no convex QP has it as Hessian and the "
+          f"symmetric–skew splitting cannot be applied to the steady problem.\n")
+
+
 SECTIONS = {"contact": section_contact, "mesh": section_mesh, "limit": section_limit,
-            "friction": section_friction, "signs": section_signs, "newton": section_newton}
+            "friction": section_friction, "signs": section_signs, "newton": section_newton,
+            "start": section_start}
 
 
 def main(argv=None):

@@ -342,8 +342,13 @@ class _March:
         cnt = Counters()
         M = ops.history()
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
+        from .methods.steady_start import accelerated_start
         change = np.inf
-        state = start.state
+        state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
+                                  delta=self.approach(0.0), tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
+        sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
+        if sweeps is not None:
+            sweeps(True)
         for _ in range(max_steps):
             previous = state
             state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
@@ -352,8 +357,13 @@ class _March:
             if not self.fixed:
                 change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
             if change < STEADY_TOL:
+                if sweeps is not None and sweeps(False):
+                    cnt.residual = 0.0  # one sweep stops short of the coupled limit by design: report the converged steps'
+                    continue  # then full steps (converged alternation) until steady again
                 break
         else:
+            if sweeps is not None:
+                sweeps(False)
             raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
                               f"(last change {change:.2e} mu p0)", method=self.method.name, step=0)
         return self.record(0, "rolling", 0.0, state, previous, problem, sol, cnt, P=P, shift=0.0, t0=t0)

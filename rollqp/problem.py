@@ -35,6 +35,7 @@ The residuals (:class:`Residuals`) are the max-norms of
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -109,7 +110,7 @@ def _real(name, v) -> np.ndarray:
             raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
         a = a.astype(float)
     if a.size:
-        big = np.max(np.abs(a))
+        big = np.abs(a).max()  # (the method, not np.max: a third of the time on step-sized vectors)
         if not big <= MAX_MAGNITUDE:  # NaN compares false: one test for both
             if not np.all(np.isfinite(a)):
                 raise InputError(name, "must be finite")
@@ -149,11 +150,12 @@ def _set_weights(step) -> int:
     if not isinstance(step.scales, Scales):
         raise InputError("scales", f"must be a rollqp.Scales (e.g. Scales.hertz(P, R, Estar), or Scales() for the "
                                    f"problem's own units), got {type(step.scales).__name__}")
-    n = np.asarray(step.f).shape[0] if np.ndim(step.f) == 1 else -1
+    f = step.f
+    n = np.shape(f)[0] if (f.ndim if type(f) is np.ndarray else np.ndim(f)) == 1 else -1
     if n < 1:
         raise InputError("f", "must be a 1-D array of weights")
-    f = _vec("f", step.f, n)
-    if np.any(f <= 0):
+    f = _vec("f", f, n)
+    if (f <= 0).any():
         raise InputError("f", "weights must all be > 0")
     object.__setattr__(step, "f", f)
     return n
@@ -204,6 +206,49 @@ def _exactly_one(names, values):
         raise InputError(" / ".join(names), f"give exactly one of {' or '.join(names)} (got {len(given)})")
 
 
+def _trusted(cls, **values):
+    """A step problem of class ``cls`` from values that are already valid, without re-validation.
+
+    For the halves of a checked :class:`CoupledStep` and the symmetrized or shifted copies of a
+    checked step (each QP of the symmetric–skew splitting): their operators are the checked
+    step's own :class:`Operator`\\ s and their vectors are products of them with checked or
+    solver-computed arrays, so the ``O(n)``–``O(n²)`` checks of ``__post_init__`` would only
+    repeat (measured 3–14 % of a QP step on §6.1.1). The caller vouches for the values.
+    """
+    obj = object.__new__(cls)
+    for f in dataclasses.fields(cls):
+        object.__setattr__(obj, f.name, values[f.name] if f.name in values else f.default
+                           if f.default is not dataclasses.MISSING else f.default_factory())
+    return obj
+
+
+def _derived(step, **changes):
+    """``step`` with ``changes`` (already valid: :func:`_trusted`), not re-validated."""
+    values = {f.name: getattr(step, f.name) for f in dataclasses.fields(step)}
+    values.update(changes)
+    return _trusted(type(step), **values)
+
+
+def qp_hessian(A, fh, factor: float):
+    """``(H / obj, obj)``: the QP Hessian ``sym(F̂ Â)·factor`` normalized by its largest diagonal entry.
+
+    Computed once per operator, weights and factor and kept in the operator's memo (read-only):
+    every step of a scene, every QP of the splitting, reuses it, and the backends recognize it as
+    the Hessian their solver object was built for. ``Â = A·E*/a_H``, ``factor`` ``1`` (normal) or
+    ``1/Δq̂`` (tangential).
+    """
+    def build():
+        Ah = A.dense() * factor[0] / factor[1]
+        FA = fh[:, None] * Ah if factor[2] is None else fh[:, None] * Ah / factor[2]
+        H = 0.5 * (FA + FA.T)
+        obj = float(np.max(np.abs(np.diag(H))))
+        Hn = H / obj
+        Hn.flags.writeable = False
+        return Hn, obj
+
+    return A.memo(("qp-hessian", fh.tobytes(), factor), build)
+
+
 def friction_residual(t, s, bound):
     """``t − Proj_[−b, b](t − s)`` (eq. 60): zero iff ``|t| <= b`` and ``t`` opposes the slip ``s``.
 
@@ -243,16 +288,50 @@ class QPForm:
     obj_scale: float
     eq_scale: float
     kind: str
+    #: ``obj/f̂``: maps the bound multipliers ``λ = Hx + q + y a`` to the nondimensional gap ``ĝ``
+    #: (normal) or slip ``ŝ`` (tangential), so that :meth:`residual` is rollqp's residual (None: unknown).
+    dual_scale: np.ndarray | None = None
+    #: ``∂q/∂e``: the change of ``q`` per unit (displacement) added to the gap offset (normal) or the
+    #: history vector (tangential), the shift of the splitting's QPs (None: unknown).
+    shift_scale: np.ndarray | None = None
+
+    def with_q(self, q: np.ndarray) -> "QPForm":
+        """The same QP with the linear term ``q`` (the splitting's next QP); the cached :attr:`structure` kept."""
+        new = object.__new__(QPForm)  # frozen: the fields set through __dict__, as dataclasses.replace would
+        new.__dict__.update(self.__dict__)
+        new.__dict__["q"] = q
+        return new
+
+    def traction(self, x) -> np.ndarray:
+        """The nondimensional traction of a QP solution: ``x`` (normal) or ``x`` clipped to its bounds (tangential)."""
+        x = np.asarray(x, dtype=float)
+        return x if self.kind == "normal" else np.clip(x, self.lower, self.upper)
+
+    def residual(self, x, y, lam=None) -> float:
+        """rollqp's residual of ``(x, y)`` on the problem this QP poses, from the QP data alone.
+
+        ``max |x̂ − Proj_[ℓ, u](x̂ − λ·obj/f̂)|`` (Signorini ``min(p̂, ĝ)`` for ``ℓ = 0, u = ∞``; the friction
+        law eq. 60 for ``±μp̂``) and the load row ``|f̂ᵀx̂ − P̂|`` (eq. 67), with ``x̂`` :meth:`traction`: the
+        same numbers as the step problem's :meth:`~NormalStep.residuals` up to rounding (``H`` is
+        ``sym(F̂Â)/obj``). Needs :attr:`dual_scale`; ``lam``: ``Hx + q + y a`` if known.
+        """
+        xh = self.traction(x)
+        if lam is None:
+            lam = self.H @ np.asarray(x, dtype=float) + self.q + (float(y) * self.a if self.a is not None else 0.0)
+        r = float(np.max(np.abs(xh - np.clip(xh - lam * self.dual_scale, self.lower, self.upper))))
+        if self.a is not None:
+            r = max(r, abs(float(self.a @ xh - self.b)) * self.eq_scale)
+        return r
 
     def unscaled_multiplier(self, y: float) -> float:
         """The multiplier of the unscaled problem (``−δ̂`` normal, ``ξ̂`` tangential)."""
         return float(y) * self.obj_scale / self.eq_scale
 
-    @property
+    @functools.cached_property
     def structure(self) -> tuple:
         """What fixes the constraint matrix: the solver object can be reused while it holds."""
         return (self.kind, self.H.shape[0], self.a is not None,
-                tuple(np.isfinite(self.lower)), tuple(np.isfinite(self.upper)), tuple(self.fixed))
+                np.isfinite(self.lower).tobytes(), np.isfinite(self.upper).tobytes(), self.fixed.tobytes())
 
     @property
     def fixed(self) -> np.ndarray:
@@ -306,6 +385,10 @@ class NormalStep:
     def replace(self, **kw) -> "NormalStep":
         return dataclasses.replace(self, **kw)
 
+    def derived(self, **kw) -> "NormalStep":
+        """:meth:`replace` without re-validation, for values the caller guarantees valid (:func:`_trusted`)."""
+        return _derived(self, **kw)
+
     @property
     def h_total(self) -> np.ndarray:
         return self.h if self.offset is None else self.h + self.offset
@@ -324,7 +407,7 @@ class NormalStep:
 
     def shifted(self, extra: np.ndarray) -> "NormalStep":
         """The same problem with ``extra`` (displacement units) added to the gap: ``o + extra``."""
-        return self.replace(offset=extra if self.offset is None else self.offset + extra)
+        return _derived(self, offset=extra if self.offset is None else self.offset + extra)
 
     def evaluate(self, sol: "StepSolution") -> "StepSolution":
         """``sol``'s pressure and approach re-evaluated on this problem (rollqp's residuals)."""
@@ -346,19 +429,17 @@ class NormalStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        Ah = self.A.dense() * sc.modulus / sc.length
-        FA = fh[:, None] * Ah
-        H = 0.5 * (FA + FA.T)
+        H, obj = qp_hessian(self.A, fh, (sc.modulus, sc.length, None))  # once per operator (its memo)
         q = fh * self.h_total / sc.displacement
         if self.delta is not None:
             q = q - fh * (self.delta / sc.displacement)
-        obj = float(np.max(np.abs(np.diag(H))))
         eq = float(np.max(fh))
         a = b = None
         if self.P is not None:
             a, b = fh / eq, self.P / sc.force / eq
-        return QPForm(H=H / obj, q=q / obj, lower=np.zeros(self.n), upper=np.full(self.n, np.inf),
-                      a=a, b=b, obj_scale=obj, eq_scale=eq, kind="normal")
+        return QPForm(H=H, q=q / obj, lower=np.zeros(self.n), upper=np.full(self.n, np.inf),
+                      a=a, b=b, obj_scale=obj, eq_scale=eq, kind="normal", dual_scale=obj / fh,
+                      shift_scale=fh / (sc.displacement * obj))
 
     def solution_from_qp(self, form: QPForm, x, y, **meta) -> "StepSolution":
         """Map a QP solution back (pressure, approach) and evaluate it on this problem."""
@@ -450,6 +531,10 @@ class TangentialStep:
     def replace(self, **kw) -> "TangentialStep":
         return dataclasses.replace(self, **kw)
 
+    def derived(self, **kw) -> "TangentialStep":
+        """:meth:`replace` without re-validation, for values the caller guarantees valid (:func:`_trusted`)."""
+        return _derived(self, **kw)
+
     def slip(self, t, xi, At=None) -> np.ndarray:
         """``s = ξ e + (c + A t)/Δq`` (eq. 36, 47); ``At``: the product ``A t`` if already computed."""
         return xi + (self.c + (self.A @ t if At is None else At)) / self.dq
@@ -464,7 +549,7 @@ class TangentialStep:
 
     def shifted(self, extra: np.ndarray) -> "TangentialStep":
         """The same problem with ``extra`` (displacement units) added to the history: ``c + extra``."""
-        return self.replace(c=self.c + extra)
+        return _derived(self, c=self.c + extra)
 
     def evaluate(self, sol: "StepSolution") -> "StepSolution":
         """``sol``'s traction and creepage re-evaluated on this problem (rollqp's residuals)."""
@@ -488,21 +573,19 @@ class TangentialStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        Ah = self.A.dense() * sc.modulus / sc.length
         dqh = self.dq / sc.length
-        FA = fh[:, None] * Ah / dqh
-        H = 0.5 * (FA + FA.T)
+        H, obj = qp_hessian(self.A, fh, (sc.modulus, sc.length, dqh))  # once per operator and Δq (its memo)
         q = fh * (self.c / sc.displacement) / dqh
         if self.xi is not None:
             q = q + fh * (self.xi / sc.slip)
-        obj = float(np.max(np.abs(np.diag(H))))
         eq = float(np.max(fh))
         bh = self.bound / sc.stress
         a = b = None
         if self.Q is not None:
             a, b = fh / eq, self.Q / sc.force / eq
-        return QPForm(H=H / obj, q=q / obj, lower=-bh, upper=bh, a=a, b=b, obj_scale=obj,
-                      eq_scale=eq, kind="tangential")
+        return QPForm(H=H, q=q / obj, lower=-bh, upper=bh, a=a, b=b, obj_scale=obj,
+                      eq_scale=eq, kind="tangential", dual_scale=obj / fh,
+                      shift_scale=fh / (sc.displacement * dqh * obj))
 
     def solution_from_qp(self, form: QPForm, x, y, **meta) -> "StepSolution":
         """Map a QP solution back (traction, creepage) and evaluate it on this problem."""
@@ -612,15 +695,28 @@ class CoupledStep:
 
     def normal_half(self, t) -> NormalStep:
         """The normal step with the shear ``t`` fixed (eq. 53): offset ``A_nt t``."""
-        off = None if self.Ant is None else self.Ant @ t
-        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=self.P, delta=self.delta, offset=off,
-                          scales=self.scales)
+        off = None if self.Ant is None else self.Ant @ np.asarray(t, dtype=float)
+        if off is not None and not np.all(np.isfinite(off)):
+            raise InputError("t", "the fixed shear must be finite")
+        # not re-validated: the coupled step's checked data (_trusted)
+        return _trusted(NormalStep, A=self.Ann, f=self.f, h=self.h, P=self.P, delta=self.delta, offset=off,
+                        scales=self.scales)
 
     def tangential_half(self, p) -> TangentialStep:
         """The tangential step with the pressure ``p`` fixed (eq. 61/62): bound ``μ p⁺``."""
+        p = np.asarray(p, dtype=float)
+        if not np.all(np.isfinite(p)):
+            raise InputError("p", "the fixed pressure must be finite")
         c = self.c if self.Atn is None else self.c + self.Atn @ p
-        return TangentialStep(A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q,
-                              xi=self.xi, scales=self.scales, law=self.law)
+        # not re-validated (_trusted) but for the sliding limit, which depends on this pressure
+        half = _trusted(TangentialStep, A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q,
+                        xi=self.xi, scales=self.scales, law=self.law)
+        if self.Q is not None:
+            cap = float(self.f @ half.bound)
+            if not abs(self.Q) < cap:
+                raise InputError("Q", f"|Q| = {abs(self.Q):.6g} must be below the sliding limit "
+                                      f"mu fᵀp = {cap:.6g} for a solution with stick")
+        return half
 
     def coefficient(self, s=None):
         """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""

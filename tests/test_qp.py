@@ -24,6 +24,8 @@ from hypothesis import strategies as st
 import rollqp
 from rollqp import SolverError, compare, get_method
 
+from rollqp.problem import CoupledStep
+
 from conftest import BACKENDS, MU, P, RATIO, hertz_problem, pair_tolerance
 
 CASES = ("normal", "braked", "rolling")
@@ -334,3 +336,96 @@ def test_osqp_solves_small_tangential_problems(args):
     ref = get_method("qp-clarabel").solve(tangential)
     assert compare(sol, ref, mu=tangential.mu)["t"] <= pair_tolerance((BACKENDS["osqp"], BACKENDS["clarabel"])), \
         "OSQP agrees with Clarabel"
+
+
+# ------------------------------------------------------------------------------- the QP data (issue 18)
+@pytest.mark.parametrize("element", ["constant", "quadratic"])
+@pytest.mark.parametrize("case", CASES)
+def test_qp_form_residual_is_rollqps_residual(element, case, solved):
+    """QPForm.residual (the splitting's test of a QP answer) is the step problem's own residual.
+
+    On the problem the QP poses (the symmetrized operator), for the solver's answer and for a
+    perturbed one (so that both parts of the residual, complementarity and load row, are far
+    from zero); they differ only by rounding: the Hessian ``sym(F̂Â)/obj`` against the operator
+    ``F⁻¹sym(FA)`` times the weights, entries of order one, so 1e-12 relative.
+    """
+    prob, sol = solved(BACKENDS["osqp"], element, case)
+    sym = prob.symmetrized()
+    form = sym.qp_form()
+    x = np.asarray(prob.traction(sol)) / prob.scales.stress
+    y = form.a @ x if form.a is not None else 0.0  # any multiplier: the residual is evaluated, not minimized
+    rng = np.random.default_rng(7)
+    for xx in (x, x + 0.05 * rng.standard_normal(x.size)):
+        expected = sym.solution_from_qp(form, xx, y).residual
+        assert expected > 0
+        assert abs(form.residual(xx, y) - expected) <= 1e-12 * max(1.0, expected)
+
+
+def test_qp_hessian_is_built_once_per_operator(quadratic_problem):
+    """Every step on one operator gets the same read-only Hessian (the operator's memo), so that a
+    backend's solver object is recognized without comparing matrices; the vectors differ per step."""
+    a = quadratic_problem.rolling()
+    b = a.replace(c=2 * a.c)
+    fa, fb = a.qp_form(), b.qp_form()
+    assert fa.H is fb.H and not fa.H.flags.writeable
+    assert not np.array_equal(fa.q, fb.q)
+    sc = a.scales  # docs/formulation.md §7: H = sym(F̂Â)/Δq̂, F̂ = F/a_H, Â = A E*/a_H, Δq̂ = Δq/a_H
+    FA = (a.f / sc.length)[:, None] * a.A.dense() * sc.modulus / sc.length / (a.dq / sc.length)
+    np.testing.assert_allclose(fa.H * fa.obj_scale, 0.5 * (FA + FA.T), rtol=1e-12)  # rounding of n-term sums
+
+
+def test_halves_of_a_coupled_step_are_its_problems(quadratic_problem):
+    """The N–T halves are built without re-validation, as the validated problems they stand for;
+    the sliding limit, which depends on the half's pressure, is still checked."""
+    hp = quadratic_problem
+    A = hp.influence.Ann
+    cp = CoupledStep(Ann=A, Att=hp.influence.Att, Ant=0.1 * A, Atn=0.1 * A, f=hp.f, h=hp.influence.h,
+                            mu=MU, c=np.zeros(hp.n), dq=hp.dq, P=P, Q=0.5 * MU * P, scales=hp.scales)
+    t = hp.t_cattaneo
+    half = cp.normal_half(t)
+    ref = rollqp.NormalStep(A=cp.Ann, f=hp.f, h=hp.influence.h, P=P, offset=cp.Ant @ t, scales=hp.scales)
+    for name in ("f", "h", "offset"):
+        np.testing.assert_array_equal(getattr(half, name), getattr(ref, name))
+    assert half.A is cp.Ann and half.P == ref.P and half.delta is None
+    th = cp.tangential_half(hp.p_hertz)
+    np.testing.assert_array_equal(th.c, cp.Atn @ hp.p_hertz)
+    assert th.A is cp.Att and th.Q == cp.Q
+    with pytest.raises(rollqp.InputError, match="sliding limit"):
+        cp.tangential_half(0.1 * hp.p_hertz)  # μ fᵀp = 0.1 μP < |Q| = 0.5 μP
+    with pytest.raises(rollqp.InputError, match="finite"):
+        cp.normal_half(np.full(hp.n, np.nan))
+
+
+def test_one_sweep_mode_of_the_alternation(quadratic_problem):
+    """In the rolling start's one-sweep mode a coupled solve is one N–T sweep; switched off it
+    converges again."""
+    from rollqp.methods.alternation import Alternation
+    hp = quadratic_problem
+    A = hp.influence.Ann
+    cp = CoupledStep(Ann=A, Att=hp.influence.Att, Ant=0.05 * A, Atn=0.05 * A, f=hp.f, h=hp.influence.h,
+                            mu=MU, c=np.zeros(hp.n), dq=hp.dq, P=P, Q=0.5 * MU * P, scales=hp.scales)
+    alt = Alternation(get_method("qp-osqp", tolerance=1e-10))
+    converged = alt.solve(cp)
+    assert converged.iterations > 1 and converged.residual <= alt.stall_limit
+    assert alt.single_sweeps(True) is False
+    one = alt.solve(cp)
+    assert one.iterations == 1 and one.residual > converged.residual
+    assert alt.single_sweeps(False) is True
+    assert alt.solve(cp).iterations == converged.iterations
+
+
+def test_rolling_start_leaves_the_alternation_converging():
+    """The coupled QP rolling start (one sweep a step, then converged steps) ends in a converged
+    coupled state and leaves the method out of the one-sweep mode."""
+    scene = rollqp.load_scene("goodman-bentall").replace(**{
+        "load.start": "rolling", "discretization.distance": 0.0, "discretization.elements": 10})
+    from rollqp.march import prepare
+    prepared = prepare(scene, "qp-osqp")
+    meth = prepared[1]
+    r = rollqp.run(scene, method=meth)
+    assert r.meta["rolling_start"] == "marching to steady state"
+    assert meth.single_sweeps(False) is False
+    assert float(r["residual"][0]) <= meth.stall_limit  # the converged steps' residual, not the sweeps'
+    meth.single_sweeps(True)
+    meth.setup(prepared[2])  # a new scene starts converging
+    assert meth.single_sweeps(False) is False

@@ -104,7 +104,8 @@ def test_direct_steady_is_the_qp_marched_limit():
     qp-osqp's rolling start, which marches the transient at constant loads.
 
     The two limits are the same discrete problem (module docstring), so they differ only by
-    the march's stopping distance (MARCH_TOL). Measured: 7.3e-8 μp0, ξ 1.0e-8, p 1.6e-13 p0.
+    the march's stopping distance (MARCH_TOL). Measured: 7.3e-8 μp0, ξ 1.0e-8, p 1.6e-13 p0 with the
+    plain march; 1.9e-11 μp0, ξ 2.9e-12, p 2.3e-13 p0 with the Anderson-accelerated start (issue 18).
     """
     scene = similar()
     direct, marched = steady(scene, "newton"), steady(scene, "qp-osqp")
@@ -150,7 +151,8 @@ def test_convective_local_limit_is_the_steady_state_for_any_step():
 @pytest.mark.slow
 def test_coupled_direct_steady_is_the_qp_marched_limit():
     """Dissimilar, full coupling: nt-newton's direct steady state against qp-osqp's rolling start
-    (N–T alternation of QPs, marched at constant loads; ≈ 10 s). Measured: 3.6e-7 μp0, ξ 1.6e-8."""
+    (N–T alternation of QPs, marched at constant loads). Measured: 3.6e-7 μp0, ξ 1.6e-8 with the plain
+    march (≈ 10 s); 1.3e-10 μp0 and p0, ξ 4.7e-12 with the Anderson-accelerated start (≈ 1 s)."""
     scene = dissimilar()
     direct, marched = steady(scene, "nt-newton"), steady(scene, "qp-osqp")
     dt, dp, dxi = differences(direct, marched, scene)

@@ -60,11 +60,14 @@ class QPMethod:
     ``info`` of a solution: ``qp_solves`` (QPs of the splitting), ``backend_time`` (wall time of
     the backend's calls: data update, solve, retries), ``setups`` (solver objects built),
     ``retried`` (QPs solved again after a failed polish), ``splitting_changes`` (max change of
-    ``x/p0`` from QP to QP: its ratios are the splitting's contraction), ``asymmetry``, ``operator``.
+    ``x/p0`` from QP to QP: its ratios are the splitting's contraction), ``asymmetry``, ``operator``,
+    ``solve_call_time`` and ``solve_call_cpu`` (wall and CPU time inside the solver's own solve calls,
+    summed over the QPs; NaN for a backend that does not report them: what rollqp adds to a step is
+    the rest).
 
     One solver object is kept per constraint structure (:meth:`structure_key`) with the Hessian
-    it was built for, recognized by its source (the symmetrized operator, the weights and the
-    scales: the Hessian is normalized by its largest diagonal entry, so ``Δq`` drops out);
+    it was built for, recognized by its source (the Hessian array of the operator's memo,
+    :func:`~rollqp.problem.qp_hessian`);
     :meth:`setup` drops them at the start of a scene. The splitting itself is the operator's own (:meth:`Operator.split
     <rollqp.influence.operator.Operator.split>`), computed once per scene.
     """
@@ -97,6 +100,8 @@ class QPMethod:
         self.operator = operator
         self.options = options
         self._solvers = {}
+        self._kkt = KKTCache()
+        self._bounds_of = None  # (solver object, QPForm) of the last QP (_same_bounds)
 
     @classmethod
     def from_settings(cls, settings, **options) -> "QPMethod":
@@ -107,10 +112,17 @@ class QPMethod:
     def setup(self, operators) -> None:
         """A new scene: drop the solver objects of the previous one (they are rebuilt on first use)."""
         self._solvers = {}
+        self._kkt = KKTCache()
+        self._bounds_of = None
 
     # --------------------------------------------------------------- public
     def solve(self, problem, warm: StepSolution | None = None) -> StepSolution:
-        """Solve a normal or tangential step; raise :class:`SolverError` short of solved."""
+        """Solve a normal or tangential step; raise :class:`SolverError` short of solved.
+
+        The step's QP data are formed once (:meth:`~rollqp.problem.NormalStep.qp_form`: the Hessian
+        comes from the operator's memo); each QP of the splitting changes only ``q``
+        (``q + ∂q/∂e · F⁻¹S x_{k−1}``), and rollqp's residual is evaluated once, on the answer.
+        """
         check_kind(self, problem)
         if getattr(problem, "law", None) is not None:
             raise InputError("problem", f"method {self.name!r} solves steps with a fixed friction bound; this one depends on "
@@ -119,74 +131,97 @@ class QPMethod:
         t0 = time.perf_counter()
         sp = problem.A.split(problem.f)
         check_convex(sp.sym, problem.f)
-        sym_problem = problem.replace(A=sp.sym) if sp.asymmetry > 0 else problem
+        sym_problem = problem.derived(A=sp.sym) if sp.asymmetry > 0 else problem  # checked step: not re-validated
+        exact = self.operator == "exact" and sp.asymmetry > 0
         x_prev = None
         if warm is not None:
             w = problem.traction(warm)
             if w is not None and np.shape(w) == (problem.n,):
                 x_prev = np.asarray(w, dtype=float)
-        exact = self.operator == "exact" and sp.asymmetry > 0
-        # what the QP Hessian is a function of (the solver objects are kept per source, _solver_for)
-        source = (sym_problem.A, sym_problem.f.tobytes(), sym_problem.scales)
-        iters, solver_time, outer, change = 0, 0.0, 0, np.inf
-        backend, setups, retried, changes = 0.0, 0, 0, []
-        x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
-        while True:
-            outer += 1
-            prob = sym_problem.shifted(sp.skew @ x_phys) if exact else sym_problem  # F⁻¹ S x_{k−1}
-            form = prob.qp_form()
-            x0 = None if x_prev is None else x_prev / problem.scales.stress
-            tb = time.perf_counter()
-            x, y, status, it, st, info = self._solve_form(form, x0, source)
-            backend += time.perf_counter() - tb
-            setups += int(bool(info.get("built", False)))
-            retried += int(info.get("tries", 1) > 1)
-            iters += int(it)
-            solver_time += float(st)
-            if status == "solved" and self.refine:
-                x, y = self._refined(prob, form, x, y, info)
-            sol = prob.solution_from_qp(form, x, y)
-            if status != "solved":
-                raise SolverError(f"the {problem.kind} QP was not solved", method=self.name, status=status,
-                                  residual=sol.residual, iterations=iters)
-            if not exact:
-                break
-            x_new = problem.traction(sol)
-            last, change = change, float(np.max(np.abs(x_new - x_phys))) / problem.scales.stress
-            changes.append(change)
-            x_phys = x_prev = x_new
-            if change <= self.tolerance or (change >= 0.5 * last and change <= self.residual_limit):
-                break  # converged, or stalled at the QP solver's own accuracy
-            if outer >= self.max_splitting:
-                raise SolverError("the symmetric-skew splitting did not converge", method=self.name,
-                                  status=f"change {change:.2e} after {outer} QPs", iterations=iters,
-                                  residual=problem.evaluate(sol).residual)
-        final = (problem if exact or sp.asymmetry == 0 else sym_problem).evaluate(sol)
-        final.method, final.status, final.iterations = self.name, "solved", iters
-        final.solver_time = solver_time
+        target = problem if exact or sp.asymmetry == 0 else sym_problem
+        form, x, y, status, stats, info = self._splitting(target, sym_problem.qp_form(), sp.skew if exact else None,
+                                                           x_prev)
+        final = target.solution_from_qp(form, x, y)  # rollqp's residuals, once
+        final.method, final.status, final.iterations = self.name, "solved", stats["iterations"]
+        final.solver_time = stats["solver_time"]
         final.time = time.perf_counter() - t0
         final.info.update(info)
         final.info.update(asymmetry=sp.asymmetry, operator="exact" if (exact or sp.asymmetry == 0) else "symmetrized",
-                          qp_solves=outer, backend_time=backend, setups=setups, retried=retried,
-                          splitting_changes=changes)
+                          qp_solves=stats["outer"], backend_time=stats["backend"], setups=stats["setups"],
+                          retried=stats["retried"], splitting_changes=stats["changes"], solve_call_time=stats["calls"],
+                          solve_call_cpu=stats["calls_cpu"])
         if not final.residual <= self.residual_limit:
             raise SolverError(f"the {problem.kind} QP solution's residual is above {self.residual_limit:.1e}",
-                              method=self.name, status=status, residual=final.residual, iterations=iters)
+                              method=self.name, status=status, residual=final.residual, iterations=stats["iterations"])
         return final
 
+    def _splitting(self, problem, form, skew, x_prev):
+        """The QPs of one step: one, or (``skew`` given) the symmetric–skew splitting's sequence.
+
+        Returns ``(form, x, y, status, stats, info)`` of the last QP. QP ``k`` has the linear term
+        ``q + shift_scale · (F⁻¹S x_{k−1})`` (the gap offset or history shifted by ``F⁻¹S x``,
+        docs/formulation.md §8) and stops when ``max|x_k − x_{k−1}|/p0`` is below the tolerance, or
+        stalls at the QP solver's own accuracy.
+        """
+        stress = problem.scales.stress
+        q0, source = form.q, form.H  # the Hessian (from the operator's memo) identifies the solver object
+        stats = dict(iterations=0, solver_time=0.0, outer=0, backend=0.0, setups=0, retried=0, changes=[], calls=0.0,
+                     calls_cpu=0.0)
+        change = np.inf
+        x_phys = x_prev if x_prev is not None else np.zeros(problem.n)
+        while True:
+            stats["outer"] += 1
+            if skew is not None:
+                form = form.with_q(q0 + form.shift_scale * (skew @ x_phys))  # F⁻¹ S x_{k−1}
+            x0 = None if x_prev is None else x_prev / stress
+            tb = time.perf_counter()
+            x, y, status, it, st, info = self._solve_form(form, x0, source)
+            stats["backend"] += time.perf_counter() - tb
+            stats["calls"] += float(info.get("solve_call_time", np.nan))
+            stats["calls_cpu"] += float(info.get("solve_call_cpu", np.nan))
+            stats["setups"] += int(bool(info.get("built", False)))
+            stats["retried"] += int(info.get("tries", 1) > 1)
+            stats["iterations"] += int(it)
+            stats["solver_time"] += float(st)
+            if status == "solved" and self.refine:
+                x, y = self._refined(form, x, y, info)
+            if status != "solved":
+                raise SolverError(f"the {problem.kind} QP was not solved", method=self.name, status=status,
+                                  residual=form.residual(x, y), iterations=stats["iterations"])
+            if skew is None:
+                return form, x, y, status, stats, info
+            x_new = form.traction(x) * stress
+            last, change = change, float(np.abs(x_new - x_phys).max()) / stress
+            stats["changes"].append(change)
+            x_phys = x_prev = x_new
+            if change <= self.tolerance or (change >= 0.5 * last and change <= self.residual_limit):
+                return form, x, y, status, stats, info  # converged, or stalled at the QP solver's own accuracy
+            if stats["outer"] >= self.max_splitting:
+                raise SolverError("the symmetric-skew splitting did not converge", method=self.name,
+                                  status=f"change {change:.2e} after {stats['outer']} QPs",
+                                  iterations=stats["iterations"],
+                                  residual=problem.solution_from_qp(form, x, y).residual)
+
     # --------------------------------------------------------------- helpers
-    @staticmethod
-    def _refined(prob, form, x, y, info):
-        """The refined ``(x, y)`` if rollqp's residual of it is smaller, else the solver's own."""
-        cand = active_set_refine(form, x, y)
-        base = prob.solution_from_qp(form, x, y).residual
+    def _refined(self, form, x, y, info):
+        """The refined ``(x, y)`` if rollqp's residual of it (:meth:`QPForm.residual
+        <rollqp.problem.QPForm.residual>`) is smaller, else the solver's own."""
+        cand = active_set_refine(form, x, y, self._kkt)
+        base = form.residual(x, y)
         info["unrefined_residual"] = max(base, info.get("unrefined_residual", 0.0))
         if cand is not None:
-            res = prob.solution_from_qp(form, *cand).residual
+            res = form.residual(*cand)
             if res < base:
                 info["refined"] = info.get("refined", 0) + 1
                 return cand
         return x, y
+
+    def _same_bounds(self, obj, form) -> bool:
+        """Whether ``form`` has the bounds and load row of the last QP given to the solver object ``obj``
+        (the same arrays: the splitting's QPs of one step share them), so that only ``q`` needs an update."""
+        last = self._bounds_of
+        return (last is not None and last[0] is obj and last[1].lower is form.lower and last[1].upper is form.upper
+                and last[1].b == form.b)
 
     def structure_key(self, form):
         """What the backend's solver object depends on besides the Hessian (default: :attr:`QPForm.structure`)."""
@@ -196,15 +231,16 @@ class QPMethod:
         """``(solver object, fresh)`` for this constraint structure and Hessian, built on first use.
 
         One solver object is kept per structure (:meth:`structure_key`) with the Hessian it was
-        built for. ``source`` is what the Hessian is a function of — the (symmetrized) operator,
-        the weights and the scales; the same source costs nothing to recognize, another one (a
-        user's new problem on the same matrix) is compared entry by entry (``O(n²)``).
+        built for. ``source`` is the Hessian array of the step problem's operator memo
+        (:func:`~rollqp.problem.qp_hessian`), the same object for every step of a scene and costs
+        nothing to recognize; another one (a user's new problem on the same matrix) is compared
+        entry by entry (``O(n²)``).
         """
         key = self.structure_key(form)
         hit = self._solvers.get(key)
         if hit is not None and hit[2].shape == form.H.shape:
             src, obj, H = hit
-            same = src is not None and source is not None and src[0] is source[0] and src[1:] == source[1:]
+            same = src is not None and src is source
             if same or np.array_equal(H, form.H):
                 if not same:
                     self._solvers[key] = (source, obj, H)
@@ -260,7 +296,7 @@ def constraint_rows(form):
     return n, up, lo, np.flatnonzero(fixed)
 
 
-def active_set_refine(form, x, y):
+def active_set_refine(form, x, y, cache: "KKTCache | None" = None):
     r"""One equality-constrained KKT solve on the active set the solver found.
 
     An interior-point method stops with every complementary pair ``(slack, multiplier)``
@@ -276,11 +312,14 @@ def active_set_refine(form, x, y):
         \begin{bmatrix} x_F \\ y \end{bmatrix} =
         \begin{bmatrix} -q_F - H_{FA} x_A \\ b - a_A^T x_A \end{bmatrix}
 
-    with ``x_A`` at its bounds. This is OSQP's *polishing* (Stellato et al., Math. Prog. Comp.
-    12 (2020) §5) applied to another solver's answer. The caller keeps the result only if
-    rollqp's residual of it is smaller than that of the solver's own answer, so a wrong
-    guess of the active set cannot make things worse. Returns ``None`` if the reduced
-    system is singular.
+    with ``x_A`` at its bounds, solved with the Cholesky factor of ``H_FF`` (positive definite: a
+    principal block of the convex QP's Hessian) and the Schur complement ``a_Fᵀ H_FF⁻¹ a_F`` of the
+    load row; ``cache`` (:class:`KKTCache`) keeps both per free set, so a step whose active set did
+    not change since an earlier QP (the splitting's QPs, the next step) solves with them only.
+    This is OSQP's *polishing* (Stellato et al., Math. Prog. Comp. 12 (2020) §5) applied to
+    another solver's answer. The caller keeps the result only if rollqp's residual of it is
+    smaller than that of the solver's own answer, so a wrong guess of the active set cannot make
+    things worse. Returns ``None`` if the reduced system is singular.
     """
     H, q, l, u, a = form.H, form.q, form.lower, form.upper, form.a
     x = np.asarray(x, dtype=float)
@@ -288,30 +327,72 @@ def active_set_refine(form, x, y):
     fixed = form.fixed.copy()
     at_lo = np.isfinite(l) & (x - l < lam) & ~fixed
     at_up = np.isfinite(u) & (u - x < -lam) & ~fixed
-    xa = x.copy()
+    xa = np.zeros_like(x)
     xa[fixed] = l[fixed]
     xa[at_lo] = l[at_lo]
     xa[at_up] = u[at_up]
-    act = fixed | at_lo | at_up
-    F = np.flatnonzero(~act)
-    A_ = np.flatnonzero(act)
-    rhs = -(q[F] + H[np.ix_(F, A_)] @ xa[A_])
-    try:
-        if a is None:
-            xF = np.linalg.solve(H[np.ix_(F, F)], rhs) if F.size else np.empty(0)
-            yr = 0.0
-        else:
-            if F.size == 0:
-                return None
-            m = F.size
-            K = np.zeros((m + 1, m + 1))
-            K[:m, :m] = H[np.ix_(F, F)]
-            K[:m, m] = K[m, :m] = a[F]
-            sol = np.linalg.solve(K, np.append(rhs, form.b - a[A_] @ xa[A_]))
-            xF, yr = sol[:m], float(sol[m])
-    except np.linalg.LinAlgError:
+    free = ~(fixed | at_lo | at_up)
+    if a is not None and not free.any():
         return None
+    fac = (cache or KKTCache()).get(H, free, a)
+    if fac is None:
+        return None
+    chol, z2, schur = fac
+    F = np.flatnonzero(free)
+    rhs = -(q[F] + (H @ xa)[F])  # xa is zero on the free set: H_FA x_A
+    if F.size == 0:
+        xF, yr = np.empty(0), 0.0
+    else:
+        from scipy.linalg import cho_solve
+        xF = cho_solve(chol, rhs)
+        yr = 0.0
+        if a is not None:
+            yr = float((a[F] @ xF - (form.b - a @ xa)) / schur)
+            xF = xF - yr * z2
     if not np.all(np.isfinite(xF)):
         return None
     xa[F] = xF
     return xa, yr
+
+
+class KKTCache:
+    """The factorizations of :func:`active_set_refine`'s reduced KKT systems, per Hessian and free set.
+
+    An entry is ``(Cholesky factor of H_FF, H_FF⁻¹ a_F, a_Fᵀ H_FF⁻¹ a_F)``, kept for the Hessian
+    array it was computed from (compared by identity: the step problems' Hessians come from their
+    operator's memo, :func:`~rollqp.problem.qp_hessian`) and the load row's values; at most
+    :attr:`MAX` entries, the oldest dropped first. ``None`` records a singular ``H_FF``.
+    """
+
+    MAX = 64
+
+    def __init__(self):
+        self._entries = {}
+
+    def get(self, H, free, a):
+        key = (free.tobytes(), None if a is None else a.tobytes())
+        hit = self._entries.get(key)
+        if hit is not None and hit[0] is H:
+            return hit[1]
+        value = _kkt_factor(H, free, a)
+        if len(self._entries) >= self.MAX:
+            self._entries.pop(next(iter(self._entries)))
+        self._entries[key] = (H, value)
+        return value
+
+
+def _kkt_factor(H, free, a):
+    """``(chol, H_FF⁻¹ a_F, a_Fᵀ H_FF⁻¹ a_F)`` for the free set, or ``None`` if ``H_FF`` is not positive definite."""
+    from scipy.linalg import LinAlgError, cho_factor, cho_solve
+    F = np.flatnonzero(free)
+    if F.size == 0:
+        return (None, None, None)
+    try:
+        chol = cho_factor(H[np.ix_(F, F)])
+    except (LinAlgError, ValueError):
+        return None
+    if a is None:
+        return chol, None, None
+    z2 = cho_solve(chol, a[F])
+    schur = float(a[F] @ z2)
+    return (chol, z2, schur) if np.isfinite(schur) and schur > 0 else None

@@ -88,9 +88,26 @@ class Alternation:
         self.tolerance = inner.tolerance
         #: the halves' own capability (rollqp.methods.compose): a slip-dependent bound reaches them unchanged
         self.slip_dependent = bool(getattr(inner, "slip_dependent", False))
+        self._single = False  # single_sweeps
+
+    def single_sweeps(self, on: bool) -> bool:
+        """Switch the one-sweep mode on or off; return whether it was on.
+
+        In it :meth:`solve` makes one N–T sweep per coupled step and returns its state without
+        iterating to the limit. For a march toward a steady rolling state (``rollqp.march``'s
+        rolling start), where only the fixed point counts: the march's own steps continue the
+        alternation, whose fixed point with the history of the previous step is the coupled steady
+        state. Measured on the Bentall–Johnson coupled start (216 constant elements,
+        ``benchmarks/bentall.py --only start``): the march takes about as many steps with one sweep as
+        with the full alternation (3 sweeps a step on average), a third of the QPs. The march ends
+        with full steps (mode off), so the state it keeps is a converged coupled step.
+        """
+        was, self._single = self._single, bool(on)
+        return was
 
     def setup(self, operators) -> None:
-        """A new scene: the inner method's set-up."""
+        """A new scene: the inner method's set-up (and the one-sweep mode off)."""
+        self._single = False
         self.inner.setup(operators)
 
     def solve(self, problem, warm=None):
@@ -114,7 +131,7 @@ class Alternation:
             t = tsol.t
             sol = problem.solution(nsol.p, t, nsol.delta, tsol.xi)
             history.append(sol.residual)
-            if sol.residual <= self.limit:
+            if sol.residual <= self.limit or self._single:
                 break
             if (len(history) > 1 and sol.residual <= self.stall_limit
                     and sol.residual >= 0.5 * history[-2]):

@@ -10,6 +10,8 @@ and then rollqp's own residual decides (``info["status_polish"]`` records the ou
 """
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import osqp
 import scipy.sparse as sp
@@ -69,18 +71,26 @@ class OsqpQP(QPMethod):
     def _solve_form(self, form, x0, source=None):
         m, fresh = self._solver_for(form, source, self._build)
         if not fresh:
-            l, u = self._bounds(form)
-            m.update(q=form.q, l=l, u=u)
+            if self._same_bounds(m, form):  # the splitting's next QP: only q changed
+                m.update(q=form.q)
+            else:
+                l, u = self._bounds(form)
+                m.update(q=form.q, l=l, u=u)
+        self._bounds_of = (m, form)
         if x0 is not None:
             m.warm_start(x=x0)
+        tc, cc = time.perf_counter(), time.process_time()
         res = m.solve(raise_error=False)  # statuses are checked here, not raised by OSQP
         tries = 1
+        calls, cpu = time.perf_counter() - tc, time.process_time() - cc  # inside OSQP's solve() calls
         spent = res.info.solve_time + res.info.polish_time
         iters = res.info.iter
         while res.info.status_polish != 1 and tries < 3:
             eps = self._eps() * 10.0 ** (-2 * tries)
             m.update_settings(eps_abs=eps, eps_rel=eps)
+            tc, cc = time.perf_counter(), time.process_time()  # the retry's solve call counts, its settings update not
             res = m.solve(raise_error=False)  # statuses are checked here, not raised by OSQP
+            calls, cpu = calls + time.perf_counter() - tc, cpu + time.process_time() - cc
             tries += 1
             spent += res.info.solve_time + res.info.polish_time  # every try counts
             iters += res.info.iter
@@ -92,4 +102,4 @@ class OsqpQP(QPMethod):
         y = res.y[0] if form.a is not None else 0.0
         return (np.asarray(res.x), y, status, iters, spent,
                 {"solver_status": res.info.status, "status_polish": int(res.info.status_polish),
-                 "tries": tries, "built": fresh})
+                 "tries": tries, "built": fresh, "solve_call_time": calls, "solve_call_cpu": cpu})

@@ -150,7 +150,7 @@ class QpsolversQP(QPMethod):
             A_rows.append(I[fx])
             b.extend(form.lower[fx])
         A = np.vstack(A_rows) if A_rows else None
-        P, G = form.H, (G if G.shape[0] else None)
+        P, G = np.array(form.H), (G if G.shape[0] else None)  # a copy: the Hessian is read-only (a memo), DAQP writes
         if self.solver == "highs":  # HiGHS takes sparse matrices only (qpsolvers would convert and warn)
             import scipy.sparse as sp
             P, G, A = (None if M is None else sp.csc_matrix(M) for M in (P, G, A))
