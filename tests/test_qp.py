@@ -411,7 +411,8 @@ def test_one_sweep_mode_of_the_alternation(quadratic_problem):
     one = alt.solve(cp)
     assert one.iterations == 1 and one.residual > converged.residual
     assert alt.single_sweeps(False) is True
-    assert alt.solve(cp).iterations == converged.iterations
+    again = alt.solve(cp)
+    assert again.iterations > 1 and again.residual <= alt.stall_limit
 
 
 def test_rolling_start_leaves_the_alternation_converging():

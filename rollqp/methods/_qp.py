@@ -206,8 +206,10 @@ class QPMethod:
     def _refined(self, form, x, y, info):
         """The refined ``(x, y)`` if rollqp's residual of it (:meth:`QPForm.residual
         <rollqp.problem.QPForm.residual>`) is smaller, else the solver's own."""
-        cand = active_set_refine(form, x, y, self._kkt)
-        base = form.residual(x, y)
+        x = np.asarray(x, dtype=float)
+        lam = form.H @ x + form.q + (float(y) * form.a if form.a is not None else 0.0)  # once for both
+        cand = active_set_refine(form, x, y, self._kkt, lam=lam)
+        base = form.residual(x, y, lam)
         info["unrefined_residual"] = max(base, info.get("unrefined_residual", 0.0))
         if cand is not None:
             res = form.residual(*cand)
@@ -296,7 +298,7 @@ def constraint_rows(form):
     return n, up, lo, np.flatnonzero(fixed)
 
 
-def active_set_refine(form, x, y, cache: "KKTCache | None" = None):
+def active_set_refine(form, x, y, cache: "KKTCache | None" = None, lam=None):
     r"""One equality-constrained KKT solve on the active set the solver found.
 
     An interior-point method stops with every complementary pair ``(slack, multiplier)``
@@ -319,11 +321,12 @@ def active_set_refine(form, x, y, cache: "KKTCache | None" = None):
     This is OSQP's *polishing* (Stellato et al., Math. Prog. Comp. 12 (2020) §5) applied to
     another solver's answer. The caller keeps the result only if rollqp's residual of it is
     smaller than that of the solver's own answer, so a wrong guess of the active set cannot make
-    things worse. Returns ``None`` if the reduced system is singular.
+    things worse. Returns ``None`` if the reduced system is singular. ``lam``: ``H x + q + y a``, if known.
     """
     H, q, l, u, a = form.H, form.q, form.lower, form.upper, form.a
     x = np.asarray(x, dtype=float)
-    lam = H @ x + q + (float(y) * a if a is not None else 0.0)
+    if lam is None:
+        lam = H @ x + q + (float(y) * a if a is not None else 0.0)
     fixed = form.fixed.copy()
     at_lo = np.isfinite(l) & (x - l < lam) & ~fixed
     at_up = np.isfinite(u) & (u - x < -lam) & ~fixed
@@ -344,7 +347,7 @@ def active_set_refine(form, x, y, cache: "KKTCache | None" = None):
         xF, yr = np.empty(0), 0.0
     else:
         from scipy.linalg import cho_solve
-        xF = cho_solve(chol, rhs)
+        xF = cho_solve(chol, rhs, check_finite=False)  # (finiteness checked below)
         yr = 0.0
         if a is not None:
             yr = float((a[F] @ xF - (form.b - a @ xa)) / schur)
@@ -393,6 +396,6 @@ def _kkt_factor(H, free, a):
         return None
     if a is None:
         return chol, None, None
-    z2 = cho_solve(chol, a[F])
+    z2 = cho_solve(chol, a[F], check_finite=False)
     schur = float(a[F] @ z2)
     return (chol, z2, schur) if np.isfinite(schur) and schur > 0 else None
