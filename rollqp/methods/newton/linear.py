@@ -78,7 +78,7 @@ class ReducedSystem:
     few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "unit", "partial", "last", "_base", "factorizations",
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "_K_nl", "unit", "partial", "last", "_base", "factorizations",
                  "updates")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
@@ -95,7 +95,7 @@ class ReducedSystem:
         K[:, :n] = (r / t_scale) * Ahat
         K[:, n] = r * last_column
         self.K = K
-        self.K_nl = np.ascontiguousarray(K[:, :n])
+        self._K_nl = None  # made on first use: a scene with the load row never needs it
         #: ``K_nl x̂ = unit · (A x)`` for a traction ``x`` in the problem's units (``x̂ = x/p0``)
         self.unit = (r / t_scale) * unit
         self.partial = n >= PARTIAL_MIN
@@ -108,6 +108,13 @@ class ReducedSystem:
     def matrices(self, with_load):
         """``K`` with or without the load column."""
         return self.K if with_load else self.K_nl
+
+    @property
+    def K_nl(self) -> np.ndarray:
+        """``K`` without the load column (contiguous: the products of a prescribed δ/ξ)."""
+        if self._K_nl is None:
+            self._K_nl = np.ascontiguousarray(self.K[:, :-1])
+        return self._K_nl
 
     def jacobian(self, mask, with_load):
         """The full pseudo-Jacobian ``J`` (for tests and diagnostics; the iteration never forms it)."""
