@@ -78,8 +78,8 @@ class ReducedSystem:
     few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "_K_nl", "unit", "partial", "last", "_base", "factorizations",
-                 "updates")
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "_K_nl", "unit", "partial", "last", "settled", "_base",
+                 "factorizations", "updates")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
     #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
@@ -101,6 +101,9 @@ class ReducedSystem:
         self.partial = n >= PARTIAL_MIN
         #: ``(x, A x)`` of the last solution: the next step, warm-started from ``x``, needs no new product
         self.last = None
+        #: The last step converged in one iteration (the iteration then multiplies at the full step
+        #: instead of carrying y: :func:`~.uncoupled.iterate`)
+        self.settled = False
         self._base = {}  # with_load -> (mask, free, position of each node in free or -1, lu, piv)
         self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
         self.updates = 0  # directions solved by a Schur complement on an older factorization
