@@ -42,8 +42,9 @@ class Result:
         missing = [k for k in self.rows if k not in values]
         if missing:
             raise TypeError(f"Result.append: missing field(s) {', '.join(missing)}")
-        for k in self.rows:
-            self.rows[k].append(np.array(values[k], copy=True))
+        new = [(rows, np.array(values[k], copy=True)) for k, rows in self.rows.items()]
+        for rows, v in new:  # an interrupt (Ctrl-C, SIGTERM) in here leaves a partial state: len() ignores it
+            rows.append(v)
 
     def extend(self, arrays: dict) -> None:
         """Append every state of a result file's ``arrays`` (an earlier part of the same run);
@@ -80,15 +81,18 @@ class Result:
         self.append(**values)
 
     def __len__(self):
-        return len(self.rows["q"])
+        """The complete states (every field appended; one cut short by an interrupt is not counted)."""
+        return min(len(v) for v in self.rows.values())
 
     def arrays(self) -> dict:
-        """All arrays of the result file, keyed as in docs/results.md."""
+        """All arrays of the result file, keyed as in docs/results.md (the complete states)."""
         n = self.x.size
+        K1 = len(self)
         out = {"x": np.asarray(self.x, dtype=float)}
         for k, v in self.rows.items():
+            v = v[:K1]
             per_state = k in _PER_STATE or (k in FIELDS and FIELDS[k].shape == "state")
-            shape = (len(self), n) if per_state else (len(self),)
+            shape = (K1, n) if per_state else (K1,)
             out[k] = np.asarray(v, dtype=dtype_of(k)).reshape(shape)
         for k, v in self.scalars.items():
             out[k] = np.asarray(v)

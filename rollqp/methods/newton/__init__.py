@@ -30,7 +30,11 @@ reuses its LU likewise, by a Woodbury update of the rows whose node case changed
 (:class:`~.linear.CoupledFactors`). Step length (eq. 75–79): ``α = ρ^m`` (``s = 1``), the first
 ``m`` with ``θ(z + αd) <= (1 − 2σα) θ(z)``, ``θ = ½‖Φ‖²``. Along the search line only the
 ``min``/``Proj`` are re-evaluated: the linear parts ``r ĝ``, ``r ŝ`` move by ``α K d`` with
-``K d`` computed once per iteration.
+``K d`` computed once per iteration. The linear part is carried from iterate to iterate this way
+(on large strips ``K d`` is ``−Φ`` on the free rows and block products on the rows ``Φ`` reads:
+:func:`~.linear.partial_product`), and evaluated anew from one product ``A x`` of the traction
+wherever the stopping test is passed; the step's solution reuses that product (slip, residuals,
+``w``) and the next step starts from it.
 
 **The augmentation r.** The paper's ``r = 0.1 N/mm`` is dimensional. Here ``r`` is
 nondimensional and chosen so that the two arguments of ``min``/``Proj`` respond alike to a

@@ -78,8 +78,8 @@ class ReducedSystem:
     few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "K_nl", "unit", "partial", "last", "_base", "factorizations",
-                 "updates")
+    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "_K_nl", "unit", "partial", "last", "settled", "_base",
+                 "factorizations", "updates")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
     #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
@@ -95,12 +95,15 @@ class ReducedSystem:
         K[:, :n] = (r / t_scale) * Ahat
         K[:, n] = r * last_column
         self.K = K
-        self.K_nl = np.ascontiguousarray(K[:, :n])
+        self._K_nl = None  # made on first use: a scene with the load row never needs it
         #: ``K_nl x̂ = unit · (A x)`` for a traction ``x`` in the problem's units (``x̂ = x/p0``)
         self.unit = (r / t_scale) * unit
         self.partial = n >= PARTIAL_MIN
         #: ``(x, A x)`` of the last solution: the next step, warm-started from ``x``, needs no new product
         self.last = None
+        #: The last step converged in one iteration (the iteration then multiplies at the full step
+        #: instead of carrying y: :func:`~.uncoupled.iterate`)
+        self.settled = False
         self._base = {}  # with_load -> (mask, free, position of each node in free or -1, lu, piv)
         self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
         self.updates = 0  # directions solved by a Schur complement on an older factorization
@@ -108,6 +111,13 @@ class ReducedSystem:
     def matrices(self, with_load):
         """``K`` with or without the load column."""
         return self.K if with_load else self.K_nl
+
+    @property
+    def K_nl(self) -> np.ndarray:
+        """``K`` without the load column (contiguous: the products of a prescribed δ/ξ)."""
+        if self._K_nl is None:
+            self._K_nl = np.ascontiguousarray(self.K[:, :-1])
+        return self._K_nl
 
     def jacobian(self, mask, with_load):
         """The full pseudo-Jacobian ``J`` (for tests and diagnostics; the iteration never forms it)."""

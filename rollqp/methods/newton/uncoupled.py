@@ -182,12 +182,30 @@ class _Iterate:
 
     def refresh(self):
         """``y`` and ``Φ`` from a new product ``A x`` of the iterate."""
-        x = self.xphys = self.z[:self.n] * self.pb.scales.stress
-        if self.sys.partial:  # the columns where x ≠ 0 (the contact: a zero traction outside it)
-            self.Ax = partial_product(self.pb.A.dense(), self.all_rows, x, np.flatnonzero(x))
-        else:
-            self.Ax = self.pb.A @ x
+        self.xphys, self.Ax, _ = self.product(self.z, with_y=False)
         self._y_from_product()
+
+    def product(self, z, with_y=True):
+        """``(x, A x, y)`` at the unknowns ``z`` (``x`` the traction in the problem's units)."""
+        x = z[:self.n] * self.pb.scales.stress
+        if self.sys.partial:  # the columns where x ≠ 0 (the contact: a zero traction outside it)
+            Ax = partial_product(self.pb.A.dense(), self.all_rows, x, np.flatnonzero(x))
+        else:
+            Ax = self.pb.A @ x
+        if not with_y:
+            return x, Ax, None
+        y = self.sys.unit * Ax + self.k0
+        if self.with_load:
+            y += self.K[:, self.n] * z[self.n]
+        return x, Ax, y
+
+    def take(self, z, trial):
+        """The iterate ``z`` with its product ``(x, A x, y)`` (:meth:`product`)."""
+        self.z = z
+        self.x = z[:self.n]
+        self.xphys, self.Ax, self.y = trial
+        self.fresh, self.since = True, 0
+        self.phi = self.residual(self.x, self.y)
 
     def _y_from_product(self):
         y = self.sys.unit * self.Ax + self.k0
@@ -297,10 +315,21 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         if d is None or not np.all(np.isfinite(d)):
             raise SolverError(f"the {pb.kind} Newton matrix is singular",
                               method=meth.name, status="singular", iterations=it, residual=nrm)
-        Kd = st.Kd(d, mask)
+        trial = None
+        if it == 1 and sys_.settled:
+            # the last step took one iteration, so this one likely does too: the product at the full
+            # step gives K d (all rows) and, if the step is taken, the iterate's own y, no second product
+            trial = st.product(st.z + d)
+            Kd = trial[2] - st.y
+        else:
+            Kd = st.Kd(d, mask)
         alpha = st.line_search(d, Kd, warm)
         st.steps.append(alpha)
-        st.update(st.z + alpha * d, alpha, Kd)  # eq. 79
+        if trial is not None and alpha == 1.0:
+            st.take(st.z + d, trial)  # eq. 79, α = 1
+        else:
+            st.update(st.z + alpha * d, alpha, Kd)  # eq. 79
+    sys_.settled = sys_.partial and it == 1
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
