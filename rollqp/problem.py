@@ -229,24 +229,25 @@ def _derived(step, **changes):
     return _trusted(type(step), **values)
 
 
-def qp_hessian(A, fh, factor: float):
-    """``(H / obj, obj)``: the QP Hessian ``sym(F̂ Â)·factor`` normalized by its largest diagonal entry.
+def qp_hessian(A, fh, scale):
+    """``(H / obj, obj)``: the QP Hessian ``sym(F̂ Â)`` normalized by its largest diagonal entry.
 
-    Computed once per operator, weights and factor and kept in the operator's memo (read-only):
-    every step of a scene, every QP of the splitting, reuses it, and the backends recognize it as
-    the Hessian their solver object was built for. ``Â = A·E*/a_H``, ``factor`` ``1`` (normal) or
-    ``1/Δq̂`` (tangential).
+    Computed once per operator, weights and ``scale = (E*, a_H)`` (``Â = A·E*/a_H``) and kept in
+    the operator's memo (read-only): every step of a scene, every QP of the splitting, reuses it,
+    and the backends recognize it as the Hessian their solver object was built for. The
+    tangential QP's ``sym(F̂Â)/Δq̂`` has the same normalized Hessian and ``obj/Δq̂``
+    (:meth:`TangentialStep.qp_form`): one array for every Δq of a load path.
     """
     def build():
-        Ah = A.dense() * factor[0] / factor[1]
-        FA = fh[:, None] * Ah if factor[2] is None else fh[:, None] * Ah / factor[2]
+        Ah = A.dense() * scale[0] / scale[1]
+        FA = fh[:, None] * Ah
         H = 0.5 * (FA + FA.T)
         obj = float(np.max(np.abs(np.diag(H))))
         Hn = H / obj
         Hn.flags.writeable = False
         return Hn, obj
 
-    return A.memo(("qp-hessian", fh.tobytes(), factor), build)
+    return A.memo(("qp-hessian", fh.tobytes(), tuple(scale)), build)
 
 
 def friction_residual(t, s, bound):
@@ -429,7 +430,7 @@ class NormalStep:
         """
         sc = self.scales
         fh = self.f / sc.length
-        H, obj = qp_hessian(self.A, fh, (sc.modulus, sc.length, None))  # once per operator (its memo)
+        H, obj = qp_hessian(self.A, fh, (sc.modulus, sc.length))  # once per operator (its memo)
         q = fh * self.h_total / sc.displacement
         if self.delta is not None:
             q = q - fh * (self.delta / sc.displacement)
@@ -574,7 +575,10 @@ class TangentialStep:
         sc = self.scales
         fh = self.f / sc.length
         dqh = self.dq / sc.length
-        H, obj = qp_hessian(self.A, fh, (sc.modulus, sc.length, dqh))  # once per operator and Δq (its memo)
+        # sym(F̂Â)/Δq̂ normalized by its largest diagonal entry is the normal Hessian whatever Δq̂:
+        # one array per operator (its memo), so a solver object serves every Δq of a load path
+        H, obj = qp_hessian(self.A, fh, (sc.modulus, sc.length))
+        obj = obj / dqh
         q = fh * (self.c / sc.displacement) / dqh
         if self.xi is not None:
             q = q + fh * (self.xi / sc.slip)
