@@ -262,13 +262,13 @@ class FullAlternation(PlainMarch):
     single_sweeps = None  # rollqp.march then never switches to one sweep per step
 
 
-def _timed_run(s, method):
+def timed_cpu_run(s, method):
     c0, t0 = time.process_time(), time.perf_counter()
     r = rollqp.run(s, method=method)
     return r, time.process_time() - c0, time.perf_counter() - t0
 
 
-def _distance(r, ref, s):
+def start_distance(r, ref, s):
     a, b = r.arrays(), ref.arrays()
     dp = np.max(np.abs(a["pn"][0] - b["pn"][0])) / s.p0
     dt = np.max(np.abs(a["pt"][0] - b["pt"][0])) / (s.contact.friction * s.p0)
@@ -304,14 +304,14 @@ def section_start():
           "converged steps); `full alternation`: the alternation converged at every step (rollqp before issue 18). "
           "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
           "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
-    ref, cpu_ref, wall_ref = _timed_run(s, "newton")
+    ref, cpu_ref, wall_ref = timed_cpu_run(s, "newton")
     rows = [["`newton` (direct steady solve)", f"{cpu_ref:.2f}", f"{wall_ref:.2f}", "1", "–", "0", "0"]]
     qp = lambda cls, name="qp-osqp": cls(rollqp.methods.get_method(name, tolerance=s.solver.tolerance))  # noqa: E731
     cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, plain march", qp(PlainMarch)),
              ("`qp-osqp`, full alternation (before)", qp(FullAlternation)), ("`qp-clarabel`", "qp-clarabel")]
     for label, method in cases:
-        r, cpu, wall = _timed_run(s, method)
-        dist, dxi = _distance(r, ref, s)
+        r, cpu, wall = timed_cpu_run(s, method)
+        dist, dxi = start_distance(r, ref, s)
         rows.append([label, f"{cpu:.2f}", f"{wall:.2f}", f"{cpu / cpu_ref:.0f}", int(r.arrays()["iterations"][0]),
                      f"{dist:.1e}", f"{dxi:.1e}"])
     print(table(["method", "CPU [s]", "wall [s]", "CPU / newton", "N–T sweeps (state 0)", "distance from newton",
