@@ -147,6 +147,10 @@ class StepRecord:
         The time-like parameter τ_k (length units; :mod:`rollqp.kinematics`), None for the start.
     direction : int
         Direction of the material in the step (±1), 0 for a static shift.
+    note : str or None
+        What the record's solve did instead of the usual (a rolling start marched because the
+        direct steady solve failed: :meth:`_March.rolling_start`); the result keeps it in
+        ``meta["start_note"]``.
     """
 
     k: int
@@ -165,6 +169,7 @@ class StepRecord:
     gross_sliding: bool = False
     tau: float | None = None
     direction: int = 0
+    note: str | None = None
 
     @property
     def normal(self):
@@ -315,6 +320,19 @@ class _March:
             shift += state.tsol.xi * delta
         ops.check_inside(state.p, 0)
         return self.record(0, "static-shift", 0.0, state, previous, problem, sol, cnt, P=P, shift=shift, t0=t0)
+
+    def rolling_start(self, braked: StepRecord) -> StepRecord:
+        """Rolling start from the braked state: the direct steady solve for a method that declares
+        ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says
+        why in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`)."""
+        if "steady" not in self.method.solves:
+            return self.steady_by_marching(braked)
+        try:
+            return self.steady_direct(braked)
+        except SolverError as err:
+            rec = self.steady_by_marching(braked)
+            rec.note = f"the direct steady solve failed ({err}); the steady state was reached by marching"
+            return rec
 
     def steady_direct(self, start: StepRecord) -> StepRecord:
         """Rolling start: the steady rolling problem ``s = ξ e + d·D_up w`` solved directly.
@@ -467,7 +485,7 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         try:
             start = m.braked_start()
             if scene.load.start == "rolling":
-                start = m.steady_direct(start) if "steady" in meth.solves else m.steady_by_marching(start)
+                start = m.rolling_start(start)
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
@@ -550,6 +568,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
     try:
         for rec in march(scene, prepared=prepared, resume=resume):
             result.add(rec, ops)
+            if rec.note is not None:
+                result.meta["start_note"] = rec.note
             if observe is not None:
                 observe(rec, ops)
             if progress is not None and rec.k > 0:

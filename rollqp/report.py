@@ -95,11 +95,24 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _bem_rows(res, scene)
+    rows += _start_rows(res)
     rows += energy_rows(res, scene, stresses)
     for name, val, what in closed_form_errors(res, scene):
         rows.append((f"error: {name}", f"{val:.4f}  {what}"))
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
+
+
+def _meta(res: dict) -> dict:
+    import json
+    meta = res.get("meta") or {}
+    return json.loads(str(meta)) if not isinstance(meta, dict) else meta
+
+
+def _start_rows(res: dict) -> list[tuple[str, str]]:
+    """A rolling start that marched because the direct steady solve failed says so (rollqp.march)."""
+    note = _meta(res).get("start_note")
+    return [] if note is None else [("starting state", str(note))]
 
 
 def _bem_rows(res: dict, scene) -> list[tuple[str, str]]:

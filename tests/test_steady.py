@@ -288,3 +288,30 @@ def test_direct_steady_slip_matches_carter_slip():
     assert errors[0] <= 2.5e-2, f"steady slip rms error {errors[0]:.3e} μa/R on 40 QCE"
     for coarse, fine in zip(errors, errors[1:]):
         assert fine <= 0.6 * coarse, f"slip error {coarse:.2e} → {fine:.2e}: not first order"
+
+
+def test_a_failed_direct_steady_solve_falls_back_to_marching():
+    """A method that declares "steady" but fails on the steady problem (as mf-newton's GMRES can at
+    10,001 nodes, docs/matrix-free.md) marches to the steady state instead; the result says so in
+    ``meta["start_note"]`` and reaches the direct solution to the march's tolerance (MARCH_TOL)."""
+    from conftest import Delegate
+    from rollqp.errors import SolverError
+    from rollqp.methods import get_method
+
+    class NoSteady(Delegate):
+        def solve(self, problem, warm=None):
+            if str(getattr(problem.A, "name", "")).startswith("steady"):
+                raise SolverError("refused the steady problem (test double)", method=self.name, residual=1.0)
+            return super().solve(problem, warm=warm)
+
+    s = rollqp.load_scene("cattaneo-carter").replace(**{"load.start": "rolling", "discretization.distance": 0.5})
+    direct = rollqp.run(s, method="newton")
+    marched = rollqp.run(s, method=NoSteady(get_method("newton", tolerance=s.solver.tolerance)))
+    assert "start_note" not in direct.meta
+    assert "direct steady solve failed" in marched.meta["start_note"]
+    assert "refused the steady problem" in marched.meta["start_note"]
+    a, b = direct.arrays(), marched.arrays()
+    mu = s.contact.friction
+    assert np.max(np.abs(a["pt"] - b["pt"])) / (mu * s.p0) < MARCH_TOL
+    from rollqp.report import summary
+    assert "direct steady solve failed" in summary(b, s, "newton", 0.0)   # the run's summary table says it
