@@ -21,9 +21,16 @@ from rollqp.result import OutputLock, TEMP_PREFIX, load_result, save_npz
 LONG = {"discretization.elements": 320, "discretization.distance": 12.0, "solver.method": "newton"}
 
 
+def _default_sigint():
+    """In the child before exec: SIGINT back to its default, so that Python installs its Ctrl-C handler.
+    A test run started in the background by a non-interactive shell (``cmd &``, as a CI script may do)
+    inherits SIGINT ignored, and Python then keeps ignoring it (seen: the run finished, exit 0)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _cli(*args, cwd, env=None):
     return subprocess.Popen([sys.executable, "-m", "rollqp.cli", *args], cwd=cwd, stderr=subprocess.PIPE,
-                            stdout=subprocess.PIPE, text=True,
+                            stdout=subprocess.PIPE, text=True, preexec_fn=_default_sigint,
                             env=dict(os.environ, OPENBLAS_NUM_THREADS="1", **(env or {})))
 
 
