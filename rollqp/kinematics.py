@@ -75,8 +75,8 @@ def plan(scene) -> Plan:
 
 
 class HistoryCache:
-    """The history operator ``M`` of each (Δq, d) met, from :meth:`SceneOperators.history
-    <rollqp.operators.SceneOperators.history>`.
+    """The history operator ``M`` of each (Δq, d) met, from :meth:`SceneOperators.build_history
+    <rollqp.operators.SceneOperators.build_history>` (sparse on either path).
 
     A table's Δq differs from step to step by round-off (``q(τ_k) − q(τ_{k−1})`` of interpolated
     values): steps within ``rtol`` (1e-12, far below the discretization error of the shift) reuse
@@ -92,8 +92,7 @@ class HistoryCache:
             if d0 == d and abs(dq - dq0) <= self.rtol * dq0:
                 self.items.append(self.items.pop(i))
                 return M
-        from .strip import RowSparse  # at most three non-zeros a row: O(n) products
-        M = RowSparse.from_dense(self.ops.strip.history_operator(self.ops.scene.discretization.formulation, dq, d))
+        M = self.ops.build_history(self.ops.scene.discretization.formulation, dq, d)
         self.items.append((dq, d, M))
         if len(self.items) > self.size:
             self.items.pop(0)

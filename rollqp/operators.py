@@ -194,9 +194,17 @@ class SceneOperators:
         direction = sc.load.direction if direction is None else direction
         key = ("history", formulation, float(dq), int(direction))
         if key not in self._memo:
-            self._memo[key] = (matrixfree.sparse_history(self.strip, formulation, dq, direction) if self.matrix_free
-                               else RowSparse.from_dense(self.strip.history_operator(formulation, dq, direction)))
+            self._memo[key] = self.build_history(formulation, dq, direction)
         return self._memo[key]
+
+    def build_history(self, formulation: str, dq: float, direction: int):
+        """A new history operator ``M`` (eq. 37, 48), not kept: sparse rows on either path (scipy.sparse,
+        built without a matrix, on the matrix-free path; :class:`~rollqp.strip.RowSparse` on the dense one).
+        :meth:`history` keeps the scene's; a load path's variable steps keep theirs in a bounded cache
+        (:class:`rollqp.kinematics.HistoryCache`)."""
+        if self.matrix_free:
+            return matrixfree.sparse_history(self.strip, formulation, dq, direction)
+        return RowSparse.from_dense(self.strip.history_operator(formulation, dq, direction))
 
     def steady(self) -> tuple[Operator | None, Operator]:
         """``(Δ·d·D_up·A_tn, Δ·d·D_up·A_tt)`` with ``Δ = a_H``: the steady slip operators, built once.

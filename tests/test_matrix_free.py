@@ -226,3 +226,19 @@ def test_load_paths_matrix_free_equal_dense(name, operator):
         assert np.max(np.abs(a.state.t - b.state.t)) / (mu * p0) < 1e-10
     stops = [r.solution.iterations for r in mf if r.phase == "static-shift" and r.k > 0]
     assert stops and max(stops) <= 10, f"set iterations on the stop's steps: {stops}"
+
+
+def test_load_path_history_operators_are_sparse_on_the_matrix_free_path():
+    """A load path's variable steps build their history operators as the scene's own are built: sparse,
+    never an n × n matrix, on the matrix-free path (O(n) memory), and equal to the dense path's."""
+    import scipy.sparse
+
+    from rollqp.kinematics import HistoryCache
+    from rollqp.march import prepare
+    s = rollqp.load_scene("stop-reverse").replace(**{"solver.method": "mf-newton", "solver.operator": "matrix-free"})
+    _, _, ops = prepare(s)
+    M = HistoryCache(ops).get(0.5 * s.dq, +1)
+    assert scipy.sparse.issparse(M) and M.nnz <= 3 * ops.n
+    _, _, dense_ops = prepare(s.replace(**{"solver.method": "newton", "solver.operator": "dense"}))
+    Md = HistoryCache(dense_ops).get(0.5 * s.dq, +1)
+    np.testing.assert_allclose(M.toarray(), Md.dense(), rtol=0, atol=1e-15)   # the same shift weights
