@@ -206,6 +206,15 @@ def _exactly_one(names, values):
         raise InputError(" / ".join(names), f"give exactly one of {' or '.join(names)} (got {len(given)})")
 
 
+def _check_sliding_limit(step) -> None:
+    """A tangential step with ``Q`` prescribed needs ``|Q| < μ fᵀp`` (a solution with stick), else an InputError."""
+    if step.Q is not None:
+        cap = float(step.f @ step.bound)
+        if not abs(step.Q) < cap:
+            raise InputError("Q", f"|Q| = {abs(step.Q):.6g} must be below the sliding limit "
+                                  f"mu fᵀp = {cap:.6g} for a solution with stick")
+
+
 def _trusted(cls, **values):
     """A step problem of class ``cls`` from values that are already valid, without re-validation.
 
@@ -500,11 +509,7 @@ class TangentialStep:
             raise InputError("xi", f"the prescribed creepage must be finite, got {self.xi!r}")
         if self.Q is not None and not np.isfinite(self.Q):
             raise InputError("Q", f"the tangential load must be finite, got {self.Q!r}")
-        if self.Q is not None:
-            cap = float(self.f @ self.bound)
-            if not abs(self.Q) < cap:
-                raise InputError("Q", f"|Q| = {abs(self.Q):.6g} must be below the sliding limit "
-                                      f"mu fᵀp = {cap:.6g} for a solution with stick")
+        _check_sliding_limit(self)
 
     @property
     def n(self) -> int:
@@ -715,11 +720,7 @@ class CoupledStep:
         # not re-validated (_trusted) but for the sliding limit, which depends on this pressure
         half = _trusted(TangentialStep, A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q,
                         xi=self.xi, scales=self.scales, law=self.law)
-        if self.Q is not None:
-            cap = float(self.f @ half.bound)
-            if not abs(self.Q) < cap:
-                raise InputError("Q", f"|Q| = {abs(self.Q):.6g} must be below the sliding limit "
-                                      f"mu fᵀp = {cap:.6g} for a solution with stick")
+        _check_sliding_limit(half)
         return half
 
     def coefficient(self, s=None):

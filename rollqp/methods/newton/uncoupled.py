@@ -95,7 +95,7 @@ def solve_normal(meth, pb, warm, t0):
     dhat_fixed = None if with_load else pb.delta / u0
     z, start = _normal_start(pb, sys_, warm)
     k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
-    known = _known_product(sys_, warm.p if start == "warm" else None)
+    known = _last_product(sys_, warm.p if start == "warm" else None)
     z, it, info, p, Ap = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
     delta = z[n] * u0 if with_load else pb.delta
     info["start"] = start
@@ -123,7 +123,7 @@ def solve_tangential(meth, pb, warm, t0):
             xi0 = warm.xi / sc.slip
     z = np.append(t, xi0) if with_load else t.copy()
     k0 = r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
-    known = _known_product(sys_, warm.t if start == "warm" else None)
+    known = _last_product(sys_, warm.t if start == "warm" else None)
     z, it, info, tt, At = iterate(meth, pb, sys_, z, k0, Qhat, TangentialNCP(b), start == "warm", known)
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
@@ -133,7 +133,7 @@ def solve_tangential(meth, pb, warm, t0):
     return meth.finish(sol, it, info, t0)
 
 
-def _known_product(sys_, x):
+def _last_product(sys_, x):
     """``(x, A x)`` if the system's last solution was the traction ``x`` (the warm start), else None."""
     last = sys_.last
     if x is None or last is None or not (last[0] is x or np.array_equal(last[0], x)):
@@ -205,12 +205,14 @@ class _Iterate:
             Ax = partial_product(self.pb.A.dense(), self.all_rows, x, np.flatnonzero(x))
         else:
             Ax = self.pb.A @ x
-        if not with_y:
-            return x, Ax, None
+        return x, Ax, (self._y(Ax, z) if with_y else None)
+
+    def _y(self, Ax, z):
+        """``y = K z + k0`` from the product ``A x`` of ``z``'s traction: ``unit·(A x) + k0 (+ K_load z_n)``."""
         y = self.sys.unit * Ax + self.k0
         if self.with_load:
             y += self.K[:, self.n] * z[self.n]
-        return x, Ax, y
+        return y
 
     def take(self, z, trial):
         """The iterate ``z`` with its product ``(x, A x, y)`` (:meth:`product`)."""
@@ -221,10 +223,7 @@ class _Iterate:
         self.phi = self.residual(self.x, self.y)
 
     def _y_from_product(self):
-        y = self.sys.unit * self.Ax + self.k0
-        if self.with_load:
-            y += self.K[:, self.n] * self.z[self.n]
-        self.y = y
+        self.y = self._y(self.Ax, self.z)
         self.fresh, self.since = True, 0
         self.phi = self.residual(self.x, self.y)
 
