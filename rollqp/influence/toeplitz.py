@@ -201,24 +201,17 @@ class ToeplitzOperator(Operator):
         return self._m
 
     def diagonal(self) -> np.ndarray:
-        """``M[i, i] = Σ_a P_a[i - (i - a) + ... ]``: one generating entry per local node."""
-        d = np.zeros(self._n)
-        for a in range(self._P.shape[0]):
-            cols = np.arange(a, a + self._r * (self._ne - 1) + 1, self._r)
-            d[cols] += self._P[a, cols - (cols - a) // self._r * self._r - self.kmin]
-        return d
+        """``M[i, i]`` (``O(n)``): :meth:`entries` on the diagonal."""
+        i = np.arange(self._n)
+        return self.entries(i, i)
 
     def column(self, j: int) -> np.ndarray:
         """Column ``j`` of the matrix (``O(n)``): for preconditioners."""
-        out = np.zeros(self._n)
-        for a in range(self._P.shape[0]):
-            if (j - a) % self._r == 0 and 0 <= (j - a) // self._r < self._ne:
-                e = (j - a) // self._r
-                out += self._P[a, np.arange(self._n) - self._r * e - self.kmin]
-        return out
+        return self.entries(np.arange(self._n), np.full(self._n, int(j)))
 
     def entries(self, i, j) -> np.ndarray:
-        """``M[i, j]`` for index arrays ``i``, ``j`` (``O(len)``): for the diagonal of products."""
+        """``M[i, j]`` for index arrays ``i``, ``j`` (``O(len)``): ``Σ_a P_a[i − r e − k_min]`` over the local
+        nodes ``a`` with ``j = r e + a`` (the diagonal, a column, the diagonal of a product)."""
         i, j = np.asarray(i, dtype=int), np.asarray(j, dtype=int)
         out = np.zeros(np.broadcast(i, j).shape)
         for a in range(self._P.shape[0]):
