@@ -104,6 +104,7 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
 
 
 def _meta(res: dict) -> dict:
+    """The result's ``meta`` (a dict, or its JSON as stored in a result file)."""
     import json
     meta = res.get("meta") or {}
     return json.loads(str(meta)) if not isinstance(meta, dict) else meta
@@ -119,10 +120,7 @@ def _bem_rows(res: dict, scene) -> list[tuple[str, str]]:
     """``model = "bem"``: assembly cost, the geometric coupling and the asymmetry of F·A (docs/bem.md)."""
     if scene.contact.model != "bem":
         return []
-    import json
-    meta = res.get("meta")
-    meta = json.loads(str(meta)) if not isinstance(meta, dict) else meta
-    m = meta.get("model", {})
+    m = _meta(res).get("model", {})
     cost = ("cached (same geometry built before)" if m.get("bem_cached") else
             f"{m.get('bem_seconds', float('nan')):.3f} s assembly + condensation")
     return [("BEM", f"{cost}, {m.get('bem_memory_bytes', 0) / 2 ** 20:.1f} MiB per body system; "
