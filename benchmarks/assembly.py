@@ -35,20 +35,26 @@ print(json.dumps({"nodes": s.n, "seconds": dt, "peak_bytes": rss, "matrix_bytes"
 """
 
 
+def measure(n: int, element: str = "quadratic", source: str | None = None) -> dict:
+    """One assembly of ``n`` nodes in a fresh process (of ``source``'s rollqp, default this checkout):
+    ``nodes``, ``seconds``, ``peak_bytes`` (the process's peak RSS), ``matrix_bytes``, ``min_eig_rel``."""
+    src = os.path.abspath(source or os.path.join(os.path.dirname(__file__), ".."))
+    env = dict(os.environ, PYTHONPATH=src)
+    out = subprocess.run([sys.executable, "-c", _CHILD, str(n), element], env=env, cwd=src,
+                         capture_output=True, text=True, check=True).stdout
+    return json.loads(out.strip().splitlines()[-1])
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--nodes", type=int, nargs="+", default=[2561, 5121])
     ap.add_argument("--element", default="quadratic", choices=("constant", "linear", "quadratic"))
     ap.add_argument("--source", default=None, help="checkout whose rollqp is timed (default: this one)")
     args = ap.parse_args(argv)
-    src = os.path.abspath(args.source or os.path.join(os.path.dirname(__file__), ".."))
-    env = dict(os.environ, PYTHONPATH=src)
     print("| nodes | assembly (s) | peak RSS (GB) | peak / matrix | min_eig_rel |")
     print("|---|---|---|---|---|")
     for n in args.nodes:
-        out = subprocess.run([sys.executable, "-c", _CHILD, str(n), args.element], env=env, cwd=src,
-                             capture_output=True, text=True, check=True).stdout
-        r = json.loads(out.strip().splitlines()[-1])
+        r = measure(n, args.element, args.source)
         print(f"| {r['nodes']} | {r['seconds']:.2f} | {r['peak_bytes'] / 1e9:.2f} | "
               f"{r['peak_bytes'] / r['matrix_bytes']:.2f} | {r['min_eig_rel']:.6g} |", flush=True)
 

@@ -98,25 +98,13 @@ def newton_step_ratio(repeats=5) -> dict:
     return {"n": n, "step": step, "product": product, "ratio": step / (3.0 * product)}
 
 
-_ASSEMBLY = r"""
-import json, resource, sys, time
-import scipy.fft, scipy.linalg, scipy.sparse.linalg  # imported before timing: a process's one-time cost
-from rollqp.strip import Strip
-from rollqp.influence import halfspace_influence
-n = int(sys.argv[1])
-s = Strip(1.25, (n - 1) // 2, "quadratic")
-t0 = time.perf_counter()
-halfspace_influence(s, Estar=1.0, beta=0.0, R_A=20.0, R_B=40.0)
-print(json.dumps({"seconds": time.perf_counter() - t0,
-                  "peak": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 / (8.0 * s.n * s.n)}))
-"""
-
-
 def assembly(nodes=5121, repeats=3) -> dict:
-    """Half-space assembly of ``nodes`` quadratic nodes in a fresh process: median seconds, peak RSS in matrices."""
-    runs = _child(_ASSEMBLY, nodes, repeats=repeats)
+    """Half-space assembly of ``nodes`` quadratic nodes, a fresh process each (``benchmarks/assembly.py``):
+    median seconds and peak RSS in matrices."""
+    from assembly import measure
+    runs = [measure(nodes) for _ in range(repeats)]
     return {"seconds": float(np.median([r["seconds"] for r in runs])),
-            "peak": float(np.median([r["peak"] for r in runs]))}
+            "peak": float(np.median([r["peak_bytes"] / r["matrix_bytes"] for r in runs]))}
 
 
 def cattaneo_carter_fine(elements=1280) -> dict:
