@@ -49,7 +49,7 @@ import numpy as np
 from .errors import InputError, SolverError
 from .kinematics import HistoryCache, plan
 from .operators import SceneOperators
-from .problem import StepSolution, classify
+from .problem import SLIP, STICK, StepSolution, classify
 from .result import Result
 from .scene import Scene, load_scene
 
@@ -188,6 +188,19 @@ class _March:
         self.cache = HistoryCache(ops) if self.plan.rolled else None
         self.fixed = self._normal_fixed()
         self.frictionless = ops.frictionless  # the scene's law: the same at every step
+        self.at = self._loads_at(self.plan.tau)
+
+    def _loads_at(self, tau) -> list:
+        """``(P, Q, ξ, δ)`` at each τ of the plan (:meth:`loads`, :meth:`approach`), each history evaluated
+        once over the whole plan: the same numbers as one τ at a time (tests/test_dense_path.py)."""
+        sc = self.scene
+        n = tau.size
+        none = [None] * n
+        P = none if sc.load.approach is not None else sc.normal_load(tau).tolist()
+        Q, xi = (none, sc.prescribed_creepage(tau).tolist()) if sc.load.creepage is not None else \
+            (sc.tangential_load(tau).tolist(), none)
+        D = none if sc.load.approach is None else sc.prescribed_approach(tau).tolist()
+        return list(zip(P, Q, xi, D))
 
     # ------------------------------------------------------------ loads
     def loads(self, q):
@@ -238,10 +251,10 @@ class _March:
         nsol, npb = state.nsol, state.normal
         if not normal_fixed or nsol is None:
             # goodman/off: the normal half does not see t (A_nt = 0); offset kept for generality
-            npb = ops.normal_step(P, state.t, delta=delta, h=h)
+            npb = ops.normal_step(P, state.t, delta=delta, h=h, validate=False)
             nsol = meth.solve(npb, warm=state.nsol)
             cnt.add(nsol, "normal")
-        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady, friction=fr)
+        pb = ops.tangential_step(nsol.p, c, dq, Q=Q, xi=xi, steady=steady, friction=fr, validate=False)
         tsol = meth.solve(pb, warm=state.tsol)
         cnt.add(tsol, "tangential")
         _keep_mu(pb, tsol)
@@ -271,8 +284,10 @@ class _March:
         ops = self.ops
         tsol = state.tsol
         mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s)
-        nodes = classify(state.p, state.t, tsol.s, mu, ops.scales)
-        gross = bool(np.any(nodes == 2) and not np.any(nodes == 1))
+        bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
+        nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound)
+        count = np.bincount(nodes, minlength=3)
+        gross = bool(count[SLIP] and not count[STICK])
         return StepRecord(k=k, phase=phase, q=float(q), P=float(ops.f @ state.p) if P is None else P,
                           Q=float(ops.f @ state.t), state=state, previous=previous, problem=problem, solution=sol, counters=cnt,
                           shift=shift, step_time=time.perf_counter() - t0, nodes=nodes, gross_sliding=gross)
@@ -402,7 +417,7 @@ class _March:
         scene, pl = self.scene, self.plan
         t0 = time.perf_counter()
         tau = float(pl.tau[k])
-        P, Q, xi = self.loads(tau)
+        P, Q, xi, D = self.at[k]
         cnt = Counters()
         d = int(pl.d[k])
         h = self.ops.gap(q) if self.moving else None
@@ -413,7 +428,7 @@ class _March:
         else:
             c, dq, phase = -(M @ state.w), scene.dq, "rolling"
         new, problem, sol = self.step(state, cnt, P=P, c=c, dq=dq, Q=Q, xi=xi,
-                                      normal_fixed=self.fixed, delta=self.approach(tau), h=h,
+                                      normal_fixed=self.fixed, delta=D, h=h,
                                       q=q, transport=self._transport(k, dq) if phase == "rolling" else None)
         if not self.fixed:
             self.ops.check_inside(new.p, k)
@@ -644,5 +659,5 @@ def _product(sol, problem, A):
 def _keep_mu(problem, sol) -> None:
     """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
     the result field ``friction_coefficient``); Coulomb steps are left as they were."""
-    if problem.law is not None or np.ndim(problem.mu) != 0:
+    if problem.law is not None or (type(problem.mu) is not float and np.ndim(problem.mu) != 0):
         sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s), (problem.n,)).astype(float)

@@ -20,7 +20,7 @@ from . import matrixfree
 from .errors import InputError
 from .influence import build_influence
 from .influence.operator import Operator, asymmetry
-from .problem import CoupledStep, NormalStep, Scales, TangentialStep
+from .problem import CoupledStep, NormalStep, Scales, TangentialStep, _check_sliding_limit, _trusted
 from .strip import RowSparse, Strip
 
 __all__ = ["SceneOperators"]
@@ -221,20 +221,41 @@ class SceneOperators:
         return self._memo["steady"]
 
     # ------------------------------------------------------------ step problems
-    def normal_step(self, P, t=None, delta=None, h=None) -> NormalStep:
+    def normal_step(self, P, t=None, delta=None, h=None, validate=True) -> NormalStep:
         """The normal step (eq. 53): load ``P`` (or approach ``delta``), shear ``t`` fixed; ``h``: the
-        undeformed gap of the step (default :attr:`h`; a moving profile's :meth:`gap`)."""
-        offset = None if (self.Ant is None or t is None) else self.Ant @ t
-        return NormalStep(A=self.Ann, f=self.f, h=self.h if h is None else h, P=P, delta=delta, offset=offset, scales=self.scales)
+        undeformed gap of the step (default :attr:`h`; a moving profile's :meth:`gap`).
 
-    def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False, friction=None) -> TangentialStep:
+        ``validate=False`` (rollqp.march): the values are the scene's validated data and the method's
+        checked solutions, and the step is built without re-validating them (:func:`~rollqp.problem._trusted`)."""
+        offset = None if (self.Ant is None or t is None) else self.Ant @ t
+        h = self.h if h is None else h
+        if not validate:
+            return _trusted(NormalStep, A=self.Ann, f=self.f, h=h, P=_float(P), delta=_float(delta), offset=offset,
+                            scales=self.scales)
+        return NormalStep(A=self.Ann, f=self.f, h=h, P=P, delta=delta, offset=offset, scales=self.scales)
+
+    def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False, friction=None, validate=True) -> TangentialStep:
         """The tangential step (eq. 61/62) at the pressure ``p``; ``steady``: the steady slip operators;
-        ``friction``: ``(mu, law)`` of the step (:meth:`step_friction`; default the scene's Coulomb ``μ``)."""
+        ``friction``: ``(mu, law)`` of the step (:meth:`step_friction`; default the scene's Coulomb ``μ``);
+        ``validate`` as for :meth:`normal_step` (the sliding limit, which depends on ``p``, is checked
+        either way)."""
         Atn, Att = self.steady() if steady else (self.Atn, self.Att)
         if Atn is not None:
             c = c + Atn @ p
         mu, law = (self.mu, None) if friction is None else friction
-        return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
+        if validate:
+            return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
+        pb = _trusted(TangentialStep, A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
+                      scales=self.scales, law=law)
+        last = self._memo.get("bound")  # (p, μ, bound, sliding limit) of the last march-built step
+        if last is not None and last[0] is p and last[1] is mu and law is None:
+            pb.__dict__["bound"] = last[2]  # the same pressure (a fixed normal half) and μ: the same bound
+            _check_sliding_limit(pb, last[3])
+        elif law is None:
+            self._memo["bound"] = (p, mu, pb.bound, _check_sliding_limit(pb))
+        else:
+            _check_sliding_limit(pb)
+        return pb
 
     def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None, h=None,
                      friction=None) -> CoupledStep:
@@ -258,3 +279,9 @@ class SceneOperators:
                              f"the contact reaches the edge of the zone at step {step} "
                              f"(p/p0 = {max(ends) / self.scales.stress:.2e} at an end node): increase zone "
                              f"(now {self.scene.discretization.zone})")
+
+
+def _float(v):
+    """A load, approach or creepage of a march-built step as a float (``None`` kept): what
+    ``__post_init__`` would store."""
+    return None if v is None else float(v)

@@ -206,36 +206,56 @@ def _exactly_one(names, values):
         raise InputError(" / ".join(names), f"give exactly one of {' or '.join(names)} (got {len(given)})")
 
 
-def _check_sliding_limit(step) -> None:
-    """A tangential step with ``Q`` prescribed needs ``|Q| < μ fᵀp`` (a solution with stick), else an InputError."""
+def _check_sliding_limit(step, cap=None) -> float | None:
+    """A tangential step with ``Q`` prescribed needs ``|Q| < μ fᵀp`` (a solution with stick), else an InputError.
+    ``cap``: ``fᵀ(μ p⁺)`` if the caller has it. Returns the cap (None without ``Q``)."""
     if step.Q is not None:
-        cap = float(step.f @ step.bound)
+        cap = float(step.f @ step.bound) if cap is None else cap
         if not abs(step.Q) < cap:
             raise InputError("Q", f"|Q| = {abs(step.Q):.6g} must be below the sliding limit "
                                   f"mu fᵀp = {cap:.6g} for a solution with stick")
+    return cap
 
 
 def _trusted(cls, **values):
     """A step problem of class ``cls`` from values that are already valid, without re-validation.
 
-    For the halves of a checked :class:`CoupledStep` and the symmetrized or shifted copies of a
-    checked step (each QP of the symmetric–skew splitting): their operators are the checked
-    step's own :class:`Operator`\\ s and their vectors are products of them with checked or
-    solver-computed arrays, so the ``O(n)``–``O(n²)`` checks of ``__post_init__`` would only
-    repeat (measured 3–14 % of a QP step on §6.1.1). The caller vouches for the values.
+    For the halves of a checked :class:`CoupledStep`, the symmetrized or shifted copies of a
+    checked step (each QP of the symmetric–skew splitting), and the steps rollqp.march builds from
+    the scene's validated operators and the method's checked solutions
+    (:meth:`~rollqp.operators.SceneOperators.tangential_step` with ``validate=False``): their
+    operators are checked :class:`Operator`\\ s and their vectors are products of them with
+    checked or solver-computed arrays, so the ``O(n)``–``O(n²)`` checks of ``__post_init__`` would
+    only repeat (measured 3–14 % of a QP step and 13 % of a Newton rolling step on §6.1.1). The
+    caller vouches for the values.
     """
     obj = object.__new__(cls)
-    for f in dataclasses.fields(cls):
-        object.__setattr__(obj, f.name, values[f.name] if f.name in values else f.default
-                           if f.default is not dataclasses.MISSING else f.default_factory())
+    d = obj.__dict__
+    plain, factories = _defaults(cls)
+    d.update(plain)
+    d.update(values)
+    for name, make in factories:
+        if name not in values:
+            d[name] = make()
     return obj
+
+
+@functools.cache
+def _defaults(cls) -> tuple:
+    """``(defaults, factories)`` of ``cls``'s fields: the plain default values, and the
+    ``(name, default_factory)`` pairs (called for each object: a factory's value may be mutable)."""
+    fields = dataclasses.fields(cls)
+    return ({f.name: f.default for f in fields if f.default is not dataclasses.MISSING},
+            tuple((f.name, f.default_factory) for f in fields if f.default_factory is not dataclasses.MISSING))
 
 
 def _derived(step, **changes):
     """``step`` with ``changes`` (already valid: :func:`_trusted`), not re-validated."""
-    values = {f.name: getattr(step, f.name) for f in dataclasses.fields(step)}
-    values.update(changes)
-    return _trusted(type(step), **values)
+    obj = object.__new__(type(step))  # frozen: the fields set through __dict__, as dataclasses.replace would
+    obj.__dict__.update(step.__dict__)
+    obj.__dict__.update(changes)
+    obj.__dict__.pop("bound", None)  # a cached property of the old values (TangentialStep.bound)
+    return obj
 
 
 def qp_hessian(A, fh, scale):
@@ -259,13 +279,18 @@ def qp_hessian(A, fh, scale):
     return A.memo(("qp-hessian", fh.tobytes(), tuple(scale)), build)
 
 
-def friction_residual(t, s, bound):
+def friction_residual(t, s, bound, minus_bound=None):
     """``t − Proj_[−b, b](t − s)`` (eq. 60): zero iff ``|t| <= b`` and ``t`` opposes the slip ``s``.
 
     The one expression of the friction law's projection residual: rollqp's residuals use it with
     nondimensional ``t̂, ŝ, b̂``; the Newton method with ``r ŝ`` in place of ``ŝ`` (eq. 56, 63).
+    ``minus_bound``: ``−b`` if the caller keeps it.
     """
-    return t - np.clip(t - s, -bound, bound)
+    if minus_bound is None:
+        minus_bound = -bound
+    # np.maximum/np.minimum rather than np.clip: the same numbers (``b >= 0``), without np.clip's
+    # Python-level dispatch (half the time on a step's vectors, and Newton evaluates it a few times an iteration)
+    return t - np.maximum(np.minimum(t - s, bound), minus_bound)
 
 
 def symmetrized(A, f: np.ndarray) -> Operator:
@@ -515,12 +540,16 @@ class TangentialStep:
     def n(self) -> int:
         return self.f.size
 
-    @property
+    @functools.cached_property
     def bound(self) -> np.ndarray:
-        """``μ·max(p̄, 0)`` (with a slip-dependent ``law``: at zero slip, the static bound)."""
+        """``μ·max(p̄, 0)`` (with a slip-dependent ``law``: at zero slip, the static bound); computed once
+        per step problem (read-only: the march, the solver and rollqp's residual each read it)."""
         if self.law is not None:
-            return self.law.mu(np.zeros(self.n)) * np.maximum(self.p, 0.0)
-        return self.mu * np.maximum(self.p, 0.0)
+            b = self.law.mu(np.zeros(self.n)) * np.maximum(self.p, 0.0)
+        else:
+            b = self.mu * np.maximum(self.p, 0.0)
+        b.flags.writeable = False
+        return b
 
     def bound_at(self, s) -> np.ndarray:
         """The bound at the slip ``s``: ``μ(s)·max(p̄, 0)`` (``law``), else :attr:`bound`."""
@@ -569,7 +598,7 @@ class TangentialStep:
         th, sh, bh = t / sc.stress, s / sc.slip, self.bound_at(s) / sc.stress
         fr = friction_residual(th, sh, bh)
         load = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
-        return Residuals(friction=float(np.max(np.abs(fr))), load_tangential=abs(float(load)))
+        return Residuals(friction=float(np.abs(fr).max()), load_tangential=abs(float(load)))
 
     def qp_form(self) -> QPForm:
         r"""``min ½ t̂ᵀ sym(F̂Â) t̂/Δq̂ + (F̂ĉ/Δq̂)ᵀ t̂`` s.t. ``|t̂| <= μp̂``, ``f̂ᵀt̂ = Q̂``; ``ξ̂ = y``.
@@ -764,7 +793,9 @@ class Residuals:
     @property
     def max(self) -> float:
         """The largest residual; NaN if any is NaN (so that no limit check can pass it)."""
-        return float(np.max((self.signorini, self.friction, self.load_normal, self.load_tangential)))
+        v = (self.signorini, self.friction, self.load_normal, self.load_tangential)
+        m = max(v)  # (builtin max on four floats: np.max costs 10× as much, and is called for every solve)
+        return float("nan") if any(x != x for x in v) else float(m)
 
     def __or__(self, other: "Residuals") -> "Residuals":
         a = np.asarray(dataclasses.astuple(self), dtype=float)
@@ -800,16 +831,18 @@ class StepSolution:
         return self.residuals.max
 
 
-def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7) -> np.ndarray:
+def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7, bound=None) -> np.ndarray:
     """Node states: 0 separation (``p̂ <= tol``), 2 slip (``|ŝ| > tol`` at the bound), 1 stick.
 
-    ``t`` or ``s`` may be ``None`` (normal problem only): contact nodes are then stick.
+    ``t`` or ``s`` may be ``None`` (normal problem only): contact nodes are then stick. ``bound``:
+    ``μ max(p, 0)`` if the caller has it (a step problem's :attr:`TangentialStep.bound`).
     """
     p = np.asarray(p, dtype=float)
-    state = np.where(p / scales.stress > tol, STICK, SEPARATION).astype(np.int8)
+    contact = p > tol * scales.stress  # (thresholds scaled, not the arrays: 3 fewer array operations)
+    state = contact.astype(np.int8)  # STICK where in contact, SEPARATION elsewhere
     if t is not None and s is not None:
-        at_bound = (mu * np.maximum(p, 0) - np.abs(t)) / scales.stress <= tol
-        slipping = (np.abs(s) / scales.slip > tol) & at_bound & (state == STICK)
+        at_bound = (mu * np.maximum(p, 0) if bound is None else bound) - np.abs(t) <= tol * scales.stress
+        slipping = (np.abs(s) > tol * scales.slip) & at_bound & contact
         state[slipping] = SLIP
     return state
 

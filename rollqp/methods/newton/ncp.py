@@ -58,18 +58,20 @@ class TangentialNCP:
 
     def __init__(self, b):
         self.b = b
+        self._minus_b = -b
         self.sep = b <= 0.0
         #: Rows whose ``y`` enters ``Φ``: a zero bound gives ``Φ_i = t̂_i`` whatever ``r ŝ_i`` (eq. 85).
         self.needs = ~self.sep
 
     def phi(self, x, y):
-        """``Φ_i = t̂_i − Proj_[−b_i, b_i](t̂_i − r ŝ_i)`` (eq. 60)."""
-        return friction_residual(x, y, self.b)
+        """``Φ_i = t̂_i − Proj_[−b_i, b_i](t̂_i − r ŝ_i)`` (eq. 60): :func:`~rollqp.problem.friction_residual`
+        with ``−b`` formed once per step (Newton evaluates ``Φ`` a few times an iteration)."""
+        return friction_residual(x, y, self.b, self._minus_b)
 
     def mask(self, x, y):
         """Nodes with the ``∂(r ŝ_i)`` row: ``|t̂_i − r ŝ_i| <= b_i`` (eq. 86/87, stick); the others
         ``∂t̂_i``: slip (eq. 88, ``b`` fixed) or a zero bound (eq. 85, separation)."""
-        return (np.abs(x - y) <= self.b) & ~self.sep
+        return (np.abs(x - y) <= self.b) & self.needs
 
     def nearest(self, x, y):
         """All ``|t̂ − r ŝ| > b``: the node with the smallest excess sticks when ``r ŝ`` moves by it."""

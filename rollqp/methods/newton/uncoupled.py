@@ -110,27 +110,37 @@ def solve_tangential(meth, pb, warm, t0):
     sys_ = meth.system(pb, pb.dq / sc.length)
     n, r = pb.n, sys_.r
     dqh = pb.dq / sc.length
-    b = pb.bound / sc.stress
     with_load = pb.Q is not None
     Qhat = pb.Q / sc.force if with_load else None
     xi_fixed = None if with_load else pb.xi / sc.slip
+    z = np.zeros(n + 1 if with_load else n)  # (t̂, ξ̂) or t̂: the start, Step 1
     start = "cold"
-    t = np.zeros(n)
-    xi0 = 0.0
     if warm is not None and warm.t is not None and np.shape(warm.t) == (n,):
-        t, start = np.asarray(warm.t, dtype=float) / sc.stress, "warm"
-        if warm.xi is not None:
-            xi0 = warm.xi / sc.slip
-    z = np.append(t, xi0) if with_load else t.copy()
-    k0 = r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
+        np.divide(warm.t, sc.stress, out=z[:n])
+        start = "warm"
+        if warm.xi is not None and with_load:
+            z[n] = warm.xi / sc.slip
+    k0 = pb.c * (r / (sc.displacement * dqh))  # r ĉ/Δq̂ (+ r ξ̂ prescribed)
+    if xi_fixed is not None:
+        k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    z, it, info, tt, At = iterate(meth, pb, sys_, z, k0, Qhat, TangentialNCP(b), start == "warm", known)
+    z, it, info, tt, At = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
     sol = pb.solution(tt, xi, At=At)
     sys_.last = (sol.t, At)
     info["At"] = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
+
+
+def _friction_rows(sys_, pb):
+    """The friction rows of ``pb`` (:class:`~.ncp.TangentialNCP` of ``b̂ = μp̄⁺/p0``), kept on the system
+    while the steps share their read-only bound array (a fixed normal half: the same pressure every step)."""
+    bound = pb.bound
+    last = sys_.ncp
+    if last is None or last[0] is not bound:
+        last = sys_.ncp = (bound, TangentialNCP(bound / pb.scales.stress))
+    return last[1]
 
 
 def _last_product(sys_, x):
@@ -165,7 +175,6 @@ class _Iterate:
         self.K = sys_.matrices(self.with_load)
         self.k0 = k0
         self.needs = getattr(ncp, "needs", None)
-        self.all_rows = np.arange(self.n)
         self.z = z
         self.x = z[:self.n]
         #: full products from here on (:meth:`exact_products`): the carried ``y`` reached its round-off floor
@@ -190,8 +199,13 @@ class _Iterate:
         self.exact = True
 
     def residual(self, x, y):
-        ph = self.ncp.phi(x, y)
-        return np.append(ph, self.sys.fhat @ x - self.load) if self.with_load else ph
+        """``Φ = [φ(x, y); f̂ᵀx − load]`` (eq. 74; the load row eq. 67 only with the load prescribed)."""
+        if not self.with_load:
+            return self.ncp.phi(x, y)
+        out = np.empty(self.n + 1)
+        out[:self.n] = self.ncp.phi(x, y)
+        out[self.n] = self.sys.fhat @ x - self.load
+        return out
 
     def refresh(self):
         """``y`` and ``Φ`` from a new product ``A x`` of the iterate."""
@@ -202,7 +216,7 @@ class _Iterate:
         """``(x, A x, y)`` at the unknowns ``z`` (``x`` the traction in the problem's units)."""
         x = z[:self.n] * self.pb.scales.stress
         if self.sys.partial and not self.exact:  # the columns where x ≠ 0 (the contact: zero traction outside)
-            Ax = partial_product(self.pb.A.dense(), self.all_rows, x, np.flatnonzero(x))
+            Ax = partial_product(self.pb.A.dense(), np.arange(self.n), x, np.flatnonzero(x))
         else:
             Ax = self.pb.A @ x
         return x, Ax, (self._y(Ax, z) if with_y else None)
@@ -211,21 +225,22 @@ class _Iterate:
         """``y = K z + k0`` from the product ``A x`` of ``z``'s traction: ``unit·(A x) + k0 (+ K_load z_n)``."""
         y = self.sys.unit * Ax + self.k0
         if self.with_load:
-            y += self.K[:, self.n] * z[self.n]
+            y += self.sys.load_column * z[self.n]
         return y
 
-    def take(self, z, trial):
-        """The iterate ``z`` with its product ``(x, A x, y)`` (:meth:`product`)."""
+    def take(self, z, trial, phi, merit):
+        """The iterate ``z`` with its product ``(x, A x, y)`` (:meth:`product`), its ``Φ`` and merit ``θ``
+        (the line search's)."""
         self.z = z
         self.x = z[:self.n]
         self.xphys, self.Ax, self.y = trial
         self.fresh, self.since = True, 0
-        self.phi = self.residual(self.x, self.y)
+        self.phi, self.merit = phi, merit
 
     def _y_from_product(self):
         self.y = self._y(self.Ax, self.z)
         self.fresh, self.since = True, 0
-        self.phi = self.residual(self.x, self.y)
+        self.phi, self.merit = self.residual(self.x, self.y), None
 
     def update(self, z, alpha, Kd):
         """The iterate ``z`` reached by the step ``α d``, with ``K d`` (:meth:`Kd`)."""
@@ -237,7 +252,7 @@ class _Iterate:
             return
         self.y = self.y + alpha * Kd
         self.fresh = False
-        self.phi = self.residual(self.x, self.y)
+        self.phi, self.merit = self.residual(self.x, self.y), None
 
     def Kd(self, d, mask):
         """``K d`` on the rows ``Φ`` reads. On the free rows (``mask``) the Newton equations give it,
@@ -270,31 +285,42 @@ class _Iterate:
                 self._y_from_product()
             else:
                 self.y = self.y + self.K[:, n] * (dy / self.K[j, n])
-                self.phi = self.residual(self.x, self.y)
+                self.phi, self.merit = self.residual(self.x, self.y), None
             m = ncp.mask(self.x, self.y)
             m[j] = True
             self.shifts += 1
         mask[:n] = m
 
-    def line_search(self, d, Kd, warm):
+    def line_search(self, d, Kd, warm, full=None):
         """Armijo (eq. 75–78, ``s = 1``): ``α = ρ^m``, the first with ``θ(z + αd) <= (1 − 2σα) θ(z)``;
-        below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start)."""
+        below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start).
+
+        ``full = (z + d, its product)`` (:meth:`product`): ``α = 1`` is tried on the full step's own
+        ``y``. Returns ``(α, (Φ, θ) at z + αd)``, the latter ``None`` unless ``α = 1`` was taken on ``full``."""
         meth = self.meth
         rho, two_sigma = meth.rho, 2.0 * meth.sigma
         dx = d[:self.n]
         theta = self.merits[-1]
-        alpha = 1.0
+        if full is not None:
+            pa = self.residual(full[0][:self.n], full[1][2])
+            merit = 0.5 * float(pa @ pa)
+            if merit <= (1.0 - two_sigma) * theta:
+                return 1.0, (pa, merit)
+            alpha = rho
+            self.backtracks += 1
+        else:
+            alpha = 1.0
         while True:
             pa = self.residual(self.x + alpha * dx, self.y + alpha * Kd)
             if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
-                return alpha
+                return alpha, None
             alpha *= rho
             self.backtracks += 1
             if alpha < ALPHA_MIN:
                 if warm:
                     raise Stalled()
                 self.nonmono += 1
-                return 1.0
+                return 1.0, None
 
 
 def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
@@ -308,17 +334,17 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     n, r = pb.n, sys_.r
     st = _Iterate(meth, pb, sys_, z, k0, load, ncp, start)
     stop = meth.tolerance * min(1.0, r)
-    mask = np.ones(n + 1 if st.with_load else n, dtype=bool)  # last entry: load row (always the JK row)
+    mask = sys_.mask(st.with_load)  # last entry: load row (always the JK row)
     it = 0
     while True:
-        nrm = float(np.max(np.abs(st.phi)))
+        nrm = float(np.abs(st.phi).max())
         if nrm <= stop and not st.fresh:  # converged on the carried y: test on the iterate's own product
             st.refresh()
-            nrm = float(np.max(np.abs(st.phi)))
+            nrm = float(np.abs(st.phi).max())
             if nrm > stop:
                 st.exact_products()
         st.history.append(nrm)
-        st.merits.append(0.5 * float(st.phi @ st.phi))
+        st.merits.append(0.5 * float(st.phi @ st.phi) if st.merit is None else st.merit)
         if nrm <= stop:
             break
         if it >= meth.max_iterations:
@@ -326,21 +352,20 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         it += 1
         st.rows(mask)
         d = sys_.direction(mask, st.phi, st.with_load)  # reduced system on the free nodes
-        if d is None or not np.all(np.isfinite(d)):
+        if d is None or not np.isfinite(d).all():
             raise SolverError(f"the {pb.kind} Newton matrix is singular",
                               method=meth.name, status="singular", iterations=it, residual=nrm)
-        trial = None
-        if it == 1 and sys_.settled:
-            # the last step took one iteration, so this one likely does too: the product at the full
-            # step gives K d (all rows) and, if the step is taken, the iterate's own y, no second product
-            trial = st.product(st.z + d)
-            Kd = trial[2] - st.y
+        if not sys_.partial or (it == 1 and sys_.settled):
+            # small n, or the last step took one iteration (so this one likely does too): the product at
+            # the full step gives K d (all rows) and, if the step is taken, the iterate's own y and Φ
+            full = (st.z + d, st.product(st.z + d))
+            Kd = full[1][2] - st.y
         else:
-            Kd = st.Kd(d, mask)
-        alpha = st.line_search(d, Kd, warm)
+            full, Kd = None, st.Kd(d, mask)
+        alpha, at_full = st.line_search(d, Kd, warm, full)
         st.steps.append(alpha)
-        if trial is not None and alpha == 1.0:
-            st.take(st.z + d, trial)  # eq. 79, α = 1
+        if at_full is not None:
+            st.take(full[0], full[1], *at_full)  # eq. 79, α = 1
         else:
             st.update(st.z + alpha * d, alpha, Kd)  # eq. 79
     sys_.settled = sys_.partial and it == 1
