@@ -358,7 +358,8 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         if not sys_.partial or (it == 1 and sys_.settled):
             # small n, or the last step took one iteration (so this one likely does too): the product at
             # the full step gives K d (all rows) and, if the step is taken, the iterate's own y and Φ
-            full = (st.z + d, st.product(st.z + d))
+            zf = st.z + d
+            full = (zf, st.product(zf))
             Kd = full[1][2] - st.y
         else:
             full, Kd = None, st.Kd(d, mask)
