@@ -7,7 +7,11 @@
 * Newton with the partial products and the carried ``y`` (``n >= PARTIAL_MIN``) reaches the
   tractions of the plain dense products, step by step over a transient;
 * the march's ``w`` reuses the solution's product ``A_tt t`` and equals ``A_tt t``;
-* the elastic energy read from the state's gap and ``w`` equals the quadratic form.
+* the elastic energy read from the state's gap and ``w`` equals the quadratic form;
+* the small-``n`` path: the direction on kept factors (the block ``[K_FP; f̂_Pᵀ]``, a free set met
+  again) solves the pseudo-Jacobian; the march's step problems (``validate=False``) are the
+  validated ones and keep the sliding-limit check; the loads of the plan, evaluated once, are the
+  loads at each step.
 """
 from __future__ import annotations
 
@@ -17,6 +21,7 @@ import pytest
 import rollqp
 from rollqp.energy import elastic_energy
 from rollqp.march import prepare
+from rollqp.scene import builtin_scenes
 from rollqp.methods.newton import linear
 from rollqp.strip import RowSparse, Strip
 
@@ -32,6 +37,9 @@ TOL = {
     "transient": 1e-10,
     # U from g − h + δ instead of A p: round-off of the gap's terms (h, δ ~ u0) against U
     "energy": 1e-12,
+    # the reduced system's LU against a dense solve of the whole pseudo-Jacobian: round-off times
+    # the reduced matrix's condition (~1e3 on 81 nodes), relative to |d|
+    "direction": 1e-11,
 }
 
 
@@ -49,6 +57,17 @@ def test_rowsparse_history_is_the_dense_operator(element, formulation):
         scale = np.max(np.abs(M)) * np.max(np.abs(w)) * 3
         assert np.max(np.abs(R @ w[:, 0] - ref[:, 0])) <= TOL["rowsparse"] * scale
         assert np.max(np.abs(R @ w - ref)) <= TOL["rowsparse"] * scale
+
+
+def test_rowsparse_vector_product_in_both_forms():
+    """Up to RowSparse.DENSE_MAX entries a vector goes through the dense copy, beyond through the rows."""
+    for elements in (24, 100):  # 49 and 201 quadratic nodes: either side of DENSE_MAX
+        s = Strip(1.25, elements, "quadratic")
+        M = s.history_operator("material", 0.3 * s.element_length, 1)
+        assert (s.n * s.n <= RowSparse.DENSE_MAX) == (elements == 24)
+        w = np.random.default_rng(3).standard_normal(s.n)
+        got = RowSparse.from_dense(M) @ w
+        assert np.max(np.abs(got - M @ w)) <= TOL["rowsparse"] * np.max(np.abs(M)) * np.max(np.abs(w)) * 3
 
 
 def test_scene_history_is_row_sparse(builtin_scene):
@@ -124,3 +143,73 @@ def test_result_ignores_a_state_cut_short_by_an_interrupt(builtin_scene):
     assert len(res) == K1
     a = res.arrays()
     assert a["q"].shape == (K1,) and a[first].shape[0] == K1
+
+
+def _rolling_step(builtin_scene, k=100):
+    """A rolling step of §6.1.1 (81 nodes) with newton set up on it, and the record that solved it."""
+    scene, meth, ops = prepare(builtin_scene("cattaneo-carter"), "newton")
+    for rec in rollqp.march(scene, prepared=(scene, meth, ops)):
+        if rec.k == k:
+            return scene, meth, ops, rec
+    raise AssertionError("the march ended early")
+
+
+def test_direction_on_kept_factors_solves_the_jacobian(builtin_scene):
+    """The direction of a free set (factored, then found again among the kept factors, after another set)
+    solves J d = −Φ of the whole pseudo-Jacobian (eq. 80), and a set met again is not refactored."""
+    scene, meth, ops, rec = _rolling_step(builtin_scene)
+    pb, sc = rec.problem, rec.problem.scales
+    sys_ = meth.system(pb, pb.dq / sc.length)
+    rng = np.random.default_rng(4)
+    z = np.append(rec.state.t / sc.stress, rec.solution.xi / sc.slip)
+    found = []
+    for scale in (0.0, 0.05, 0.0):  # the solution's set, a perturbed iterate's set, the first set again
+        zz = z + scale * rng.standard_normal(z.size) * np.abs(z).max()
+        phi, J, cases = meth.residual_and_jacobian(pb, zz)
+        mask = np.append(np.isin(cases, ["eq86", "eq87"]), True)  # stick rows, and the load row
+        before = sys_.factorizations
+        d = sys_.direction(mask, phi, True)
+        ref = np.linalg.solve(J, -phi)
+        assert np.max(np.abs(d - ref)) <= TOL["direction"] * np.abs(ref).max()
+        found.append((mask.copy(), d, sys_.factorizations - before))
+    assert not np.array_equal(found[0][0], found[1][0]), "the perturbation must change the free set"
+    assert found[2][2] == 0, "a free set met again is solved on its kept factors"
+    assert np.array_equal(found[0][1], found[2][1])  # the same factors and right-hand side: the same numbers
+
+
+def test_march_step_problems_are_the_validated_ones(builtin_scene):
+    """``validate=False`` (the march) builds the problem ``validate=True`` would, and still refuses a load
+    beyond the sliding limit, which depends on the step's pressure."""
+    scene, meth, ops, rec = _rolling_step(builtin_scene)
+    pb = rec.problem
+    for Q in (pb.Q, 0.5 * pb.Q):
+        a = ops.tangential_step(pb.p, pb.c, pb.dq, Q=Q, validate=False)
+        b = ops.tangential_step(pb.p, pb.c, pb.dq, Q=Q)
+        for name in ("A", "f", "p", "mu", "c", "dq", "Q", "xi", "scales", "law"):
+            x, y = getattr(a, name), getattr(b, name)
+            assert x is y or np.array_equal(x, y) or x == y, name
+        assert np.array_equal(a.bound, b.bound)
+    cap = float(ops.f @ pb.bound)
+    for validate in (True, False):
+        with pytest.raises(rollqp.InputError, match="sliding limit"):
+            ops.tangential_step(pb.p, pb.c, pb.dq, Q=1.01 * cap, validate=validate)
+    n1, n2 = ops.normal_step(scene.load.normal, validate=False), ops.normal_step(scene.load.normal)
+    assert n1.P == n2.P and n1.h is n2.h and n1.A is n2.A and n1.offset is None and n2.offset is None
+
+
+@pytest.mark.parametrize("name", sorted(builtin_scenes()))
+def test_plan_loads_are_the_loads_at_each_step(builtin_scene, name):
+    """The loads the march reads from the plan (each history evaluated once over all steps) are the
+    scene's loads at each step's τ, to the bit."""
+    scene = builtin_scene(name)
+    plan = rollqp.kinematics.plan(scene)
+    for rec in rollqp.march(scene, method="newton"):
+        if rec.k == 0 or rec.problem is None:
+            continue
+        tau = plan.tau[rec.k]
+        if scene.load.approach is None:
+            assert rec.P == float(scene.normal_load(tau))
+        if scene.load.creepage is None and rec.problem.kind == "tangential":
+            assert rec.problem.Q == float(scene.tangential_load(tau))
+        elif scene.load.creepage is not None:
+            assert rec.solution.xi == float(scene.prescribed_creepage(tau))
