@@ -146,8 +146,13 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
     if not applies(method, ops):
         return state
     G = sweep_map(method, ops, state, counters, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
-    best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
-                             max_evaluations=max_evaluations)
+    inner = method.inner if isinstance(method, Alternation) else method
+    was = inner.predicting(True)  # the map's QPs: active-set prediction first (module docstring)
+    try:
+        best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
+                                 max_evaluations=max_evaluations)
+    finally:
+        inner.predicting(was)
     return state if best is None else _state(ops, state, best, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
 
 
