@@ -232,13 +232,14 @@ class QPMethod:
         """``(x, y, status, iterations, solver_time, info)`` of a QP: the predicted answer
         (:meth:`predicting`) if it is within the tolerance, else the backend's (:meth:`_solve_form`)."""
         if self._predict and x0 is not None and y0 is not None:
-            x, y = x0, y0
+            x, y, lam = x0, y0, None
             for _ in range(self.PREDICT_STEPS):
-                cand = active_set_refine(form, x, y, self._kkt)
+                cand = active_set_refine(form, x, y, self._kkt, lam=lam)
                 if cand is None:
                     break
                 x, y = cand
-                if form.residual(x, y) <= self.tolerance:
+                lam = form.H @ x + form.q + (y * form.a if form.a is not None else 0.0)  # for both uses
+                if form.residual(x, y, lam) <= self.tolerance:
                     return x, y, "solved", 0, 0.0, {"predicted": True, "solve_call_time": 0.0, "solve_call_cpu": 0.0}
         return self._solve_form(form, x0, source)
 
@@ -385,8 +386,7 @@ def active_set_refine(form, x, y, cache: "KKTCache | None" = None, lam=None):
     if F.size == 0:
         xF, yr = np.empty(0), 0.0
     else:
-        from scipy.linalg import cho_solve
-        xF = cho_solve(chol, rhs, check_finite=False)  # (finiteness checked below)
+        xF = _chol_solve(chol, rhs)  # (finiteness checked below)
         yr = 0.0
         if a is not None:
             yr = float((a[F] @ xF - (form.b - a @ xa)) / schur)
@@ -424,17 +424,27 @@ class KKTCache:
 
 
 def _kkt_factor(H, free, a):
-    """``(chol, H_FF⁻¹ a_F, a_Fᵀ H_FF⁻¹ a_F)`` for the free set, or ``None`` if ``H_FF`` is not positive definite."""
-    from scipy.linalg import LinAlgError, cho_factor, cho_solve
+    """``(chol, H_FF⁻¹ a_F, a_Fᵀ H_FF⁻¹ a_F)`` for the free set, or ``None`` if ``H_FF`` is not positive definite.
+
+    ``chol``: the upper Cholesky factor from LAPACK's ``dpotrf`` (what ``scipy.linalg.cho_factor``
+    calls, without its wrappers: a step of the accelerated rolling start factors and solves with
+    matrices of a few hundred rows, where the wrappers cost as much as the work).
+    """
+    from scipy.linalg import lapack
     F = np.flatnonzero(free)
     if F.size == 0:
         return (None, None, None)
-    try:
-        chol = cho_factor(H[np.ix_(F, F)])
-    except (LinAlgError, ValueError):
+    chol, info = lapack.dpotrf(H[np.ix_(F, F)], lower=0, clean=0)
+    if info != 0:  # a pivot not positive (or NaN: LAPACK tests it): H_FF not positive definite
         return None
     if a is None:
         return chol, None, None
-    z2 = cho_solve(chol, a[F], check_finite=False)
+    z2 = _chol_solve(chol, a[F])
     schur = float(a[F] @ z2)
     return (chol, z2, schur) if np.isfinite(schur) and schur > 0 else None
+
+
+def _chol_solve(chol, b):
+    """``H_FF⁻¹ b`` with the factor of :func:`_kkt_factor` (LAPACK's ``dpotrs``)."""
+    from scipy.linalg import lapack
+    return lapack.dpotrs(chol, b, lower=0)[0]
