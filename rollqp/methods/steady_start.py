@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError, SolverError
 from ._qp import QPMethod
 from .alternation import Alternation
 
@@ -43,6 +44,18 @@ TARGET = 1e-2
 #: … or when its best residual has not improved by 10 % over this many evaluations (the QP
 #: solvers' own accuracy, or a map Anderson does not help): the march takes over from the best state.
 PATIENCE = 200
+
+
+#: The quasi-Newton phase (:func:`chord_newton`) starts once the plain iteration's residual is below this
+#: (in μp0). Measured on the Bentall–Johnson coupled start (``python benchmarks/bentall.py --only start``):
+#: from the braked state (residual 0.6) the Newton steps overshoot to where the stick and slip zones are
+#: elsewhere and the iteration diverges; from 0.3 and 0.1 it converges (see :data:`REFRESH`).
+NEWTON_FROM = 0.1
+#: The Jacobian is computed anew when a step reduces the residual by less than this factor.
+REFRESH = 0.2
+#: … at most this many times, and the quasi-Newton phase gives up (Anderson continues from its best
+#: state) when the residual grows above DIVERGE times its best.
+MAX_JACOBIANS, DIVERGE = 10, 10.0
 
 
 def applies(method, ops) -> bool:
@@ -150,15 +163,18 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
     was = inner.predicting(True)  # the map's QPs: active-set prediction first (module docstring)
     try:
         best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
-                                 max_evaluations=max_evaluations)
+                                 max_evaluations=max_evaluations,
+                                 jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta))
     finally:
         inner.predicting(was)
     return state if best is None else _state(ops, state, best, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
 
 
 def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FROM, patience=PATIENCE,
-                max_evaluations=1000):
-    """Iterate ``x ← G(x)`` with Anderson acceleration below ``anderson_from`` (module docstring).
+                max_evaluations=1000, jacobian=None, newton_from=NEWTON_FROM):
+    """Iterate ``x ← G(x)`` with Anderson acceleration below ``anderson_from`` (module docstring); with
+    ``jacobian`` (``K(x, *extra)``, :class:`MapJacobian`), the quasi-Newton phase (:func:`chord_newton`)
+    once the residual is below ``newton_from``, and Anderson from its best state if it stops short.
 
     ``G(x)`` returns ``(G(x), *extra)``; the residual is ``max|G(x) − x|/scale``. Returns ``(best,
     evaluations, best residual)`` with ``best = (x, G(x), *extra)`` of the smallest residual (None if
@@ -178,6 +194,18 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
             best, best_r = (x, gx, *extra), r
         if r <= target or since >= patience:
             break
+        if jacobian is not None and r <= newton_from:
+            nb, nk, nr = chord_newton(G, jacobian, (x, gx, *extra), scale, target=target,
+                                      max_evaluations=max_evaluations - k)
+            jacobian, k = None, k + nk  # once: Anderson (below) from the best state if it stopped short
+            if nr < best_r:
+                best, best_r, since = nb, nr, 0
+            if best_r <= target:
+                break
+            x = best[1]  # Anderson from the best state's output
+            if acc is not None:
+                acc.reset()
+            continue
         if acc is None or r > anderson_from or r > 1e3 * best_r:  # far from steady, or the extrapolation went astray
             if acc is not None:
                 acc.reset()
@@ -185,6 +213,119 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
         else:
             x = acc.next(x, gx)
     return best, k, best_r
+
+
+def chord_newton(G, jacobian, start, scale, *, target, max_evaluations, refresh=REFRESH,
+                 max_jacobians=MAX_JACOBIANS, diverge=DIVERGE):
+    """Newton's method on ``G(x) − x = 0`` with the Jacobian kept while it serves (a chord method):
+    ``x ← x + (I − K)⁻¹ (G(x) − x)``, ``K = jacobian(x, *extra)`` computed at the start and again
+    where a step reduced the residual by less than ``refresh``. From ``start = (x, G(x), *extra)``;
+    stops at ``target``, on a failed evaluation (a QP not solved at an iterate far off), a residual
+    above ``diverge`` times the best, ``max_jacobians`` or ``max_evaluations``. Returns ``(best,
+    evaluations, best residual)`` as :func:`fixed_point`.
+    """
+    from scipy.linalg import lu_factor, lu_solve
+    x, gx, *extra = start
+    r = float(np.abs(gx - x).max()) / scale
+    best, best_r, lu, jacobians, k = start, r, None, 0, 0
+    while k < max_evaluations:
+        if lu is None:
+            if jacobians >= max_jacobians:
+                break
+            lu, jacobians = lu_factor(np.eye(x.size) - jacobian(x, *extra), check_finite=False), jacobians + 1
+        x = x + lu_solve(lu, gx - x, check_finite=False)
+        k += 1
+        try:
+            gx, *extra = G(x)
+        except (SolverError, InputError):  # an iterate far off: Anderson takes over from the best state
+            break
+        r_new = float(np.abs(gx - x).max()) / scale
+        if not np.isfinite(r_new) or r_new > diverge * best_r:
+            break
+        if r_new < best_r:
+            best, best_r = (x, gx, *extra), r_new
+        if r_new <= target:
+            break
+        if r_new > refresh * r:
+            lu = None
+        r = r_new
+    return best, k, best_r
+
+
+class MapJacobian:
+    r"""``K = ∂G/∂t``: the march map's Jacobian on the active sets of its QP answers (QP sensitivity).
+
+    On fixed active sets each half's answer is affine in its data: with the free set ``F`` and the
+    nodes at a bound ``A`` of a QP (:class:`~rollqp.problem.QPForm`), ``dx_A`` is the bounds'
+    change and ``dx_F = H_FF⁻¹ dr − z (a_Fᵀ H_FF⁻¹ dr − dβ)/(a_Fᵀ z)``, ``z = H_FF⁻¹ a_F``, with
+    ``dr = −dq_F − H_FA dx_A`` and ``dβ = −a_Aᵀ dx_A`` (the load row's right-hand side fixed). The
+    map's data depend on ``t`` through the normal half's gap offset ``A_nt t`` (``dq = ∂q/∂e · A_nt dt``,
+    :attr:`QPForm.shift_scale`), the history ``c = −M w(p, t)`` of the tangential half, whose own
+    history is ``c + A_tn p`` (so ``dc = (I − M) A_tn dp − M A_tt dt``), and its bounds ``±μ p⁺``.
+    The Hessians are the QPs' own (the symmetric part ``sym(F·A)`` for an asymmetric ``F·A``: an
+    approximate Jacobian there, exact for constant elements). Dense ``n × n`` products, ``O(n³)`` a call.
+    """
+
+    def __init__(self, ops, *, P, Q, xi, dq, M, delta):
+        n = ops.n
+        self.ops, self.M, self.data = ops, M, dict(P=P, Q=Q, xi=xi, dq=dq, delta=delta)
+        Md = _dense(M, n)
+        self.MAtt = Md @ _dense(ops.Att, n)  # fixed for the start: once
+        if ops.coupled:
+            Atn = _dense(ops.Atn, n)
+            self.Ant, self.ImMAtn = _dense(ops.Ant, n), Atn - Md @ Atn
+
+    def __call__(self, t, nsol, tsol):
+        ops, d, stress = self.ops, self.data, self.ops.scales.stress
+        c = -(self.M @ ops.w(nsol.p, t))
+        if ops.coupled:
+            step = ops.coupled_step(d["P"], np.zeros(ops.n), d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"])
+            fn = step.normal_half(t).qp_form()
+            Jn = stress * qp_response(fn, nsol.p / stress, nsol.info["qp_multiplier"],
+                                      fn.shift_scale[:, None] * self.Ant)  # dp/dt
+            dc = self.ImMAtn @ Jn - self.MAtt
+            dbound = (ops.mu / stress) * (nsol.p > 0)[:, None] * Jn
+            ft = ops.coupled_step(d["P"], c, d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"]).tangential_half(nsol.p)
+        else:
+            dc, dbound = -self.MAtt, None
+            ft = ops.tangential_step(nsol.p, c, d["dq"], Q=d["Q"], xi=d["xi"])
+        ft = ft.qp_form()
+        return stress * qp_response(ft, tsol.t / stress, tsol.info["qp_multiplier"], ft.shift_scale[:, None] * dc,
+                                    dbound)
+
+
+def qp_response(form, x, y, dq, dbound=None):
+    """``dx``: the change of the QP answer ``x`` (multiplier ``y``) with ``q`` changed by ``dq`` and the
+    bounds' magnitude (``upper = −lower``) by ``dbound`` (columns: directions), on the active set of
+    ``(x, y)`` read as :func:`~rollqp.methods._qp.active_set_refine` reads it (:class:`MapJacobian`)."""
+    from scipy.linalg import cho_factor, cho_solve
+    H, a = form.H, form.a
+    lam = H @ x + form.q + (float(y) * a if a is not None else 0.0)
+    fixed = form.fixed
+    at_lo = np.isfinite(form.lower) & (x - form.lower < lam) & ~fixed
+    at_up = np.isfinite(form.upper) & (form.upper - x < -lam) & ~fixed
+    dx = np.zeros(dq.shape)
+    if dbound is not None:
+        dx[at_up], dx[at_lo] = dbound[at_up], -dbound[at_lo]
+    F = np.flatnonzero(~(fixed | at_lo | at_up))
+    if F.size == 0:
+        return dx
+    chol = cho_factor(H[np.ix_(F, F)])
+    z = cho_solve(chol, -dq[F] - H[F] @ dx)  # dx is zero on F: H[F] dx = H_FA dx_A
+    if a is not None:
+        z2 = cho_solve(chol, a[F])
+        z -= np.outer(z2, (a[F] @ z + a @ dx) / float(a[F] @ z2))  # a_Fᵀ dx_F = −a_Aᵀ dx_A
+    dx[F] = z
+    return dx
+
+
+def _dense(op, n):
+    """An operator (dense, row-sparse or ``scipy.sparse``) as an ``n × n`` array."""
+    if hasattr(op, "dense"):
+        return np.asarray(op.dense(), dtype=float)
+    if hasattr(op, "toarray"):
+        return op.toarray()
+    return np.asarray(op @ np.eye(n))
 
 
 def _state(ops, start, best, *, P, Q, xi, dq, M, delta):
