@@ -1,4 +1,4 @@
-r"""The QP methods' rolling start: the march toward steady rolling, Anderson-accelerated (issue 18).
+r"""The QP methods' rolling start: the march toward steady rolling, accelerated (issue 18).
 
 A QP method cannot pose the steady rolling problem (its slip operator ``d·D_up·A`` has an
 indefinite weighted symmetric part: no convex QP has it as Hessian), so :func:`rollqp.march`
@@ -10,15 +10,26 @@ fixed point, and the plain march ``t ← G(t)`` converges to it only linearly an
 disturbance is carried through the stick zone by the rolling and decays by about 10× per 100
 steps of ``Δq = Le`` on the Bentall–Johnson coupled start (216 constant elements; 750 steps).
 
-:func:`accelerated_start` iterates the same map with Anderson acceleration (type II; Walker & Ni,
-SIAM J. Numer. Anal. 49 (2011); the extrapolation of the last ``m`` differences that minimizes
-the linearized residual): plain steps while the residual ``max|G(t) − t|/(μp0)`` is above
-:data:`ANDERSON_FROM` (far from steady the stick and slip zones still move, the map is not
-affine, and extrapolating across those kinks costs evaluations: :data:`ANDERSON_FROM`), then Anderson with :data:`MEMORY`
-differences. Every iterate it returns is a map's *output*, i.e. QP answers (each state solved
-by the QP backend); the march then continues with its own steps (N–T alternation converged)
-until a step changes ``t`` by less than its tolerance, so the state it keeps is a marching step
-like any other. Measured with ``python benchmarks/bentall.py --only start``.
+:func:`accelerated_start` iterates the same map in three phases. Plain steps while the residual
+``max|G(t) − t|/(μp0)`` is above :data:`NEWTON_FROM` (far from steady the stick and slip zones
+still move and the map is far from affine). Then Newton's method on ``G(t) − t = 0``
+(:func:`chord_newton`: damped, the Jacobian kept while it serves), with the map's Jacobian from the
+QPs' own active sets (:class:`MapJacobian`, the QP answers' sensitivity to their data): on fixed
+active sets the map is affine, and Newton lands on its fixed point in a step or two, where
+Anderson needs about as many evaluations as there are nodes (the slow modes, transport through the
+stick zone, span the space). If the Newton phase stops short (the active sets still change under
+its steps), Anderson acceleration continues from its best state (type II; Walker & Ni, SIAM J.
+Numer. Anal. 49 (2011): the extrapolation of the last ``m`` differences that minimizes the
+linearized residual) with :data:`MEMORY` differences.
+
+Every QP of the map is first solved on the active set of the previous evaluation
+(:meth:`QPMethod.predicting <rollqp.methods._qp.QPMethod.predicting>`: an exact KKT solve on cached
+factors, accepted at the backend's tolerance; the backend when it is not): near steady state the
+active sets no longer change, and the map costs two such solves instead of two QP solver runs.
+Every iterate the start returns is a map's *output*, i.e. QP answers within the tolerance; the
+march then continues with its own steps, solved by the backend (N–T alternation converged), until
+a step changes ``t`` by less than its tolerance, so the state it keeps is a marching step like any
+other. Measured with ``python benchmarks/bentall.py --only start``.
 """
 from __future__ import annotations
 
@@ -28,7 +39,8 @@ from ..errors import InputError, SolverError
 from ._qp import QPMethod
 from .alternation import Alternation
 
-#: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this. Measured on the
+#: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this (without the Newton phase,
+#: or after it stopped short). Measured on the
 #: Bentall–Johnson coupled start (216 constant elements, μ = 0.05, memory 150; ``python
 #: benchmarks/bentall.py --only start``): map evaluations to 1e-10 from 1 (Anderson from the first
 #: step): 452; from 1e-1: 316; from 1e-2: 350; plain iteration: not within 800 (5e-9 after 800).
@@ -51,11 +63,11 @@ PATIENCE = 200
 #: from the braked state (residual 0.6) the Newton steps overshoot to where the stick and slip zones are
 #: elsewhere and the iteration diverges; from 0.3 and 0.1 it converges (see :data:`REFRESH`).
 NEWTON_FROM = 0.1
-#: The Jacobian is computed anew when a step reduces the residual by less than this factor.
-REFRESH = 0.2
-#: … at most this many times, and the quasi-Newton phase gives up (Anderson continues from its best
-#: state) when the residual grows above DIVERGE times its best.
-MAX_JACOBIANS, DIVERGE = 10, 10.0
+#: The Jacobian is computed anew when an accepted step reduces the Newton correction by less than this
+#: factor, or when the damping factor falls below MIN_STEP …
+REFRESH, MIN_STEP = 0.2, 1 / 16
+#: … at most this many times: then Anderson continues from the best state.
+MAX_JACOBIANS = 10
 
 
 def applies(method, ops) -> bool:
@@ -164,7 +176,8 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
     try:
         best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
                                  max_evaluations=max_evaluations,
-                                 jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta))
+                                 jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
+                                 if getattr(method, "quasi_newton", True) else None)
     finally:
         inner.predicting(was)
     return state if best is None else _state(ops, state, best, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
@@ -216,39 +229,48 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
 
 
 def chord_newton(G, jacobian, start, scale, *, target, max_evaluations, refresh=REFRESH,
-                 max_jacobians=MAX_JACOBIANS, diverge=DIVERGE):
-    """Newton's method on ``G(x) − x = 0`` with the Jacobian kept while it serves (a chord method):
-    ``x ← x + (I − K)⁻¹ (G(x) − x)``, ``K = jacobian(x, *extra)`` computed at the start and again
-    where a step reduced the residual by less than ``refresh``. From ``start = (x, G(x), *extra)``;
-    stops at ``target``, on a failed evaluation (a QP not solved at an iterate far off), a residual
-    above ``diverge`` times the best, ``max_jacobians`` or ``max_evaluations``. Returns ``(best,
-    evaluations, best residual)`` as :func:`fixed_point`.
+                 max_jacobians=MAX_JACOBIANS, min_step=MIN_STEP):
+    """Newton's method on ``G(x) − x = 0``, damped, with the Jacobian kept while it serves: the
+    correction ``d = (I − K)⁻¹ (G(x) − x)``, ``K = jacobian(x, *extra)``, and the step ``x + α d``.
+
+    A step is accepted when the next correction with the same ``K`` is smaller, ``|d̄| ≤ (1 − α/4)|d|``
+    (the natural monotonicity test of affine-invariant Newton methods, Deuflhard, *Newton Methods for
+    Nonlinear Problems* §3.1: the residual ``max|G(x) − x|`` is no measure of the distance to the fixed
+    point here, the march contracting by ~2.5 % a step), else ``α`` is halved; ``α`` doubles again
+    after an accepted step. ``K`` is computed at the start, where an accepted step reduced the
+    correction by less than ``refresh``, and where ``α`` fell below ``min_step``. Stops at the residual
+    ``target``, on a failed evaluation (a QP not solved at an iterate far off), after ``max_jacobians``
+    or ``max_evaluations``. Returns ``(best, evaluations, best residual)`` as :func:`fixed_point`.
     """
     from scipy.linalg import lu_factor, lu_solve
     x, gx, *extra = start
-    r = float(np.abs(gx - x).max()) / scale
-    best, best_r, lu, jacobians, k = start, r, None, 0, 0
+    best, best_r, lu, jacobians, k, alpha = start, float(np.abs(gx - x).max()) / scale, None, 0, 0, 1.0
     while k < max_evaluations:
         if lu is None:
             if jacobians >= max_jacobians:
                 break
             lu, jacobians = lu_factor(np.eye(x.size) - jacobian(x, *extra), check_finite=False), jacobians + 1
-        x = x + lu_solve(lu, gx - x, check_finite=False)
+            d = lu_solve(lu, gx - x, check_finite=False)
+        xt = x + alpha * d
         k += 1
         try:
-            gx, *extra = G(x)
-        except (SolverError, InputError):  # an iterate far off: Anderson takes over from the best state
+            gt, *et = G(xt)
+        except (SolverError, InputError):  # an iterate far off
+            gt = None
+        rt = np.inf if gt is None else float(np.abs(gt - xt).max()) / scale
+        if rt < best_r:
+            best, best_r = (xt, gt, *et), rt
+        if rt <= target:
             break
-        r_new = float(np.abs(gx - x).max()) / scale
-        if not np.isfinite(r_new) or r_new > diverge * best_r:
-            break
-        if r_new < best_r:
-            best, best_r = (x, gx, *extra), r_new
-        if r_new <= target:
-            break
-        if r_new > refresh * r:
-            lu = None
-        r = r_new
+        dt = lu_solve(lu, gt - xt, check_finite=False) if np.isfinite(rt) else None
+        if dt is not None and np.abs(dt).max() <= (1 - alpha / 4) * np.abs(d).max():
+            if np.abs(dt).max() > (1 - alpha * (1 - refresh)) * np.abs(d).max():  # slower than refresh a full step
+                lu = None  # slow: a new Jacobian at the accepted point
+            x, gx, extra, d, alpha = xt, gt, et, dt, min(1.0, 2 * alpha)
+        else:
+            alpha /= 2
+            if alpha < min_step:
+                lu, alpha = None, 1.0  # a new Jacobian where we are
     return best, k, best_r
 
 
