@@ -319,13 +319,17 @@ class MapJacobian:
 def qp_response(form, x, y, dq, dbound=None):
     """``dx``: the change of the QP answer ``x`` (multiplier ``y``) with ``q`` changed by ``dq`` and the
     bounds' magnitude (``upper = −lower``) by ``dbound`` (columns: directions), on the active set of
-    ``(x, y)`` read as :func:`~rollqp.methods._qp.active_set_refine` reads it (:class:`MapJacobian`)."""
+    ``(x, y)`` read as :func:`~rollqp.methods._qp.active_set_refine` reads it, and with the nodes on a
+    bound counted at it (:class:`MapJacobian`)."""
     from scipy.linalg import cho_factor, cho_solve
     H, a = form.H, form.a
     lam = H @ x + form.q + (float(y) * a if a is not None else 0.0)
-    fixed = form.fixed
-    at_lo = np.isfinite(form.lower) & (x - form.lower < lam) & ~fixed
-    at_up = np.isfinite(form.upper) & (form.upper - x < -lam) & ~fixed
+    width = form.upper - form.lower  # a bound pair closer than rounding (μp of ~1e-21 p0 at the contact's
+    fixed = form.fixed | (width <= 1e-12 * np.max(width, initial=0.0, where=np.isfinite(width)))  # edge): fixed
+    # at a bound also where x is on it with a zero multiplier (a node at the edge of a zone): its
+    # derivative is one-sided, and the answer's traction is clipped to the bound
+    at_lo = np.isfinite(form.lower) & ((x - form.lower < lam) | (x <= form.lower)) & ~fixed
+    at_up = np.isfinite(form.upper) & ((form.upper - x < -lam) | (x >= form.upper)) & ~fixed
     dx = np.zeros(dq.shape)
     if dbound is not None:
         dx[at_up], dx[at_lo] = dbound[at_up], -dbound[at_lo]
