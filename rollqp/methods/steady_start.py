@@ -291,11 +291,10 @@ class MapJacobian:
     def __init__(self, ops, *, P, Q, xi, dq, M, delta):
         n = ops.n
         self.ops, self.M, self.data = ops, M, dict(P=P, Q=Q, xi=xi, dq=dq, delta=delta)
-        Md = _dense(M, n)
-        self.MAtt = Md @ _dense(ops.Att, n)  # fixed for the start: once
+        self.MAtt = np.asarray(M @ _dense(ops.Att, n))  # fixed for the start: once (M has ≤ 3 entries a row)
         if ops.coupled:
             Atn = _dense(ops.Atn, n)
-            self.Ant, self.ImMAtn = _dense(ops.Ant, n), Atn - Md @ Atn
+            self.Ant, self.ImMAtn = _dense(ops.Ant, n), Atn - np.asarray(M @ Atn)
 
     def __call__(self, t, nsol, tsol):
         ops, d, stress = self.ops, self.data, self.ops.scales.stress
@@ -346,12 +345,10 @@ def qp_response(form, x, y, dq, dbound=None):
 
 
 def _dense(op, n):
-    """An operator (dense, row-sparse or ``scipy.sparse``) as an ``n × n`` array."""
+    """An influence operator as an ``n × n`` array (its own, or its columns)."""
     if hasattr(op, "dense"):
         return np.asarray(op.dense(), dtype=float)
-    if hasattr(op, "toarray"):
-        return op.toarray()
-    return np.asarray(op @ np.eye(n))
+    return np.column_stack([op @ e for e in np.eye(n)])
 
 
 def _state(ops, start, best, *, P, Q, xi, dq, M, delta):
