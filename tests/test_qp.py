@@ -245,6 +245,22 @@ def test_a_wrong_prediction_falls_back_to_the_backend(backend, constant_problem)
     assert compare(sol, reference, mu=MU, scales=constant_problem.scales)["t"] <= 2 * backend.accuracy
 
 
+def test_a_prediction_outside_the_bounds_is_not_an_answer(backend, constant_problem):
+    """Prescribed creepage (no load row), warm-started from twice the creepage: the active-set candidate
+    leaves free nodes beyond their friction bound, where QPForm.residual (which clips the traction to the
+    bounds) is small but rollqp's residual of the clipped traction is not (measured 5e-2 before the
+    check). The prediction must refuse it; the answer is the backend's (accuracy bound as above)."""
+    hp = constant_problem
+    xi = get_method(backend.method).solve(hp.rolling()).xi
+    warm = get_method(backend.method).solve(hp.rolling(xi=2.0 * xi))
+    method = get_method(backend.method)
+    method.predicting(True)
+    sol = method.solve(hp.rolling(xi=xi), warm=warm)
+    assert sol.residual <= method.residual_limit
+    reference = get_method(backend.method).solve(hp.rolling(xi=xi))
+    assert compare(sol, reference, mu=MU, scales=hp.scales)["t"] <= 2 * backend.accuracy
+
+
 # ------------------------------------------------------------------------------- failures
 @pytest.mark.filterwarnings("ignore:Solution may be inaccurate")
 def test_solver_error_carries_method_status_residual(backend, constant_problem):

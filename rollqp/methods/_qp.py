@@ -239,7 +239,8 @@ class QPMethod:
                     break
                 x, y = cand
                 lam = form.H @ x + form.q + (y * form.a if form.a is not None else 0.0)  # for both uses
-                if form.residual(x, y, lam) <= self.tolerance:
+                outside = float(np.abs(form.traction(x) - x).max(initial=0.0))  # QPForm.residual reads x clipped
+                if max(form.residual(x, y, lam), outside) <= self.tolerance:
                     return x, y, "solved", 0, 0.0, {"predicted": True, "solve_call_time": 0.0, "solve_call_cpu": 0.0}
         return self._solve_form(form, x0, source)
 
