@@ -167,6 +167,8 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
 
     ``tol``: the march's tolerance on the change of ``t`` per step, in μp0; the iteration stops at
     :data:`TARGET`·tol, after :data:`PATIENCE` evaluations without progress, or ``max_evaluations``.
+    A method whose ``quasi_newton`` attribute is False skips the Newton phase (benchmarks measure
+    Anderson alone so).
     """
     if not applies(method, ops):
         return state
