@@ -256,6 +256,20 @@ class PlainMarch(Alternation):
     accelerated_start = False
 
 
+def unpredicted(name, tolerance):
+    """``name``'s QP backend with the active-set prediction kept off (QPMethod.predicting): every QP of
+    the accelerated start solved by the backend itself, as before the prediction."""
+    meth = rollqp.methods.get_method(name, tolerance=tolerance)
+    meth.predicting = lambda on: False  # the accelerated start switches it on through this call
+    return meth
+
+
+class AndersonOnly(Alternation):
+    """The accelerated start without its Newton phase: plain steps, then Anderson (before the phase)."""
+
+    quasi_newton = False
+
+
 class FullAlternation(PlainMarch):
     """The plain march with the alternation converged at every step (rollqp before issue 18)."""
 
@@ -283,6 +297,7 @@ def start_map(s, name):
     braked = s.replace(**{"load.start": "braked", "discretization.distance": 0.0})
     _, meth, ops = prepare(braked, name)
     state = next(rollqp.march(braked, name)).state
+    meth.inner.predicting(True)  # as in the accelerated start: the QPs near steady state on their active sets
     G0 = sweep_map(meth, ops, state, P=float(s.normal_load(0.0)), Q=0.0, xi=None, dq=s.dq, M=ops.history())
     count = [0]
 
@@ -299,16 +314,24 @@ def section_start():
           "full coupling)\n")
     print("`newton` solves the steady problem directly; the QP methods reach it by marching (rollqp.march's "
           "rolling start): the march map (one N–T sweep of a step of Δq = Le as a function of the shear) iterated "
-          "with Anderson acceleration (rollqp.methods.steady_start), then marching steps with the alternation "
-          "converged until max|Δt| per step < 1e-8 μp0. `plain march`: without Anderson (one sweep per step, then "
+          "plainly to a residual of 0.1 μp0, then by Newton's method with the map's Jacobian from the QPs' active sets "
+          "(Anderson acceleration if that stops short; rollqp.methods.steady_start), each QP of the map solved first "
+          "on the active set of the previous evaluation (QPMethod.predicting; the backend when that is not within the "
+          "tolerance), then marching steps with the alternation converged, solved by the backend, until max|Δt| per "
+          "step < 1e-8 μp0. `without the Newton phase`: plain steps, then Anderson; `without the active-set "
+          "prediction`: every QP by the backend; `plain march`: neither Newton nor Anderson (one sweep per step, then "
           "converged steps); `full alternation`: the alternation converged at every step (rollqp before issue 18). "
           "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
           "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
     ref, cpu_ref, wall_ref = timed_cpu_run(s, "newton")
     rows = [["`newton` (direct steady solve)", f"{cpu_ref:.2f}", f"{wall_ref:.2f}", "1", "–", "0", "0"]]
     qp = lambda cls, name="qp-osqp": cls(rollqp.methods.get_method(name, tolerance=s.solver.tolerance))  # noqa: E731
-    cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, plain march", qp(PlainMarch)),
-             ("`qp-osqp`, full alternation (before)", qp(FullAlternation)), ("`qp-clarabel`", "qp-clarabel")]
+    tol = s.solver.tolerance
+    cases = [("`qp-osqp`", "qp-osqp"), ("`qp-osqp`, without the Newton phase", qp(AndersonOnly)),
+             ("`qp-osqp`, without the active-set prediction", unpredicted("qp-osqp", tol)),
+             ("`qp-osqp`, plain march", qp(PlainMarch)), ("`qp-osqp`, full alternation", qp(FullAlternation)),
+             ("`qp-clarabel`", "qp-clarabel"), ("`qp-clarabel`, without the active-set prediction",
+                                                unpredicted("qp-clarabel", tol))]
     for label, method in cases:
         r, cpu, wall = timed_cpu_run(s, method)
         dist, dxi = start_distance(r, ref, s)
@@ -317,19 +340,25 @@ def section_start():
     print(table(["method", "CPU [s]", "wall [s]", "CPU / newton", "N–T sweeps (state 0)", "distance from newton",
                  "|ξ/ξ_newton − 1|"], rows))
     print()
-    from rollqp.methods.steady_start import fixed_point
+    from rollqp.methods.steady_start import MapJacobian, fixed_point
     G, t0, ops, count = start_map(s, "qp-osqp")
+    jac = MapJacobian(ops, P=float(s.normal_load(0.0)), Q=0.0, xi=None, dq=s.dq, M=ops.history(), delta=None)
     rows = []
-    for memory, start in ((0, None), (10, 0.1), (60, 1.0), (150, 1.0), (150, 0.1), (150, 0.01), (300, 0.1)):
+    for newton, memory, start in ((None, 0, None), (None, 10, 0.1), (None, 60, 1.0), (None, 150, 1.0),
+                                  (None, 150, 0.1), (None, 150, 0.01), (None, 300, 0.1), (0.3, 150, 0.1),
+                                  (0.1, 150, 0.1), (0.05, 150, 0.1)):
         count[0] = 0
         _, evals, best = fixed_point(G, t0.copy(), s.contact.friction * s.p0, target=1e-10, memory=memory,
                                      anderson_from=start if start is not None else 1.0, patience=800,
-                                     max_evaluations=800)
-        rows.append([memory or "0 (plain)", "–" if start is None else f"{start:g}", evals, count[0], f"{best:.1e}"])
-    print("Anderson acceleration of the march map, `qp-osqp`, from the braked state: memory (differences kept), "
-          "residual max|G(t) − t|/(μp0) below which it extrapolates, map evaluations to 1e-10 (at most 800), and "
-          "the smallest residual reached:\n")
-    print(table(["memory", "from residual", "evaluations", "QPs", "smallest residual"], rows))
+                                     max_evaluations=800, jacobian=None if newton is None else jac,
+                                     newton_from=newton or 0.0)
+        rows.append(["–" if newton is None else f"{newton:g}", memory or "0 (plain)",
+                     "–" if start is None else f"{start:g}", evals, count[0], f"{best:.1e}"])
+    print("The march map, `qp-osqp` (with the active-set prediction), from the braked state: residual max|G(t) − t|/"
+          "(μp0) below which the Newton phase starts (– : none), Anderson's memory (differences kept) and the "
+          "residual below which it extrapolates, map evaluations to 1e-10 (at most 800; the Newton phase's Jacobians "
+          "not counted), and the smallest residual reached:\n")
+    print(table(["Newton from", "memory", "Anderson from", "evaluations", "QPs", "smallest residual"], rows))
     Atn, Att = ops.steady()
     FA = ops.f[:, None] * Att.dense()
     lam = np.linalg.eigvalsh(0.5 * (FA + FA.T))

@@ -208,6 +208,59 @@ def test_warm_start_reuses_the_solver(backend, constant_problem):
     assert builds == ["normal", "tangential"], f"a new structure builds a new solver: {builds}"
 
 
+# ------------------------------------------------------------------------------- active-set prediction
+@pytest.mark.parametrize("element", ["constant", "quadratic"])
+def test_predicted_answer_is_the_backends(backend, element):
+    """With the prediction on (the accelerated rolling start's mode, QPMethod.predicting) a QP near
+    its warm start is solved on the active set read off it, without the backend, and the answer
+    is the backend's own (same accuracy bound as two backends' agreement: the prediction is
+    accepted at the residual the backend is asked for, 1e-10, exact KKT solve otherwise)."""
+    hp = hertz_problem(element, 40)
+    first = get_method(backend.method).solve(hp.rolling())
+    near = hp.rolling().replace(c=1.001 * hp.rolling().c)  # the next QP of a march near steady state
+    reference = get_method(backend.method).solve(near, warm=first)
+    method = get_method(backend.method)
+    assert method.predicting(True) is False, "off by default"
+    sol = method.solve(near, warm=first)
+    assert sol.info["predicted"] == sol.info["qp_solves"] >= 1, "every QP of the step predicted"
+    assert sol.info["solve_call_cpu"] == 0.0, "the backend's solver never called"
+    assert sol.residual <= method.tolerance
+    assert compare(sol, reference, mu=MU, scales=near.scales)["t"] <= 2 * backend.accuracy
+    assert method.predicting(False) is True
+    assert get_method(backend.method).solve(near, warm=first).info["predicted"] == 0, "off: the backend"
+
+
+def test_a_wrong_prediction_falls_back_to_the_backend(backend, constant_problem):
+    """A warm start whose active set is far from the answer's (the reversed tangential load: every
+    slip node on the other bound) is not accepted after one candidate: the backend solves the QP,
+    and the answer is the right one (the residual check, not the guess, decides)."""
+    reverse = constant_problem.rolling(Q=-RATIO * MU * P)
+    wrong = get_method(backend.method).solve(reverse)
+    method = get_method(backend.method)
+    method.PREDICT_STEPS = 1
+    method.predicting(True)
+    sol = method.solve(constant_problem.rolling(), warm=wrong)
+    assert sol.info["predicted"] == 0, "one candidate from the reversed state is not the answer"
+    reference = get_method(backend.method).solve(constant_problem.rolling())
+    assert compare(sol, reference, mu=MU, scales=constant_problem.scales)["t"] <= 2 * backend.accuracy
+
+
+def test_a_prediction_outside_the_bounds_is_not_an_answer(backend, constant_problem):
+    """Prescribed creepage (no load row), warm-started from twice the creepage: the active-set candidate
+    leaves free nodes beyond their friction bound, where QPForm.residual (which clips the traction to the
+    bounds) is small but rollqp's residual of the clipped traction is not (measured 5e-2 before the
+    check). The prediction must refuse it; the answer is the backend's (accuracy bound as above)."""
+    hp = constant_problem
+    xi = get_method(backend.method).solve(hp.rolling()).xi
+    warm = get_method(backend.method).solve(hp.rolling(xi=2.0 * xi))
+    method = get_method(backend.method)
+    method.predicting(True)
+    sol = method.solve(hp.rolling(xi=xi), warm=warm)
+    assert sol.residual <= method.residual_limit
+    reference = get_method(backend.method).solve(hp.rolling(xi=xi))
+    assert compare(sol, reference, mu=MU, scales=hp.scales)["t"] <= 2 * backend.accuracy
+
+
 # ------------------------------------------------------------------------------- failures
 @pytest.mark.filterwarnings("ignore:Solution may be inaccurate")
 def test_solver_error_carries_method_status_residual(backend, constant_problem):
@@ -431,6 +484,7 @@ def test_rolling_start_leaves_the_alternation_converging():
     r = rollqp.run(scene, method=meth)
     assert r.meta["rolling_start"] == "marching to steady state"
     assert meth.single_sweeps(False) is False
+    assert meth.inner.predicting(False) is False, "the active-set prediction is off after the accelerated start"
     assert float(r["residual"][0]) <= meth.stall_limit  # the converged steps' residual, not the sweeps'
     meth.single_sweeps(True)
     meth.setup(prepared[2])  # a new scene starts converging

@@ -1,4 +1,4 @@
-r"""The QP methods' rolling start: the march toward steady rolling, Anderson-accelerated (issue 18).
+r"""The QP methods' rolling start: the march toward steady rolling, accelerated (issue 18).
 
 A QP method cannot pose the steady rolling problem (its slip operator ``d·D_up·A`` has an
 indefinite weighted symmetric part: no convex QP has it as Hessian), so :func:`rollqp.march`
@@ -10,24 +10,37 @@ fixed point, and the plain march ``t ← G(t)`` converges to it only linearly an
 disturbance is carried through the stick zone by the rolling and decays by about 10× per 100
 steps of ``Δq = Le`` on the Bentall–Johnson coupled start (216 constant elements; 750 steps).
 
-:func:`accelerated_start` iterates the same map with Anderson acceleration (type II; Walker & Ni,
-SIAM J. Numer. Anal. 49 (2011); the extrapolation of the last ``m`` differences that minimizes
-the linearized residual): plain steps while the residual ``max|G(t) − t|/(μp0)`` is above
-:data:`ANDERSON_FROM` (far from steady the stick and slip zones still move, the map is not
-affine, and extrapolating across those kinks costs evaluations: :data:`ANDERSON_FROM`), then Anderson with :data:`MEMORY`
-differences. Every iterate it returns is a map's *output*, i.e. QP answers (each state solved
-by the QP backend); the march then continues with its own steps (N–T alternation converged)
-until a step changes ``t`` by less than its tolerance, so the state it keeps is a marching step
-like any other. Measured with ``python benchmarks/bentall.py --only start``.
+:func:`accelerated_start` iterates the same map in three phases. Plain steps while the residual
+``max|G(t) − t|/(μp0)`` is above :data:`NEWTON_FROM` (far from steady the stick and slip zones
+still move and the map is far from affine). Then Newton's method on ``G(t) − t = 0``
+(:func:`chord_newton`: damped, the Jacobian kept while it serves), with the map's Jacobian from the
+QPs' own active sets (:class:`MapJacobian`, the QP answers' sensitivity to their data): on fixed
+active sets the map is affine, and Newton lands on its fixed point in a step or two, where
+Anderson needs about as many evaluations as there are nodes (the slow modes, transport through the
+stick zone, span the space). If the Newton phase stops short (the active sets still change under
+its steps), Anderson acceleration continues from its best state (type II; Walker & Ni, SIAM J.
+Numer. Anal. 49 (2011): the extrapolation of the last ``m`` differences that minimizes the
+linearized residual) with :data:`MEMORY` differences.
+
+Every QP of the map is first solved on the active set of the previous evaluation
+(:meth:`QPMethod.predicting <rollqp.methods._qp.QPMethod.predicting>`: an exact KKT solve on cached
+factors, accepted at the backend's tolerance; the backend when it is not): near steady state the
+active sets no longer change, and the map costs two such solves instead of two QP solver runs.
+Every iterate the start returns is a map's *output*, i.e. QP answers within the tolerance; the
+march then continues with its own steps, solved by the backend (N–T alternation converged), until
+a step changes ``t`` by less than its tolerance, so the state it keeps is a marching step like any
+other. Measured with ``python benchmarks/bentall.py --only start``.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError, SolverError
 from ._qp import QPMethod
 from .alternation import Alternation
 
-#: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this. Measured on the
+#: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this (without the Newton phase,
+#: or after it stopped short). Measured on the
 #: Bentall–Johnson coupled start (216 constant elements, μ = 0.05, memory 150; ``python
 #: benchmarks/bentall.py --only start``): map evaluations to 1e-10 from 1 (Anderson from the first
 #: step): 452; from 1e-1: 316; from 1e-2: 350; plain iteration: not within 800 (5e-9 after 800).
@@ -43,6 +56,18 @@ TARGET = 1e-2
 #: … or when its best residual has not improved by 10 % over this many evaluations (the QP
 #: solvers' own accuracy, or a map Anderson does not help): the march takes over from the best state.
 PATIENCE = 200
+
+
+#: The quasi-Newton phase (:func:`chord_newton`) starts once the plain iteration's residual is below this
+#: (in μp0). Measured on the Bentall–Johnson coupled start (``python benchmarks/bentall.py --only start``):
+#: from the braked state (residual 0.6) the Newton steps overshoot to where the stick and slip zones are
+#: elsewhere and the iteration diverges; from 0.3 and 0.1 it converges (see :data:`REFRESH`).
+NEWTON_FROM = 0.1
+#: The Jacobian is computed anew when an accepted step reduces the Newton correction by less than this
+#: factor, or when the damping factor falls below MIN_STEP …
+REFRESH, MIN_STEP = 0.2, 1 / 16
+#: … at most this many times: then Anderson continues from the best state.
+MAX_JACOBIANS = 10
 
 
 def applies(method, ops) -> bool:
@@ -142,18 +167,29 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
 
     ``tol``: the march's tolerance on the change of ``t`` per step, in μp0; the iteration stops at
     :data:`TARGET`·tol, after :data:`PATIENCE` evaluations without progress, or ``max_evaluations``.
+    A method whose ``quasi_newton`` attribute is False skips the Newton phase (benchmarks measure
+    Anderson alone so).
     """
     if not applies(method, ops):
         return state
     G = sweep_map(method, ops, state, counters, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
-    best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
-                             max_evaluations=max_evaluations)
+    inner = method.inner if isinstance(method, Alternation) else method
+    was = inner.predicting(True)  # the map's QPs: active-set prediction first (module docstring)
+    try:
+        best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
+                                 max_evaluations=max_evaluations,
+                                 jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
+                                 if getattr(method, "quasi_newton", True) else None)
+    finally:
+        inner.predicting(was)
     return state if best is None else _state(ops, state, best, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
 
 
 def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FROM, patience=PATIENCE,
-                max_evaluations=1000):
-    """Iterate ``x ← G(x)`` with Anderson acceleration below ``anderson_from`` (module docstring).
+                max_evaluations=1000, jacobian=None, newton_from=NEWTON_FROM):
+    """Iterate ``x ← G(x)`` with Anderson acceleration below ``anderson_from`` (module docstring); with
+    ``jacobian`` (``K(x, *extra)``, :class:`MapJacobian`), the quasi-Newton phase (:func:`chord_newton`)
+    once the residual is below ``newton_from``, and Anderson from its best state if it stops short.
 
     ``G(x)`` returns ``(G(x), *extra)``; the residual is ``max|G(x) − x|/scale``. Returns ``(best,
     evaluations, best residual)`` with ``best = (x, G(x), *extra)`` of the smallest residual (None if
@@ -173,6 +209,18 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
             best, best_r = (x, gx, *extra), r
         if r <= target or since >= patience:
             break
+        if jacobian is not None and r <= newton_from:
+            nb, nk, nr = chord_newton(G, jacobian, (x, gx, *extra), scale, target=target,
+                                      max_evaluations=max_evaluations - k)
+            jacobian, k = None, k + nk  # once: Anderson (below) from the best state if it stopped short
+            if nr < best_r:
+                best, best_r, since = nb, nr, 0
+            if best_r <= target:
+                break
+            x = best[1]  # Anderson from the best state's output
+            if acc is not None:
+                acc.reset()
+            continue
         if acc is None or r > anderson_from or r > 1e3 * best_r:  # far from steady, or the extrapolation went astray
             if acc is not None:
                 acc.reset()
@@ -180,6 +228,129 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
         else:
             x = acc.next(x, gx)
     return best, k, best_r
+
+
+def chord_newton(G, jacobian, start, scale, *, target, max_evaluations, refresh=REFRESH,
+                 max_jacobians=MAX_JACOBIANS, min_step=MIN_STEP):
+    """Newton's method on ``G(x) − x = 0``, damped, with the Jacobian kept while it serves: the
+    correction ``d = (I − K)⁻¹ (G(x) − x)``, ``K = jacobian(x, *extra)``, and the step ``x + α d``.
+
+    A step is accepted when the next correction with the same ``K`` is smaller, ``|d̄| ≤ (1 − α/4)|d|``
+    (the natural monotonicity test of affine-invariant Newton methods, Deuflhard, *Newton Methods for
+    Nonlinear Problems* §3.1: the residual ``max|G(x) − x|`` is no measure of the distance to the fixed
+    point here, the march contracting by ~2.5 % a step), else ``α`` is halved; ``α`` doubles again
+    after an accepted step. ``K`` is computed at the start, where an accepted step reduced the
+    correction by less than ``refresh``, and where ``α`` fell below ``min_step``. Stops at the residual
+    ``target``, on a failed evaluation (a QP not solved at an iterate far off), after ``max_jacobians``
+    or ``max_evaluations``. Returns ``(best, evaluations, best residual)`` as :func:`fixed_point`.
+    """
+    from scipy.linalg import lu_factor, lu_solve
+    x, gx, *extra = start
+    best, best_r, lu, jacobians, k, alpha = start, float(np.abs(gx - x).max()) / scale, None, 0, 0, 1.0
+    while k < max_evaluations:
+        if lu is None:
+            if jacobians >= max_jacobians:
+                break
+            lu, jacobians = lu_factor(np.eye(x.size) - jacobian(x, *extra), check_finite=False), jacobians + 1
+            d = lu_solve(lu, gx - x, check_finite=False)
+        xt = x + alpha * d
+        k += 1
+        try:
+            gt, *et = G(xt)
+        except (SolverError, InputError):  # an iterate far off
+            gt = None
+        rt = np.inf if gt is None else float(np.abs(gt - xt).max()) / scale
+        if rt < best_r:
+            best, best_r = (xt, gt, *et), rt
+        if rt <= target:
+            break
+        dt = lu_solve(lu, gt - xt, check_finite=False) if np.isfinite(rt) else None
+        if dt is not None and np.abs(dt).max() <= (1 - alpha / 4) * np.abs(d).max():
+            if np.abs(dt).max() > (1 - alpha * (1 - refresh)) * np.abs(d).max():  # slower than refresh a full step
+                lu = None  # slow: a new Jacobian at the accepted point
+            x, gx, extra, d, alpha = xt, gt, et, dt, min(1.0, 2 * alpha)
+        else:
+            alpha /= 2
+            if alpha < min_step:
+                lu, alpha = None, 1.0  # a new Jacobian where we are
+    return best, k, best_r
+
+
+class MapJacobian:
+    r"""``K = ∂G/∂t``: the march map's Jacobian on the active sets of its QP answers (QP sensitivity).
+
+    On fixed active sets each half's answer is affine in its data: with the free set ``F`` and the
+    nodes at a bound ``A`` of a QP (:class:`~rollqp.problem.QPForm`), ``dx_A`` is the bounds'
+    change and ``dx_F = H_FF⁻¹ dr − z (a_Fᵀ H_FF⁻¹ dr − dβ)/(a_Fᵀ z)``, ``z = H_FF⁻¹ a_F``, with
+    ``dr = −dq_F − H_FA dx_A`` and ``dβ = −a_Aᵀ dx_A`` (the load row's right-hand side fixed). The
+    map's data depend on ``t`` through the normal half's gap offset ``A_nt t`` (``dq = ∂q/∂e · A_nt dt``,
+    :attr:`QPForm.shift_scale`), the history ``c = −M w(p, t)`` of the tangential half, whose own
+    history is ``c + A_tn p`` (so ``dc = (I − M) A_tn dp − M A_tt dt``), and its bounds ``±μ p⁺``.
+    The Hessians are the QPs' own (the symmetric part ``sym(F·A)`` for an asymmetric ``F·A``: an
+    approximate Jacobian there, exact for constant elements). Dense ``n × n`` products, ``O(n³)`` a call.
+    """
+
+    def __init__(self, ops, *, P, Q, xi, dq, M, delta):
+        n = ops.n
+        self.ops, self.M, self.data = ops, M, dict(P=P, Q=Q, xi=xi, dq=dq, delta=delta)
+        self.MAtt = np.asarray(M @ _dense(ops.Att, n))  # fixed for the start: once (M has ≤ 3 entries a row)
+        if ops.coupled:
+            Atn = _dense(ops.Atn, n)
+            self.Ant, self.ImMAtn = _dense(ops.Ant, n), Atn - np.asarray(M @ Atn)
+
+    def __call__(self, t, nsol, tsol):
+        ops, d, stress = self.ops, self.data, self.ops.scales.stress
+        c = -(self.M @ ops.w(nsol.p, t))
+        if ops.coupled:
+            step = ops.coupled_step(d["P"], np.zeros(ops.n), d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"])
+            fn = step.normal_half(t).qp_form()
+            Jn = stress * qp_response(fn, nsol.p / stress, nsol.info["qp_multiplier"],
+                                      fn.shift_scale[:, None] * self.Ant)  # dp/dt
+            dc = self.ImMAtn @ Jn - self.MAtt
+            dbound = (ops.mu / stress) * (nsol.p > 0)[:, None] * Jn
+            ft = ops.coupled_step(d["P"], c, d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"]).tangential_half(nsol.p)
+        else:
+            dc, dbound = -self.MAtt, None
+            ft = ops.tangential_step(nsol.p, c, d["dq"], Q=d["Q"], xi=d["xi"])
+        ft = ft.qp_form()
+        return stress * qp_response(ft, tsol.t / stress, tsol.info["qp_multiplier"], ft.shift_scale[:, None] * dc,
+                                    dbound)
+
+
+def qp_response(form, x, y, dq, dbound=None):
+    """``dx``: the change of the QP answer ``x`` (multiplier ``y``) with ``q`` changed by ``dq`` and the
+    bounds' magnitude (``upper = −lower``) by ``dbound`` (columns: directions), on the active set of
+    ``(x, y)`` read as :func:`~rollqp.methods._qp.active_set_refine` reads it, and with the nodes on a
+    bound counted at it (:class:`MapJacobian`)."""
+    from scipy.linalg import cho_factor, cho_solve
+    H, a = form.H, form.a
+    lam = H @ x + form.q + (float(y) * a if a is not None else 0.0)
+    width = form.upper - form.lower  # a bound pair closer than rounding (μp of ~1e-21 p0 at the contact's
+    fixed = form.fixed | (width <= 1e-12 * np.max(width, initial=0.0, where=np.isfinite(width)))  # edge): fixed
+    # at a bound also where x is on it with a zero multiplier (a node at the edge of a zone): its
+    # derivative is one-sided, and the answer's traction is clipped to the bound
+    at_lo = np.isfinite(form.lower) & ((x - form.lower < lam) | (x <= form.lower)) & ~fixed
+    at_up = np.isfinite(form.upper) & ((form.upper - x < -lam) | (x >= form.upper)) & ~fixed
+    dx = np.zeros(dq.shape)
+    if dbound is not None:
+        dx[at_up], dx[at_lo] = dbound[at_up], -dbound[at_lo]
+    F = np.flatnonzero(~(fixed | at_lo | at_up))
+    if F.size == 0:
+        return dx
+    chol = cho_factor(H[np.ix_(F, F)])
+    z = cho_solve(chol, -dq[F] - H[F] @ dx)  # dx is zero on F: H[F] dx = H_FA dx_A
+    if a is not None:
+        z2 = cho_solve(chol, a[F])
+        z -= np.outer(z2, (a[F] @ z + a @ dx) / float(a[F] @ z2))  # a_Fᵀ dx_F = −a_Aᵀ dx_A
+    dx[F] = z
+    return dx
+
+
+def _dense(op, n):
+    """An influence operator as an ``n × n`` array (its own, or its columns)."""
+    if hasattr(op, "dense"):
+        return np.asarray(op.dense(), dtype=float)
+    return np.column_stack([op @ e for e in np.eye(n)])
 
 
 def _state(ops, start, best, *, P, Q, xi, dq, M, delta):

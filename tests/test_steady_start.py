@@ -1,0 +1,113 @@
+"""The QP methods' accelerated rolling start (rollqp.methods.steady_start, issue 18).
+
+* The march map's Jacobian from the QPs' active sets (MapJacobian) is the map's derivative:
+  against finite differences of the map itself, coupled and uncoupled.
+* The Newton phase (chord_newton inside fixed_point) on an affine map lands on its fixed point at
+  once; with a wrong Jacobian the iteration still converges (Anderson takes over).
+* A coupled rolling start with qp-osqp is newton's direct steady state (constant elements, Δq = Le:
+  the same discrete problem, tests/test_steady.py), uses the Newton phase (fewer sweeps than without
+  it), and leaves the active-set prediction off.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rollqp
+from rollqp.march import prepare
+from rollqp.methods.alternation import Alternation
+from rollqp.methods.steady_start import MapJacobian, fixed_point, sweep_map
+from rollqp.refcases import bentall_scene
+
+#: Tolerance of the march on the change of t per step (rollqp.march.STEADY_TOL): the rolling start's
+#: answer is within it of the steady state (measured 1e-12, see the test).
+MARCH_TOL = 1e-8
+
+
+def _steady_map(scene, method="qp-osqp"):
+    """``(G, t, jacobian, scale)``: the march map of ``scene``'s rolling start from its braked state, near
+    steady (Anderson to 1e-9 μp0), with the active-set prediction on as in the accelerated start."""
+    braked = scene.replace(**{"load.start": "braked", "discretization.distance": 0.0})
+    _, meth, ops = prepare(braked, method)
+    state = next(rollqp.march(braked, meth)).state
+    inner = meth.inner if isinstance(meth, Alternation) else meth
+    inner.predicting(True)
+    data = dict(P=float(scene.normal_load(0.0)), Q=float(scene.tangential_load(0.0)), xi=None, dq=scene.dq,
+                M=ops.history())
+    G = sweep_map(meth, ops, state, **data)
+    scale = ops.mu * ops.scales.stress
+    best, _, r = fixed_point(G, state.t, scale, target=1e-9, max_evaluations=600)
+    assert r <= 1e-9, f"the map's fixed point is reached ({r:.1e})"
+    return G, best[1], MapJacobian(ops, delta=None, **data), scale
+
+
+@pytest.mark.parametrize("case", ["coupled", "uncoupled"])
+def test_map_jacobian_is_the_maps_derivative(case):
+    """K v against G(t + v) − G(t) near the steady state, where the active sets hold for a small v.
+
+    Step 1e-6 μp0: the QP answers are exact KKT solves (rounding ~1e-14 p0, i.e. ~1e-12 μp0), so
+    the difference quotient is good to ~1e-6 of |Kv|; bound 1e-4. A Jacobian that missed the
+    coupling (A_nt, A_tn), the history or the moving bounds μp is off by far more (the coupling
+    alone is ~10 % of K on this scene). Coupled: Bentall–Johnson, free rolling; uncoupled: §6.1.1's
+    similar rollers at Q = 0.75 μP; both 40 constant elements (an exact Jacobian: F·A symmetric)."""
+    scene = bentall_scene(0.05, elements=40, coupling="full") if case == "coupled" else \
+        rollqp.load_scene("cattaneo-carter").replace(**{"discretization.element": "constant",
+                                                         "discretization.elements": 40})
+    G, t, jac, scale = _steady_map(scene)
+    out = G(t)
+    K = jac(t, *out[1:])
+    v = 1e-6 * scale * np.random.default_rng(3).standard_normal(t.size)
+    diff = G(t + v)[0] - out[0]
+    Kv = K @ v
+    assert np.abs(Kv).max() > 1e-3 * np.abs(v).max(), "the map does depend on t"
+    err = np.abs(diff - Kv).max() / np.abs(Kv).max()
+    assert err <= 1e-4, f"K v differs from the map's difference by {err:.1e} of |K v|"
+
+
+def test_newton_phase_on_an_affine_map():
+    """G(x) = A x + b with a slow transport mode (spectral radius 0.99): with its Jacobian the Newton
+    phase reaches the fixed point in one step (two evaluations after the plain ones); with a wrong
+    Jacobian it stops short and Anderson still converges."""
+    n = 30
+    A = 0.99 * np.eye(n, k=-1) + 0.005 * np.random.default_rng(0).standard_normal((n, n))
+    b = np.linspace(-1.0, 1.0, n)
+    exact = np.linalg.solve(np.eye(n) - A, b)
+    counts = []
+
+    def G(x):
+        counts.append(1)
+        return A @ x + b, None
+
+    best, evals, r = fixed_point(G, np.zeros(n), 1.0, target=1e-12, jacobian=lambda x, _: A, newton_from=1e9)
+    assert r <= 1e-12 and np.abs(best[1] - exact).max() <= 1e-10
+    assert evals == len(counts) <= 3, f"Newton on an affine map: {evals} evaluations"
+    counts.clear()
+    wrong = -5.0 * np.eye(n)
+    best, evals, r = fixed_point(G, np.zeros(n), 1.0, target=1e-12, jacobian=lambda x, _: wrong, newton_from=1e9,
+                                 max_evaluations=500)
+    assert r <= 1e-12 and np.abs(best[1] - exact).max() <= 1e-10, f"Anderson after a failed Newton phase: {r:.1e}"
+
+
+def test_coupled_rolling_start_is_newtons_steady_state():
+    """qp-osqp's accelerated rolling start (Bentall–Johnson, 40 constant elements, μ = 0.05, full
+    coupling) against newton's direct steady solve: the same discrete state within the march's
+    tolerance (measured 1e-12); in fewer N–T sweeps than without the Newton phase (measured 26
+    against 60), and with the active-set prediction off afterwards (the march's own steps, which
+    give the state kept, are the backend's)."""
+    scene = bentall_scene(0.05, elements=40, coupling="full")
+    ref = rollqp.run(scene, method="newton")
+    meth = prepare(scene, "qp-osqp")[1]
+    r = rollqp.run(scene, method=meth)
+    assert r.meta["rolling_start"] == "marching to steady state"
+    mu, p0 = scene.contact.friction, scene.p0
+    dt = float(np.max(np.abs(r["pt"][0] - ref["pt"][0]))) / (mu * p0)
+    dp = float(np.max(np.abs(r["pn"][0] - ref["pn"][0]))) / p0
+    assert max(dt, dp) <= MARCH_TOL, f"Δt {dt:.1e} μp0, Δp {dp:.1e} p0"
+    assert meth.inner.predicting(False) is False, "prediction off after the start"
+
+    class WithoutNewton(Alternation):
+        quasi_newton = False
+
+    plain = rollqp.run(scene, method=WithoutNewton(rollqp.get_method("qp-osqp", tolerance=scene.solver.tolerance)))
+    sweeps, without = int(r["iterations"][0]), int(plain["iterations"][0])
+    assert sweeps < without, f"the Newton phase saves sweeps: {sweeps} against {without} without it"
