@@ -191,8 +191,9 @@ class _March:
         self.at = self._loads_at(self.plan.tau)
 
     def _loads_at(self, tau) -> list:
-        """``(P, Q, ξ, δ)`` at each τ of the plan (:meth:`loads`, :meth:`approach`), each history evaluated
-        once over the whole plan: the same numbers as one τ at a time (tests/test_dense_path.py)."""
+        """``(τ, d, P, Q, ξ, δ)`` at each step of the plan (``d`` its direction; the loads of :meth:`loads`,
+        :meth:`approach`), each history evaluated once over the whole plan: the same numbers as one τ at
+        a time (tests/test_dense_path.py)."""
         sc = self.scene
         n = tau.size
         none = [None] * n
@@ -200,7 +201,7 @@ class _March:
         Q, xi = (none, sc.prescribed_creepage(tau).tolist()) if sc.load.creepage is not None else \
             (sc.tangential_load(tau).tolist(), none)
         D = none if sc.load.approach is None else sc.prescribed_approach(tau).tolist()
-        return list(zip(P, Q, xi, D))
+        return list(zip(tau.tolist(), self.plan.d.tolist(), P, Q, xi, D))
 
     # ------------------------------------------------------------ loads
     def loads(self, q):
@@ -416,10 +417,8 @@ class _March:
         """
         scene, pl = self.scene, self.plan
         t0 = time.perf_counter()
-        tau = float(pl.tau[k])
-        P, Q, xi, D = self.at[k]
+        tau, d, P, Q, xi, D = self.at[k]
         cnt = Counters()
-        d = int(pl.d[k])
         h = self.ops.gap(q) if self.moving else None
         if d == 0:  # a stop: static shift under the loads of τ_k (§4.4)
             c, dq, phase = -state.w, self.ops.scales.length, "static-shift"

@@ -247,12 +247,13 @@ class SceneOperators:
             return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
         pb = _trusted(TangentialStep, A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
                       scales=self.scales, law=law)
-        last = self._memo.get("bound")  # (p, μ, bound, sliding limit) of the last march-built step
+        last = self._memo.get("bound")  # (p, μ, bound, sliding limit, bound_hat) of the last march-built step
         if last is not None and last[0] is p and last[1] is mu and law is None:
-            pb.__dict__["bound"] = last[2]  # the same pressure (a fixed normal half) and μ: the same bound
+            # the same pressure (a fixed normal half) and μ: the same bound (TangentialStep's cached properties)
+            pb.__dict__["bound"], pb.__dict__["bound_hat"] = last[2], last[4]
             _check_sliding_limit(pb, last[3])
         elif law is None:
-            self._memo["bound"] = (p, mu, pb.bound, _check_sliding_limit(pb))
+            self._memo["bound"] = (p, mu, pb.bound, _check_sliding_limit(pb), pb.bound_hat)
         else:
             _check_sliding_limit(pb)
         return pb

@@ -254,7 +254,8 @@ def _derived(step, **changes):
     obj = object.__new__(type(step))  # frozen: the fields set through __dict__, as dataclasses.replace would
     obj.__dict__.update(step.__dict__)
     obj.__dict__.update(changes)
-    obj.__dict__.pop("bound", None)  # a cached property of the old values (TangentialStep.bound)
+    obj.__dict__.pop("bound", None)  # cached properties of the old values (TangentialStep.bound, .bound_hat)
+    obj.__dict__.pop("bound_hat", None)
     return obj
 
 
@@ -551,6 +552,15 @@ class TangentialStep:
         b.flags.writeable = False
         return b
 
+    @functools.cached_property
+    def bound_hat(self) -> tuple:
+        """``(b̂, −b̂)``, ``b̂ = μp̄⁺/p0`` of :attr:`bound` (read-only): rollqp's friction residual and
+        Newton's friction rows read them."""
+        bh = self.bound / self.scales.stress
+        nb = -bh
+        bh.flags.writeable = nb.flags.writeable = False
+        return bh, nb
+
     def bound_at(self, s) -> np.ndarray:
         """The bound at the slip ``s``: ``μ(s)·max(p̄, 0)`` (``law``), else :attr:`bound`."""
         return self.bound if self.law is None else self.law.mu(s) * np.maximum(self.p, 0.0)
@@ -595,8 +605,8 @@ class TangentialStep:
         ``s``: its slip if already computed."""
         sc = self.scales
         s = self.slip(t, xi) if s is None else s
-        th, sh, bh = t / sc.stress, s / sc.slip, self.bound_at(s) / sc.stress
-        fr = friction_residual(th, sh, bh)
+        bh, nb = self.bound_hat if self.law is None else (self.bound_at(s) / sc.stress, None)
+        fr = friction_residual(t / sc.stress, s / sc.slip, bh, nb)
         load = 0.0 if self.Q is None else (self.f @ t - self.Q) / sc.force
         return Residuals(friction=float(np.abs(fr).max()), load_tangential=abs(float(load)))
 

@@ -56,9 +56,9 @@ class TangentialNCP:
 
     kind = "tangential"
 
-    def __init__(self, b):
+    def __init__(self, b, minus_b=None):
         self.b = b
-        self._minus_b = -b
+        self._minus_b = -b if minus_b is None else minus_b
         self.sep = b <= 0.0
         #: Rows whose ``y`` enters ``Φ``: a zero bound gives ``Φ_i = t̂_i`` whatever ``r ŝ_i`` (eq. 85).
         self.needs = ~self.sep

@@ -139,7 +139,7 @@ def _friction_rows(sys_, pb):
     bound = pb.bound
     last = sys_.ncp
     if last is None or last[0] is not bound:
-        last = sys_.ncp = (bound, TangentialNCP(bound / pb.scales.stress))
+        last = sys_.ncp = (bound, TangentialNCP(*pb.bound_hat))
     return last[1]
 
 
@@ -296,7 +296,7 @@ class _Iterate:
         below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start).
 
         ``full = (z + d, its product)`` (:meth:`product`): ``α = 1`` is tried on the full step's own
-        ``y``. Returns ``(α, (Φ, θ) at z + αd)``, the latter ``None`` unless ``α = 1`` was taken on ``full``."""
+        ``y`` (``Kd`` may then be None: ``y(z + d) − y``, formed only if the full step is refused). Returns ``(α, (Φ, θ) at z + αd)``, the latter ``None`` unless ``α = 1`` was taken on ``full``."""
         meth = self.meth
         rho, two_sigma = meth.rho, 2.0 * meth.sigma
         dx = d[:self.n]
@@ -308,6 +308,7 @@ class _Iterate:
                 return 1.0, (pa, merit)
             alpha = rho
             self.backtracks += 1
+            Kd = full[1][2] - self.y
         else:
             alpha = 1.0
         while True:
@@ -359,8 +360,7 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
             # small n, or the last step took one iteration (so this one likely does too): the product at
             # the full step gives K d (all rows) and, if the step is taken, the iterate's own y and Φ
             zf = st.z + d
-            full = (zf, st.product(zf))
-            Kd = full[1][2] - st.y
+            full, Kd = (zf, st.product(zf)), None  # K d = y(z + d) − y, if the full step is refused
         else:
             full, Kd = None, st.Kd(d, mask)
         alpha, at_full = st.line_search(d, Kd, warm, full)
@@ -368,7 +368,7 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         if at_full is not None:
             st.take(full[0], full[1], *at_full)  # eq. 79, α = 1
         else:
-            st.update(st.z + alpha * d, alpha, Kd)  # eq. 79
+            st.update(st.z + alpha * d, alpha, full[1][2] - st.y if Kd is None else Kd)  # eq. 79
     sys_.settled = sys_.partial and it == 1
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
