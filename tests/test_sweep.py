@@ -100,7 +100,9 @@ def test_killed_sweep_keeps_its_points_and_a_rerun_computes_only_the_rest(client
     """SIGKILL the ``rollqp sweep`` process mid-sweep; the stored points stay and are not recomputed."""
     store = tmp_path / "k.zarr"
     vary = ["load.tangential=0.1:0.8:12"]
-    base = _small().replace(**{"discretization.distance": 6.0})
+    # points of ~0.2 s (321 nodes, 3 a_H): the kill comes while most are still to do (the test polls every
+    # 20 ms; twelve 41-node points, ~20 ms each, could all be stored before it)
+    base = _small().replace(**{"discretization.elements": 160, "discretization.distance": 3.0})
     scene_file = tmp_path / "base.toml"
     scene_file.write_text(base.to_toml())
     env = dict(os.environ, PYTHONPATH=str(ROOT), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
@@ -138,7 +140,9 @@ def test_worker_killed_mid_sweep_loses_only_its_point_in_flight(client, tmp_path
     """SIGKILL a busy worker process: its point is computed again elsewhere, every point ends equal."""
     store = tmp_path / "w.zarr"
     vary = ["load.tangential=0.2:0.7:6"]
-    base = _small().replace(**{"discretization.distance": 6.0})
+    # points long enough (~0.2 s each: 321 nodes, 3 a_H) that the next ones are still in flight when the
+    # sweep has written the first: with 41-node points (~20 ms) all six could be done by then
+    base = _small().replace(**{"discretization.elements": 160, "discretization.distance": 3.0})
     pids = client.run(os.getpid)
     killed = []
 
