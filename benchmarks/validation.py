@@ -341,12 +341,13 @@ def section_splitting():
         for n in CONV_ELEMENTS:
             m = SceneOperators.build(base.replace(**{"discretization.elements": n, "discretization.element": el}),
                             symmetrized=False)
-            FA = m.f[:, None] * m.Att
+            Att = m.Att.dense()  # (an Operator: products only; its matrix for the eigenvalues)
+            FA = m.f[:, None] * Att
             H, S = 0.5 * (FA + FA.T), 0.5 * (FA - FA.T)
             w, V = np.linalg.eigh(H)
             Hi = (V / np.sqrt(w)) @ V.T
             rho = float(np.abs(np.linalg.eigvals(Hi @ S @ Hi)).max())
-            asym_A = float(np.linalg.norm(m.Att - m.Att.T) / np.linalg.norm(m.Att))
+            asym_A = float(np.linalg.norm(Att - Att.T) / np.linalg.norm(Att))
             hertz = []
             for op in ("exact", "symmetrized"):  # the splitting, or one QP with F⁻¹ sym(F A)
                 sol = rollqp.get_method("qp-osqp", operator=op).solve(m.normal_step(m.scene.load.normal))
