@@ -368,7 +368,11 @@ class _March:
         """Rolling start: roll at the initial loads until the tractions stop changing.
 
         For methods that cannot pose the non-symmetric steady problem (``STEADY_TOL``,
-        ``STEADY_MAX_DISTANCE``).
+        ``STEADY_MAX_DISTANCE``). A QP method first takes the accelerated start
+        (:mod:`rollqp.methods.steady_start`), then marches with its QPs solved on their predicted
+        active sets (:func:`~rollqp.methods.steady_start.predicting`) until a step changes the state by
+        less than ``STEADY_TOL``, and on with the backend (and the N–T alternation converged) until
+        one does again: the state kept is the backend's.
         """
         scene, ops = self.scene, self.ops
         t0 = time.perf_counter()
@@ -376,30 +380,37 @@ class _March:
         cnt = Counters()
         M = ops.history()
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
-        from .methods.steady_start import accelerated_start
+        from .methods.steady_start import accelerated_start, predicting
         change = np.inf
         state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
                                   delta=self.approach(0.0), tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
         sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
         if sweeps is not None:
             sweeps(True)
-        for _ in range(max_steps):
-            previous = state
-            state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                                            normal_fixed=self.fixed, delta=self.approach(0.0), transport=scene.dq)
-            change = np.max(np.abs(state.t - previous.t)) / (max(ops.mu, 1e-300) * ops.scales.stress)
-            if not self.fixed:
-                change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
-            if change < STEADY_TOL:
-                if sweeps is not None and sweeps(False):
-                    cnt.residual = 0.0  # one sweep stops short of the coupled limit by design: report the converged steps'
-                    continue  # then full steps (converged alternation) until steady again
-                break
-        else:
-            if sweeps is not None:
-                sweeps(False)
-            raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
-                              f"(last change {change:.2e} mu p0)", method=self.method.name, step=0)
+        was = predicting(self.method, True)  # QP methods: each QP on its predicted active set first, until steady
+        try:
+            for _ in range(max_steps):
+                previous = state
+                state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
+                                                normal_fixed=self.fixed, delta=self.approach(0.0), transport=scene.dq)
+                change = np.max(np.abs(state.t - previous.t)) / (max(ops.mu, 1e-300) * ops.scales.stress)
+                if not self.fixed:
+                    change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
+                if change < STEADY_TOL:
+                    one_sweep = sweeps is not None and sweeps(False)
+                    if one_sweep:
+                        cnt.residual = 0.0  # one sweep stops short of the coupled limit by design: report the converged steps'
+                    if one_sweep | bool(predicting(self.method, False)):
+                        continue  # then full steps (converged alternation, the backend's QPs) until steady again
+                    break
+            else:
+                if sweeps is not None:
+                    sweeps(False)
+                raise SolverError(f"the rolling start did not reach a steady state within {STEADY_MAX_DISTANCE} a_H "
+                                  f"(last change {change:.2e} mu p0)", method=self.method.name, step=0)
+        finally:
+            if was is not None:
+                predicting(self.method, was)
         return self.record(0, "rolling", 0.0, state, previous, problem, sol, cnt, P=P, shift=0.0, t0=t0)
 
     def _transport(self, k: int, dq: float) -> float:

@@ -127,9 +127,9 @@ class QPMethod:
         bounds are within :attr:`tolerance`. Such a candidate *is* the QP's solution to the accuracy the
         backend is asked for (a strictly convex QP has one KKT point; the residual measures the
         distance from it), found with the factors :class:`KKTCache` keeps per free set. For a
-        sequence of QPs whose active set rarely changes: rollqp.march's accelerated rolling start
-        (:mod:`rollqp.methods.steady_start`), whose fixed-point iteration approaches a steady state;
-        the march's own steps, which give the state it keeps, are solved with the prediction off.
+        sequence of QPs whose active set rarely changes: rollqp.march's rolling start (its accelerated
+        phase, :mod:`rollqp.methods.steady_start`, and its march to the steady state), which approaches
+        a steady state; the steps that give the state it keeps are solved with the prediction off.
         """
         was, self._predict = self._predict, bool(on)
         return was

@@ -79,6 +79,16 @@ def applies(method, ops) -> bool:
             and not ops.profiles_move and ops.coupled == isinstance(method, Alternation))
 
 
+def predicting(method, on: bool) -> bool | None:
+    """Switch the active-set prediction of ``method``'s QPs on or off (:meth:`QPMethod.predicting
+    <rollqp.methods._qp.QPMethod.predicting>`; a QP backend or the N–T alternation of one); return
+    whether it was on, or None for a method without it. rollqp.march's rolling start keeps it on while
+    it marches to the steady state and takes its last steps with it off, so that the state it keeps
+    is the backend's."""
+    inner = method.inner if isinstance(method, Alternation) else method
+    return inner.predicting(on) if isinstance(inner, QPMethod) else None
+
+
 def sweep_map(method, ops, state, counters=None, *, P, Q, xi, dq, M, delta=None):
     """``G(t) -> (t_new, nsol, tsol)``: one marching step from the shear ``t`` (module docstring), each
     half warm-started from the previous evaluation (first from ``state``); its solves are counted in
