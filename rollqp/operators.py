@@ -11,6 +11,7 @@ steady operators only for a direct steady rolling start, each history operator o
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -230,6 +231,8 @@ class SceneOperators:
         offset = None if (self.Ant is None or t is None) else self.Ant @ t
         h = self.h if h is None else h
         if not validate:
+            if offset is not None:
+                _finite("t", offset)
             return _trusted(NormalStep, A=self.Ann, f=self.f, h=h, P=_float(P), delta=_float(delta), offset=offset,
                             scales=self.scales)
         return NormalStep(A=self.Ann, f=self.f, h=h, P=P, delta=delta, offset=offset, scales=self.scales)
@@ -245,6 +248,7 @@ class SceneOperators:
         mu, law = (self.mu, None) if friction is None else friction
         if validate:
             return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
+        _finite("c", c)
         pb = _trusted(TangentialStep, A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
                       scales=self.scales, law=law)
         last = self._memo.get("bound")  # (p, μ, bound, sliding limit, bound_hat) of the last march-built step
@@ -252,10 +256,12 @@ class SceneOperators:
             # the same pressure (a fixed normal half) and μ: the same bound (TangentialStep's cached properties)
             pb.__dict__["bound"], pb.__dict__["bound_hat"] = last[2], last[4]
             _check_sliding_limit(pb, last[3])
-        elif law is None:
-            self._memo["bound"] = (p, mu, pb.bound, _check_sliding_limit(pb), pb.bound_hat)
         else:
-            _check_sliding_limit(pb)
+            _finite("p", pb.bound)
+            if law is None:
+                self._memo["bound"] = (p, mu, pb.bound, _check_sliding_limit(pb), pb.bound_hat)
+            else:
+                _check_sliding_limit(pb)
         return pb
 
     def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None, h=None,
@@ -280,6 +286,14 @@ class SceneOperators:
                              f"the contact reaches the edge of the zone at step {step} "
                              f"(p/p0 = {max(ends) / self.scales.stress:.2e} at an end node): increase zone "
                              f"(now {self.scene.discretization.zone})")
+
+
+def _finite(name, v) -> None:
+    """The one check a march-built step keeps on the arrays it takes from the last step's solution:
+    finite (one sum: a NaN or an infinity makes it non-finite), else the InputError a validated step
+    would raise."""
+    if not math.isfinite(float(np.add.reduce(v))):  # (the ufunc: np.sum costs three times as much)
+        raise InputError(name, "must be finite (the last step's solution was not)")
 
 
 def _float(v):

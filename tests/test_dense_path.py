@@ -22,6 +22,7 @@ import rollqp
 from rollqp.energy import elastic_energy
 from rollqp.march import prepare
 from rollqp.scene import builtin_scenes
+from conftest import Delegate
 from rollqp.methods.newton import linear
 from rollqp.strip import RowSparse, Strip
 
@@ -213,3 +214,27 @@ def test_plan_loads_are_the_loads_at_each_step(builtin_scene, name):
             assert rec.problem.Q == float(scene.tangential_load(tau))
         elif scene.load.creepage is not None:
             assert rec.solution.xi == float(scene.prescribed_creepage(tau))
+
+
+@pytest.mark.parametrize("field, key", [("p", "p"), ("t", "c")])
+def test_a_non_finite_solution_stops_the_march_as_a_validated_step_would(builtin_scene, field, key):
+    """A method whose solution holds a NaN (here a wrapper breaking newton's after a few solves): the next
+    march-built step refuses it with the one-line InputError naming the array (``p`` the pressure under the
+    bound, ``c`` the history from the shear), and the completed states are kept (``err.partial``)."""
+    class Broken(Delegate):
+        calls = 0
+
+        def solve(self, problem, warm=None):
+            sol = self.inner.solve(problem, warm=warm)
+            self.calls += 1
+            value = getattr(sol, field)
+            if self.calls > 6 and value is not None:
+                value = value.copy()
+                value[value.size // 2] = np.nan
+                setattr(sol, field, value)
+            return sol
+
+    scene = builtin_scene("dent", **{"discretization.distance": 0.5})  # a moving profile: a new pressure every step
+    with pytest.raises(rollqp.InputError, match=rf"^{key}: must be finite") as err:
+        rollqp.run(scene, method=Broken(rollqp.get_method("newton", tolerance=scene.solver.tolerance)))
+    assert 0 < len(err.value.partial) < scene.n_steps + 1
