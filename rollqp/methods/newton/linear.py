@@ -99,7 +99,10 @@ class ReducedSystem:
         K[:, :n] = (r / t_scale) * Ahat
         K[:, n] = r * last_column
         self.K = K
-        self.load_column = K[:, n].copy()  # contiguous: y's load term (a strided column costs twice as much)
+        col = K[:, n].copy()  # contiguous: y's load term (a strided column costs twice as much)
+        #: ``K``'s load column, or the one number it holds (``±r``: the normal and tangential steps'
+        #: ``∂y/∂δ̂``, ``∂y/∂ξ̂``), which ``y`` then adds as a number: the same values, one operation less
+        self.load_column = float(col[0]) if n and np.all(col == col[0]) else col
         self._K_nl = None  # made on first use: a scene with the load row never needs it
         #: ``K_nl x̂ = unit · (A x)`` for a traction ``x`` in the problem's units (``x̂ = x/p0``)
         self.unit = (r / t_scale) * unit

@@ -9,6 +9,8 @@ rows ``φ`` and their cases (eq. 82–88) are :mod:`.ncp`'s.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...errors import SolverError
@@ -353,7 +355,7 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         it += 1
         st.rows(mask)
         d = sys_.direction(mask, st.phi, st.with_load)  # reduced system on the free nodes
-        if d is None or not np.isfinite(d).all():
+        if d is None or not math.isfinite(float(np.add.reduce(d))):  # a NaN or an infinity anywhere (one sum)
             raise SolverError(f"the {pb.kind} Newton matrix is singular",
                               method=meth.name, status="singular", iterations=it, residual=nrm)
         if not sys_.partial or (it == 1 and sys_.settled):
