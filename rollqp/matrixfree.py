@@ -18,11 +18,15 @@ path cannot hold is refused before any work, naming ``mf-newton`` (:func:`check_
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .errors import InputError
 from .influence.operator import Operator
+
+if TYPE_CHECKING:  # annotations only: scipy.sparse is imported at first use (`import rollqp` stays free of it)
+    from scipy import sparse
 
 __all__ = ["MODES", "THRESHOLD", "mode", "memory_estimate", "check_scene", "sparse_history",
            "sparse_steady", "SteadyOperator", "steady_operators", "build"]

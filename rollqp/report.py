@@ -26,7 +26,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     if scene.coupling_level != "off" or scene.contact.model != "halfspace":
         return out
     x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
-    mu, lead = scene.contact.mu, int(res["leading_edge"])
+    mu = scene.contact.mu
     if not isinstance(scene.contact.friction, float):  # a friction law: no closed form to compare with
         mu = 0.0
     P0 = float(res["P"][0])

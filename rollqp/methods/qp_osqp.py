@@ -17,7 +17,7 @@ import osqp
 import scipy.sparse as sp
 
 from ..errors import SolverError
-from ._qp import QPMethod, constraint_rows
+from ._qp import QPMethod
 
 
 class OsqpQP(QPMethod):
@@ -41,7 +41,6 @@ class OsqpQP(QPMethod):
         return form.structure[:-1]  # (kind, n, has_eq, finite lower, finite upper)
 
     def _bounds(self, form):
-        n = form.H.shape[0]
         l, u = form.lower.copy(), form.upper.copy()
         if form.a is not None:
             l = np.concatenate([[form.b], l])

@@ -61,7 +61,7 @@ class _Coupled:
 
     def set(self, z):
         """Take the iterate ``z``: the linear parts and ``Φ`` evaluated anew."""
-        n, S = self.n, self.S
+        n = self.n
         self.z = z
         self.p, self.t = z[:n], z[n:2 * n]
         self.refresh()

@@ -334,7 +334,7 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     ``start``: ``(x, A x)`` of the start in the problem's units, if the product is known.
     Returns ``(z, iterations, info, x, A x)``, ``x`` the solution's traction in the problem's units.
     """
-    n, r = pb.n, sys_.r
+    r = sys_.r
     st = _Iterate(meth, pb, sys_, z, k0, load, ncp, start)
     stop = meth.tolerance * min(1.0, r)
     mask = sys_.mask(st.with_load)  # last entry: load row (always the JK row)
