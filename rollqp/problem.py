@@ -226,8 +226,8 @@ def _trusted(cls, **values):
     (:meth:`~rollqp.operators.SceneOperators.tangential_step` with ``validate=False``): their
     operators are checked :class:`Operator`\\ s and their vectors are products of them with
     checked or solver-computed arrays, so the ``O(n)``–``O(n²)`` checks of ``__post_init__`` would
-    only repeat (measured 3–14 % of a QP step and 13 % of a Newton rolling step on §6.1.1). The
-    caller vouches for the values.
+    only repeat (measured 3–14 % of a QP step on §6.1.1; a validated tangential step costs 16 µs
+    there against 2.4 µs, a fifth of a Newton rolling step). The caller vouches for the values.
     """
     obj = object.__new__(cls)
     d = obj.__dict__
