@@ -186,14 +186,15 @@ class _March:
         self.plan = plan(scene)
         self.moving = ops.profiles_move
         self.cache = HistoryCache(ops) if self.plan.rolled else None
-        self.fixed = self._normal_fixed()
         self.frictionless = ops.frictionless  # the scene's law: the same at every step
         self.at = self._loads_at(self.plan.tau)
+        self.fixed = self._normal_fixed()
 
     def _loads_at(self, tau) -> list:
-        """``(τ, d, P, Q, ξ, δ)`` at each step of the plan (``d`` its direction; the loads of :meth:`loads`,
-        :meth:`approach`), each history evaluated once over the whole plan: the same numbers as one τ at
-        a time (tests/test_dense_path.py)."""
+        """``(τ, d, P, Q, ξ, δ)`` at each step of the plan: ``d`` its direction; the normal load ``P`` (None
+        when the approach ``δ`` is prescribed, else ``δ`` is None); the tangential load ``Q`` or the
+        prescribed creepage ``ξ`` (the other None). Each history is evaluated once over the whole plan:
+        the same numbers as one τ at a time (tests/test_dense_path.py). Step 0 (τ = 0) is the start's."""
         sc = self.scene
         n = tau.size
         none = [None] * n
@@ -203,28 +204,13 @@ class _March:
         D = none if sc.load.approach is None else sc.prescribed_approach(tau).tolist()
         return list(zip(tau.tolist(), self.plan.d.tolist(), P, Q, xi, D))
 
-    # ------------------------------------------------------------ loads
-    def loads(self, q):
-        """``(P, Q, ξ)`` at ``q``; ``P`` is None when the approach is prescribed (:meth:`approach`)."""
-        sc = self.scene
-        P = None if sc.load.approach is not None else float(sc.normal_load(q))
-        if sc.load.creepage is not None:
-            return P, None, float(sc.prescribed_creepage(q))
-        return P, float(sc.tangential_load(q)), None
-
-    def approach(self, q):
-        """The prescribed approach δ(q), or None (the normal load is prescribed)."""
-        d = self.scene.prescribed_approach(q)
-        return None if d is None else float(d)
-
     def _normal_fixed(self) -> bool:
-        """The normal step cannot change: no shear feedback (A_nt absent) and constant P."""
+        """The normal step cannot change: no shear feedback (A_nt absent), a fixed profile, and the same
+        normal load (or approach) at every step."""
         if self.ops.Ant is not None or self.moving:
             return False
-        qs = self.scene.time_steps
-        sc = self.scene
-        P = sc.normal_load(qs) if sc.load.approach is None else sc.prescribed_approach(qs)
-        return bool(np.all(P == P[0]))
+        first = self.at[0]
+        return all(a[2] == first[2] and a[5] == first[5] for a in self.at)
 
     # ------------------------------------------------------------ one step
     def step(self, state: State, cnt: Counters, *, P, c, dq, Q=None, xi=None, normal_fixed=False,
@@ -308,8 +294,7 @@ class _March:
         """
         scene, ops = self.scene, self.ops
         t0 = time.perf_counter()
-        P, Q, _ = self.loads(0.0)
-        D = self.approach(0.0)  # prescribed approach: applied like the load, in start_steps parts
+        _, _, P, Q, _, D = self.at[0]  # a prescribed approach D is applied like the load, in start_steps parts
         Qtarget = Q if Q is not None else 0.0
         n = ops.n
         N = scene.load.start_steps
@@ -357,10 +342,10 @@ class _March:
         warm-started from the braked state.
         """
         t0 = time.perf_counter()
-        P, Q, xi = self.loads(0.0)
+        _, _, P, Q, xi, D = self.at[0]
         cnt = Counters()
         state, problem, sol = self.step(start.state, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
-                                        Q=Q, xi=xi, steady=True, delta=self.approach(0.0))
+                                        Q=Q, xi=xi, steady=True, delta=D)
         self.ops.check_inside(state.p, 0)
         return self.record(0, "steady", 0.0, state, start.state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
 
@@ -376,14 +361,14 @@ class _March:
         """
         scene, ops = self.scene, self.ops
         t0 = time.perf_counter()
-        P, Q, xi = self.loads(0.0)
+        _, _, P, Q, xi, D = self.at[0]
         cnt = Counters()
         M = ops.history()
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
         from .methods.steady_start import accelerated_start, predicting
         change = np.inf
         state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
-                                  delta=self.approach(0.0), tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
+                                  delta=D, tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
         sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
         if sweeps is not None:
             sweeps(True)
@@ -392,7 +377,7 @@ class _March:
             for _ in range(max_steps):
                 previous = state
                 state, problem, sol = self.step(state, cnt, P=P, c=-(M @ state.w), dq=scene.dq, Q=Q, xi=xi,
-                                                normal_fixed=self.fixed, delta=self.approach(0.0), transport=scene.dq)
+                                                normal_fixed=self.fixed, delta=D, transport=scene.dq)
                 change = np.max(np.abs(state.t - previous.t)) / (max(ops.mu, 1e-300) * ops.scales.stress)
                 if not self.fixed:
                     change = max(change, np.max(np.abs(state.p - previous.p)) / ops.scales.stress)
