@@ -151,3 +151,16 @@ def test_march_to_steady_predicts_its_qps_and_keeps_the_backends_step():
     # steady state (the change shrinks by only ~12 % a step: measured 7.6e-8 and 7.3e-8 μp0 from newton's
     # direct steady state); so they agree within twice that (measured 3.0e-9 μp0 apart)
     assert np.max(np.abs(r["pt"][0] - plain["pt"][0])) <= 16 * MARCH_TOL * mu_p0
+
+
+def test_newton_phase_without_a_jacobian_hands_back_its_start():
+    """Where no Jacobian can be formed (MapJacobian gives None: a QP's reduced KKT system singular) the
+    Newton phase stops at once, without an evaluation, and the fixed-point iteration goes on from its start."""
+    from rollqp.methods.steady_start import chord_newton
+    B = 0.5 * np.eye(3)
+    G = lambda x: (B @ x + 1.0,)  # noqa: E731 - fixed point x = 2
+    x = np.zeros(3)
+    best, k, r = chord_newton(G, lambda *a: None, (x, *G(x)), 1.0, target=1e-12, max_evaluations=10)
+    assert k == 0 and best[0] is x and r == 1.0
+    best, k, r = fixed_point(G, x, 1.0, target=1e-12, jacobian=lambda *a: None, newton_from=10.0)
+    assert r <= 1e-12 and np.abs(best[1] - 2.0).max() <= 1e-11  # Anderson: an affine map in a few steps

@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ._qp import QPMethod
+from ._qp import QPMethod, _chol_solve, _kkt_factor
 from .alternation import Alternation
 
 #: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this (without the Newton phase,
@@ -252,16 +252,17 @@ def chord_newton(G, jacobian, start, scale, *, target, max_evaluations, refresh=
     after an accepted step. ``K`` is computed at the start, where an accepted step reduced the
     correction by less than ``refresh``, and where ``α`` fell below ``min_step``. Stops at the residual
     ``target``, on a failed evaluation (a QP not solved at an iterate far off), after ``max_jacobians``
-    or ``max_evaluations``. Returns ``(best, evaluations, best residual)`` as :func:`fixed_point`.
+    or ``max_evaluations``, and where ``jacobian`` gives None (a singular QP sensitivity). Returns ``(best, evaluations, best residual)`` as :func:`fixed_point`.
     """
     from scipy.linalg import lu_factor, lu_solve
     x, gx, *extra = start
     best, best_r, lu, jacobians, k, alpha = start, float(np.abs(gx - x).max()) / scale, None, 0, 0, 1.0
     while k < max_evaluations:
         if lu is None:
-            if jacobians >= max_jacobians:
+            K = jacobian(x, *extra) if jacobians < max_jacobians else None
+            if K is None:  # enough Jacobians, or none to be had here (a singular QP sensitivity)
                 break
-            lu, jacobians = lu_factor(np.eye(x.size) - jacobian(x, *extra), check_finite=False), jacobians + 1
+            lu, jacobians = lu_factor(np.eye(x.size) - K, check_finite=False), jacobians + 1
             d = lu_solve(lu, gx - x, check_finite=False)
         xt = x + alpha * d
         k += 1
@@ -301,21 +302,23 @@ class MapJacobian:
     """
 
     def __init__(self, ops, *, P, Q, xi, dq, M, delta):
-        n = ops.n
         self.ops, self.M, self.data = ops, M, dict(P=P, Q=Q, xi=xi, dq=dq, delta=delta)
-        self.MAtt = np.asarray(M @ _dense(ops.Att, n))  # fixed for the start: once (M has ≤ 3 entries a row)
+        self.MAtt = np.asarray(M @ ops.Att.dense())  # fixed for the start: once (M has ≤ 3 entries a row)
         if ops.coupled:
-            Atn = _dense(ops.Atn, n)
-            self.Ant, self.ImMAtn = _dense(ops.Ant, n), Atn - np.asarray(M @ Atn)
+            Atn = ops.Atn.dense()
+            self.Ant, self.ImMAtn = ops.Ant.dense(), Atn - np.asarray(M @ Atn)
 
     def __call__(self, t, nsol, tsol):
+        """``K`` at the map output ``(t, nsol, tsol)``, or None if a QP's reduced KKT system there is singular."""
         ops, d, stress = self.ops, self.data, self.ops.scales.stress
         c = -(self.M @ ops.w(nsol.p, t))
         if ops.coupled:
             step = ops.coupled_step(d["P"], np.zeros(ops.n), d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"])
             fn = step.normal_half(t).qp_form()
-            Jn = stress * qp_response(fn, nsol.p / stress, nsol.info["qp_multiplier"],
-                                      fn.shift_scale[:, None] * self.Ant)  # dp/dt
+            Jn = qp_response(fn, nsol.p / stress, nsol.info["qp_multiplier"], fn.shift_scale[:, None] * self.Ant)
+            if Jn is None:
+                return None
+            Jn *= stress  # dp/dt
             dc = self.ImMAtn @ Jn - self.MAtt
             dbound = (ops.mu / stress) * (nsol.p > 0)[:, None] * Jn
             ft = ops.coupled_step(d["P"], c, d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"]).tangential_half(nsol.p)
@@ -323,16 +326,16 @@ class MapJacobian:
             dc, dbound = -self.MAtt, None
             ft = ops.tangential_step(nsol.p, c, d["dq"], Q=d["Q"], xi=d["xi"])
         ft = ft.qp_form()
-        return stress * qp_response(ft, tsol.t / stress, tsol.info["qp_multiplier"], ft.shift_scale[:, None] * dc,
-                                    dbound)
+        Jt = qp_response(ft, tsol.t / stress, tsol.info["qp_multiplier"], ft.shift_scale[:, None] * dc, dbound)
+        return None if Jt is None else stress * Jt
 
 
 def qp_response(form, x, y, dq, dbound=None):
     """``dx``: the change of the QP answer ``x`` (multiplier ``y``) with ``q`` changed by ``dq`` and the
     bounds' magnitude (``upper = −lower``) by ``dbound`` (columns: directions), on the active set of
     ``(x, y)`` read as :func:`~rollqp.methods._qp.active_set_refine` reads it, and with the nodes on a
-    bound counted at it (:class:`MapJacobian`)."""
-    from scipy.linalg import cho_factor, cho_solve
+    bound counted at it (:class:`MapJacobian`). Solved with :func:`~rollqp.methods._qp.active_set_refine`'s
+    factors (the Cholesky factor of ``H_FF`` and the load row's Schur complement); None if singular."""
     H, a = form.H, form.a
     lam = H @ x + form.q + (float(y) * a if a is not None else 0.0)
     width = form.upper - form.lower  # a bound pair closer than rounding (μp of ~1e-21 p0 at the contact's
@@ -344,23 +347,19 @@ def qp_response(form, x, y, dq, dbound=None):
     dx = np.zeros(dq.shape)
     if dbound is not None:
         dx[at_up], dx[at_lo] = dbound[at_up], -dbound[at_lo]
-    F = np.flatnonzero(~(fixed | at_lo | at_up))
+    free = ~(fixed | at_lo | at_up)
+    F = np.flatnonzero(free)
     if F.size == 0:
         return dx
-    chol = cho_factor(H[np.ix_(F, F)])
-    z = cho_solve(chol, -dq[F] - H[F] @ dx)  # dx is zero on F: H[F] dx = H_FA dx_A
+    fac = _kkt_factor(H, free, a)
+    if fac is None:
+        return None
+    chol, z2, schur = fac
+    z = _chol_solve(chol, -dq[F] - H[F] @ dx)  # dx is zero on F: H[F] dx = H_FA dx_A
     if a is not None:
-        z2 = cho_solve(chol, a[F])
-        z -= np.outer(z2, (a[F] @ z + a @ dx) / float(a[F] @ z2))  # a_Fᵀ dx_F = −a_Aᵀ dx_A
+        z -= np.outer(z2, (a[F] @ z + a @ dx) / schur)  # a_Fᵀ dx_F = −a_Aᵀ dx_A
     dx[F] = z
     return dx
-
-
-def _dense(op, n):
-    """An influence operator as an ``n × n`` array (its own, or its columns)."""
-    if hasattr(op, "dense"):
-        return np.asarray(op.dense(), dtype=float)
-    return np.column_stack([op @ e for e in np.eye(n)])
 
 
 def _state(ops, start, best, *, P, Q, xi, dq, M, delta):
