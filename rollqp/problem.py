@@ -254,9 +254,16 @@ def _derived(step, **changes):
     obj = object.__new__(type(step))  # frozen: the fields set through __dict__, as dataclasses.replace would
     obj.__dict__.update(step.__dict__)
     obj.__dict__.update(changes)
-    obj.__dict__.pop("bound", None)  # cached properties of the old values (TangentialStep.bound, .bound_hat)
-    obj.__dict__.pop("bound_hat", None)
+    for name in _cached(type(step)):  # cached properties of the old values (TangentialStep.bound, …)
+        obj.__dict__.pop(name, None)
     return obj
+
+
+@functools.cache
+def _cached(cls) -> tuple:
+    """The names of ``cls``'s cached properties (computed from the fields, so not carried to a copy)."""
+    return tuple(name for klass in cls.__mro__ for name, v in vars(klass).items()
+                 if isinstance(v, functools.cached_property))
 
 
 def qp_hessian(A, fh, scale):
