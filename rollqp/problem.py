@@ -350,6 +350,12 @@ class QPForm:
         x = np.asarray(x, dtype=float)
         return x if self.kind == "normal" else np.clip(x, self.lower, self.upper)
 
+    def multipliers(self, x, y) -> np.ndarray:
+        """The bound multipliers ``λ = H x + q + y a`` of the Lagrangian (class docstring): ``λ_i > 0`` at a
+        lower bound, ``< 0`` at an upper one, zero where ``x_i`` is free."""
+        lam = self.H @ np.asarray(x, dtype=float) + self.q
+        return lam + float(y) * self.a if self.a is not None else lam
+
     def residual(self, x, y, lam=None) -> float:
         """rollqp's residual of ``(x, y)`` on the problem this QP poses, from the QP data alone.
 
@@ -360,7 +366,7 @@ class QPForm:
         """
         xh = self.traction(x)
         if lam is None:
-            lam = self.H @ np.asarray(x, dtype=float) + self.q + (float(y) * self.a if self.a is not None else 0.0)
+            lam = self.multipliers(x, y)
         r = float(np.max(np.abs(xh - np.clip(xh - lam * self.dual_scale, self.lower, self.upper))))
         if self.a is not None:
             r = max(r, abs(float(self.a @ xh - self.b)) * self.eq_scale)

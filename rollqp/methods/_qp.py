@@ -240,7 +240,7 @@ class QPMethod:
                 if cand is None:
                     break
                 x, y = cand
-                lam = form.H @ x + form.q + (y * form.a if form.a is not None else 0.0)  # for both uses
+                lam = form.multipliers(x, y)  # for both uses
                 outside = float(np.abs(form.traction(x) - x).max(initial=0.0))  # QPForm.residual reads x clipped
                 if max(form.residual(x, y, lam), outside) <= self.tolerance:
                     return x, y, "solved", 0, 0.0, {"predicted": True, "solve_call_time": 0.0, "solve_call_cpu": 0.0}
@@ -250,7 +250,7 @@ class QPMethod:
         """The refined ``(x, y)`` if rollqp's residual of it (:meth:`QPForm.residual
         <rollqp.problem.QPForm.residual>`) is smaller, else the solver's own."""
         x = np.asarray(x, dtype=float)
-        lam = form.H @ x + form.q + (float(y) * form.a if form.a is not None else 0.0)  # once for both
+        lam = form.multipliers(x, y)  # once for both
         cand = active_set_refine(form, x, y, self._kkt, lam=lam)
         base = form.residual(x, y, lam)
         info["unrefined_residual"] = max(base, info.get("unrefined_residual", 0.0))
@@ -369,7 +369,7 @@ def active_set_refine(form, x, y, cache: "KKTCache | None" = None, lam=None):
     H, q, l, u, a = form.H, form.q, form.lower, form.upper, form.a
     x = np.asarray(x, dtype=float)
     if lam is None:
-        lam = H @ x + q + (float(y) * a if a is not None else 0.0)
+        lam = form.multipliers(x, y)
     fixed = form.fixed.copy()
     at_lo = np.isfinite(l) & (x - l < lam) & ~fixed
     at_up = np.isfinite(u) & (u - x < -lam) & ~fixed

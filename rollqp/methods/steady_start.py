@@ -337,7 +337,7 @@ def qp_response(form, x, y, dq, dbound=None):
     bound counted at it (:class:`MapJacobian`). Solved with :func:`~rollqp.methods._qp.active_set_refine`'s
     factors (the Cholesky factor of ``H_FF`` and the load row's Schur complement); None if singular."""
     H, a = form.H, form.a
-    lam = H @ x + form.q + (float(y) * a if a is not None else 0.0)
+    lam = form.multipliers(x, y)
     width = form.upper - form.lower  # a bound pair closer than rounding (μp of ~1e-21 p0 at the contact's
     fixed = form.fixed | (width <= 1e-12 * np.max(width, initial=0.0, where=np.isfinite(width)))  # edge): fixed
     # at a bound also where x is on it with a zero multiplier (a node at the edge of a zone): its
