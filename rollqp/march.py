@@ -98,7 +98,7 @@ class Counters:
         elif half == "tangential":
             self.inner_tangential += sol.iterations
         self.backtracks += int(sol.info.get("backtracks", 0))
-        self.residual = max(self.residual, sol.residual)
+        self._residual(sol.residual)
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
@@ -106,7 +106,12 @@ class Counters:
         self.inner_normal += int(sol.info.get("inner_normal", 0))
         self.inner_tangential += int(sol.info.get("inner_tangential", 0))
         self.backtracks += int(sol.info.get("backtracks", 0))
-        self.residual = max(self.residual, sol.residual)
+        self._residual(sol.residual)
+
+    def _residual(self, r: float) -> None:
+        """The largest residual so far; a NaN stays (the builtin ``max`` would drop it when it comes second)."""
+        if r > self.residual or r != r:
+            self.residual = r
 
 
 @dataclass

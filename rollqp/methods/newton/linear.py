@@ -433,7 +433,6 @@ class _Store:
         return self.G[np.ix_(rs, cs)]
 
 
-
 @dataclass
 class CoupledSystem:
     """The r-scaled linear parts of the coupled step, ``y_N = K_N z + k_N``, ``y_T = K_T z + k_T`` (eq. 63–64).
