@@ -19,11 +19,11 @@ import numpy as np
 import pytest
 
 import rollqp
+from conftest import Delegate
 from rollqp.energy import elastic_energy
 from rollqp.march import prepare
-from rollqp.scene import builtin_scenes
-from conftest import Delegate
 from rollqp.methods.newton import linear
+from rollqp.scene import builtin_scenes
 from rollqp.strip import RowSparse, Strip
 
 # Tolerances, each with its reason.
