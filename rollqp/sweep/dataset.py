@@ -261,15 +261,20 @@ def _check_schema(path, group, sweep) -> None:
 def create_store(path, sweep, per_chunk: int = 1):
     """Create the empty store of ``sweep`` (metadata and coordinates only) and return its zarr group.
 
-    Written with zarr directly in xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes,
+    Written with zarr in xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes,
     consolidated metadata), chunked ``per_chunk`` points per chunk (:func:`chunk_shape`), every
-    state and node of a point in its chunk; ``xarray.open_zarr`` reads it.
+    state and node of a point in its chunk; ``xarray.open_zarr`` reads it. zarr builds the store
+    in memory, whose files are then written into a new folder renamed to ``path`` at the end:
+    a store is there whole or not at all, and ~70 small files cost milliseconds, not zarr's
+    asynchronous round trip per file.
     """
     import zarr
+    from zarr.storage import MemoryStore
     chunks = chunk_shape(sweep.shape, per_chunk)
     sizes = dict(zip(sweep.keys, sweep.shape), step=int(sweep.facts.states.max()), node=int(sweep.facts.nodes.max()))
-    group = zarr.open_group(path, mode="w-", zarr_format=2)
-    group.attrs.update(_global_attrs(sweep))
+    files = {}
+    memory = MemoryStore(store_dict=files)
+    group = zarr.open_group(memory, mode="w-", zarr_format=2, attributes=_global_attrs(sweep))
     point = dict(zip(sweep.keys, chunks))
     for name, (dims, values, attrs, chunk) in _coords(sweep, chunks).items():
         fill = None if values.dtype.kind == "U" else np.nan if values.dtype.kind == "f" else 0
@@ -279,18 +284,49 @@ def create_store(path, sweep, per_chunk: int = 1):
     for name, (dims, dt, fill, attrs) in _variables(sweep, result_fields(sweep)).items():
         group.create_array(name, shape=tuple(sizes[d] for d in dims), chunks=tuple(point.get(d, sizes[d]) for d in dims),
                            dtype=dt, fill_value=fill, attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
-    zarr.consolidate_metadata(path, zarr_format=2)
+    zarr.consolidate_metadata(memory, zarr_format=2)
+    tmp = f"{path}.creating-{os.getpid()}"
+    for key, buf in files.items():
+        _write_file(os.path.join(tmp, *key.split("/")), buf.to_bytes(), atomic=False)
+    os.rename(tmp, path)
     return zarr.open_group(path, mode="r+", zarr_format=2)
+
+
+def _write_file(target: str, data: bytes, atomic: bool = True) -> None:
+    """``data`` into the file ``target`` (its folder made); ``atomic``: through a temporary file
+    renamed over it, so that a reader or a kill never meets half a file."""
+    folder = os.path.dirname(target)
+    if not os.path.isdir(folder):
+        os.makedirs(folder, exist_ok=True)
+    tmp = os.path.join(folder, f".{os.path.basename(target)}.{os.getpid()}.tmp") if atomic else target
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+    if atomic:
+        os.replace(tmp, target)
+
+
+def _chunk_files(group, a):
+    """``(folder, codec, separator, dtype)`` to write whole chunks of the zarr-2 array ``a`` as
+    files, or ``None`` when zarr must write them (another format, filters, a store not on disk)."""
+    from zarr.storage import LocalStore
+    m = a.metadata
+    if getattr(m, "zarr_format", None) != 2 or not isinstance(group.store, LocalStore) or m.filters or m.order != "C":
+        return None
+    folder = os.path.join(str(group.store.root), *[p for p in a.path.split("/") if p])
+    return folder, m.compressor, m.dimension_separator, np.dtype(m.dtype.to_native_dtype())
 
 
 class StoreWriter:
     """Writes points into a sweep's store, one chunk at a time: every variable's chunk, ``status`` last.
 
-    The arrays are opened once. A write is the points of one chunk (one task of the sweep):
-    each variable's block of that chunk is filled in memory and written whole, the variables
-    concurrently (zarr's asynchronous API: one file per chunk, so the writes are independent),
-    then ``status``. Points of the chunk not in the write keep what the store holds (a re-run
-    that computes only a chunk's failed points reads the chunk first).
+    A write is the points of one chunk (one task of the sweep): each variable's block of that
+    chunk is filled in memory and written whole. In a zarr-2 store on disk (what
+    :func:`create_store` makes) a block is encoded with the array's own compressor and written
+    as its chunk file (zarr-2's key ``i.j.k``) through a temporary file renamed over it, so a
+    kill never leaves half a chunk; zarr's asynchronous path costs ~1 ms of thread hops per
+    array, ~30 arrays a chunk, and far more on a loaded machine. Otherwise zarr writes the
+    blocks. Points of the chunk not in the write keep what the store holds (a re-run that
+    computes only a chunk's failed points reads the chunk first).
     """
 
     def __init__(self, group, sweep):
@@ -298,6 +334,7 @@ class StoreWriter:
         self.arrays = {k: group[k] for k in group.array_keys()}
         self.chunks = tuple(self.arrays["status"].chunks)
         self.names = [k for k in self.arrays if k not in sweep.keys and (k not in ("q", "x") or self.arrays[k].ndim > 1)]
+        self.files = {k: _chunk_files(group, self.arrays[k]) for k in self.names + ["status"]}
 
     def tasks(self, status) -> list:
         """The points to compute, grouped by chunk: lists of flat indices whose ``status`` is not done."""
@@ -312,53 +349,60 @@ class StoreWriter:
         return out
 
     def _region(self, points) -> tuple:
+        """The chunk of the first of ``points``, as slices (clipped at the arrays' ends)."""
         first = self.sweep.index(points[0])
         return tuple(slice(j - j % c, min(j - j % c + c, n)) for j, c, n in zip(first, self.chunks, self.sweep.shape))
-
-    def _blocks(self, region, points, outs) -> dict:
-        """``name -> block`` of the chunk at ``region`` with ``outs`` (one per point) filled in."""
-        whole = len(points) == int(np.prod([s.stop - s.start for s in region]))
-        blocks = {}
-        for name in self.names + ["status"]:
-            a = self.arrays[name]
-            shape = tuple(s.stop - s.start for s in region) + tuple(a.shape[len(region):])
-            fill = a.fill_value if a.fill_value is not None else np.zeros((), a.dtype)[()]
-            blocks[name] = np.full(shape, fill, dtype=a.dtype) if whole else np.asarray(a[region])
-        for i, out in zip(points, outs):
-            local = tuple(j - s.start for j, s in zip(self.sweep.index(i), region))
-            for name, value in _point_items(out):
-                if name in blocks:
-                    value = np.asarray(value)
-                    blocks[name][local + tuple(slice(0, n) for n in value.shape)] = value
-        return blocks
 
     def points_in_chunk(self, points) -> bool:
         """``points`` all lie in one chunk (what :meth:`write` takes)."""
         region = self._region(points)
         return all(s.start <= j < s.stop for i in points for j, s in zip(self.sweep.index(i), region))
 
+    def _blocks(self, region, points, outs) -> dict:
+        """``name -> block`` of the whole chunk at ``region`` with ``outs`` (one per point) filled in."""
+        clipped = tuple(s.stop - s.start for s in region)
+        whole = len(points) == int(np.prod(clipped))
+        blocks = {}
+        for name in self.names + ["status"]:
+            a = self.arrays[name]
+            fill = a.fill_value if a.fill_value is not None else np.zeros((), a.dtype)[()]
+            block = np.full(self.chunks + tuple(a.shape[len(region):]), fill, dtype=a.dtype)
+            if not whole:  # keep the chunk's other points
+                block[tuple(slice(0, n) for n in clipped)] = a[region]
+            blocks[name] = block
+        for i, out in zip(points, outs):
+            local = tuple(j - s.start for j, s in zip(self.sweep.index(i), region))
+            for name, value in _point_items(out):
+                if name in blocks:
+                    value = np.asarray(value)
+                    blocks[name][local + tuple(slice(0, n) for n in value.shape)] = value
+            blocks["status"][local] = STATUS["done" if out.get("error") is None else "failed"]
+        return blocks
+
+    def _put(self, names, region, blocks) -> None:
+        """Write the chunk at ``region`` of each array in ``names``."""
+        clipped = tuple(slice(0, s.stop - s.start) for s in region)
+        chunk = tuple(s.start // c for s, c in zip(region, self.chunks))
+        slow = []
+        for name in names:
+            spec = self.files[name]
+            if spec is None:
+                slow.append(name)
+                continue
+            folder, codec, sep, dt = spec
+            data = np.ascontiguousarray(blocks[name], dtype=dt)
+            key = sep.join(str(c) for c in chunk + (0,) * (data.ndim - len(chunk)))
+            _write_file(os.path.join(folder, *key.split("/")), codec.encode(data) if codec is not None else data.tobytes())
+        for name in slow:
+            self.arrays[name][region] = blocks[name][clipped]
+
     def write(self, points, outs) -> None:
         """Store the points ``points`` (flat indices, all in one chunk) with their results ``outs``
         (:func:`rollqp.sweep.executor.compute_points`), ``status`` last."""
         region = self._region(points)
         blocks = self._blocks(region, points, outs)
-        status = blocks.pop("status")
-        items = [(self.arrays[name], block) for name, block in blocks.items()]
-        try:
-            import asyncio
-
-            from zarr.core.sync import sync
-
-            async def _all():
-                await asyncio.gather(*(a._async_array.setitem(region, v) for a, v in items))
-            sync(_all())
-        except (ImportError, AttributeError):  # pragma: no cover - another zarr: one array at a time
-            for a, v in items:
-                a[region] = v
-        for i, out in zip(points, outs):
-            local = tuple(j - s.start for j, s in zip(self.sweep.index(i), region))
-            status[local] = STATUS["done" if out.get("error") is None else "failed"]
-        self.arrays["status"][region] = status
+        self._put(self.names, region, blocks)
+        self._put(["status"], region, blocks)
 
 
 def _point_items(out: dict):
