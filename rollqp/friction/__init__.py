@@ -23,7 +23,7 @@ from __future__ import annotations
 import dataclasses
 
 from ..errors import InputError
-from ..scene.validate import suggestion
+from ..validate import suggestion
 from .laws import FRAMES, MAX_FRICTION, VELOCITY_FORMS, Coulomb, Patch, SlipVelocity, Table
 
 __all__ = ["LAWS", "parse_friction", "Coulomb", "Patch", "Table", "SlipVelocity", "MAX_FRICTION", "FRAMES",
@@ -42,7 +42,7 @@ def parse_friction(value):
     if isinstance(value, (Coulomb, Patch, Table, SlipVelocity)):
         value = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
     if not isinstance(value, dict):
-        from ..scene.validate import number
+        from ..validate import number
         return number(KEY, value, f">= 0 (and <= {MAX_FRICTION:g}), or a table [contact.friction] with law = "
                                   f"{', '.join(map(repr, LAWS))}", lambda x: 0 <= x <= MAX_FRICTION)
     name = value.get("law")

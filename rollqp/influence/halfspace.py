@@ -82,7 +82,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..scene.validate import positive_real
+from ..validate import positive_real
 from .operator import asymmetry
 
 __all__ = [

@@ -29,7 +29,7 @@ from ..histories import History, parse_history
 from .checks import safe_name
 from .core import Scene
 from .schema import Body, Contact, Discretization, Load, SolverSettings
-from .validate import suggestion
+from ..validate import suggestion
 
 __all__ = ["load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes", "scene_to_dict", "scene_to_toml"]
 
