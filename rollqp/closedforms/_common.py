@@ -6,13 +6,10 @@ semi-ellipses ``√(1 − u²)`` written without cancellation at their ends.
 """
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from ..errors import InputError
 from ..validate import nonnegative, positive, scalar
-
 
 #: The textbook the closed forms are quoted from.
 _JOHNSON = "K. L. Johnson, Contact Mechanics, Cambridge University Press, 1985"

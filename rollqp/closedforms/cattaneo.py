@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import math
 
-from ..errors import InputError
 from ._common import _JOHNSON, _coords, _nonnegative, _out, _positive, _ratio, _semi_ellipse
 
 

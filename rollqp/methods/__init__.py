@@ -34,7 +34,7 @@ _REGISTRY = {
     "qp-osqp": ("rollqp.methods.qp_osqp", "OsqpQP", None),
     "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"),
     "newton": ("rollqp.methods.newton", "NewtonMethod", None),
-    "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None),
+    "nt-newton": ("rollqp.methods.nt_newton", "AlternationNewton", None),
     "mf-newton": ("rollqp.methods.krylov", "KrylovNewton", None),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
     **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers")
