@@ -23,7 +23,7 @@ import numpy as np
 from harness import table  # (pins BLAS first)
 
 from rollqp import closedforms as cf
-from rollqp.friction.fixedpoint import BoundFixedPoint
+from rollqp.methods.fixedpoint import BoundFixedPoint
 from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
 from friction_cases import VELDEP, veldep_scene

@@ -6,7 +6,7 @@ import pytest
 
 from rollqp.errors import InputError, SolverError
 from friction_cases import VELDEP, patch_scene, veldep_scene
-from rollqp.friction.fixedpoint import BoundFixedPoint
+from rollqp.methods.fixedpoint import BoundFixedPoint
 from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
 from rollqp.scene import load_scene

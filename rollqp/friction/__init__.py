@@ -11,7 +11,7 @@ problem takes in place of the old number ``mu``:
 * a slip-velocity law: a :class:`~.bound.SlipBound` — ``μ_i(s_i)`` depends on the unknown slip,
   and the step becomes a quasi-variational inequality (docs/theory.md, "Slip-dependent
   friction"), solved by the Newton method with ``∂b/∂s`` in its pseudo-Jacobian or by a
-  fixed point on the bound around any QP backend (:class:`~.fixedpoint.BoundFixedPoint`).
+  fixed point on the bound around any QP backend (:class:`rollqp.methods.fixedpoint.BoundFixedPoint`).
 
 ``contact.friction`` is a number (Coulomb) or a table with ``law = "<name>"`` and the law's keys:
 :data:`LAWS` maps each name to its record. Adding a law is one record in :mod:`.laws` with

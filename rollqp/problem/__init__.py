@@ -32,7 +32,7 @@ The residuals (:class:`Residuals`) are the max-norms of
 * friction law:   ``t̂ − Proj_[−μp̂⁺, μp̂⁺](t̂ − ŝ)``             (eq. 60),
 * load equations: ``(fᵀp − P)/(a_H p0)``, ``(fᵀt − Q)/(a_H p0)``  (eq. 67).
 
-The package, one responsibility per module: :mod:`.scales` (the units), :mod:`.checks` (the
+The package, one responsibility per module: :mod:`.scales` (the units), :mod:`.validation` (the
 inputs' checks), :mod:`.normal`, :mod:`.tangential`, :mod:`.coupled` (the three step problems),
 :mod:`.qp` (their convex QP, shared by the backends), :mod:`.solution` (solutions, residuals,
 node states), :mod:`.state` (the state between two steps of the transient).
@@ -40,7 +40,6 @@ node states), :mod:`.state` (the state between two steps of the transient).
 from __future__ import annotations
 
 from ..influence.operator import Operator, as_operator, asymmetry, split  # noqa: F401 - re-exported
-from .checks import MAX_MAGNITUDE, _check_sliding_limit, _trusted  # noqa: F401 - used by rollqp.operators
 from .coupled import CoupledStep
 from .normal import NormalStep
 from .qp import QPForm, qp_hessian, symmetrized
@@ -49,6 +48,7 @@ from .solution import (SEPARATION, SLIP, STICK, Residuals, StepSolution, classif
                        friction_residual)
 from .state import State
 from .tangential import TangentialStep
+from .validation import MAX_MAGNITUDE, _check_sliding_limit, _trusted  # noqa: F401 - used by rollqp.operators
 
 __all__ = ["Scales", "State", "NormalStep", "TangentialStep", "CoupledStep", "QPForm", "StepSolution", "Residuals",
            "classify", "compare", "friction_residual", "qp_hessian", "symmetrized", "SEPARATION", "STICK", "SLIP",

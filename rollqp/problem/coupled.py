@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .checks import _check_arrays, _check_friction, _check_sliding_limit, _exactly_one, _per_node, _set_scalars, _trusted
+from .validation import _check_arrays, _check_friction, _check_sliding_limit, _exactly_one, _per_node, _set_scalars, _trusted
 from .normal import NormalStep
 from .scales import Scales
 from .solution import Residuals, StepSolution, friction_residual

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from .checks import _check_arrays, _check_friction, _check_sliding_limit, _derived, _exactly_one, _per_node, _set_scalars
+from .validation import _check_arrays, _check_friction, _check_sliding_limit, _derived, _exactly_one, _per_node, _set_scalars
 from .qp import QPForm, qp_hessian, symmetrized
 from .scales import Scales
 from .solution import Residuals, StepSolution, friction_residual

@@ -89,10 +89,10 @@ from ...problem import StepSolution
 from ..base import check_options
 from . import linear
 from .coupled import solve_coupled
+from .creepage import tangential_by_creepage
 from .linear import CoupledFactors, ReducedSystem, coupled_system, coupled_vectors
 from .ncp import NormalNCP, TangentialNCP, coupled_cases, coupled_jacobian, coupled_labels, coupled_phi
 from .slip import solve_slip
-from .creepage import tangential_by_creepage
 from .uncoupled import solve_uncoupled
 
 __all__ = ["NewtonMethod"]
@@ -130,7 +130,7 @@ class NewtonMethod:
     name = "newton"
     solves = frozenset({"normal", "tangential", "coupled", "steady"})
     #: Solves steps whose friction bound depends on the slip (:mod:`.slip`); the others are wrapped in
-    #: the fixed point on the bound (:class:`rollqp.friction.fixedpoint.BoundFixedPoint`).
+    #: the fixed point on the bound (:class:`rollqp.methods.fixedpoint.BoundFixedPoint`).
     slip_dependent = True
     operator = "exact"  # the collocation operator itself, not F⁻¹ sym(F A)
     #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
