@@ -160,9 +160,9 @@ def _coord_names(dims) -> str:
 def _global_attrs(sweep) -> dict:
     import importlib.metadata as md
 
-    import rollqp
     from ..march import _versions
-    versions = dict(_versions(), rollqp=rollqp.__version__)
+    from ..version import __version__
+    versions = dict(_versions(), rollqp=__version__)
     for pkg in ("dask", "distributed", "xarray", "zarr"):
         try:
             versions[pkg] = md.version(pkg)
