@@ -63,7 +63,7 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
         ``on_point(i, out)`` after point ``i`` is stored.
     per_chunk : int, optional
         Points per chunk of a new store, and so per task (default
-        :func:`~.dataset.points_per_chunk`: about four tasks per worker, at most 32 points); a
+        :func:`~.dataset.points_per_chunk`: ⌈√(N/(4·workers))⌉ of N points, at most 32); a
         store that exists keeps its own.
     """
     import time

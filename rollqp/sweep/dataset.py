@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import os
 import re
 
@@ -100,15 +101,20 @@ def result_fields(sweep) -> list:
 
 
 def points_per_chunk(sweep, workers: int = 1) -> int:
-    """Points in one chunk of the store (and in one task of the sweep).
+    """Points in one chunk of the store (and in one task of the sweep): ``⌈√(N/(4·workers))⌉``.
 
-    At most :data:`MAX_POINTS_PER_CHUNK`, at most :data:`CHUNK_BYTES` of the largest field per
-    chunk, and small enough that the sweep makes about four tasks per worker (so that the
-    workers finish together); at least one.
+    A task costs a round trip through the scheduler and a write of ~30 files whatever its
+    points, and the last tasks leave workers idle while the others finish: for N points of
+    cost c each, a per-task cost o and B points a task, the wall time is about
+    ``(N·c + (N/B)·o)/workers + B·c/2``, least at ``B = √(2·N·o/(workers·c))`` — the formula
+    above for o/c ≈ 1/8 (a §6.1.1 point of ~0.1 s against ~10 ms a task on a loaded machine).
+    At most :data:`MAX_POINTS_PER_CHUNK`, and at most :data:`CHUNK_BYTES` of the largest field
+    per chunk; at least one.
     """
     f = sweep.facts
     per_point = int(f.states.max()) * int(f.nodes.max()) * 8
-    return max(1, min(MAX_POINTS_PER_CHUNK, CHUNK_BYTES // max(per_point, 1), sweep.size // (4 * max(workers, 1))))
+    balance = math.ceil(math.sqrt(sweep.size / (4 * max(workers, 1))))
+    return max(1, min(MAX_POINTS_PER_CHUNK, CHUNK_BYTES // max(per_point, 1), balance))
 
 
 def chunk_shape(shape: tuple, per_chunk: int) -> tuple:
