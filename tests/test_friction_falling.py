@@ -11,7 +11,7 @@ import pytest
 
 from rollqp.energy import balance
 from rollqp.friction import SlipVelocity
-from rollqp.friction.cases import contact_velocity, veldep_scene
+from friction_cases import contact_velocity, veldep_scene
 from rollqp.march import march, run
 from rollqp.scene import load_scene, scene_from_dict
 

@@ -37,7 +37,7 @@ stick row (``info["shifts"]``).
 **When the Newton iteration still fails** (a singular matrix, or an Armijo search that finds no
 decrease: the direction of a non-monotone law need not descend on a kink), the step is not
 given up: :func:`solve_slip_step` runs the fixed point on the bound
-(:class:`~rollqp.friction.fixedpoint.BoundFixedPoint`) with Newton's own constant-bound solves as
+(:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`) with Newton's own constant-bound solves as
 its inner method, trying this iteration from each fixed-point iterate that improved (a few
 iterations from near a solution, quadratic), then a cold start, then the creepage search. A step
 none of them solves is a :class:`~rollqp.errors.SolverError` naming the residual.
@@ -53,7 +53,7 @@ import numpy as np
 
 from ...errors import SolverError
 from ...problem import friction_residual
-from .uncoupled import ALPHA_MIN, not_converged
+from .common import ALPHA_MIN, not_converged
 
 __all__ = ["solve_slip", "solve_slip_step"]
 
@@ -230,7 +230,7 @@ def solve_slip_step(meth, pb, warm, t0):
         except SolverError:
             pass
     if pb.Q is not None:
-        from .uncoupled import tangential_by_creepage
+        from .creepage import tangential_by_creepage
         try:
             return meth.checked(tangential_by_creepage(meth, pb, warm, t0, first))
         except SolverError:
@@ -243,7 +243,7 @@ def solve_slip_step(meth, pb, warm, t0):
 
 def _by_fixed_point(meth, pb, warm, t0):
     """The fixed point on the bound with Newton's constant-bound solves, polished by :func:`solve_slip`."""
-    from ...friction.fixedpoint import BoundFixedPoint
+    from ..fixedpoint import BoundFixedPoint
 
     def polish(sol):
         try:

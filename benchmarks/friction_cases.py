@@ -13,7 +13,7 @@ docs/friction.md.
   wheel half an element off rollqp's symmetric strip likewise (:func:`offset_profile`).
 * :func:`contact_velocity`: CONTACT's SABSH1 (the slip velocity at which the falling term is *halved*)
   as rollqp's ``velocity`` ``v_h`` of each law (docs/friction.md).
-* :func:`patch_scene`: CONTACT's Carter problem (rollqp.refcases.contact_scene) with a patch of low
+* :func:`patch_scene`: CONTACT's Carter problem (refcases.contact_scene) with a patch of low
   friction carried by the material through the contact.
 """
 from __future__ import annotations
@@ -21,10 +21,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from refcases import E_CONTACT, NU_CONTACT, contact_scene
 
-from ..errors import InputError
-from ..refcases import E_CONTACT, NU_CONTACT, contact_scene
-from ..scene import scene_from_dict
+from rollqp.errors import InputError
+from rollqp.scene import scene_from_dict
 
 __all__ = ["VELDEP", "veldep_scene", "patch_scene", "contact_velocity", "offset_profile"]
 
@@ -56,7 +56,7 @@ def offset_profile(offset, radius=VELDEP["R"], half_width=VELDEP["XL"] + 0.1, po
     ``radius`` on a flat rail centred at ``x = offset`` (``z(x − offset)``; circle heights of
     :func:`rollqp.profiles.circle_height`, linear between ``points`` points on ``±half_width``: 2e-9 mm at
     most from the circle, 1e-7 of the gap at the contact's edge)."""
-    from ..profiles import circle_height
+    from rollqp.profiles import circle_height
     x = np.linspace(-half_width, half_width, points)
     h = circle_height(x - offset, radius) - circle_height(x, 2.0 * radius)
     return {"kind": "table", "x": x.tolist(), "h": h.tolist()}
@@ -70,7 +70,7 @@ def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponentia
     ``velocity``: rollqp's ``v_h`` (default CONTACT's SABSH1 = 100 mm/s mapped by :func:`contact_velocity`);
     ``grid``: ``"contact"`` (the wheel half an element off the strip's centre, as on CONTACT's grid whose
     first element centre is at XC1 = −XL) or ``"symmetric"`` (the wheel at the strip's centre)."""
-    from ..closedforms import hertz_half_width
+    from rollqp.closedforms import hertz_half_width
     if grid not in ("contact", "symmetric"):
         raise InputError("grid", f"must be 'contact' or 'symmetric', got {grid!r}")
     if velocity is None:
@@ -103,7 +103,7 @@ def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponentia
 
 def patch_scene(mu=0.1, inside=0.05, start=2.0, end=2.5, elements=88, ratio=0.5, distance=8.0, method="newton",
                 frame="material"):
-    """CONTACT's Cattaneo → Carter problem (``rollqp.refcases.contact_scene``) with a patch ``[start, end]``
+    """CONTACT's Cattaneo → Carter problem (``refcases.contact_scene``) with a patch ``[start, end]``
     (a_H units, at q = 0) of coefficient ``inside`` carried by the material through the contact."""
     base = contact_scene(elements=elements, ratio=ratio, distance=distance, mu=mu, method=method)
     return base.replace(**{"contact.friction": {"law": "patch", "mu": mu, "inside": inside, "start": start,
