@@ -237,8 +237,11 @@ def solve_slip_step(meth, pb, warm, t0):
             pass
     best = min(r for r in (first.residual, second.residual) if r is not None) if (
         first.residual is not None or second.residual is not None) else None
-    raise SolverError(f"{first.message}; the fixed point on the bound failed too ({second.message})",
-                      method=meth.name, status=first.status, iterations=first.iterations, residual=best)
+    inner = second.message.split("; try")[0]  # its advice names newton itself
+    raise SolverError(f"{first.message}; the fixed point on the bound failed too ({inner}); the step may "
+                      "have no quasi-static solution (a breakaway: docs/friction.md): prescribe the creepage, ramp "
+                      "the force or roll slower", method=meth.name, status=first.status, iterations=first.iterations,
+                      residual=best)
 
 
 def _by_fixed_point(meth, pb, warm, t0):
