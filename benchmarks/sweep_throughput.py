@@ -4,7 +4,8 @@ Usage::
 
     python benchmarks/sweep_throughput.py                 # small and large points, 3 interleaved repetitions
     python benchmarks/sweep_throughput.py --sizes small --repeats 5
-    python benchmarks/sweep_throughput.py --creep         # also time the docs' creep-curve command, whole
+    python benchmarks/sweep_throughput.py --creep         # also the docs' creep-curve command, whole,
+                                                          # on a local cluster and with --workers 0
 
 Two kinds of points, both the paper's §6.1.1 scene (``cattaneo-carter``: Δq = Le/2, 6 a_H,
 ``newton``) over load ratio × friction:
@@ -109,11 +110,11 @@ def _sweep(base, vary, client, folder, summaries) -> float:
     return wall
 
 
-def _creep_command(folder) -> float:
+def _creep_command(folder, extra=()) -> float:
     """Wall seconds of the docs' ``rollqp creep-curve`` command as a user runs it (a new process)."""
     store = os.path.join(folder, "creep.zarr")
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "rollqp.cli", *CREEP, "--out", store, "--quiet"], check=True)
+    subprocess.run([sys.executable, "-m", "rollqp.cli", *CREEP, *extra, "--out", store, "--quiet"], check=True)
     wall = time.perf_counter() - t0
     shutil.rmtree(store, ignore_errors=True)
     return wall
@@ -168,7 +169,10 @@ def main(argv=None):
                                     log=lambda k, i, n: print(f"  {k} {i}/{n}", flush=True))
     finally:
         close_client(client)
-    creep = [_creep_command(folder) for _ in range(args.repeats)] if args.creep else []
+    creep = {"": [], " --workers 0": []}
+    for _ in range(args.repeats if args.creep else 0):  # alternating, as the sweeps above
+        for extra in creep:
+            creep[extra].append(_creep_command(folder, extra.split()))
     shutil.rmtree(folder, ignore_errors=True)
     rows = [(f"local cluster start ({args.workers} workers; once, not in the sweep times)", f"{startup:.2f} s")]
     for s in sizes:
@@ -180,9 +184,10 @@ def main(argv=None):
     rows += [(f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
               f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
               f"{args.workers}× on an idle machine)")]
-    if creep:
-        rows += [(f"`rollqp {' '.join(CREEP)}` (whole command, new process; median)",
-                  f"{statistics.median(creep):.2f} s ({', '.join(f'{w:.2f}' for w in creep)})")]
+    for extra, walls_ in creep.items():
+        if walls_:
+            rows += [(f"`rollqp {' '.join(CREEP)}{extra}` (whole command, new process; median)",
+                      f"{statistics.median(walls_):.2f} s ({', '.join(f'{w:.2f}' for w in walls_)})")]
     rows += [("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg()))]
     print()
     print(harness.table(["", "value"], rows))
