@@ -81,10 +81,14 @@ def _parallelism(workers: int) -> float:
     return workers * alone / together
 
 
-def _serial(scenes) -> float:
-    t0 = time.perf_counter()
+CPU = {}  # size -> CPU seconds of each serial run
+
+
+def _serial(scenes, size) -> float:
+    t0, c0 = time.perf_counter(), time.process_time()
     for s in scenes:
         rollqp.run(s)
+    CPU.setdefault(size, []).append(time.process_time() - c0)
     return time.perf_counter() - t0
 
 
@@ -133,6 +137,9 @@ def _rows(size, walls, summaries, workers, startup):
         ("**throughput ratio serial/sweep**", f"**{ser / par:.2f}×**"),
         ("ratio with the cluster's start in the sweep", f"{ser / (par + startup):.2f}×"),
         ("mean point time: serial / on the workers", f"{1e3 * ser / n:.0f} ms / {1e3 * statistics.median(pts) / n:.0f} ms"),
+        ("mean point CPU time: serial / on the workers",
+         f"{1e3 * statistics.median(CPU[size]) / n:.0f} ms / "
+         f"{1e3 * statistics.median(sum(s.point_cpu) for _, s in summaries) / n:.0f} ms"),
         ("validation and store creation (median)", f"{1e3 * statistics.median(fixed):.0f} ms"),
         ("(workers × points' wall − Σ point times)/points (median)", f"{1e3 * statistics.median(extra):.1f} ms"),
     ]
@@ -162,7 +169,7 @@ def main(argv=None):
         _TimedWriter.writes.clear()
         cases = {}
         for s in sizes:
-            cases[f"serial {s}"] = lambda s=s: _serial(points[s])
+            cases[f"serial {s}"] = lambda s=s: _serial(points[s], s)
             cases[f"sweep {s}"] = lambda s=s: _sweep(scenes[s], SIZES[s][1], client, folder, summaries[s])
         cases["control"] = lambda: _parallelism(args.workers)
         walls = harness.interleaved(args.repeats, cases, lambda f: f(),

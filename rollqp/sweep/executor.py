@@ -261,22 +261,23 @@ def _short(value, n: int = 80) -> str:
 
 def compute_point(scene) -> dict:
     """Run one scene (a :class:`~rollqp.scene.Scene` or its dict) on a worker: ``{"arrays", "time",
-    "worker"}``, or ``{"error", "time", "worker"}`` with its one-line error."""
+    "cpu", "worker"}`` (wall and CPU seconds of the worker's process), or ``{"error", "time", "cpu",
+    "worker"}`` with its one-line error."""
     from threadpoolctl import threadpool_limits
 
     from ..march import run
     from ..scene import scene_from_dict
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     worker = f"{socket.gethostname()}:{os.getpid()}"
     with threadpool_limits(limits=1):
         try:
             result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene)
         except Exception as err:  # an input the method cannot run, or a bug: one line, the sweep goes on
             return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0,
-                    "worker": worker}
+                    "cpu": time.process_time() - c0, "worker": worker}
     arrays = result.arrays()
     arrays.pop("meta")
-    return {"arrays": arrays, "time": time.perf_counter() - t0, "worker": worker}
+    return {"arrays": arrays, "time": time.perf_counter() - t0, "cpu": time.process_time() - c0, "worker": worker}
 
 
 def compute_points(base, points) -> list:
@@ -319,6 +320,7 @@ class Summary:
     failed: list = field(default_factory=list)
     wall: float = 0.0
     point_times: list = field(default_factory=list)
+    point_cpu: list = field(default_factory=list)
     interrupted: bool = False
     startup: float = 0.0
     prepare: float = 0.0
@@ -438,6 +440,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
                 else:
                     summary.failed.append((sweep.label(i), out["error"]))
                 summary.point_times.append(out["time"])
+                summary.point_cpu.append(out.get("cpu", float("nan")))
                 if on_point is not None:
                     on_point(i, out)
             n += len(points)
