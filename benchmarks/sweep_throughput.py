@@ -23,7 +23,8 @@ first (the workers' first import of rollqp). Serial and sweep alternate within e
 (:func:`harness.interleaved`); the ratios are of the medians.
 
 Overheads, measured on the way: the sweep's fixed part (validation and store), the store
-writes (``StoreWriter.write``, timed in the client, per chunk and per point), and
+writes (``StoreWriter.write``, timed in the client, wall and the writing thread's CPU), each
+point's CPU time beside its wall time (in the serial run and on the workers), and
 ``(workers × points' wall − Σ point times)/points``: what a point costs beyond its own
 computation on a worker, its share of the writes, the scheduler and the tail included.
 
@@ -98,9 +99,9 @@ class _TimedWriter(dataset.StoreWriter):
     writes: list = []
 
     def write(self, points, outs):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         super().write(points, outs)
-        _TimedWriter.writes.append((time.perf_counter() - t0, len(points)))
+        _TimedWriter.writes.append((time.perf_counter() - t0, len(points), time.thread_time() - c0))
 
 
 def _sweep(base, vary, client, folder, summaries) -> float:
@@ -185,9 +186,11 @@ def main(argv=None):
     for s in sizes:
         rows += _rows(s, walls, summaries[s], args.workers, startup)
     writes = _TimedWriter.writes
-    rows += [("store write of one chunk (median; client)", f"{1e3 * statistics.median(w for w, _ in writes):.1f} ms, "
-                                                          f"{1e3 * sum(w for w, _ in writes) / sum(k for _, k in writes):.1f}"
-                                                          " ms a point")]
+    per_point = sum(k for _, k, _ in writes)
+    rows += [("store write of one chunk in the client: wall / CPU (medians; CPU a point)",
+              f"{1e3 * statistics.median(w for w, _, _ in writes):.1f} ms / "
+              f"{1e3 * statistics.median(c for _, _, c in writes):.1f} ms "
+              f"({1e3 * sum(c for _, _, c in writes) / per_point:.1f} ms a point)")]
     rows += [(f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
               f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
               f"{args.workers}× on an idle machine)")]
