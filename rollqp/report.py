@@ -97,6 +97,7 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _model_rows(res, scene)
     rows += _start_rows(res)
+    rows += _gross_rows(res)
     rows += energy_rows(res, scene, stresses)
     for name, val, what in closed_form_errors(res, scene):
         rows.append((f"error: {name}", f"{val:.4f}  {what}"))
@@ -123,6 +124,12 @@ def _model_rows(res: dict, scene) -> list[tuple[str, str]]:
     from .influence import get_model
     rows = get_model(scene.contact.model).report
     return [] if rows is None else rows(_meta(res).get("model", {}))
+
+
+def _gross_rows(res: dict) -> list[tuple[str, str]]:
+    """States where every contact node slips (``meta["gross_sliding"]``, rollqp.result): said in words."""
+    ks = _meta(res).get("gross_sliding") or []
+    return [] if not ks else [("gross sliding", f"every contact node slips at {len(ks)} state(s) (first: state {ks[0]})")]
 
 
 def energy_rows(res: dict, scene, stresses=None) -> list[tuple[str, str]]:
