@@ -12,8 +12,8 @@ and declares what it can solve in :attr:`Method.solves`, a subset of :data:`KIND
 ``"normal"``, ``"tangential"``, ``"coupled"``
     the step problems of :mod:`rollqp.problem` (their ``kind``);
 ``"steady"``
-    the non-symmetric steady-rolling tangential/coupled problem (slip ``s = ξ e + d·D_up w``,
-    docs/formulation.md §9), posed directly for a rolling start.
+    the non-symmetric steady-rolling tangential/coupled problem (slip ``s = ξ e + T w``, ``T`` the
+    transient step's fixed point, docs/formulation.md §9), posed directly for a rolling start.
 
 The registry (:mod:`rollqp.methods`) composes methods from these declarations only — a QP
 backend on a coupled scene runs inside the N–T alternation (:class:`~rollqp.methods.alternation.Alternation`);
