@@ -330,8 +330,18 @@ class _March:
         nsol = self.method.solve(npb, warm=None)
         return State(nsol.p, zero, ops.w(nsol.p, zero), nsol, None, None if ops.coupled else npb)
 
+    def guess(self) -> State:
+        """Where a rolling start sets out from: :meth:`pressed`, or, with a slip-dependent friction law,
+        the braked state (:meth:`braked_start`). A falling law can have two steady states at one force, and
+        the guess decides which one the start returns: from the braked state it is the one that grows
+        from Coulomb's (docs/friction.md, "Which steady state a rolling start returns")."""
+        from .friction import law_kind
+        if law_kind(self.scene.contact.friction) == "slip":
+            return self.braked_start().state
+        return self.pressed()
+
     def rolling_start(self, start: State) -> StepRecord:
-        """Rolling start from the guess ``start`` (:meth:`pressed`): the direct steady solve for a method
+        """Rolling start from the guess ``start`` (:meth:`guess`): the direct steady solve for a method
         that declares ``"steady"``, else, or if that solve fails, the march to the steady state (its
         record then says why in ``note``: the march reaches the same discrete state, to
         :data:`STEADY_TOL`)."""
@@ -508,7 +518,7 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         state, first = resumed_state(scene, ops, resume), len(resume["q"])
     else:
         try:
-            start = m.rolling_start(m.pressed()) if scene.load.start == "rolling" else m.braked_start()
+            start = m.rolling_start(m.guess()) if scene.load.start == "rolling" else m.braked_start()
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
