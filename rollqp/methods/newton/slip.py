@@ -42,8 +42,18 @@ its inner method, trying this iteration from each fixed-point iterate that impro
 iterations from near a solution, quadratic), then a cold start, then the creepage search. A step
 none of them solves is a :class:`~rollqp.errors.SolverError` naming the residual.
 
-Falling friction can make the step non-unique (docs/theory.md): the iteration finds the solution
-its start leads to — the previous step's, and then the fixed point's from the previous slip.
+**Which solution.** Falling friction can make the step non-unique (docs/theory.md). A solution is
+taken as it is found only if the falling law makes none of its modes unstable
+(:func:`unstable_modes`: no real eigenvalue ``<= 0`` of ``J_f⁻¹ J``, ``J_f`` the pseudo-Jacobian with the
+bound frozen) — the solution lies on the branch that grows continuously from the frozen bound as the
+law's slope is switched on, the only kind the fixed point on the bound can converge to (it contracts
+only where the spectral radius of its map is below 1, and ``J_f⁻¹ J = I − (that map's derivative)`` on
+the slipping nodes). Measured on a ramped transient (exponential law, ``v_h = 10`` mm/s, ``V = 10``
+m/s, step 43): the warm Newton iteration converged to a solution with one unstable mode, 0.19 μ_s p0
+from the previous state; the fixed point's, 0.15 away, has none, and is the one now returned. A
+solution with unstable modes is returned only when no attempt finds another (``info["unstable"]``).
+Steeper laws can have several stable solutions of one step; then the first attempt that finds one
+decides (docs/friction.md, "When the step has several solutions").
 """
 from __future__ import annotations
 
@@ -209,34 +219,93 @@ def _direction(J, phi):
     return d if np.isfinite(d).all() else None
 
 
+def _rows(meth, pb):
+    """:class:`_SlipRows` of ``pb`` and the unknowns ``z`` of a solution of it (``z(sol)``)."""
+    sc = pb.scales
+    dqh = pb.dq / sc.length
+    sys_ = meth.system(pb, dqh)
+    with_load = pb.Q is not None
+    xi_fixed = None if with_load else pb.xi / sc.slip
+    k0 = sys_.r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
+    rows = _SlipRows(pb, sys_, with_load, pb.Q / sc.force if with_load else None, k0)
+
+    def z(sol):
+        t = np.asarray(sol.t, dtype=float) / sc.stress
+        return np.append(t, sol.xi / sc.slip) if with_load else t
+    return rows, z
+
+
+def unstable_modes(meth, pb, sol) -> int:
+    r"""How many modes of the solution ``sol`` the falling law makes unstable: the real eigenvalues ``<= 0`` of
+    ``J_f⁻¹ J`` (module docstring, "Which solution").
+
+    ``J`` is the pseudo-Jacobian at ``sol`` (eq. 88s) and ``J_f`` the same with the bound frozen (``μ' = 0``:
+    the slip rows identity rows). Along the homotopy ``J(λ) = J_f + λ (J − J_f)`` from the frozen bound
+    (``λ = 0``) to the law (``λ = 1``), ``det J(λ) = det J_f ∏ (1 + λ(e_i − 1))`` vanishes for some
+    ``λ ∈ (0, 1]`` exactly when an eigenvalue ``e_i`` of ``J_f⁻¹ J`` is real and ``<= 0``: the solution then
+    lies past a fold of the branch that grows from the frozen bound as the law's slope is switched on.
+    ``J − J_f`` is nonzero on the slipping rows only, so the nontrivial ``e_i`` are ``1 + eig(C J_f⁻¹ E)``
+    (``C`` those rows of ``J − J_f``, ``E`` their unit columns): an ``m × m`` eigenproblem, ``m`` the
+    slipping nodes. 0 when no node slips, the law is flat there, or ``J_f`` is singular (no node sticks with
+    the load row: the frozen step is degenerate and tells nothing)."""
+    rows, z = _rows(meth, pb)
+    x, y, s, b, _ = rows.at(z(sol))
+    stick = rows.stick(x, y, b)
+    isl = np.flatnonzero(~stick & (b > 0.0))
+    if isl.size == 0 or (rows.with_load and not stick.any()):
+        return 0
+    J = rows.jacobian(x, y, s, b, stick)
+    N = J.shape[1]
+    C = J[isl] - np.eye(rows.n, N)[isl]
+    if not np.any(C):
+        return 0
+    Jf = J.copy()
+    Jf[isl] = np.eye(rows.n, N)[isl]
+    E = np.zeros((N, isl.size))
+    E[isl, np.arange(isl.size)] = 1.0
+    try:
+        X = np.linalg.solve(Jf, E)
+    except np.linalg.LinAlgError:
+        return 0
+    e = 1.0 + np.linalg.eigvals(C @ X)
+    real = np.abs(e.imag) <= 1e-12 * np.maximum(1.0, np.abs(e.real))
+    return int(np.count_nonzero(real & (e.real <= 0.0)))
+
+
 def solve_slip_step(meth, pb, warm, t0):
     """A slip-dependent tangential step, safeguarded (module docstring): Newton from ``warm``; else the fixed
     point on the bound around Newton's constant-bound solves, polished by Newton from each iterate that
-    improved; else Newton from zero shear; with ``Q`` prescribed, else the creepage search. The first
-    error is raised if all fail, with the best residual reached."""
-    try:
-        return meth.checked(solve_slip(meth, pb, warm, t0))
-    except SolverError as err:
-        first = err
-    try:
-        return _by_fixed_point(meth, pb, warm, t0)
-    except SolverError as err:
-        second = err
+    improved; else Newton from zero shear; with ``Q`` prescribed, else the creepage search. A solution with
+    unstable modes (:func:`unstable_modes`) is kept only if no attempt finds a stable one (``info["unstable"]``
+    says how many). The first error is raised if all fail, with the best residual reached."""
+    found = []  # unstable solutions, in the order found
+
+    def stable(sol):
+        sol.info["unstable"] = unstable_modes(meth, pb, sol)
+        if sol.info["unstable"]:
+            found.append(sol)
+            return None
+        return sol
+
+    attempts = [lambda: meth.checked(solve_slip(meth, pb, warm, t0)),
+                lambda: _by_fixed_point(meth, pb, warm, t0, stable)]
     if warm is not None:
-        try:
-            sol = meth.checked(solve_slip(meth, pb, None, t0))  # the warm start's branch lost
-            sol.info["restarts"] = 1
-            return sol
-        except SolverError:
-            pass
+        attempts.append(lambda: _restarted(meth.checked(solve_slip(meth, pb, None, t0))))
     if pb.Q is not None:
-        from .creepage import tangential_by_creepage
+        attempts.append(lambda: meth.checked(_by_creepage(meth, pb, warm, t0)))
+    errors = []
+    for attempt in attempts:
         try:
-            return meth.checked(tangential_by_creepage(meth, pb, warm, t0, first))
-        except SolverError:
-            pass
-    best = min(r for r in (first.residual, second.residual) if r is not None) if (
-        first.residual is not None or second.residual is not None) else None
+            sol = stable(attempt())
+        except SolverError as err:
+            errors.append(err)
+            continue
+        if sol is not None:
+            return sol
+    if found:
+        return found[0]
+    first, second = errors[0], errors[1]
+    best = min((e.residual for e in errors if e.residual is not None), default=None)
     inner = second.message.split("; try")[0]  # its advice names newton itself
     raise SolverError(f"{first.message}; the fixed point on the bound failed too ({inner}); the step may "
                       "have no quasi-static solution (a breakaway: docs/friction.md): prescribe the creepage, ramp "
@@ -244,13 +313,25 @@ def solve_slip_step(meth, pb, warm, t0):
                       residual=best)
 
 
-def _by_fixed_point(meth, pb, warm, t0):
-    """The fixed point on the bound with Newton's constant-bound solves, polished by :func:`solve_slip`."""
+def _restarted(sol):
+    sol.info["restarts"] = 1  # the warm start's branch lost
+    return sol
+
+
+def _by_creepage(meth, pb, warm, t0):
+    from .creepage import tangential_by_creepage
+    err = SolverError("the slip-dependent tangential step", method=meth.name)
+    return tangential_by_creepage(meth, pb, warm, t0, err)
+
+
+def _by_fixed_point(meth, pb, warm, t0, stable=lambda sol: sol):
+    """The fixed point on the bound with Newton's constant-bound solves, polished by :func:`solve_slip` (a polished
+    solution is taken if ``stable`` keeps it)."""
     from ..fixedpoint import BoundFixedPoint
 
     def polish(sol):
         try:
-            return meth.checked(solve_slip(meth, pb, sol, t0, max_iterations=POLISH_ITERATIONS))
+            return stable(meth.checked(solve_slip(meth, pb, sol, t0, max_iterations=POLISH_ITERATIONS)))
         except SolverError:
             return None
 
