@@ -22,7 +22,8 @@ transient then carried on.
 
 **Polishing.** ``polish(solution)`` (optional) is tried on every iterate whose residual fell: a
 method that converges fast from near a solution (Newton on the slip-dependent step) returns the
-solution, else ``None`` and the fixed point goes on.
+solution, else ``None`` and the fixed point goes on. ``stall_window`` (default ``STALL_WINDOW``) sets
+the window of the cycling test: a caller with other ways to go on (Newton) gives up sooner.
 
 **Failure.** The map contracts only where ``|∂b/∂s|`` is small against the elastic stiffness
 (the falling branch near saturation is where it does not; docs/stability.md): a
@@ -57,7 +58,8 @@ class BoundFixedPoint:
 
     slip_dependent = True
 
-    def __init__(self, inner, max_iterations: int = 200, relaxation: float = 1.0, polish=None):
+    def __init__(self, inner, max_iterations: int = 200, relaxation: float = 1.0, polish=None,
+                 stall_window: int = STALL_WINDOW):
         if int(max_iterations) != max_iterations or max_iterations < 1:
             raise InputError("max_iterations", f"must be an integer >= 1, got {max_iterations!r}")
         if not (0.0 < relaxation <= 1.0):
@@ -66,6 +68,7 @@ class BoundFixedPoint:
         self.max_iterations = int(max_iterations)
         self.relaxation = float(relaxation)
         self.polish = polish
+        self.stall_window = int(stall_window)
         self.name = getattr(inner, "name", "fixed-point")
         self.solves = inner.solves
         self.operator = getattr(inner, "operator", "exact")
@@ -114,7 +117,7 @@ class BoundFixedPoint:
             raise SolverError(f"the fixed point on the friction bound diverges: residual {last:.3e} after {k} QPs "
                               f"(first {h[0]:.3e}); try method newton", method=self.name, status="diverged",
                               residual=float(last), iterations=k)
-        W = STALL_WINDOW
+        W = self.stall_window
         if len(h) >= 2 * W and min(h[-W:]) > STALL_FACTOR * min(h[:-W]):
             raise SolverError(f"the fixed point on the friction bound cycles: best residual {min(h[-W:]):.3e} over "
                               f"the last {W} QPs, {min(h[:-W]):.3e} before them; try method newton or a smaller "
