@@ -22,7 +22,7 @@ CASES = [  # (label, method, scene keywords, rolling speed)
     ("V = 45 m/s, ξ prescribed, braked, 12 a_H", "newton", dict(start="braked", distance=12.0), 45000.0),
     ("V = 45 m/s, Q = 0.5 μ_s P, braked, 1 a_H", "qp-osqp", dict(start="braked", distance=1.0, tangential=0.5), 45000.0),
     ("V = 45 m/s, Q = 0.5 μ_s P, braked, 1 a_H", "newton", dict(start="braked", distance=1.0, tangential=0.5), 45000.0),
-    ("V = 45 m/s, Q = 0.8 μ_s P (above the creep curve's peak), rolling start", "newton", dict(tangential=0.8), 45000.0),
+    ("V = 45 m/s, Q = 0.85 μ_s P (above the creep curve's peak, 0.8067), rolling start", "newton", dict(tangential=0.85), 45000.0),
     ("V = 45 m/s, Q = 0.5 μ_s P, braked, 6 a_H, 184 elements", "newton",
      dict(start="braked", distance=6.0, tangential=0.5, elements=184), 45000.0),
     ("V = 4.5 m/s, Q = 0.5 μ_s P, braked, 6 a_H, 184 elements", "newton",

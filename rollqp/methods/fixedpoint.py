@@ -87,7 +87,7 @@ class BoundFixedPoint:
         mu = law.mu(s)
         history, its, sol = [], 0, warm
         for k in range(1, self.max_iterations + 1):
-            sol = self.inner.solve(problem.replace(mu=mu, law=None), warm=sol)
+            sol = self.inner.solve(self._frozen(problem, mu, history), warm=sol)
             its += sol.iterations
             true = problem.evaluate(sol)
             history.append(true.residual)
@@ -110,6 +110,19 @@ class BoundFixedPoint:
         true.info.update(bound_iterations=len(history), bound_history=history)
         true.time = time.perf_counter() - t0
         return true
+
+    def _frozen(self, problem, mu, history):
+        """The step with the bound frozen at ``mu``; a frozen bound whose sliding limit ``μ fᵀp`` is below ``|Q|``
+        poses no step with stick (an InputError of the step problem): the iteration cannot go on (SolverError)."""
+        try:
+            return problem.replace(mu=mu, law=None)
+        except InputError as err:
+            if err.key != "Q":
+                raise
+            last = history[-1] if history else float("nan")
+            raise SolverError(f"the fixed point on the friction bound reached a bound below the load ({err}); "
+                              "try method newton", method=self.name, status="bound below the load",
+                              residual=last, iterations=len(history)) from None
 
     def _check(self, h, k):
         last = h[-1]

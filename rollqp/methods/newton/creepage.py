@@ -10,7 +10,7 @@ import numpy as np
 
 from ...errors import SolverError
 from .common import Stalled
-from .slip import solve_slip
+from .slip import solve_slip, solve_slip_step
 from .uncoupled import solve_tangential, solve_uncoupled
 
 __all__ = ["tangential_by_creepage"]
@@ -66,8 +66,8 @@ class _CreepageSearch:
     def solve_at(self, xh):
         sc = self.pb.scales
         sub = self.pb.replace(Q=None, xi=xh * sc.slip)
-        if sub.law is not None:  # a slip-dependent bound (rollqp.methods.newton.slip)
-            return self.meth.checked(solve_slip(self.meth, sub, self.sol, self.t0))
+        if sub.law is not None:  # a slip-dependent bound: safeguarded like the step itself (rollqp.methods.newton.slip)
+            return solve_slip_step(self.meth, sub, self.sol, self.t0)
         return solve_uncoupled(self.meth, sub, self.sol, self.t0)
 
     def F(self, xh):
