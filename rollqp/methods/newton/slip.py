@@ -36,7 +36,7 @@ stick row (``info["shifts"]``).
 
 **When the Newton iteration still fails** (a singular matrix, or an Armijo search that finds no
 decrease: the direction of a non-monotone law need not descend on a kink), the step is not
-given up: :func:`solve_slip_step` runs the fixed point on the bound
+given up: :func:`~.slip_step.solve_slip_step` runs the fixed point on the bound
 (:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`) with Newton's own constant-bound solves as
 its inner method, trying this iteration from each fixed-point iterate that improved (a few
 iterations from near a solution, quadratic), then a cold start, then the creepage search. A step
@@ -57,15 +57,13 @@ decides (docs/friction.md, "When the step has several solutions").
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from ...errors import SolverError
 from ...problem import friction_residual
 from .common import ALPHA_MIN, not_converged
 
-__all__ = ["solve_slip", "solve_slip_step"]
+__all__ = ["solve_slip", "unstable_modes", "POLISH_ITERATIONS", "FIXED_POINT_WINDOW"]
 
 #: Newton iterations allowed when polishing a fixed-point iterate (quadratic convergence from near a
 #: solution takes a handful; more means the iterate is not near enough yet).
@@ -283,84 +281,3 @@ def unstable_modes(meth, pb, sol) -> int:
     e = 1.0 + np.linalg.eigvals(C @ X)
     real = np.abs(e.imag) <= 1e-12 * np.maximum(1.0, np.abs(e.real))
     return int(np.count_nonzero(real & (e.real <= 0.0)))
-
-
-def solve_slip_step(meth, pb, warm, t0):
-    """A slip-dependent tangential step, safeguarded (module docstring): Newton from ``warm``; else the fixed
-    point on the bound around Newton's constant-bound solves, polished by Newton from each iterate that
-    improved; else Newton from zero shear; with ``Q`` prescribed, else the creepage search. A solution with
-    unstable modes (:func:`unstable_modes`) is kept only if no attempt finds a stable one (``info["unstable"]``
-    says how many). The first error is raised if all fail, with the best residual reached."""
-    found = []  # unstable solutions, in the order found
-
-    def stable(sol):
-        sol.info["unstable"] = unstable_modes(meth, pb, sol)
-        if sol.info["unstable"]:
-            found.append(sol)
-            return None
-        return sol
-
-    attempts = [lambda: meth.checked(solve_slip(meth, pb, warm, t0)),
-                lambda: _by_fixed_point(meth, pb, warm, t0, stable)]
-    if warm is not None:
-        attempts.append(lambda: _restarted(meth.checked(solve_slip(meth, pb, None, t0, stall=False))))
-    if pb.Q is not None:
-        attempts.append(lambda: meth.checked(_by_creepage(meth, pb, warm, t0)))
-    errors = []
-    for attempt in attempts:
-        try:
-            sol = stable(attempt())
-        except SolverError as err:
-            errors.append(err)
-            continue
-        if sol is not None:
-            return sol
-    if found:
-        return found[0]
-    first, second = errors[0], errors[1]
-    best = min((e.residual for e in errors if e.residual is not None), default=None)
-    inner = second.message.split("; try")[0]  # its advice names newton itself
-    raise SolverError(f"{first.message}; the fixed point on the bound failed too ({inner}); the step may "
-                      "have no quasi-static solution (a breakaway: docs/friction.md): prescribe the creepage, ramp "
-                      "the force or roll slower", method=meth.name, status=first.status, iterations=first.iterations,
-                      residual=best)
-
-
-def _restarted(sol):
-    sol.info["restarts"] = 1  # the warm start's branch lost
-    return sol
-
-
-def _by_creepage(meth, pb, warm, t0):
-    from .creepage import tangential_by_creepage
-    err = SolverError("the slip-dependent tangential step", method=meth.name)
-    return tangential_by_creepage(meth, pb, warm, t0, err)
-
-
-def _by_fixed_point(meth, pb, warm, t0, stable=lambda sol: sol):
-    """The fixed point on the bound with Newton's constant-bound solves, polished by :func:`solve_slip` (a polished
-    solution is taken if ``stable`` keeps it)."""
-    from ..fixedpoint import BoundFixedPoint
-
-    def polish(sol):
-        try:
-            return stable(meth.checked(solve_slip(meth, pb, sol, t0, max_iterations=POLISH_ITERATIONS)))
-        except SolverError:
-            return None
-
-    fixed = BoundFixedPoint(_ConstantBound(meth), polish=polish, stall_window=FIXED_POINT_WINDOW)
-    sol = fixed.solve(pb, warm)
-    sol.info["fixed_point"] = sol.info.get("bound_iterations", 0)
-    sol.time = time.perf_counter() - t0
-    return meth.checked(sol)
-
-
-class _ConstantBound:
-    """Newton on the constant-bound steps of the fixed point (never its own slip path: ``law`` is None there)."""
-
-    def __init__(self, meth):
-        self.meth = meth
-        self.name, self.solves, self.tolerance = meth.name, meth.solves, meth.tolerance
-
-    def solve(self, problem, warm=None):
-        return self.meth.solve(problem, warm=warm)
