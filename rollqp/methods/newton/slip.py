@@ -53,7 +53,7 @@ m/s, step 43): the warm Newton iteration converged to a solution with one unstab
 from the previous state; the fixed point's, 0.15 away, has none, and is the one now returned. A
 solution with unstable modes is returned only when no attempt finds another (``info["unstable"]``).
 Steeper laws can have several stable solutions of one step; then the first attempt that finds one
-decides (docs/friction.md, "When the step has several solutions").
+decides (docs/friction.md, "Newton against the QP fixed point over the velocity scale").
 """
 from __future__ import annotations
 
