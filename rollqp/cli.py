@@ -469,7 +469,7 @@ def main(argv=None) -> int:
             limiter.unregister() if hasattr(limiter, "unregister") else None
 
 
-# ----------------------------------------------------------------------------- stresses (issue 12)
+# ----------------------------------------------------------------------------- stresses
 def _stresses_parser(sub):
     t = sub.add_parser("stresses", help="subsurface stresses of one state of a result file (docs/stresses.md)")
     t.add_argument("result", metavar="RESULT.npz")

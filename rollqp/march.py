@@ -80,15 +80,15 @@ class Counters:
             self.inner_normal += sol.iterations
         elif half == "tangential":
             self.inner_tangential += sol.iterations
-        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.backtracks += sol.backtracks
         self._residual(sol.residual)
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
         self.iterations += sol.iterations
-        self.inner_normal += int(sol.info.get("inner_normal", 0))
-        self.inner_tangential += int(sol.info.get("inner_tangential", 0))
-        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.inner_normal += sol.inner_normal
+        self.inner_tangential += sol.inner_tangential
+        self.backtracks += sol.backtracks
         self._residual(sol.residual)
 
     def _residual(self, r: float) -> None:
@@ -216,7 +216,7 @@ class _March:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
         if not self.constant_friction:  # a law: this step's μ (Coulomb keeps the fast path)
-            prev = None if state.tsol is None else state.tsol.info.get("mu")
+            prev = None if state.tsol is None else state.tsol.mu
             fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
             pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta, h=h, friction=fr)
@@ -361,7 +361,7 @@ class _March:
         from .methods.steady_start import accelerated_start, predicting
         change = np.inf
         state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
-                                  delta=D, tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
+                                  delta=D, tol=STEADY_TOL)  # QP methods: Anderson
         # N–T alternation: one sweep a step until near steady
         sweeps = self.method.single_sweeps if self.method.capabilities.single_sweeps else None
         if sweeps is not None:
@@ -639,9 +639,9 @@ def _unloaded(ops: SceneOperators, xi=None) -> State:
 
 
 def _product(sol, problem, A):
-    """``A t`` of the tangential solution ``sol``, if its method handed it back (``info["At"]``, a pair
+    """``A t`` of the tangential solution ``sol``, if its method handed it back (``sol.At``, a pair
     ``(t, A t)``) for this very operator ``A`` (not a steady slip operator), else None."""
-    got = sol.info.get("At")
+    got = sol.At
     if got is None or problem.A is not A:
         return None
     t, At = got
@@ -649,7 +649,7 @@ def _product(sol, problem, A):
 
 
 def _keep_mu(problem, sol) -> None:
-    """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
+    """With a friction law, the step's ``μ`` at the nodes in ``sol.mu`` (the next step's memory,
     the result field ``friction_coefficient``); Coulomb steps are left as they were."""
     if problem.law is not None or (type(problem.mu) is not float and np.ndim(problem.mu) != 0):
-        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)
+        sol.mu = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)

@@ -1,4 +1,4 @@
-"""Subsurface stresses, energy and wear (issue 12; docs/stresses.md).
+"""Subsurface stresses, energy and wear (docs/stresses.md).
 
 The measured numbers behind each tolerance are in docs/stresses.md (``python
 benchmarks/stresses_validation.py``); the tests re-measure the cheap ones.
