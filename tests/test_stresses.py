@@ -14,7 +14,7 @@ from rollqp import closedforms as cf
 from rollqp.cli import main
 from rollqp.energy import balance, steady_identity
 from rollqp.errors import InputError
-from rollqp.stresses import influence_matrices, invariants, stress_components, stress_history
+from rollqp.subsurface import influence_matrices, invariants, stress_components, stress_history
 
 
 def _quad_field(strip, p, t, x, z):
