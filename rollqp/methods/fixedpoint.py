@@ -107,8 +107,9 @@ class BoundFixedPoint:
                               f"{history[-1]:.3e} > {self.limit:.1e} after {self.max_iterations} QPs",
                               method=self.name, status="bound iteration limit", residual=history[-1], iterations=its)
         true.method, true.status, true.iterations = self.name, "solved", its
-        true.info.update(sol.info)
-        true.info.update(bound_iterations=len(history), bound_history=history)
+        true.extras.update(sol.extras)  # the last inner solve's statistics and data
+        true.backtracks, true.At = sol.backtracks, sol.At
+        true.extras.update(bound_iterations=len(history), bound_history=history)
         true.time = time.perf_counter() - t0
         return true
 

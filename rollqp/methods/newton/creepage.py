@@ -49,7 +49,7 @@ def tangential_by_creepage(meth, pb, warm, t0, err, slip_solve=None):
         sol = pb.solution(at_root.t, at_root.xi)
         if not sol.residual <= meth.tolerance:
             raise err from None
-        sol = meth.finish(sol, at_root.iterations, dict(at_root.info), t0)
+        sol = meth.finish(sol, at_root.iterations, dict(at_root.extras, backtracks=at_root.backtracks), t0)
     sol.info["creepage_search"] = search.evals + 1
     sol.iterations += search.its + at_root.iterations  # all Newton iterations of the step
     return sol
