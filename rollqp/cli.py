@@ -242,8 +242,10 @@ def cmd_run(args) -> int:
         if keep:
             from .crossval import spot_check
             t1 = time.perf_counter()
-            check = spot_check(list(keep.values()))
-            print(f"  cross-check   {check} ({time.perf_counter() - t1:.2f} s)")
+            head, *failures = str(spot_check(list(keep.values()))).splitlines()
+            print(f"  cross-check   {head} ({time.perf_counter() - t1:.2f} s)")
+            for line in failures:  # each in full, on a line of its own
+                print(f"                {line}")
         print(f"  result        {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
     return 0
 
