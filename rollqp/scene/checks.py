@@ -34,6 +34,15 @@ NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
 
 
 # =========================================================================== names
+def check_units(key: str, v: Any) -> str:
+    """The declared unit system (:data:`rollqp.units.UNIT_SYSTEMS`), or ``""`` for none."""
+    from ..units import UNIT_SYSTEMS
+    if v == "" or v in UNIT_SYSTEMS:
+        return v
+    raise InputError(key, f"must be one of {', '.join(map(repr, UNIT_SYSTEMS))} (the units the scene's numbers "
+                          f"are in; leave it out if none fits), got {v!r}")
+
+
 def check_scene_name(key: str, v: Any) -> str:
     """A scene's name (:data:`NAME_PATTERN`)."""
     v = string(key, v)

@@ -35,6 +35,9 @@ class Scene(Derived):
     load : Load
     discretization : Discretization
     solver : SolverSettings
+    units : str
+        The units the numbers are in, for the summary and figures only (:data:`rollqp.units.UNIT_SYSTEMS`:
+        ``"N-mm"``, ``"N-m"``, ``"lbf-in"``; ``""``: not declared). Nothing is converted.
     source : str
         Where the scene came from (a path, ``builtin:<name>`` or ``<dict>``); not compared.
 
@@ -52,6 +55,7 @@ class Scene(Derived):
     load: Load
     discretization: Discretization = field(default_factory=Discretization)
     solver: SolverSettings = field(default_factory=SolverSettings)
+    units: str = ""
     source: str = field(default="<dict>", compare=False)
 
     def __post_init__(self):
@@ -64,6 +68,7 @@ class Scene(Derived):
         put("load", checks.check_load(self.load))
         put("discretization", checks.check_discretization(self.discretization))
         put("solver", checks.check_solver(self.solver))
+        put("units", checks.check_units("units", self.units))
         put("source", str(self.source))
         checks.check_whole(self)
 

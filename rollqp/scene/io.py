@@ -64,7 +64,7 @@ def scene_to_dict(scene: Scene) -> dict:
     ``reference_distance``, the unused one of ``tangential``/``creepage``) are left out,
     since TOML has no null. JSON-serializable; :func:`scene_from_dict` reads it back.
     """
-    return {"name": scene.name, "description": scene.description,
+    return {"name": scene.name, "description": scene.description, **({"units": scene.units} if scene.units else {}),
             "bodies": {"A": part_dict(scene.A), "B": part_dict(scene.B)},
             "contact": part_dict(scene.contact), "load": part_dict(scene.load),
             "discretization": part_dict(scene.discretization), "solver": part_dict(scene.solver)}
@@ -80,7 +80,7 @@ def scene_to_toml(scene: Scene) -> str:
 
 
 # =========================================================================== input
-_TOP_KEYS = ("name", "description", "bodies", "contact", "load", "discretization", "solver")
+_TOP_KEYS = ("name", "description", "units", "bodies", "contact", "load", "discretization", "solver")
 _SECTIONS: dict[str, type] = {"contact": Contact, "load": Load,
                               "discretization": Discretization, "solver": SolverSettings}
 
@@ -173,7 +173,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     for k in ("tangential", "creepage", "approach", "rolled"):
         if k in ld:
             ld[k] = parse_history(ld[k], f"load.{k}")
-    return Scene(name=d.get("name", default_name), description=d.get("description", ""),
+    return Scene(name=d.get("name", default_name), description=d.get("description", ""), units=d.get("units", ""),
                  A=A, B=B, contact=Contact(**parts["contact"]), load=Load(**ld),
                  discretization=Discretization(**parts["discretization"]),
                  solver=SolverSettings(**parts["solver"]), source=source)
