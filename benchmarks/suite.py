@@ -61,7 +61,7 @@ SCALING_ELEMENTS = (20, 40, 80, 160, 320, 640, 1280)
 SCALING_STEPS = 12
 #: Intermediate state compared with the fine reference (q/a_H).
 Q_MID = 1.0
-#: Issue targets (docs/performance.md, "Targets").
+#: Targets (docs/performance.md, "Targets").
 TARGET_CHOL_RATIO = 3.0     # Newton step / cho_factor, n >= 321, at most
 TARGET_CLARABEL_RATIO = 10.0  # Clarabel step / Newton step, n <= 321, at least
 TARGET_EXPONENT = 3.0       # Newton step cost exponent up to n = 2561, at most

@@ -1,4 +1,4 @@
-"""Throughput of ``rollqp sweep`` on a local dask cluster against the same points run serially (issue 15).
+"""Throughput of ``rollqp sweep`` on a local dask cluster against the same points run serially.
 
 Usage::
 

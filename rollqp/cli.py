@@ -34,9 +34,34 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_INPUT, f"rollqp: error: {message} (see 'rollqp --help')\n")
 
 
+def version_text() -> str:
+    """``rollqp X (Python …, numpy …, scipy …, clarabel …, osqp …)``: what a bug report needs."""
+    import platform
+    from importlib import metadata
+    from . import __version__
+    deps = []
+    for name in ("numpy", "scipy", "clarabel", "osqp"):
+        try:
+            deps.append(f"{name} {metadata.version(name)}")
+        except metadata.PackageNotFoundError:  # pragma: no cover - core dependencies
+            deps.append(f"{name} missing")
+    return f"rollqp {__version__} (Python {platform.python_version()}, {', '.join(deps)})"
+
+
+class _Version(argparse.Action):
+    """``--version``: print :func:`version_text` and exit 0 (computed only when asked)."""
+
+    def __init__(self, option_strings, dest, **kw):
+        super().__init__(option_strings, dest, nargs=0, help="print rollqp's version (and its solvers') and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        parser.exit(0, version_text() + "\n")
+
+
 def _parser():
     from .methods import METHOD_NAMES
     p = _Parser(prog="rollqp", description="2D transient rolling contact: convex QP steps and generalized Newton.")
+    p.add_argument("--version", action=_Version)
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     r = sub.add_parser("run", help="run a scene and write its result file")
     r.add_argument("scene", nargs="?", help="a TOML scene file or the name of a built-in scene "
@@ -462,7 +487,7 @@ def main(argv=None) -> int:
             limiter.unregister() if hasattr(limiter, "unregister") else None
 
 
-# ----------------------------------------------------------------------------- stresses (issue 12)
+# ----------------------------------------------------------------------------- stresses (docs/stresses.md)
 def _stresses_parser(sub):
     t = sub.add_parser("stresses", help="subsurface stresses of one state of a result file (docs/stresses.md)")
     t.add_argument("result", metavar="RESULT.npz")

@@ -588,7 +588,7 @@ def lame_ring_displacement(r, inner, outer, pressure, E, nu):
     return _out(A * r - A * inner ** 2 / r)
 
 
-# --------------------------------------------------------------------------- issue 13: load paths and profiles
+# --------------------------------------------------------------------------- load paths and profiles (docs/kinematics.md)
 _MINDLIN = ("R. D. Mindlin and H. Deresiewicz, Elastic spheres in contact under varying oblique forces, J. Appl. "
             "Mech. 20, 327–344 (1953) (unloading and reloading as superpositions of Cattaneo solutions, with "
             "the memory of the turning points); 2D form as in " + _JOHNSON + ", §7.2 (oscillating tangential "

@@ -137,7 +137,7 @@ def markdown_table() -> str:
     return "\n".join(rows)
 
 
-# ------------------------------------------------------------------------- kinematics (issue 13)
+# ------------------------------------------------------------------------- kinematics (docs/kinematics.md)
 def _with_rolled(scene) -> bool:
     return scene.load.rolled is not None
 

@@ -373,7 +373,7 @@ class _March:
         from .methods.steady_start import accelerated_start, predicting
         change = np.inf
         state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
-                                  delta=D, tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
+                                  delta=D, tol=STEADY_TOL)  # QP methods: the accelerated start
         sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
         if sweeps is not None:
             sweeps(True)

@@ -74,6 +74,7 @@ def test_cli_run_with_a_qpsolvers_backend(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "r.npz").is_file()
 
 
+@pytest.mark.integration
 @pytest.mark.skipif("qps-highs" not in INSTALLED, reason="HiGHS not installed")
 def test_highs_banner_stays_off_stdout(tmp_path):
     """HiGHS prints its banner on the C-level stdout when a process builds its first solver

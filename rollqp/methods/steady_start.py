@@ -1,4 +1,4 @@
-r"""The QP methods' rolling start: the march toward steady rolling, accelerated (issue 18).
+r"""The QP methods' rolling start: the march toward steady rolling, accelerated.
 
 A QP method cannot pose the steady rolling problem (its slip operator ``d·D_up·A`` has an
 indefinite weighted symmetric part: no convex QP has it as Hessian), so :func:`rollqp.march`
