@@ -19,6 +19,7 @@ KINDS = {
     "dent": ({}, "profile"),
     "fretting": ({}, "rest"),
     "stop-reverse": ({}, "path"),
+    "falling-friction": ({"discretization.distance": 1.5}, "friction"),
 }
 
 

@@ -10,6 +10,7 @@ kind           the scene                                              figure
 ``profile``    a profile feature rolls through (a dent, a flat)       :func:`profile_figure`
 ``rest``       tangential loads that change at rest (fretting)        :func:`rest_figure`
 ``path``       a stop or a reversal of the rolling (``load.rolled``)  :func:`path_figure`
+``friction``   a friction law: μ that varies with x or slip velocity  :func:`friction_figure`
 ``transient``  similar bodies rolling (Cattaneo to Carter, a ramp)    :func:`transient_figure`
 =============  =====================================================  ==========================
 
@@ -33,19 +34,20 @@ from ..scene import BETA_ZERO
 from .dissimilar import (FREE_ROLLING_RATIO, SETTLED_RATE, comparison_figure, coupled_figure, dissimilar_figure,
                          draw_history, draw_pressure, draw_snapshots, draw_traction, draw_zone_map, select_states,
                          settled_q, snapshot_figure, zone_map_figure)
+from .friction import friction_figure
 from .paths import path_figure, profile_figure, rest_figure
 from .style import LABELS, REFERENCES, STATE_COLORS, STATE_NAMES, arrays, pyplot, scene_of
 from .transient import snapshot_indices, transient_figure
 
 __all__ = ["pyplot", "plot_result", "figure_kind", "FIGURES", "transient_figure", "coupled_figure", "profile_figure",
-           "rest_figure", "path_figure", "snapshot_figure", "zone_map_figure", "dissimilar_figure",
+           "rest_figure", "path_figure", "friction_figure", "snapshot_figure", "zone_map_figure", "dissimilar_figure",
            "comparison_figure", "draw_snapshots", "draw_zone_map", "draw_history", "draw_pressure", "draw_traction",
            "select_states", "settled_q", "snapshot_indices", "LABELS", "REFERENCES", "STATE_COLORS", "STATE_NAMES",
            "FREE_ROLLING_RATIO", "SETTLED_RATE"]
 
 #: The figure of each kind (:func:`figure_kind`).
 FIGURES = {"coupled": coupled_figure, "profile": profile_figure, "rest": rest_figure, "path": path_figure,
-           "transient": transient_figure}
+           "friction": friction_figure, "transient": transient_figure}
 
 
 def figure_kind(res, scene=None) -> str:
@@ -53,8 +55,8 @@ def figure_kind(res, scene=None) -> str:
 
     In this order: normal–tangential coupling (β ≠ 0, coupling not "off"); a body profile with a
     feature that rolls through the contact; tangential loads that change while the rollers stand
-    still (static steps with a varying Q); a stop or a reversal of the rolling; else a transient
-    of similar bodies.
+    still (static steps with a varying Q); a stop or a reversal of the rolling; a friction law (μ
+    not one number); else a transient of similar bodies.
     """
     res = arrays(res)
     scene = scene_of(res, scene)
@@ -64,9 +66,10 @@ def figure_kind(res, scene=None) -> str:
         return "coupled"
     if any(b.profile is not None and b.profile.moves for b in (scene.A, scene.B)):
         return "profile"
+    law = not isinstance(scene.contact.friction, (int, float))
     d = np.asarray(res["direction"]) if "direction" in res else None
     if d is None:
-        return "transient"
+        return "friction" if law else "transient"
     rest = d == 0
     rest[0] = scene.load.start == "braked"
     Q = np.asarray(res["Q"], dtype=float)
@@ -75,7 +78,7 @@ def figure_kind(res, scene=None) -> str:
     moving = d[1:][d[1:] != 0]
     if rest[1:].any() or (moving.size and np.ptp(moving) > 0):
         return "path"
-    return "transient"
+    return "friction" if law else "transient"
 
 
 def plot_result(res, scene, path, **kw) -> str:
