@@ -400,10 +400,19 @@ def _sweep_parsers(sub):
     _cluster_options(c)
 
 
+def _workers_count(text):
+    """``--workers N``: an integer of a few digits (its range is checked when the cluster starts)."""
+    t = str(text).strip()
+    if not t.isdigit() or len(t) > 6:
+        shown = t if len(t) <= 20 else f"{t[:20]}… ({len(t)} characters)"
+        raise argparse.ArgumentTypeError(f"must be a whole number of worker processes, got {shown!r}")
+    return int(t)
+
+
 def _cluster_options(p):
-    p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786); "
-                   "default: a local cluster")
-    p.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786, or "
+                   "tls://host:8786 with a dask TLS configuration); default: a local cluster")
+    p.add_argument("--workers", type=_workers_count, help="worker processes of the local cluster (default: one per core)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
