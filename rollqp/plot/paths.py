@@ -55,7 +55,7 @@ def deviation(scene, x, q) -> np.ndarray:
 
 
 def passage(res, scene, a):
-    """``(states, dz)``: the states whose contact (|x| ≤ a_H) the profile's features touch, and the
+    """``(states, dz)``: the states whose contact (``abs(x) <= a_H``) the profile's features touch, and the
     deviation of every state (``(K+1, n)``)."""
     x = np.asarray(res["x"], dtype=float)
     dz = np.array([deviation(scene, x, q) for q in res["q"]])
