@@ -175,6 +175,7 @@ class _March:
         self.moving = ops.profiles_move
         self.cache = HistoryCache(ops) if self.plan.rolled else None
         self.frictionless = ops.frictionless  # the scene's law: the same at every step
+        self.constant_friction = ops.friction.kind == "constant"  # one μ: the step problems' fast path
         self.at = self._loads_at(self.plan.tau)
         self.fixed = self._normal_fixed()
 
@@ -214,7 +215,7 @@ class _March:
         if self.frictionless:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
-        if not isinstance(ops.friction, float):  # a law: this step's μ (Coulomb keeps the old path)
+        if not self.constant_friction:  # a law: this step's μ (Coulomb keeps the fast path)
             prev = None if state.tsol is None else state.tsol.info.get("mu")
             fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
@@ -258,7 +259,7 @@ class _March:
     def record(self, k, phase, q, state, previous, problem, sol, cnt, *, P, shift, t0) -> StepRecord:
         ops = self.ops
         tsol = state.tsol
-        mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s, tsol.p)
+        mu = ops.mu if problem is None or self.constant_friction else problem.coefficient(tsol.s, tsol.p)
         bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
         nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound)
         count = np.bincount(nodes, minlength=3)
@@ -314,7 +315,7 @@ class _March:
         """Rolling start from the braked state: the direct steady solve for a method that declares
         ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says
         why in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`)."""
-        if "steady" not in self.method.solves:
+        if "steady" not in self.method.capabilities.solves:
             return self.steady_by_marching(braked)
         try:
             return self.steady_direct(braked)
@@ -361,7 +362,8 @@ class _March:
         change = np.inf
         state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
                                   delta=D, tol=STEADY_TOL)  # QP methods: the accelerated start
-        sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
+        # N–T alternation: one sweep a step until near steady
+        sweeps = self.method.single_sweeps if self.method.capabilities.single_sweeps else None
         if sweeps is not None:
             sweeps(True)
         was = predicting(self.method, True)  # QP methods: each QP on its predicted active set first, until steady
@@ -440,14 +442,14 @@ def prepare(scene, method=None):
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
-    from .friction import law_kind
     coupled = scene.coupling_level == "full"
-    kind = law_kind(scene.contact.friction)
+    kind = scene.contact.friction.kind
     if method is None or isinstance(method, str):
         meth = scene_method(scene.solver, coupled=coupled, friction=kind)
     else:
         meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
-    ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")
+    caps = meth.capabilities
+    ops = SceneOperators.build(scene, symmetrized=caps.operator == "symmetrized", capabilities=caps)
     meth.setup(ops)
     return scene, meth, ops
 

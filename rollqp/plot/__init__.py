@@ -66,7 +66,7 @@ def figure_kind(res, scene=None) -> str:
         return "coupled"
     if any(b.profile is not None and b.profile.moves for b in (scene.A, scene.B)):
         return "profile"
-    law = not isinstance(scene.contact.friction, (int, float))
+    law = scene.contact.friction.kind != "constant"
     d = np.asarray(res["direction"]) if "direction" in res else None
     if d is None:
         return "friction" if law else "transient"

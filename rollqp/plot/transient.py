@@ -22,9 +22,8 @@ def snapshot_indices(q, a, wanted=(0.0, 0.25, 0.5, 1.0, 2.0)):
 
 
 def coulomb(scene):
-    """The scene's constant friction coefficient, or None (a friction law: no closed form applies)."""
-    fr = scene.contact.friction
-    return float(fr) if isinstance(fr, (int, float)) and fr > 0 else None
+    """The scene's constant friction coefficient, or None (frictionless, or a law μ(x, s): no closed form applies)."""
+    return float(scene.contact.mu) if scene.contact.friction.kind == "constant" and scene.contact.mu > 0 else None
 
 
 def transient_figure(res: dict, scene, path: str | None = None, title: str | None = None):
