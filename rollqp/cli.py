@@ -38,7 +38,7 @@ def version_text() -> str:
     """``rollqp X (Python …, numpy …, scipy …, clarabel …, osqp …)``: what a bug report needs."""
     import platform
     from importlib import metadata
-    from . import __version__
+    from .version import __version__
     deps = []
     for name in ("numpy", "scipy", "clarabel", "osqp"):
         try:

@@ -134,8 +134,8 @@ def solve_step_file(sf: StepFile, name: str, tolerance: float = 1e-10):
     are rollqp's of that same discrete steady problem (``info["marched"]`` is then True;
     ``iterations`` counts every solve of the march).
     """
-    from .methods import get_method
-    if sf.step_type != "steady" or "steady" in get_method(name, tolerance=tolerance).solves:
+    from .methods import capabilities
+    if sf.step_type != "steady" or "steady" in capabilities(name).solves:
         return solve_stored(sf, name, tolerance=tolerance)
     from .march import march
     from .scene import scene_from_dict
