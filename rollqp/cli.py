@@ -234,6 +234,9 @@ def cmd_run(args) -> int:
               file=sys.stderr)
         return 0
     cb, close = _progress(args.quiet)
+    if not args.quiet:
+        _advise(scene)
+        cb = estimate_progress(cb, scene.n_steps - (0 if resume is None else len(resume["q"]) - 1))
     keep, observe = _spot_steps(args, scene)
     t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
@@ -263,7 +266,7 @@ def cmd_run(args) -> int:
         if getattr(args, "stresses", False):
             from .stresses import stress_history
             peaks = stress_history(result)
-        print(summary(res, scene, scene.solver.method, wall, peaks))
+        print(summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
         if keep:
             from .crossval import spot_check
             t1 = time.perf_counter()
@@ -273,6 +276,47 @@ def cmd_run(args) -> int:
                 print(f"                {line}")
         print(f"  result        {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
     return 0
+
+
+#: A run's remaining time above which ``rollqp run`` prints its estimate after the first steps (seconds).
+ANNOUNCE_SECONDS = 60.0
+
+
+def _advise(scene) -> None:
+    """Before a run: what rollqp chose for the user (the matrix-free path), or what the dense path or the N–T
+    alternation will cost and what runs faster (:mod:`rollqp.advice`), one line each on stderr."""
+    from .advice import alternation_note, estimate_note, fast_path
+    plan = fast_path(scene)
+    notes = [plan.note] if plan.note else [estimate_note(scene)]
+    notes.append(alternation_note(plan.scene))
+    for note in filter(None, notes):
+        print(f"rollqp: {note}", file=sys.stderr, flush=True)
+
+
+def estimate_progress(cb, steps: int):
+    """``cb`` that also prints, once, the estimated remaining time when it exceeds :data:`ANNOUNCE_SECONDS`:
+    measured on the first rolling steps (after at least 10 s of them, or 5 steps), the start excluded."""
+    state = {"t": None, "k": 0, "said": False}
+
+    def progress(k, K):
+        now = time.perf_counter()
+        if state["t"] is None:  # the first rolling step is done: the clock starts here
+            state["t"], state["k"] = now, k
+        elif not state["said"] and (now - state["t"] >= 10.0 or k - state["k"] >= 5):
+            per = (now - state["t"]) / (k - state["k"])
+            left = per * (K - k)
+            state["said"] = True
+            if left > ANNOUNCE_SECONDS:
+                print(f"rollqp: about {_minutes(left)} to go: {K - k} of {steps} steps left at {per:.3g} s a step "
+                      f"(measured on steps {state['k'] + 1}..{k})", file=sys.stderr, flush=True)
+        if cb is not None:
+            cb(k, K)
+
+    return progress
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
 
 
 def _spot_steps(args, scene):

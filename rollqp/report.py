@@ -90,8 +90,9 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
     """
     u = unit_names(getattr(scene, "units", ""))
     a, p0 = float(res["a_H"]), float(res["p0"])
+    ran = _meta(res).get("method") or method
     rows = [("scene", f"{scene.name} ({scene.source})"),
-            ("method", method),
+            ("method", ran if ran == method else f"{ran} (the scene names {method}: see fast path below)"),
             ("nodes", f"{res['x'].size} ({scene.discretization.elements} {scene.discretization.element} elements, "
                       f"zone ±{scene.discretization.zone} a_H = ±{scene.discretization.zone * a:.4g} {u.length})"),
             ("steps", steps_row(res, scene, u)),
@@ -103,6 +104,8 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _model_rows(res, scene)
+    if _meta(res).get("method_note"):
+        rows.append(("fast path", _meta(res)["method_note"]))
     rows += _start_rows(res)
     rows += _gross_rows(res)
     rows += energy_rows(res, scene, stresses)

@@ -247,7 +247,10 @@ def check_work(scene) -> None:
     """The work a scene asks for fits: nodes within :data:`MAX_NODES`, and the dense influence
     matrices and the result arrays within this machine's memory — refused before any work, with
     what they would need."""
+    from ..advice import fast_path
     from ..matrixfree import check_scene, memory_estimate
+    if fast_path(scene).note is not None:
+        return  # it runs matrix-free (rollqp.advice): the scene it runs as is checked when it is built
     n, K = scene.n_nodes, scene.n_steps
     dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
     need, memory = (scene.memory_estimate() if dense else memory_estimate(scene)), available_memory()
