@@ -456,7 +456,8 @@ def _workers_count(text):
 def _cluster_options(p):
     p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786, or "
                    "tls://host:8786 with a dask TLS configuration); default: a local cluster")
-    p.add_argument("--workers", type=_workers_count, help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--workers", type=_workers_count, help="worker processes of the local cluster (default: one per core; 0: the points run in this "
+                   "process, no cluster)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
