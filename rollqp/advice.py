@@ -98,16 +98,21 @@ def _needs(scene) -> set:
     return need
 
 
-def matrix_free_alternative(scene) -> str | None:
-    """A registered matrix-free method that does the scene's work, or None (the model has no FFT operators,
-    or no such method solves what the scene poses)."""
+def matrix_free_alternative(scene, same_method: bool = True) -> str | None:
+    """A registered matrix-free method that does the scene's work, or None: the model has no FFT operators,
+    or no matrix-free method solves what the scene poses. ``same_method``: it must also solve the same kinds
+    of step as the scene's method (the coupled one possibly by the N–T alternation) — Newton for Newton, not
+    Newton for the QP route, whose point is to be another route."""
     from .influence import get_model
     from .methods import METHOD_NAMES, capabilities
     if not get_model(scene.contact.model).matrix_free:
         return None
+    own = scene.method_capabilities.solves - {"coupled"}
     for name in METHOD_NAMES:
         caps = capabilities(name)
-        if caps.matrix_free and _needs(scene) <= caps.solves and caps.dimension == 2:
+        if not (caps.matrix_free and _needs(scene) <= caps.solves and caps.dimension == 2):
+            continue
+        if not same_method or caps.solves - {"coupled"} == own:
             return name
     return None
 
@@ -134,18 +139,24 @@ def fast_path(scene) -> Plan:
 
 
 def estimate_note(scene) -> str | None:
-    """One line before a run that stays on a large or slow dense path (``solver.operator = "dense"``, or no
-    matrix-free method can do its work): its estimated memory and time and the keys to change; else None."""
+    """One line before a run that stays on a large or slow dense path (``solver.operator = "dense"``, a QP
+    method, or a model without FFT operators): its estimated memory and time and what to change; else None."""
     if scene.method_capabilities.matrix_free or scene.n_nodes < 1000:
         return None
     memory, seconds = dense_memory(scene), dense_seconds(scene)
     if memory <= DENSE_MEMORY_LIMIT and seconds <= DENSE_SECONDS_LIMIT:
         return None
-    other = matrix_free_alternative(scene)
-    how = (f"solver.operator = 'auto' runs it with {other}, matrix-free" if other is not None
-           else "fewer discretization.elements or a longer discretization.step make it cheaper")
+    same, other = matrix_free_alternative(scene), matrix_free_alternative(scene, same_method=False)
+    if same is not None:
+        how = f"solver.operator = 'auto' runs it with {same}, matrix-free"
+    elif other is not None:
+        how = (f"solver.method = '{other}' solves the same scene matrix-free; fewer discretization.elements or a "
+               "longer discretization.step make this one cheaper")
+    else:
+        how = "fewer discretization.elements or a longer discretization.step make it cheaper"
     return (f"{scene.solver.method} on {scene.n_nodes} nodes, {scene.n_steps} steps: the dense path needs about "
-            f"{memory / 2 ** 30:.2g} GiB and {_duration(seconds)} here (estimate); {how}")
+            f"{memory / 2 ** 30:.2g} GiB and {_duration(seconds)} here (estimate for Newton steps: a QP method's take "
+            f"longer); {how}")
 
 
 def alternation_note(scene) -> str | None:

@@ -23,6 +23,16 @@ def test_a_large_dense_scene_runs_matrix_free_and_says_so():
     assert advice.fast_path(rollqp.load_scene("cattaneo-carter")).note is None   # 81 nodes
 
 
+def test_the_qp_route_is_not_replaced():
+    """A QP method is another route to the same steps, not a slow Newton: it is never switched, and the
+    estimate before its run names the matrix-free method as an option, not as what 'auto' does."""
+    s = rollqp.load_scene("cattaneo-carter").replace(**{**BIG, "solver.method": "qp-osqp"})
+    assert advice.fast_path(s).note is None
+    assert advice.matrix_free_alternative(s) is None and advice.matrix_free_alternative(s, same_method=False)
+    note = advice.estimate_note(s)
+    assert "solver.method = 'mf-newton' solves the same scene matrix-free" in note and "'auto' runs it" not in note
+
+
 def test_no_switch_without_fft_operators():
     """The BEM model has no FFT operators: no matrix-free method can do its work, the scene stays."""
     s = rollqp.load_scene("cattaneo-carter").replace(**{**BIG, "contact.model": "bem"})
