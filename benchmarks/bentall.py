@@ -276,7 +276,7 @@ class AndersonOnly(Alternation):
 
 
 class FullAlternation(PlainMarch):
-    """The plain march with the alternation converged at every step (rollqp without the accelerated start)."""
+    """The plain march with the alternation converged at every step (the march before the accelerated start)."""
 
     def __init__(self, *args, **kw):
         super().__init__(*args, **kw)  # rollqp.march then never switches to one sweep per step
@@ -327,7 +327,7 @@ def section_start():
           "tolerance), then marching steps with the alternation converged, solved by the backend, until max|Δt| per "
           "step < 1e-8 μp0. `without the Newton phase`: plain steps, then Anderson; `without the active-set "
           "prediction`: every QP by the backend; `plain march`: neither Newton nor Anderson (one sweep per step, then "
-          "converged steps); `full alternation`: the alternation converged at every step (rollqp without the accelerated start). "
+          "converged steps); `full alternation`: the alternation converged at every step (the march before the accelerated start). "
           "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
           "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
     ref, cpu_ref, wall_ref = timed_cpu_run(s, "newton")

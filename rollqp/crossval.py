@@ -99,12 +99,11 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
         state = classify(sol.p, sol.t, sol.s, sf.mu, sc)
         if ref is None:
             ref, ref_state = sol, state
-        info = sol.info
-        inner = f"{info.get('inner_normal', 0)}+{info.get('inner_tangential', 0)}"
-        if not info.get("iterations_reported", True):
+        inner = f"{sol.inner_normal}+{sol.inner_tangential}"
+        if not sol.extras.get("iterations_reported", True):
             inner = "—"  # DAQP and HiGHS do not report iterations through qpsolvers
-        its = f"{sol.iterations} ({inner})" if "outer" in info else (inner if sf.kind == "uncoupled" else str(sol.iterations))
-        if info.get("marched"):
+        its = f"{sol.iterations} ({inner})" if sol.outer else (inner if sf.kind == "uncoupled" else str(sol.iterations))
+        if sol.extras.get("marched"):
             its = f"{sol.iterations} (march to steady)"
         rows.append(Row(name, True, residuals=dict(signorini=sol.residuals.signorini, friction=sol.residuals.friction,
                                                    load_normal=sol.residuals.load_normal,
@@ -131,7 +130,7 @@ def solve_step_file(sf: StepFile, name: str, tolerance: float = 1e-10):
     ``"steady"``; any other method (the QP backends: the steady problem is no convex QP) reaches it
     the way ``rollqp run`` does, by the scene's march at its starting loads to steady rolling
     (:meth:`rollqp.march` state 0), and its state is evaluated on the stored step: the residuals
-    are rollqp's of that same discrete steady problem (``info["marched"]`` is then True;
+    are rollqp's of that same discrete steady problem (``extras["marched"]`` is then True;
     ``iterations`` counts every solve of the march).
     """
     from .methods import capabilities
@@ -147,7 +146,7 @@ def solve_step_file(sf: StepFile, name: str, tolerance: float = 1e-10):
     rec = next(iter(march(scene, name)))  # state 0: the rolling start, marched to steady
     sol = sf.problem().solution(rec.state.p, rec.state.t, rec.solution.delta, rec.solution.xi, method=name,
                                 iterations=rec.counters.iterations, time=time.perf_counter() - t0)
-    sol.info.update(marched=True, inner_normal=0, inner_tangential=0, iterations_reported=True)
+    sol.extras["marched"] = True
     return sol
 
 
