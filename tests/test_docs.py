@@ -206,6 +206,6 @@ def test_no_internal_issue_numbers():
     found = []
     for path in [ROOT / "README.md", *PAGES, *sorted((ROOT / "rollqp").rglob("*.py"))]:
         for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
-            if re.search(r"[Ii]ssues? [0-9]+", line):
+            if re.search(r"[Ii]ssues? [0-9]+|\b[Tt]he issue'?s?\b", line):
                 found.append(f"{path.relative_to(ROOT)}:{n}")
     assert not found, found
