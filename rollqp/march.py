@@ -258,7 +258,7 @@ class _March:
     def record(self, k, phase, q, state, previous, problem, sol, cnt, *, P, shift, t0) -> StepRecord:
         ops = self.ops
         tsol = state.tsol
-        mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s)
+        mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s, tsol.p)
         bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
         nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound)
         count = np.bincount(nodes, minlength=3)
@@ -335,7 +335,11 @@ class _March:
         state, problem, sol = self.step(start.state, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
                                         Q=Q, xi=xi, steady=True, delta=D)
         self.ops.check_inside(state.p, 0)
-        return self.record(0, "steady", 0.0, state, start.state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+        rec = self.record(0, "steady", 0.0, state, start.state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+        if problem is not None and problem.law is not None and Q is not None:
+            from .friction.bound import steady_branches
+            rec.note = steady_branches(problem.law.law, Q, rec.P, rec.gross_sliding)
+        return rec
 
     def steady_by_marching(self, start: StepRecord) -> StepRecord:
         """Rolling start: roll at the initial loads until the tractions stop changing.
@@ -586,7 +590,10 @@ def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
             "versions": _versions(), "rollqp": __version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
             "step_problem": "coupled" if ops.coupled else "normal + tangential",
-            "slip_note": "step 0 of a braked start: static-shift slip per a_H of shift"}
+            "slip_note": ("step 0 of a braked start: static-shift slip per a_H of shift" if scene.load.start == "braked"
+                          else "step 0 of a rolling start: steady-rolling slip per unit rolled distance")
+                         + ("; stops of load.rolled: static-shift slip per a_H of shift" if scene.load.rolled is not None
+                            else "")}
     scalars = {"a_H": scene.a_H, "p0": scene.p0, "R": scene.R, "Estar": scene.Estar, "beta": scene.beta,
                "leading_edge": scene.leading_edge}
     return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta, extra=fields_for(scene))
@@ -643,4 +650,4 @@ def _keep_mu(problem, sol) -> None:
     """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
     the result field ``friction_coefficient``); Coulomb steps are left as they were."""
     if problem.law is not None or (type(problem.mu) is not float and np.ndim(problem.mu) != 0):
-        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s), (problem.n,)).astype(float)
+        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)

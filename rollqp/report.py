@@ -96,6 +96,7 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _bem_rows(res, scene)
     rows += _start_rows(res)
+    rows += _gross_rows(res)
     rows += energy_rows(res, scene, stresses)
     for name, val, what in closed_form_errors(res, scene):
         rows.append((f"error: {name}", f"{val:.4f}  {what}"))
@@ -114,6 +115,12 @@ def _start_rows(res: dict) -> list[tuple[str, str]]:
     """A rolling start that marched because the direct steady solve failed says so (rollqp.march)."""
     note = _meta(res).get("start_note")
     return [] if note is None else [("starting state", str(note))]
+
+
+def _gross_rows(res: dict) -> list[tuple[str, str]]:
+    """States where every contact node slips (``meta["gross_sliding"]``, rollqp.result): said in words."""
+    ks = _meta(res).get("gross_sliding") or []
+    return [] if not ks else [("gross sliding", f"every contact node slips at {len(ks)} state(s) (first: state {ks[0]})")]
 
 
 def _bem_rows(res: dict, scene) -> list[tuple[str, str]]:

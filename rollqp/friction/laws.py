@@ -217,7 +217,7 @@ class SlipVelocity:
             return self.kinetic + dm * np.where(inside, 1.0 - v / vh, 0.0), np.where(inside, -dm / vh, 0.0)
         if self.law == "rational":
             u = 1.0 + v / vh
-            return self.kinetic + dm / u, -dm / (vh * u * u)
+            return self.kinetic + dm / u, -(dm / vh) / u / u  # not vh·u·u: it overflows for u > 1e154
         if self.law == "exponential":
             e = np.exp(-v / vh)
             return self.kinetic + dm * e, -dm * e / vh

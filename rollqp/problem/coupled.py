@@ -129,9 +129,12 @@ class CoupledStep:
         _check_sliding_limit(half)
         return half
 
-    def coefficient(self, s=None):
-        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""
-        return self.mu if self.law is None or s is None else self.law.mu(s)
+    def coefficient(self, s=None, p=None):
+        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``; with the pressure
+        ``p``, outside the contact (``p <= 0``) a law takes the slip velocity as 0 (docs/friction.md)."""
+        if self.law is None or s is None:
+            return self.mu
+        return self.law.mu(s, contact=None if p is None else p > 0.0)
 
     def residuals(self, p, t, delta, xi, g=None, s=None) -> "Residuals":
         """rollqp's residuals of the coupled step: Signorini, friction (bound ``μp⁺``), loads (eq. 70–71);

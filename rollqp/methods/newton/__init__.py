@@ -92,7 +92,7 @@ from .coupled import solve_coupled
 from .creepage import tangential_by_creepage
 from .linear import CoupledFactors, ReducedSystem, coupled_system, coupled_vectors
 from .ncp import NormalNCP, TangentialNCP, coupled_cases, coupled_jacobian, coupled_labels, coupled_phi
-from .slip import solve_slip
+from .slip import solve_slip_step
 from .uncoupled import solve_uncoupled
 
 __all__ = ["NewtonMethod"]
@@ -201,23 +201,9 @@ class NewtonMethod:
         return self.checked(sol)
 
     def _solve_slip(self, problem, warm, t0):
-        """A slip-dependent tangential step (:mod:`.slip`): from the warm start; if that fails, once from zero
-        shear (``info["restarts"]``); with ``Q`` prescribed and both failing, by the creepage search
-        (:func:`~.creepage.tangential_by_creepage`, the ξ-prescribed solves being slip-dependent too)."""
-        try:
-            return self.checked(solve_slip(self, problem, warm, t0))
-        except SolverError as err:
-            first = err
-        try:
-            if warm is None:
-                raise first
-            sol = self.checked(solve_slip(self, problem, None, t0))  # the warm start's branch lost
-            sol.info["restarts"] = 1
-            return sol
-        except SolverError as err:
-            if problem.Q is None:
-                raise
-            return self.checked(tangential_by_creepage(self, problem, warm, t0, err))
+        """A slip-dependent tangential step (:func:`.slip.solve_slip_step`: Newton from the warm start, safeguarded
+        by the fixed point on the bound, a cold start and, with ``Q`` prescribed, the creepage search)."""
+        return solve_slip_step(self, problem, warm, t0)
 
     def augmentation(self, problem) -> float:
         """The nondimensional ``r`` used for ``problem`` (package docstring)."""
