@@ -6,7 +6,8 @@ import importlib
 
 import pytest
 
-MODULES = ["grid", "materials", "influence", "operator", "operators", "geometry", "hertz"]
+MODULES = ["grid", "materials", "influence", "operator", "operators", "geometry", "hertz", "closedforms", "newton",
+           "contact"]
 
 
 @pytest.mark.parametrize("name", MODULES)
