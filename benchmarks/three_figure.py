@@ -15,7 +15,7 @@ from rollqp.three.contact import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import steady
 from rollqp.three.materials import Materials
-from rollqp.three.newton import NewtonMethod
+from rollqp.three.gnm import NewtonMethod
 
 
 def run(elements):

@@ -6,7 +6,8 @@
 1. A steady rolling step (the normal step, then the steady tangential step, Newton) on the 30 × 30
    grid of Kalker's circle and on CONTACT's 48 × 44 tractcurv grid — CONTACT's reference outputs
    print no times, so there is no CONTACT time to set it against (said in the table);
-2. the same on 100 × 100 and 300 × 300 grids: the FFT path (no matrix is formed);
+2. the same on 100 × 100 and 300 × 300 grids: the FFT path (no matrix is formed). The normal step
+   starts from the Hertz pressure (``march.normal``), the steady step from zero traction;
 3. Clarabel's SOCP against Newton on the same tangential step, both to rollqp's residual ≤ 1e-10
    (Clarabel polished; its unpolished residual beside it), on 16 × 16, 24 × 24 and 30 × 30 grids.
 
@@ -25,9 +26,9 @@ from harness import pin_threads, table
 from rollqp.three.contact import Contact, Loads
 from rollqp.three.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
-from rollqp.three.march import steady
+from rollqp.three.march import normal, steady
 from rollqp.three.materials import Materials
-from rollqp.three.newton import NewtonMethod
+from rollqp.three.gnm import NewtonMethod
 from rollqp.three.socp import ClarabelMethod
 
 FN, MU = 1000.0, 0.3
@@ -46,7 +47,7 @@ def best_of(fn, repeats):
 def steady_step(c, FN_, loads, path, repeats):
     """(normal time, steady tangential time, record) for one steady rolling step by Newton."""
     m = NewtonMethod(path=path)
-    tn, p = best_of(lambda: m.solve(c.normal_step(FN_)), repeats)
+    tn, p = best_of(lambda: normal(c, m, FN_), repeats)
     tt, rec = best_of(lambda: steady(c, m, FN_, loads, pressure=p), repeats)
     return tn, tt, rec
 
@@ -76,7 +77,7 @@ def section_socp(quick):
     rows = []
     for n in (16, 24) if quick else (16, 24, 30):
         c = Contact.hertzian(STEEL, (1 / 60, 1 / 60), FN, MU, elements=(n, n), zone=(1.15, 1.15))
-        p = NewtonMethod().solve(c.normal_step(FN))
+        p = normal(c, NewtonMethod(), FN)
         prob = c.tangential_step("rolling", p.p, Loads(Fx=0.5 * MU * FN, eta=0.0), (p.p, 0.3 * MU * np.stack([p.p, 0 * p.p])),
                                  dq=c.grid.dx)
         tn, ref = best_of(lambda: NewtonMethod().solve(prob), 3)

@@ -30,7 +30,7 @@ from rollqp.three.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.three.materials import Materials
-from rollqp.three.newton import NewtonMethod
+from rollqp.three.gnm import NewtonMethod
 from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
 from rollqp.three.socp import ClarabelMethod, CvxpyMethod, OsqpMethod
 
@@ -62,7 +62,7 @@ def section_hertz(quick):
             c = contact_for(ratio, n)
             sol = NewtonMethod().solve(c.normal_step(FN))
             e = hertz_errors(c, sol)
-            hs.append(c.grid.dx / c.ellipse.a if ratio >= 1 else c.grid.dx / c.ellipse.a)
+            hs.append(c.grid.dx / min(c.ellipse.a, c.ellipse.b))
             for k in errs:
                 errs[k].append(e[k])
             rows.append([ratio, f"{c.grid.nx}×{c.grid.ny}", f"{hs[-1]:.4f}"] + [f"{e[k]:+.2e}" for k in errs])

@@ -6,7 +6,7 @@ import importlib
 
 import pytest
 
-MODULES = ["grid", "materials", "influence", "operator", "operators", "geometry", "hertz", "closedforms", "newton",
+MODULES = ["grid", "materials", "influence", "operator", "operators", "geometry", "hertz", "closedforms", "gnm",
            "contact"]
 
 

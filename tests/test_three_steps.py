@@ -10,7 +10,7 @@ from rollqp.three.contact import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.three.materials import Materials
-from rollqp.three.newton import NewtonMethod
+from rollqp.three.gnm import NewtonMethod
 from rollqp.three.problem import SLIP, STICK, Scales, TangentialStep
 from rollqp.three.socp import ClarabelMethod, CvxpyMethod, OsqpMethod
 
@@ -192,3 +192,18 @@ def test_scales_are_hertz():
     c = elliptic()
     e = c.ellipse
     assert c.scales == Scales(length=np.sqrt(e.a * e.b), stress=e.p0, modulus=STEEL.Estar)
+
+
+def test_the_2d_normal_machinery_solves_the_3d_normal_step(contact, pressure):
+    """The 2D package's normal step takes the 3D operator unchanged: a flattened grid is a set of nodes
+    with weights f = area/c and load FN/c (its load row (fᵀp − P)/(c p0) is then eq. 3D.27's). Its
+    Newton and QP backends give the 3D step's solution: a third route."""
+    import rollqp
+    L = contact.scales.length
+    sc = rollqp.Scales(length=L, stress=contact.scales.stress, modulus=contact.scales.modulus)
+    step = rollqp.NormalStep(A=contact.ops.Ann.dense(), f=np.full(contact.grid.n, contact.grid.area / L),
+                             h=contact.h, P=FN / L, scales=sc)
+    for method in ("newton", "qp-clarabel", "qp-osqp"):
+        sol = rollqp.solve_step(step, method)
+        assert np.max(np.abs(sol.p - pressure.p)) / contact.scales.stress <= AGREE
+        assert abs(sol.delta - pressure.delta) / contact.scales.displacement <= AGREE

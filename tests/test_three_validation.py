@@ -15,7 +15,7 @@ from rollqp.three.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import static_shift, steady, transient
 from rollqp.three.materials import Materials
-from rollqp.three.newton import NewtonMethod
+from rollqp.three.gnm import NewtonMethod
 from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
 
 DATA = Path(__file__).resolve().parent / "data" / "contact3d"

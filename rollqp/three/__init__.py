@@ -12,7 +12,7 @@ The package is layered like the 2D one; each layer imports only from the ones ab
   (the influence operators of one contact, shifted and steady ones);
 * problems: :mod:`.problem` (step problems, solutions, rollqp's residuals), :mod:`.forms` (their
   QP and SOCP forms), :mod:`.contact` (one contact, built once; it makes the step problems);
-* methods: :mod:`.newton` (generalized Newton), :mod:`.socp` (Clarabel, OSQP, cvxpy);
+* methods: :mod:`.gnm` (generalized Newton), :mod:`.socp` (Clarabel, OSQP, cvxpy);
 * problems in time: :mod:`.march` (static shift, steady rolling, transient, N–T alternation);
 * post-processing: :mod:`.post` (errors against Hertz and Cattaneo, creep coefficients).
 

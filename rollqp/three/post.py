@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .contact import Loads
-from .march import steady
+from .march import normal, steady
 
 __all__ = ["semi_axes", "hertz_errors", "creep_matrix", "cattaneo_errors"]
 
@@ -67,7 +67,7 @@ def creep_matrix(contact, method, FN: float, creepage: float = 1e-8, direction: 
     c = e.c
     C = np.zeros((3, 3))
     slipping = 0
-    pressure = None if contact.ops.coupled else method.solve(contact.normal_step(FN))
+    pressure = None if contact.ops.coupled else normal(contact, method, FN)
     for k, (xi, eta, phi) in enumerate([(creepage, 0.0, 0.0), (0.0, creepage, 0.0), (0.0, 0.0, creepage / c)]):
         rec = steady(contact, method, FN, Loads(xi=xi, eta=eta, phi=phi), direction=direction, pressure=pressure)
         slipping += int(np.sum(rec.state == 2))
