@@ -75,8 +75,8 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
 
     Parameters
     ----------
-    law : float or friction law
-        ``scene.contact.friction``.
+    law : FrictionLaw
+        ``scene.contact.friction`` (:class:`rollqp.friction.FrictionLaw`).
     x_hat : (n,) array
         The nodes in ``a_H`` units.
     q_hat : float
@@ -92,9 +92,9 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
     steady : bool
         A direct steady solve: a law with memory cannot be posed there (InputError).
     """
-    kind = getattr(law, "kind", "constant")
+    kind = law.kind
     if kind == "constant":
-        return law, None  # the number itself: the old code path
+        return law.mu, None  # the number itself (a plain float): the old code path
     if kind == "spatial":
         return law.coefficient(x_hat, q_hat, direction), None
     static = law.steady(0.0)[0]

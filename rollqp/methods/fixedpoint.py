@@ -33,6 +33,7 @@ grows ``DIVERGE_FACTOR`` times above the first (diverges), when its best value o
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -55,8 +56,6 @@ class BoundFixedPoint:
     ``info`` of a solution: ``bound_iterations``, ``bound_history`` (residual per iteration).
     """
 
-    slip_dependent = True
-
     def __init__(self, inner, max_iterations: int = 200, relaxation: float = 1.0, polish=None):
         if int(max_iterations) != max_iterations or max_iterations < 1:
             raise InputError("max_iterations", f"must be an integer >= 1, got {max_iterations!r}")
@@ -66,17 +65,19 @@ class BoundFixedPoint:
         self.max_iterations = int(max_iterations)
         self.relaxation = float(relaxation)
         self.polish = polish
-        self.name = getattr(inner, "name", "fixed-point")
-        self.solves = inner.solves
-        self.operator = getattr(inner, "operator", "exact")
+        self.name = inner.name
+        #: the inner method's, with slip-dependent bounds (posed by this fixed point), without the switches of
+        #: a march to the steady state (the prediction, the accelerated start: fixed-bound QPs only)
+        self.capabilities = dataclasses.replace(inner.capabilities, slip_dependent=True, predicting=False,
+                                                single_sweeps=False, accelerated_start=False, quasi_newton=False)
         self.tolerance = inner.tolerance
-        self.limit = float(getattr(inner, "residual_limit", None) or inner.tolerance)
+        self.limit = float(inner.capabilities.residual_limit or inner.tolerance)
 
     def setup(self, operators) -> None:
         self.inner.setup(operators)
 
     def solve(self, problem, warm=None):
-        if problem.kind != "tangential" or getattr(problem, "law", None) is None:
+        if problem.kind != "tangential" or problem.law is None:
             return self.inner.solve(problem, warm=warm)
         t0 = time.perf_counter()
         law, n = problem.law, problem.n

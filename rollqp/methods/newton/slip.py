@@ -36,7 +36,7 @@ stick row (``info["shifts"]``).
 
 **When the Newton iteration still fails** (a singular matrix, or an Armijo search that finds no
 decrease: the direction of a non-monotone law need not descend on a kink), the step is not
-given up: :func:`solve_slip_step` runs the fixed point on the bound
+given up: :func:`~.slip_step.solve_slip_step` runs the fixed point on the bound
 (:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`) with Newton's own constant-bound solves as
 its inner method, trying this iteration from each fixed-point iterate that improved (a few
 iterations from near a solution, quadratic), then a cold start, then the creepage search. A step
@@ -47,15 +47,13 @@ its start leads to — the previous step's, and then the fixed point's from the 
 """
 from __future__ import annotations
 
-import time
-
 import numpy as np
 
 from ...errors import SolverError
 from ...problem import friction_residual
 from .common import ALPHA_MIN, not_converged
 
-__all__ = ["solve_slip", "solve_slip_step"]
+__all__ = ["solve_slip", "POLISH_ITERATIONS"]
 
 #: Newton iterations allowed when polishing a fixed-point iterate (quadratic convergence from near a
 #: solution takes a handful; more means the iterate is not near enough yet).
@@ -207,66 +205,3 @@ def _direction(J, phi):
     except np.linalg.LinAlgError:
         return None
     return d if np.isfinite(d).all() else None
-
-
-def solve_slip_step(meth, pb, warm, t0):
-    """A slip-dependent tangential step, safeguarded (module docstring): Newton from ``warm``; else the fixed
-    point on the bound around Newton's constant-bound solves, polished by Newton from each iterate that
-    improved; else Newton from zero shear; with ``Q`` prescribed, else the creepage search. The first
-    error is raised if all fail, with the best residual reached."""
-    try:
-        return meth.checked(solve_slip(meth, pb, warm, t0))
-    except SolverError as err:
-        first = err
-    try:
-        return _by_fixed_point(meth, pb, warm, t0)
-    except SolverError as err:
-        second = err
-    if warm is not None:
-        try:
-            sol = meth.checked(solve_slip(meth, pb, None, t0))  # the warm start's branch lost
-            sol.info["restarts"] = 1
-            return sol
-        except SolverError:
-            pass
-    if pb.Q is not None:
-        from .creepage import tangential_by_creepage
-        try:
-            return meth.checked(tangential_by_creepage(meth, pb, warm, t0, first))
-        except SolverError:
-            pass
-    best = min(r for r in (first.residual, second.residual) if r is not None) if (
-        first.residual is not None or second.residual is not None) else None
-    inner = second.message.split("; try")[0]  # its advice names newton itself
-    raise SolverError(f"{first.message}; the fixed point on the bound failed too ({inner}); the step may "
-                      "have no quasi-static solution (a breakaway: docs/friction.md): prescribe the creepage, ramp "
-                      "the force or roll slower", method=meth.name, status=first.status, iterations=first.iterations,
-                      residual=best)
-
-
-def _by_fixed_point(meth, pb, warm, t0):
-    """The fixed point on the bound with Newton's constant-bound solves, polished by :func:`solve_slip`."""
-    from ..fixedpoint import BoundFixedPoint
-
-    def polish(sol):
-        try:
-            return meth.checked(solve_slip(meth, pb, sol, t0, max_iterations=POLISH_ITERATIONS))
-        except SolverError:
-            return None
-
-    fixed = BoundFixedPoint(_ConstantBound(meth), polish=polish)
-    sol = fixed.solve(pb, warm)
-    sol.info["fixed_point"] = sol.info.get("bound_iterations", 0)
-    sol.time = time.perf_counter() - t0
-    return meth.checked(sol)
-
-
-class _ConstantBound:
-    """Newton on the constant-bound steps of the fixed point (never its own slip path: ``law`` is None there)."""
-
-    def __init__(self, meth):
-        self.meth = meth
-        self.name, self.solves, self.tolerance = meth.name, meth.solves, meth.tolerance
-
-    def solve(self, problem, warm=None):
-        return self.meth.solve(problem, warm=warm)
