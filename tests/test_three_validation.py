@@ -93,9 +93,10 @@ def test_kalker_coefficients_small_grid():
 @pytest.mark.parametrize("ratio", [1.0, 0.5, 2.0])
 def test_kalker_coefficients_extrapolated(ratio):
     """C11, C22, C23 (and C33 where tabulated) within 1 % of Kalker's table after extrapolating
-    C(h) = C0 + C1 h over a series of grids (validation3d.md §3)."""
+    C(h) = C0 + C1 h over validation3d.md §3's 11 grids (its table: at most 0.76 %; C33 of a/b = 0.5
+    scatters ±1 % about the fit, so fewer grids can miss by more)."""
     hs, vals = [], []
-    for base in range(24, 57, 8):
+    for base in range(24, 65, 4):
         n = max(6, round(base * min(1.0, ratio)))
         c = contact_for(ratio, n, nu=0.25, zone=1.1, mu=1e3)
         C, _ = creep_matrix(c, NewtonMethod(), FN, area_normalized=True)

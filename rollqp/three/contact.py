@@ -66,9 +66,13 @@ class Contact:
     """
 
     def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None):
-        if not (isinstance(mu, (int, float)) and math.isfinite(mu) and mu >= 0):
+        try:
+            coefficient = float(mu) if not isinstance(mu, (bool, str)) else math.nan
+        except (TypeError, ValueError):
+            coefficient = math.nan
+        if not (math.isfinite(coefficient) and coefficient >= 0):   # Coulomb's constant μ only (no laws in 3D yet)
             raise InputError("contact.friction", f"must be a finite number >= 0, got {mu!r}")
-        self.grid, self.materials, self.mu = grid, materials, float(mu)
+        self.grid, self.materials, self.mu = grid, materials, coefficient
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
         self.scales = Scales.hertz(self.ellipse)

@@ -97,10 +97,11 @@ class NewtonMethod:
     --------
     >>> m = NewtonMethod(tolerance=1e-10)
     >>> m.name, sorted(m.solves)
-    ('newton', ['normal', 'steady', 'tangential'])
+    ('newton-3d', ['normal', 'steady', 'tangential'])
     """
 
-    name = "newton"
+    #: The registry's names are its own (rollqp.methods): this is the class's default label.
+    name = "newton-3d"
     solves = frozenset({"normal", "tangential", "steady"})
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, r: float | None = None,

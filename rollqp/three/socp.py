@@ -36,10 +36,7 @@ from ..errors import InputError, MissingBackendError, SolverError
 from .forms import normal_form, tangential_form
 from .gnm import NewtonMethod
 
-__all__ = ["ClarabelMethod", "OsqpMethod", "CvxpyMethod", "CONE_METHODS"]
-
-#: The 3D methods that can solve a tangential (disc-constrained) step.
-CONE_METHODS = ("newton", "socp-clarabel", "socp-cvxpy")
+__all__ = ["ClarabelMethod", "OsqpMethod", "CvxpyMethod", "cone_methods"]
 #: Largest splitting sequence; the contraction is measured and a growing change stops it earlier.
 MAX_SPLITTING = 60
 #: Newton iterations of the polish: from an interior-point answer the partition is right and
@@ -82,7 +79,7 @@ class ConicMethod:
         """Solve a normal or tangential step (eq. 3D.20/3D.21); rollqp's residuals decide."""
         if problem.kind not in self.solves:
             raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step "
-                                              f"(methods that can: {', '.join(CONE_METHODS)})")
+                                              f"(methods that can: {', '.join(cone_methods())})")
         t0 = time.perf_counter()
         form = normal_form(problem) if problem.kind == "normal" else tangential_form(problem)
         x, y, info = self._splitting(form)
@@ -214,7 +211,7 @@ class ClarabelMethod(ConicMethod):
 class OsqpMethod(ConicMethod):
     """OSQP (ADMM, polished) on the normal QP of eq. 3D.20; a tangential step is an InputError."""
 
-    name = "qp-osqp"
+    name = "qp-osqp-3d"
     solves = frozenset({"normal"})
 
     def _solve_form(self, form, q):
@@ -301,3 +298,8 @@ class CvxpyMethod(ConicMethod):
         y = np.asarray(cons[0].dual_value, dtype=float).ravel() if bp is not None else np.zeros(0)
         return np.asarray(x.value), y, {"status": prob.status, "solver": self.solver,
                                         "iterations": int(prob.solver_stats.num_iters or 0)}
+
+
+def cone_methods() -> tuple:
+    """The labels of the 3D methods that can solve a tangential (disc-constrained) step."""
+    return tuple(cls.name for cls in (NewtonMethod, ClarabelMethod, CvxpyMethod) if "tangential" in cls.solves)
