@@ -205,7 +205,7 @@ def _normal_direction(method, A, s, x, Kx, phi, r, hh, ah, free_delta):
     F = np.flatnonzero(p > r * g)
     dN = np.where(p > r * g, 0.0, -p)
     if F.size == 0:   # no element in contact: raise the approach until the nearest touches
-        d = np.append(dN, np.min(g) + 1e-12 if free_delta else 0.0)
+        d = np.append(dN, np.min(g) + 1e-12 if free_delta else 0.0)   # the nearest element just inside (ĝ units)
         return d, s * (A @ d[:n])
     KdN = s * (A @ dN)
     rhs = -g[F] - KdN[F]
@@ -237,6 +237,8 @@ def _spd_solver(method, A, s, F):
     op = spla.LinearOperator((F.size, F.size), matvec=mv, dtype=float)
 
     def solve(b):
+        # to round-off of the block's condition (~n_F): the step must be exact on its contact set for
+        # Newton's finite termination on the piecewise-linear Φ_N
         x, info = spla.cg(op, b, rtol=1e-13, atol=0.0, maxiter=20 * F.size)
         if info != 0:
             raise SolverError("normal Newton: CG on the contact set did not converge", method=method.name)
@@ -281,6 +283,8 @@ def _solve_tangential(method, problem, warm):
     crp = {j: x[2 * V.size + i] * sc.slip for i, j in enumerate(free)}
     sol = problem.solution(t, crp.get(0), crp.get(1), method=method.name, iterations=info["directions"],
                            info={**info, "contact": int(V.size)})
+    # ‖Φ‖∞ ≤ tol·min(1, r) bounds the residual on the same products; the fresh FFT product of
+    # problem.solution can differ by round-off times the condition: 100× is the 2D QPs' residual_limit
     if not sol.residual <= 100 * method.tolerance:
         raise SolverError("tangential Newton: rollqp's residual above 100·tolerance", method=method.name,
                           residual=sol.residual, iterations=sol.iterations)
@@ -395,6 +399,8 @@ class _TangentialSystem:
         P = spla.LinearOperator((m, m), matvec=self._block_preconditioner(mxx, mxy, myy), dtype=float)
 
         def solve(b):
+            # 80 × 50 iterations at most: measured ≤ 150 on the 300 × 300 grid; beyond, the inexact step
+            # still goes to the line search (info > 0 is not an error)
             x, info = spla.gmres(J, b, rtol=KRYLOV_FORCING, atol=0.0, restart=80, maxiter=50, M=P)
             if info < 0 or not np.all(np.isfinite(x)):
                 raise SolverError("tangential Newton: GMRES failed", method=self.method.name)

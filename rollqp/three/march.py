@@ -28,10 +28,12 @@ from .problem import element_states
 
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
-#: N–T alternation sweeps before a :class:`SolverError` (it contracts like ``|K|``: 10–20 sweeps
-#: to 1e-10 for K ≈ 0.1, measured in docs/validation3d.md).
+#: N–T alternation sweeps before a :class:`SolverError`: it contracts about like ``|K|`` (measured,
+#: docs/validation3d.md §7: 5–7 sweeps to 1e-15 for |K| = 0.045–0.075); 100 leaves room for |K| → 0.5.
 MAX_SWEEPS = 100
-#: Rolled distance (in units of ``c = √(ab)``) after which marching to the steady state gives up.
+#: Rolled distance (in units of ``c = √(ab)``) after which marching to the steady state gives up: the
+#: march converges in 3–6 contact lengths (docs/validation3d.md §9: 70–98 steps of dx on 20 elements
+#: across a circle ≈ 4 c); 60 c is ten times that.
 MAX_MARCH_DISTANCE = 60.0
 #: Differences kept by the Anderson acceleration of the march to the steady state (the 2D
 #: project's rolling start keeps 5): measured in docs/validation3d.md against the plain march.
@@ -197,7 +199,7 @@ def _anderson(X, Gs, scale):
     F = np.array([(g - x) / scale for x, g in zip(X, Gs)]).T
     dF = np.diff(F, axis=1)
     dG = np.diff(np.array(Gs).T, axis=1)
-    gamma = np.linalg.lstsq(dF, F[:, -1], rcond=1e-12)[0]
+    gamma = np.linalg.lstsq(dF, F[:, -1], rcond=1e-12)[0]   # drop dependent differences (a repeated iterate)
     return Gs[-1] - dG @ gamma
 
 
