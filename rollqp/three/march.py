@@ -29,7 +29,7 @@ from .problem import element_states
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
 #: N–T alternation sweeps before a :class:`SolverError`: it contracts about like ``|K|`` (measured,
-#: docs/validation3d.md §7: 5–7 sweeps to 1e-15 for |K| = 0.045–0.075); 100 leaves room for |K| → 0.5.
+#: docs/validation3d.md §7: 5–7 sweeps to 1e-15 for ``|K|`` = 0.045–0.075); 100 leaves room for ``|K|`` → 0.5.
 MAX_SWEEPS = 100
 #: Rolled distance (in units of ``c = √(ab)``) after which marching to the steady state gives up: the
 #: march converges in 3–6 contact lengths (docs/validation3d.md §9: 70–98 steps of dx on 20 elements
