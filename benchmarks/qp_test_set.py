@@ -762,14 +762,35 @@ def runtime_table(df, sizes, solvers) -> list[str]:
             table(["solver"] + [names[c] for c in classes], rows), ""]
 
 
+def summarize(out: Path, header=()) -> list[str]:
+    """The tables of the last run in ``out``: qpbenchmark's results by settings and solver versions (from its
+    report), and each answer against the certified solution (also written to ``results/certified.md``)."""
+    import qpbenchmark
+    test_set = load_test_set(out)
+    df = qpbenchmark.Results(str(out / "results" / "qpbenchmark_results.csv"), test_set).df
+    distances = {}
+    with open(out / "results" / "certified.csv", encoding="utf-8") as fh:
+        for line in fh.readlines()[1:]:
+            p, s, st, d = line.strip().split(",")
+            distances[(p, s, st)] = float(d)
+    rep = certified_report(test_set, df, distances)
+    (out / "results" / "certified.md").write_text("\n".join(list(header) + rep) + "\n", encoding="utf-8")
+    load = " / ".join(f"{v:.2f}" for v in os.getloadavg())
+    return (["## qpbenchmark's report: results by settings", ""] + report_summary(out / "results" / f"{SET_NAME}.md")
+            + ["", "## Against the certified solutions", ""] + rep
+            + [f"Load average when these tables were written: {load} (1, 5, 15 min)."])
+
+
 def report_summary(path: Path) -> list[str]:
     """The "Results by settings" tables of qpbenchmark's report at ``path``, its links made plain text."""
     import re
     text = path.read_text(encoding="utf-8")
+    versions = text.split("## Solvers\n", 1)[1].split("\n## ", 1)[0].strip()
     part = text.split("## Results by settings\n", 1)[1].split("\n## ", 1)[0]
     part = re.sub(r"\[([^\]]+)\]\(#[^)]*\)", r"\1", part)
     part = re.sub(r"\[shifted geometric mean\]\(([^)]*)\)", r"shifted geometric mean (\1)", part)
-    return part.strip().replace("### ", "#### ").splitlines()
+    return ["Solver versions (qpbenchmark's table):", ""] + versions.splitlines() + [""] + \
+        part.strip().replace("### ", "#### ").splitlines()
 
 
 def conditioning(exported: list[Exported]) -> list[str]:
@@ -797,14 +818,19 @@ def main(argv=None) -> int:
     ap.add_argument("--settings", default=None, help="with --run: only these qpbenchmark settings")
     ap.add_argument("--solver", default=None, help="with --run: only this solver")
     ap.add_argument("--author", default="rollqp", help="with --run: the author field of qpbenchmark's report")
+    ap.add_argument("--summarize", action="store_true",
+                    help="only print the tables of the last --run in --out again (nothing generated or solved)")
     args = ap.parse_args(argv)
+    out = Path(args.out)
+    if args.summarize:
+        print("\n".join(summarize(out)))
+        return 0
     selected = cases(small=args.small)
     if args.only:
         keys = [k.strip() for k in args.only.split(",") if k.strip()]
         selected = [c for c in selected if any(k in c.name for k in keys)]
         if not selected:
             ap.error(f"--only {args.only!r} matches no problem name")
-    out = Path(args.out)
     log = lambda msg: print(msg, file=sys.stderr, flush=True)  # noqa: E731
     t0 = time.perf_counter()
     exported = generate(selected, log=log)
@@ -819,13 +845,8 @@ def main(argv=None) -> int:
     print("\n".join(header + ["## The problems", ""] + lines + ["", "## Conditioning against n", ""]
                     + conditioning(exported)))
     if args.run:
-        test_set, df, distances = run_benchmark(out, settings=args.settings, solver=args.solver, log=log,
-                                                author=args.author)
-        rep = certified_report(test_set, df, distances)
-        (out / "results" / "certified.md").write_text("\n".join(header + rep) + "\n", encoding="utf-8")
-        summary = report_summary(out / "results" / f"{SET_NAME}.md")
-        print("\n".join(["", "## qpbenchmark's report: results by settings", ""] + summary
-                        + ["", "## Against the certified solutions", ""] + rep))
+        run_benchmark(out, settings=args.settings, solver=args.solver, log=log, author=args.author)
+        print("\n".join([""] + summarize(out, header)))
     return 0
 
 
