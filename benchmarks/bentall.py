@@ -48,8 +48,8 @@ from rollqp.errors import SolverError
 from rollqp.methods.alternation import Alternation
 
 # CONTACT's bentall case (materials, load, grid), one copy with tests/test_bentall.py
-from rollqp.refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
-from rollqp.refcases import bentall_scene  # noqa: E402
+from refcases import CONTACT_DX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid  # noqa: E402,F401
+from refcases import bentall_scene  # noqa: E402
 
 CONTACT = {1e-4: ("5.260e-4", "goodman"), 0.05: ("4.29e-4", "full")}
 
@@ -57,7 +57,7 @@ CONTACT = {1e-4: ("5.260e-4", "goodman"), 0.05: ("4.29e-4", "full")}
 # =========================================================================== helpers
 def scene(mu, elements=80, element="constant", coupling="goodman", direction=-1, zone=1.1, swap=False,
           method="newton"):
-    """Aluminium (A) on steel (B), free rolling, steady, Δq = Le (rollqp.refcases.bentall_scene)."""
+    """Aluminium (A) on steel (B), free rolling, steady, Δq = Le (bentall_scene in benchmarks/refcases.py)."""
     return bentall_scene(mu, elements=elements, element=element, coupling=coupling, direction=direction,
                          zone=zone, swap=swap, method=method)
 

@@ -23,10 +23,10 @@ import numpy as np
 from harness import table  # (pins BLAS first)
 
 from rollqp import closedforms as cf
-from rollqp.friction.cases import VELDEP, veldep_scene
-from rollqp.friction.fixedpoint import BoundFixedPoint
+from rollqp.methods.fixedpoint import BoundFixedPoint
 from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
+from friction_cases import VELDEP, veldep_scene
 
 MESHES = (23, 46, 92, 184, 368)
 

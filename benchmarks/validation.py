@@ -38,9 +38,9 @@ from rollqp import closedforms as cf
 from rollqp.operators import SceneOperators
 
 
-# CONTACT's inputs (refdata README) and its problem as a scene: rollqp.refcases, one copy with
+# CONTACT's inputs (refdata README) and its problem as a scene: benchmarks/refcases.py, one copy with
 # the tests.
-from rollqp.refcases import (E_CONTACT, FN_CONTACT, G_CONTACT, MU_CONTACT, NU_CONTACT,  # noqa: E402,F401
+from refcases import (E_CONTACT, FN_CONTACT, G_CONTACT, MU_CONTACT, NU_CONTACT,  # noqa: E402,F401
                               RATIO_CONTACT as RATIO, REFDATA, contact_scene, convergence_errors)
 from rollqp.report import rms_in_contact  # noqa: E402
 

@@ -1,6 +1,6 @@
 """Falling friction: the steady creep curve ξ → Q of CONTACT's veldep_fric problem, with its branches.
 
-Traced twice with the Newton method's direct steady solve (rollqp.friction.cases.veldep_scene:
+Traced twice with the Newton method's direct steady solve (veldep_scene of benchmarks/friction_cases.py:
 exponential law μ = 0.18 + 0.12 exp(−V|s|/100 mm/s), V = 45 m/s):
 
 * **creepage prescribed** (each ξ solved from the braked state): one solution per ξ, rising to a
@@ -18,12 +18,16 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 import numpy as np
 
 from rollqp.errors import InputError, SolverError
-from rollqp.friction.cases import VELDEP, veldep_scene
 from rollqp.march import run
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # the reference cases (not installed)
+from friction_cases import VELDEP, veldep_scene  # noqa: E402
 
 
 def creep_by_creepage(xis, speed, elements):

@@ -1,8 +1,8 @@
 """A patch of low friction rolling through a Carter contact: the creepage transient and the zones.
 
-CONTACT's Cattaneo → Carter problem (rollqp.refcases.contact_scene: μ = 0.1, Q = 0.5 μP
+CONTACT's Cattaneo → Carter problem (contact_scene of benchmarks/refcases.py: μ = 0.1, Q = 0.5 μP
 prescribed, braked start) with a patch of μ = 0.05 on [2, 2.5] a_H of body A's material at q = 0
-(rollqp.friction.cases.patch_scene); the material moves with d = −1, so the patch enters the
+(patch_scene of benchmarks/friction_cases.py); the material moves with d = −1, so the patch enters the
 contact at the leading edge x = +a_H at q ≈ 1 a_H and leaves at x = −a_H at q ≈ 3.5 a_H.
 Compared with the same run without the patch (constant μ = 0.1).
 
@@ -13,11 +13,15 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 import numpy as np
 
-from rollqp.friction.cases import patch_scene
 from rollqp.march import run
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))  # the reference cases (not installed)
+from friction_cases import patch_scene  # noqa: E402
 
 
 def main(argv=None):

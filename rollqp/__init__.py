@@ -20,7 +20,7 @@ open_result                              a result file as an xarray Dataset (ext
 closedforms                              Hertz, Cattaneo, Carter, creep law, McEwen
 stresses                                 subsurface stresses of a state (rollqp.stresses module)
 """
-__version__ = "0.1.0"
+from .version import __version__  # noqa: F401
 
 from . import closedforms
 from .errors import InputError, MissingBackendError, RollqpError, SolverError

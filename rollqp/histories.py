@@ -31,7 +31,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from .errors import InputError
-from .scene.validate import finite_real, is_real, positive_real, real_sequence, suggestion
+from .validate import finite_real, is_real, positive_real, real_sequence, suggestion
 
 __all__ = ["History", "Constant", "Ramp", "Harmonic", "Table", "HISTORY_KINDS",
            "parse_history"]
@@ -42,7 +42,7 @@ MAX_HARMONIC_PEAKS = 100_000
 
 
 # --------------------------------------------------------------------------- value checks
-# (the project's one set of validators: rollqp.scene.validate)
+# (the project's one set of validators: rollqp.validate)
 def _q_end(q_end: Any) -> float:
     x = finite_real("q_end", q_end, "a finite number >= 0")
     if x < 0:
@@ -105,7 +105,7 @@ class History:
             d[f.name] = list(v) if isinstance(v, tuple) else v
         return d
 
-    #: each field's validator (rollqp.scene.validate), named ``key.field`` in its errors
+    #: each field's validator (rollqp.validate), named ``key.field`` in its errors
     checks: ClassVar[dict] = {}
 
     # normalization shared by __post_init__ and parse_history

@@ -49,7 +49,7 @@ import numpy as np
 from .errors import InputError, SolverError
 from .kinematics import HistoryCache, plan
 from .operators import SceneOperators
-from .problem import SLIP, STICK, StepSolution, classify
+from .problem import SLIP, STICK, State, StepSolution, classify
 from .result import Result
 from .scene import Scene, load_scene
 
@@ -61,23 +61,6 @@ __all__ = ["State", "StepRecord", "march", "run", "prepare"]
 STEADY_TOL = 1e-8
 #: … or after this many a_H of rolling (Carter's transient dies out within ~3 a_H).
 STEADY_MAX_DISTANCE = 40.0
-
-
-@dataclass(frozen=True)
-class State:
-    """An accepted state: tractions, the relative displacement ``w``, and the solutions behind it.
-
-    ``nsol`` is the normal half's solution (``normal`` its problem) and ``tsol`` the tangential
-    one; for a coupled step both are the one coupled :class:`~rollqp.problem.StepSolution`.
-    They are the warm starts of the next step.
-    """
-
-    p: np.ndarray
-    t: np.ndarray
-    w: np.ndarray
-    nsol: StepSolution | None = None
-    tsol: StepSolution | None = None
-    normal: object = None
 
 
 @dataclass
@@ -597,10 +580,10 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
 
 def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
     """An empty :class:`Result` with the scene's scalars, metadata and the computed fields it needs."""
-    import rollqp
+    from .version import __version__
     from .fields import fields_for
     meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info),
-            "versions": _versions(), "rollqp": rollqp.__version__,
+            "versions": _versions(), "rollqp": __version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
             "step_problem": "coupled" if ops.coupled else "normal + tangential",
             "slip_note": "step 0 of a braked start: static-shift slip per a_H of shift"}

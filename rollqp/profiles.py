@@ -34,7 +34,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from .errors import InputError
-from .scene.validate import choice, finite_real, positive_real, real_sequence, suggestion
+from .validate import choice, finite_real, positive_real, real_sequence, suggestion
 
 __all__ = ["Profile", "Feature", "Table", "Flat", "Defect", "FEATURE_KINDS", "register", "parse_profile",
            "circle_height", "DEFECT_SHAPES"]

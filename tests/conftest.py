@@ -19,13 +19,19 @@ collocation problem itself; quadratic elements (the paper's QCE) do not.
 from __future__ import annotations
 
 import functools
+import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rollqp
 from rollqp import closedforms as cf
+
+# The reference cases the tests share with the benchmarks (benchmarks/refcases.py,
+# benchmarks/friction_cases.py): fixtures, not part of the installed package.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 
 
 @pytest.fixture(scope="session", autouse=True)

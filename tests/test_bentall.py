@@ -41,8 +41,8 @@ import pytest
 import rollqp
 from rollqp import closedforms as cf
 # CONTACT's bentall case, one copy with benchmarks/bentall.py
-from rollqp.refcases import CONTACT_DX, CONTACT_MX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid
-from rollqp.refcases import bentall_scene as _bentall_scene
+from refcases import CONTACT_DX, CONTACT_MX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid
+from refcases import bentall_scene as _bentall_scene
 
 #: CONTACT's free-rolling creepages (magnitudes), as quoted in the issue, and their coupling.
 CONTACT_XI = {1e-4: (5.260e-4, "goodman", 1e-7), 0.05: (4.29e-4, "full", 1e-6)}  # value, coupling, last digit
@@ -50,7 +50,7 @@ CONTACT_XI = {1e-4: (5.260e-4, "goodman", 1e-7), 0.05: (4.29e-4, "full", 1e-6)} 
 
 def bentall_scene(mu, elements=80, element="constant", coupling="goodman", direction=-1, zone=1.1,
                   swap=False, method="qp-osqp", P=FN):
-    """Aluminium (A) on steel (B), free rolling, steady (rolling start), Δq = Le (rollqp.refcases)."""
+    """Aluminium (A) on steel (B), free rolling, steady (rolling start), Δq = Le (benchmarks/refcases.py)."""
     return _bentall_scene(mu, elements=elements, element=element, coupling=coupling, direction=direction,
                           zone=zone, swap=swap, method=method, P=P)
 

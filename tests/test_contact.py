@@ -20,16 +20,16 @@ import numpy as np
 import pytest
 
 import rollqp
-from rollqp import refcases as ref  # one copy of the problem with benchmarks/validation.py
+import refcases as ref  # one copy of the problem with benchmarks/validation.py
 from rollqp import closedforms as cf
-from rollqp.refcases import REFDATA
+from refcases import REFDATA
 
 if not REFDATA.is_dir():
     pytest.skip(f"CONTACT reference data not found at {REFDATA} (tests/data/contact)",
                 allow_module_level=True)
 
 # CONTACT's inputs (refdata README): G = 82000, ν = 0.28 for both bodies, R = 500 mm
-# (1/R = 1/1000 + 1/1000), FN' = 178.896248 N/mm so that a_H = 1 mm, μ = 0.1 (rollqp.refcases).
+# (1/R = 1/1000 + 1/1000), FN' = 178.896248 N/mm so that a_H = 1 mm, μ = 0.1 (benchmarks/refcases.py).
 G, NU, E, FN, MU, RATIO = (ref.G_CONTACT, ref.NU_CONTACT, ref.E_CONTACT, ref.FN_CONTACT, ref.MU_CONTACT,
                            ref.RATIO_CONTACT)
 N_TRANSIENT = 88  # DX = a/40 on ±1.1 a: 80 elements in contact

@@ -15,7 +15,7 @@ import pytest
 
 import rollqp
 from rollqp import closedforms as cf
-from rollqp.refcases import convergence_errors
+from refcases import convergence_errors
 from rollqp.report import rms_in_contact
 
 RATIO = 0.75
@@ -107,7 +107,7 @@ QUANTITIES = ("hertz", "cattaneo", "carter", "creepage")
 
 
 def _errors(element, n):
-    """Errors on n elements of §6.1.1 (rollqp.refcases.convergence_errors, one copy with
+    """Errors on n elements of §6.1.1 (convergence_errors in benchmarks/refcases.py, one copy with
     benchmarks/validation.py); raises if the distance-0 run stored more than the starting state."""
     return convergence_errors(element, n)
 

@@ -16,7 +16,8 @@ from rollqp.operators import SceneOperators
 from rollqp.errors import InputError, SolverError
 from rollqp.histories import Constant
 from rollqp.methods import get_method
-from rollqp.methods.alternation import Alternation, AlternationNewton
+from rollqp.methods.alternation import Alternation
+from rollqp.methods.nt_newton import AlternationNewton
 from rollqp.methods.newton import NewtonMethod
 from rollqp.problem import CoupledStep, Scales
 from conftest import Delegate, scene_method_of

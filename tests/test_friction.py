@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from rollqp.errors import InputError, SolverError
-from rollqp.friction.cases import VELDEP, patch_scene, veldep_scene
-from rollqp.friction.fixedpoint import BoundFixedPoint
+from friction_cases import VELDEP, patch_scene, veldep_scene
+from rollqp.methods.fixedpoint import BoundFixedPoint
 from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
 from rollqp.scene import load_scene

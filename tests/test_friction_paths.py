@@ -7,7 +7,7 @@ import pytest
 
 from rollqp.errors import InputError
 from rollqp.friction.bound import step_coefficient
-from rollqp.friction.cases import patch_scene, veldep_scene
+from friction_cases import patch_scene, veldep_scene
 from rollqp.friction import parse_friction
 from rollqp.march import run
 

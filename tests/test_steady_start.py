@@ -19,7 +19,7 @@ import rollqp
 from rollqp.march import prepare
 from rollqp.methods.alternation import Alternation
 from rollqp.methods.steady_start import MapJacobian, fixed_point, sweep_map
-from rollqp.refcases import bentall_scene
+from refcases import bentall_scene
 
 #: Tolerance of the march on the change of t per step (rollqp.march.STEADY_TOL): the rolling start's
 #: answer is within it of the steady state (measured 1e-12, see the test).

@@ -11,7 +11,7 @@ problem takes in place of the old number ``mu``:
 * a slip-velocity law: a :class:`~.bound.SlipBound` — ``μ_i(s_i)`` depends on the unknown slip,
   and the step becomes a quasi-variational inequality (docs/theory.md, "Slip-dependent
   friction"), solved by the Newton method with ``∂b/∂s`` in its pseudo-Jacobian or by a
-  fixed point on the bound around any QP backend (:class:`~.fixedpoint.BoundFixedPoint`).
+  fixed point on the bound around any QP backend (:class:`rollqp.methods.fixedpoint.BoundFixedPoint`).
 
 ``contact.friction`` is a number (Coulomb) or a table with ``law = "<name>"`` and the law's keys:
 :data:`LAWS` maps each name to its record. Adding a law is one record in :mod:`.laws` with
@@ -23,7 +23,7 @@ from __future__ import annotations
 import dataclasses
 
 from ..errors import InputError
-from ..scene.validate import suggestion
+from ..validate import suggestion
 from .laws import FRAMES, MAX_FRICTION, VELOCITY_FORMS, Coulomb, Patch, SlipVelocity, Table
 
 __all__ = ["LAWS", "parse_friction", "Coulomb", "Patch", "Table", "SlipVelocity", "MAX_FRICTION", "FRAMES",
@@ -42,7 +42,7 @@ def parse_friction(value):
     if isinstance(value, (Coulomb, Patch, Table, SlipVelocity)):
         value = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
     if not isinstance(value, dict):
-        from ..scene.validate import number
+        from ..validate import number
         return number(KEY, value, f">= 0 (and <= {MAX_FRICTION:g}), or a table [contact.friction] with law = "
                                   f"{', '.join(map(repr, LAWS))}", lambda x: 0 <= x <= MAX_FRICTION)
     name = value.get("law")

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from ..scene.validate import choice, number, real_sequence
+from ..validate import choice, number, real_sequence
 
 __all__ = ["MAX_FRICTION", "Coulomb", "Patch", "Table", "SlipVelocity", "VELOCITY_FORMS", "FRAMES"]
 

@@ -103,7 +103,8 @@ import numpy as np
 import scipy.linalg
 
 from ..errors import InputError
-from .halfspace import COUPLINGS, Influence, _log_moments, min_eigenvalue
+from .halfspace import COUPLINGS, Influence, min_eigenvalue
+from .kernels import log_moments as _log_moments
 from .operator import asymmetry
 
 __all__ = ["AnnulusMesh", "annulus_mesh", "BEMBody", "body_matrices", "contact_compliance",

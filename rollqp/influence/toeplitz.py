@@ -11,7 +11,7 @@ On the uniform strip of :class:`rollqp.strip.Strip` every collocation matrix of
 with ``r = 1`` (constant, linear) or ``2`` (quadratic), ``a`` the local node of an element and
 ``P_a`` a generating vector of ``n - k_min = n + r(n_e - 1)`` values: the reference moments of
 the kernel at the ``O(n)`` distinct offsets times the half-length
-(:func:`~rollqp.influence.halfspace.element_offsets`). Constant elements give a Toeplitz
+(:func:`~rollqp.influence.kernels.element_offsets`). Constant elements give a Toeplitz
 matrix, linear ones a Toeplitz matrix with two boundary columns, quadratic ones a 1×2 block
 Toeplitz matrix (even and odd columns). Hence
 
@@ -33,6 +33,7 @@ import numpy as np
 from numpy.lib.stride_tricks import as_strided
 
 from ..errors import InputError
+from .kernels import assemble_elements, element_offsets, lattice_offsets, log_moments, sgn_moments
 from .operator import Operator
 
 __all__ = ["kernel_moments", "elementwise", "generators", "assemble", "ToeplitzOperator", "log_operator", "sgn_operator",
@@ -45,9 +46,8 @@ _ROWS = 256
 def kernel_moments(kernel: str):
     """The reference moments of ``kernel`` (``"log"``: eq. 26's ``ln|ξ − ξ_i|``, ``"sgn"``: eq. 29's
     ``sgn(ξ_i − ξ)``), the ``moments`` argument of :func:`generators` and :func:`elementwise`."""
-    from .halfspace import _log_moments, _sgn_moments
     try:
-        return {"log": _log_moments, "sgn": _sgn_moments}[kernel]
+        return {"log": log_moments, "sgn": sgn_moments}[kernel]
     except KeyError:
         raise InputError("kernel", f"must be 'log' or 'sgn', got {kernel!r}") from None
 
@@ -55,19 +55,17 @@ def kernel_moments(kernel: str):
 def elementwise(strip, moments) -> np.ndarray:
     """The matrix of the general (node, element) gather on the lattice offsets: the reference
     that :func:`assemble` reproduces bitwise (tests)."""
-    from .halfspace import _assemble, element_offsets
-    return _assemble(strip, moments, element_offsets(strip, True))
+    return assemble_elements(strip, moments, element_offsets(strip, True))
 
 
 def generators(strip, moments, lattice=None):
     """``(P, r)``: the generating vectors ``P[a] = hl · (moments(values) @ coef.T)[:, a]`` of a lattice strip.
 
-    ``moments`` is ``halfspace._log_moments`` or ``_sgn_moments``, ``lattice`` the result of
-    :func:`~rollqp.influence.halfspace.lattice_offsets` (computed if ``None``); ``P`` has shape
+    ``moments`` is ``kernels.log_moments`` or ``sgn_moments``, ``lattice`` the result of
+    :func:`~rollqp.influence.kernels.lattice_offsets` (computed if ``None``); ``P`` has shape
     ``(nen, n - k_min)`` with ``k_min = -r (n_e - 1)``. A strip that is not a uniform lattice is
     an :class:`InputError` on ``strip``.
     """
-    from .halfspace import lattice_offsets
     lattice = lattice_offsets(strip) if lattice is None else lattice
     if lattice is None:
         raise InputError("strip", "nodes are not a uniform lattice (the FFT operator needs one)")
@@ -246,8 +244,7 @@ def log_operator(strip, d_ref: float, scale: float = 1.0, name: str = "influence
     is folded into the generating vectors: each ``P_a`` gets the constant
     ``hl ln(d_ref/hl) ∫_{-1}^{1} N_a dξ``.
     """
-    from .halfspace import _log_moments
-    P, r = generators(strip, _log_moments)
+    P, r = generators(strip, log_moments)
     hl = 0.5 * strip.element_length
     coef = np.asarray(strip.coefficients, dtype=float)
     w_ref = 2.0 * coef[:, 0] + 2.0 * coef[:, 2] / 3.0
@@ -269,8 +266,7 @@ def _coarse_log(strip, ne: int, d_ref: float, scale: float, name: str):
 
 def sgn_operator(strip, scale: float = 1.0, name: str = "influence") -> ToeplitzOperator:
     """``scale · S`` of :func:`~rollqp.influence.halfspace.sgn_kernel_matrix` as an FFT operator."""
-    from .halfspace import _sgn_moments
-    P, r = generators(strip, _sgn_moments)
+    P, r = generators(strip, sgn_moments)
     return ToeplitzOperator(scale * P, r, strip.n, np.asarray(strip.connectivity).shape[0], name)
 
 

@@ -34,7 +34,7 @@ _REGISTRY = {
     "qp-osqp": ("rollqp.methods.qp_osqp", "OsqpQP", None),
     "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"),
     "newton": ("rollqp.methods.newton", "NewtonMethod", None),
-    "nt-newton": ("rollqp.methods.alternation", "AlternationNewton", None),
+    "nt-newton": ("rollqp.methods.nt_newton", "AlternationNewton", None),
     "mf-newton": ("rollqp.methods.krylov", "KrylovNewton", None),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
     **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers")
@@ -126,7 +126,7 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
 
     With a slip-dependent friction law (``friction = "slip"``) a method that does not declare
     ``slip_dependent`` runs inside the fixed point on the bound
-    (:class:`~rollqp.friction.fixedpoint.BoundFixedPoint`: each iteration one of its QPs). A method
+    (:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`: each iteration one of its QPs). A method
     whose coupled step takes a constant coefficient only (``newton``) refuses a law on a coupled
     scene up front, naming the alternatives.
     """
@@ -135,7 +135,7 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
                                           f"coefficient only; with a {friction} friction law on a coupled scene use "
                                           "'nt-newton' (Newton halves in the N–T alternation) or a qp-* method")
     if friction == "slip" and not getattr(method, "slip_dependent", False):
-        from ..friction.fixedpoint import BoundFixedPoint
+        from .fixedpoint import BoundFixedPoint
         method = BoundFixedPoint(method)
     if coupled and "coupled" not in method.solves:
         if not {"normal", "tangential"} <= method.solves:

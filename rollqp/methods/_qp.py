@@ -145,7 +145,7 @@ class QPMethod:
         check_kind(self, problem)
         if getattr(problem, "law", None) is not None:
             raise InputError("problem", f"method {self.name!r} solves steps with a fixed friction bound; this one depends on "
-                                        "the slip: use rollqp.friction.fixedpoint.BoundFixedPoint around it (scenes do) "
+                                        "the slip: use rollqp.methods.fixedpoint.BoundFixedPoint around it (scenes do) "
                                         "or method 'newton'")
         t0 = time.perf_counter()
         sp = problem.A.split(problem.f)

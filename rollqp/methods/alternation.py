@@ -31,7 +31,6 @@ import time
 import numpy as np
 
 from ..errors import InputError, SolverError
-from .base import check_options
 
 
 def sweep(method, problem, t, warm_n=None, warm_t=None):
@@ -185,23 +184,3 @@ STALL_WINDOW = 20
 STALL_FACTOR = 0.9
 #: A residual this many times the first one is divergence.
 DIVERGE_FACTOR = 1e6
-
-
-class AlternationNewton(Alternation):
-    """``nt-newton``: the N–T alternation with Newton (GNMls) halves (paper §6.3)."""
-
-    name = "nt-newton"
-
-    def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
-        from .newton import NewtonMethod
-        super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),
-                         max_outer=max_outer)
-        self.name = "nt-newton"
-
-    @classmethod
-    def from_settings(cls, settings, **options) -> "AlternationNewton":
-        """From a scene's solver settings: ``max_iterations`` bounds both the Newton iterations of each
-        half and the outer iterations; ``augmentation`` is the halves' ``r``."""
-        check_options(cls.name, options, ("rho", "sigma"))
-        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations,
-                   max_outer=settings.max_iterations, r=settings.augmentation, **options)

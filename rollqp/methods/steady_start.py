@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError, SolverError
+from ..problem import State
 from ._qp import QPMethod, _chol_solve, _kkt_factor
 from .alternation import Alternation
 
@@ -364,7 +365,6 @@ def qp_response(form, x, y, dq, dbound=None):
 
 def _state(ops, start, best, *, P, Q, xi, dq, M, delta):
     """The march ``State`` of a map output ``G(x)`` (its solutions warm-start the march's next step)."""
-    from ..march import State
     x, t, nsol, tsol = best
     p = nsol.p
     if not ops.coupled:

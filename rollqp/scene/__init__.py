@@ -37,8 +37,7 @@ Besides the per-key ranges, a scene is checked as a whole (docs/formulation.md �
 * a harmonic history is resolved by the steps (at least two per wavelength).
 
 The package, one responsibility per module: :mod:`.schema` (the plain records and allowed
-values), :mod:`.validate` (one set of validators, shared with the histories, the closed forms
-and the influence builders), :mod:`.checks` (each part, then the whole), :mod:`.derived` (E*, R,
+values), :mod:`.checks` (each part, then the whole), :mod:`.derived` (E*, R,
 β, the Hertz scales, Δq, the loads at q), :mod:`.core` (the :class:`Scene`), :mod:`.io` (TOML,
 dicts and the built-in scenes in and out).
 
@@ -49,9 +48,7 @@ from __future__ import annotations
 
 import importlib
 
-#: Public name -> submodule. Loaded on first use (PEP 562), so that the histories, the closed
-#: forms and the influence builders can import :mod:`rollqp.scene.validate` (a leaf module)
-#: without loading the scene itself, and ``import rollqp`` stays light.
+#: Public name -> submodule. Loaded on first use (PEP 562), so that ``import rollqp`` stays light.
 _EXPORTS = {
     **{k: ".core" for k in ("Scene",)},
     **{k: ".io" for k in ("builtin_scenes", "load_scene", "scene_from_dict", "scene_from_toml", "scene_to_dict",

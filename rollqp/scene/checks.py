@@ -1,7 +1,7 @@
 """The scene's checks: each part key by key, then the scene as a whole, before any work.
 
 Per part (:func:`check_body` … :func:`check_solver`): types and ranges of every key, through the
-one set of validators (:mod:`.validate`). As a whole (:func:`check_whole`,
+one set of validators (:mod:`rollqp.validate`). As a whole (:func:`check_whole`,
 docs/formulation.md §1, §9): the loads over the rolled distance, the contact inside the zone, the
 convective-local step, the BEM geometry, the derived quantities finite (no overflow from extreme
 but finite inputs) and the work a scene asks for within bounds (nodes, steps, memory) — each
@@ -23,7 +23,7 @@ from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, CO
                      ELEMENT_TYPES, FORMULATION_TYPES, MAX_ELEMENTS, MAX_NODES, MAX_START_STEPS, MAX_STEPS,
                      MODELS, OPERATOR_MODES, STARTS,
                      Body, Contact, Discretization, Load, SolverSettings)
-from .validate import choice, integer, number, string
+from ..validate import choice, integer, number, string
 
 #: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
 MAX_FRICTION = 1e6

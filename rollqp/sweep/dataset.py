@@ -148,8 +148,8 @@ def _coord_names(dims) -> str:
 
 def _global_attrs(sweep, fields) -> dict:
     from ..march import _versions
-    import rollqp
-    versions = dict(_versions(), rollqp=rollqp.__version__)
+    from ..version import __version__
+    versions = dict(_versions(), rollqp=__version__)
     for pkg in ("dask", "distributed", "xarray", "zarr"):
         try:
             versions[pkg] = __import__(pkg).__version__

@@ -64,7 +64,7 @@ Deviations from the paper, both on degenerate iterates only:
   not the directional derivative), the full step is taken (counted in ``info["nonmonotone"]``);
 * if a tangential step with ``Q`` prescribed still fails (one stick node: the repair above can
   cycle, e.g. free rolling at μ ≲ 3e-4), it is solved with ``ξ`` prescribed and ``ξ`` is searched
-  for ``fᵀt = Q`` (:func:`~.uncoupled.tangential_by_creepage`; counted in ``info["creepage_search"]``).
+  for ``fᵀt = Q`` (:func:`~.creepage.tangential_by_creepage`; counted in ``info["creepage_search"]``).
 
 Robustness (docs/stability.md): the nondimensional ``r`` may be set (``[solver] augmentation``,
 the same for both rows) within [1e-6, 10], where every hard case converges; failures are
@@ -89,10 +89,11 @@ from ...problem import StepSolution
 from ..base import check_options
 from . import linear
 from .coupled import solve_coupled
+from .creepage import tangential_by_creepage
 from .linear import CoupledFactors, ReducedSystem, coupled_system, coupled_vectors
 from .ncp import NormalNCP, TangentialNCP, coupled_cases, coupled_jacobian, coupled_labels, coupled_phi
 from .slip import solve_slip
-from .uncoupled import solve_uncoupled, tangential_by_creepage
+from .uncoupled import solve_uncoupled
 
 __all__ = ["NewtonMethod"]
 
@@ -129,7 +130,7 @@ class NewtonMethod:
     name = "newton"
     solves = frozenset({"normal", "tangential", "coupled", "steady"})
     #: Solves steps whose friction bound depends on the slip (:mod:`.slip`); the others are wrapped in
-    #: the fixed point on the bound (:class:`rollqp.friction.fixedpoint.BoundFixedPoint`).
+    #: the fixed point on the bound (:class:`rollqp.methods.fixedpoint.BoundFixedPoint`).
     slip_dependent = True
     operator = "exact"  # the collocation operator itself, not F⁻¹ sym(F A)
     #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
@@ -202,7 +203,7 @@ class NewtonMethod:
     def _solve_slip(self, problem, warm, t0):
         """A slip-dependent tangential step (:mod:`.slip`): from the warm start; if that fails, once from zero
         shear (``info["restarts"]``); with ``Q`` prescribed and both failing, by the creepage search
-        (:func:`~.uncoupled.tangential_by_creepage`, the ξ-prescribed solves being slip-dependent too)."""
+        (:func:`~.creepage.tangential_by_creepage`, the ξ-prescribed solves being slip-dependent too)."""
         try:
             return self.checked(solve_slip(self, problem, warm, t0))
         except SolverError as err:

@@ -16,9 +16,10 @@ import numpy as np
 from ...errors import SolverError
 from ...problem import StepSolution
 from . import linear
+from .common import ALPHA_MIN, not_converged
 from .linear import coupled_vectors
 from .ncp import coupled_cases, coupled_phi
-from .uncoupled import ALPHA_MIN, not_converged
+
 
 __all__ = ["solve_coupled"]
 

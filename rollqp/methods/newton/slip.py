@@ -28,7 +28,7 @@ import numpy as np
 
 from ...errors import SolverError
 from ...problem import friction_residual
-from .uncoupled import ALPHA_MIN, not_converged
+from .common import ALPHA_MIN, not_converged
 
 __all__ = ["solve_slip"]
 

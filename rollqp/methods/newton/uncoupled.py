@@ -4,7 +4,7 @@ Steps 1–7 of the paper's §4 on ``Φ(z) = [φ(x, y); f̂ᵀx − load]`` with 
 ``z`` (the "halved system": ``g`` and ``s`` eliminated): the start (Step 1: the previous step, else
 a Hertz-like profile or zero shear), the direction on the reduced system (eq. 80,
 :class:`~.linear.ReducedSystem`), the Armijo line search (eq. 75–79), the repair of degenerate
-iterates, and the creepage search that rescues a tangential step with ``Q`` prescribed. The node
+iterates. The creepage search that rescues a tangential step with ``Q`` prescribed is :mod:`.creepage`. The node
 rows ``φ`` and their cases (eq. 82–88) are :mod:`.ncp`'s.
 """
 from __future__ import annotations
@@ -14,27 +14,11 @@ import math
 import numpy as np
 
 from ...errors import SolverError
+from .common import ALPHA_MIN, Stalled, not_converged  # noqa: F401 - re-exported
 from .linear import partial_product
 from .ncp import NormalNCP, TangentialNCP
 
-__all__ = ["ALPHA_MIN", "Stalled", "not_converged", "solve_uncoupled", "solve_normal", "solve_tangential",
-           "tangential_by_creepage"]
-
-#: Smallest Armijo step tried before the full step is taken anyway (see the package docstring).
-ALPHA_MIN = 1e-10
-
-
-class Stalled(Exception):
-    """The Armijo search failed from a warm start (the step is then restarted cold)."""
-
-
-def not_converged(meth, kind: str, merits, it: int, nrm: float, stop: float) -> SolverError:
-    """The error of an iteration that reached ``max_iterations``: the merit, the iterations, ``‖Φ‖∞``."""
-    theta = merits[-1]
-    return SolverError(f"the {kind} Newton iteration did not converge: merit θ = {theta:.3e} after {it} iterations "
-                       f"(‖Φ‖∞ = {nrm:.3e} > {stop:.1e})", method=meth.name, status=f"merit {theta:.3e}",
-                       iterations=it, residual=nrm)
-
+__all__ = ["ALPHA_MIN", "Stalled", "not_converged", "solve_uncoupled", "solve_normal", "solve_tangential"]
 
 def solve_uncoupled(meth, problem, warm, t0):
     """A normal or tangential step; a warm start that stalls is restarted once cold."""
@@ -376,88 +360,3 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
     return st.z, it, info, st.xphys, st.Ax
-
-
-# ------------------------------------------------------------------------------ the creepage search
-def tangential_by_creepage(meth, pb, warm, t0, err):
-    r"""Fallback when GNMls fails on a tangential step with ``Q`` prescribed: solve for ``ξ``.
-
-    The failure this repairs: with a single stick node (free rolling at μ ≲ 3e-4) the load
-    row's only ``ξ̂`` entry is that node's, and the "nearest node onto its kink" repair (package
-    docstring) makes Newton cycle between active sets. With ``ξ`` prescribed instead the load
-    row is gone and GNMls converges (CONTACT's workaround: solve with ξ given first). The
-    load is then met by a root search on ``F(ξ̂) = f̂ᵀt̂(ξ̂) − Q̂``, continuous, piecewise
-    linear and monotone (friction opposes slip), each evaluation a ξ-prescribed solve warm
-    started from the previous one: bracketing by doubling steps from the warm ``ξ``, then
-    Brent's method. The root's traction then warm-starts the Q-prescribed GNMls (one or two
-    iterations on the right active set); if that fails too, the ξ-prescribed solution at the
-    root is kept when rollqp's residual of the original problem is within tolerance.
-    Counted in ``info["creepage_search"]`` (evaluations). Otherwise ``err`` is raised.
-    """
-    search = _CreepageSearch(meth, pb, warm, t0, int(err.iterations or 0))
-    try:
-        at_root = search.root()
-    except (SolverError, ValueError, RuntimeError):  # a ξ-prescribed solve failed, or Brent did not converge
-        raise err from None
-    if at_root is None:
-        raise err
-    try:
-        if pb.law is not None:  # a slip-dependent bound (rollqp.methods.newton.slip)
-            from .slip import solve_slip
-            sol = solve_slip(meth, pb, at_root, t0)
-        else:
-            sol = solve_tangential(meth, pb, at_root, t0)
-    except (SolverError, Stalled):
-        sol = pb.solution(at_root.t, at_root.xi)
-        if not sol.residual <= meth.tolerance:
-            raise err from None
-        sol = meth.finish(sol, at_root.iterations, dict(at_root.info), t0)
-    sol.info["creepage_search"] = search.evals + 1
-    sol.iterations += search.its + at_root.iterations  # all Newton iterations of the step
-    return sol
-
-
-class _CreepageSearch:
-    """The root search of :func:`tangential_by_creepage` on ``F(ξ̂) = f̂ᵀt̂(ξ̂) − Q̂``."""
-
-    def __init__(self, meth, pb, warm, t0, its):
-        self.meth, self.pb, self.t0 = meth, pb, t0
-        self.sol, self.evals, self.its = warm, 0, its
-        sc = pb.scales
-        self.Qhat = pb.Q / sc.force
-        self.fhat = pb.f / sc.length
-
-    def solve_at(self, xh):
-        sc = self.pb.scales
-        sub = self.pb.replace(Q=None, xi=xh * sc.slip)
-        if sub.law is not None:  # a slip-dependent bound (rollqp.methods.newton.slip)
-            from .slip import solve_slip
-            return self.meth.checked(solve_slip(self.meth, sub, self.sol, self.t0))
-        return solve_uncoupled(self.meth, sub, self.sol, self.t0)
-
-    def F(self, xh):
-        self.evals += 1
-        sol = self.solve_at(xh)
-        self.sol = sol
-        self.its += sol.iterations
-        return float(self.fhat @ (sol.t / self.pb.scales.stress)) - self.Qhat
-
-    def root(self):
-        """The ξ-prescribed solution at the root of ``F``, or ``None`` if no sign change is found."""
-        from scipy.optimize import brentq
-        pb, sc, warm = self.pb, self.pb.scales, self.sol
-        x0 = warm.xi / sc.slip if warm is not None and warm.xi is not None else 0.0
-        f0 = self.F(x0)
-        h = 2.0 * (pb.mu if np.ndim(pb.mu) == 0 else float(np.max(pb.mu))) * max(float(np.max(pb.p)) / sc.stress, 1e-12) + 1e-6
-        lo = hi = x0
-        flo = fhi = f0
-        for _ in range(80):  # widen both ways until F changes sign
-            if flo * fhi <= 0.0:
-                break
-            lo, hi = lo - h, hi + h
-            flo, fhi = self.F(lo), self.F(hi)
-            h *= 2.0
-        else:
-            return None
-        root = brentq(self.F, lo, hi, xtol=1e-15, rtol=1e-15, maxiter=200) if flo * fhi < 0 else (lo if flo == 0 else hi)
-        return self.solve_at(root)

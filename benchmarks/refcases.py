@@ -25,9 +25,9 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from . import closedforms as cf
-from .report import rms_in_contact
-from .scene import Scene, load_scene, scene_from_dict
+from rollqp import closedforms as cf
+from rollqp.report import rms_in_contact
+from rollqp.scene import Scene, load_scene, scene_from_dict
 
 #: CONTACT's result files, shipped with the source repository in ``tests/data/contact`` (numbers
 #: computed with CONTACT, Apache-2.0; README and LICENSE there); ``$ROLLQP_CONTACT_REFDATA``
@@ -99,7 +99,7 @@ def convergence_errors(element, n, method="qp-osqp") -> dict:
     base = load_scene("cattaneo-carter")
     s = base.replace(**{"discretization.elements": n, "discretization.element": element,
                         "discretization.distance": 0.0, "solver.method": method})
-    from .march import run
+    from rollqp.march import run
     r = run(s).arrays()
     if len(r["q"]) != 1:
         raise AssertionError("distance 0: the starting state only")

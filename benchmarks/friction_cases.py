@@ -8,13 +8,13 @@ docs/friction.md.
   cylinders of 920 mm: the same R), G = 82000, ν = 0.28, FN = 622216 N on DY = 200 mm (3111.08 N/mm),
   92 constant elements of DX = 0.1 mm on ±4.6 mm, creepage CKSI = −0.0009999, V = 45000 mm/s,
   exponential law μ = 0.18 + 0.12 exp(−v/100 mm/s); CHI = 0, i.e. rollqp's d = −1 (docs/validation.md).
-* :func:`patch_scene`: CONTACT's Carter problem (rollqp.refcases.contact_scene) with a patch of low
+* :func:`patch_scene`: CONTACT's Carter problem (refcases.contact_scene) with a patch of low
   friction carried by the material through the contact.
 """
 from __future__ import annotations
 
-from ..refcases import E_CONTACT, NU_CONTACT, contact_scene
-from ..scene import scene_from_dict
+from refcases import E_CONTACT, NU_CONTACT, contact_scene
+from rollqp.scene import scene_from_dict
 
 __all__ = ["VELDEP", "veldep_scene", "patch_scene"]
 
@@ -27,7 +27,7 @@ def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponentia
                  velocity=VELDEP["SABSH1"], memory=0.0, start="rolling", distance=0.0, method="newton",
                  zone_mm=VELDEP["XL"], step=1.0, tangential=None):
     """CONTACT's falling-friction problem (module docstring); ``tangential`` (Q/(μ_s P̄)) instead of the creepage."""
-    from ..closedforms import hertz_half_width
+    from rollqp.closedforms import hertz_half_width
     Estar = E_CONTACT / (2.0 * (1.0 - NU_CONTACT ** 2))
     a = hertz_half_width(VELDEP["FN"], VELDEP["R"], Estar)
     st = VELDEP["FKIN"] + VELDEP["FEXP1"] if static is None else static
@@ -54,7 +54,7 @@ def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponentia
 
 def patch_scene(mu=0.1, inside=0.05, start=2.0, end=2.5, elements=88, ratio=0.5, distance=8.0, method="newton",
                 frame="material"):
-    """CONTACT's Cattaneo → Carter problem (``rollqp.refcases.contact_scene``) with a patch ``[start, end]``
+    """CONTACT's Cattaneo → Carter problem (``refcases.contact_scene``) with a patch ``[start, end]``
     (a_H units, at q = 0) of coefficient ``inside`` carried by the material through the contact."""
     base = contact_scene(elements=elements, ratio=ratio, distance=distance, mu=mu, method=method)
     return base.replace(**{"contact.friction": {"law": "patch", "mu": mu, "inside": inside, "start": start,

@@ -1,0 +1,27 @@
+"""``nt-newton``: the normal–tangential alternation (:mod:`.alternation`) with generalized Newton halves (:mod:`.newton`)."""
+from __future__ import annotations
+
+from .alternation import Alternation
+from .base import check_options
+from .newton import NewtonMethod
+
+__all__ = ["AlternationNewton"]
+
+
+class AlternationNewton(Alternation):
+    """``nt-newton``: the N–T alternation with Newton (GNMls) halves (paper §6.3)."""
+
+    name = "nt-newton"
+
+    def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
+        super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),
+                         max_outer=max_outer)
+        self.name = "nt-newton"
+
+    @classmethod
+    def from_settings(cls, settings, **options) -> "AlternationNewton":
+        """From a scene's solver settings: ``max_iterations`` bounds both the Newton iterations of each
+        half and the outer iterations; ``augmentation`` is the halves' ``r``."""
+        check_options(cls.name, options, ("rho", "sigma"))
+        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations,
+                   max_outer=settings.max_iterations, r=settings.augmentation, **options)
