@@ -55,7 +55,7 @@ pin_threads()
 import numpy as np  # noqa: E402  (after the thread limit)
 
 import rollqp  # noqa: E402
-from rollqp.refcases import bentall_scene  # noqa: E402
+from refcases import bentall_scene  # noqa: E402  (benchmarks/refcases.py, beside this file)
 from rollqp.scene import load_scene  # noqa: E402
 
 #: rollqp's residual (nondimensional, docs/formulation.md §5) every reference solution must meet:
