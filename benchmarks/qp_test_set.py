@@ -3,7 +3,8 @@ r"""rollqp's step QPs as a qpbenchmark test set, each with a certified solution 
 
 ::
 
-    python benchmarks/qp_test_set.py [--out DIR] [--small] [--only NAMES] [--run] [--settings S] [--solver S]
+    python benchmarks/qp_test_set.py [--out DIR] [--small] [--only NAMES] [--run [--settings S] [--solver S]]
+    python benchmarks/qp_test_set.py --out DIR --summarize
 
 writes the test set to ``DIR`` (default ``qp-test-set``)::
 
@@ -40,7 +41,6 @@ primal and dual residuals and duality gap, and the projection residual ``x − P
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import json
 import os
 import sys
@@ -60,7 +60,7 @@ from rollqp.scene import load_scene  # noqa: E402
 
 #: rollqp's residual (nondimensional, docs/formulation.md §5) every reference solution must meet:
 #: Newton terminates finitely on these piecewise-linear equations, so it reaches round-off
-#: (measured ≤ 6e-15 on the 81-node steps, ≤ 1e-13 on 2561 nodes).
+#: (measured ≤ 4.3e-14 on the 40–81-node steps, ≤ 6.7e-13 on 2561 nodes).
 CERTIFIED = 1e-12
 #: qpbenchmark's high-accuracy tolerance (primal, dual, gap): every reference solution must pass it
 #: on the exported arrays (TestSet.define_tolerances).
@@ -156,9 +156,9 @@ def _hard_cases():
         Case("cc-const40-s0-normal", const, 0, "normal", what="40 constant elements: F·A exactly symmetric", group=el),
         Case("cc-const40-k48-tangential", const, 48, "tangential", what="constant elements, rolling step 48", group=el),
         Case("cc-lin40-s0-normal", lin, 0, "normal",
-             what="40 linear elements: contact edges exactly on nodes (p = g = 0 there)", group=el),
+             what="40 linear elements: the continuum's contact edges (p = g = 0) exactly on nodes", group=el),
         Case("cc-lin40-k96-tangential", lin, 96, "tangential",
-             what="linear elements, rolling step 96: Carter's stick/slip boundary on a node", group=el),
+             what="linear elements, rolling step 96: Carter's stick/slip boundary (x = 0) on a node", group=el),
         Case("cc-qr0.99-s0-tangential", qr(0.99), 0, "tangential",
              what="Q/(μP) = 0.99: Cattaneo stick zone c/a = 0.1 (one element)", group=slip),
         Case("cc-qr0.999-s0-tangential", qr(0.999), 0, "tangential",
@@ -758,7 +758,8 @@ def runtime_table(df, sizes, solvers) -> list[str]:
         ns = sorted({n for n in sizes.values() if lo <= n < hi})
         names[(lo, hi)] = f"n = {ns[0]}–{ns[-1]}" if len(ns) > 1 else f"n = {ns[0]}"
     return ["Median wall time of one solve [s], settings *high_accuracy*, by size (qpbenchmark's `runtime`: "
-            "the qpsolvers call, including the conversion of the dense matrices to the solver's format):", "",
+            "the qpsolvers call; for the solvers that take sparse matrices only, the dense ones are converted "
+            "before the clock starts):", "",
             table(["solver"] + [names[c] for c in classes], rows), ""]
 
 
@@ -803,9 +804,10 @@ def conditioning(exported: list[Exported]) -> list[str]:
         return []
     n, kappa = np.array([r[0] for r in rows], float), np.array([r[2] for r in rows])
     slope = float(np.polyfit(np.log(n), np.log(kappa), 1)[0])
-    lines = [table(["n", "problem", "κ(P)", "κ(P_FF)", "κ(KKT)", "λ_min(P)", "κ(P)/n"],
-                   [(r[0], f"`{r[1]}`", _g(r[2]), _g(r[3]), _g(r[4]), _g(r[5]), f"{r[2] / r[0]:.1f}") for r in rows])]
-    return lines + ["", f"Least-squares fit: κ(P) ∝ n^{slope:.2f} (λ_max(P) = O(1): P is scaled to a unit largest diagonal)."]
+    lines = [table(["n", "problem", "κ(P)", "κ(P_FF)", "κ(KKT)", "λ_min(P)", "λ_max(P)", "κ(P)/n"],
+                   [(r[0], f"`{r[1]}`", _g(r[2]), _g(r[3]), _g(r[4]), _g(r[5]), _g(r[2] * r[5]), f"{r[2] / r[0]:.1f}")
+                    for r in rows])]
+    return lines + ["", f"Least-squares fit: κ(P) ∝ n^{slope:.2f} (P scaled to a unit largest diagonal entry)."]
 
 
 # ------------------------------------------------------------------------------------ command line

@@ -19,6 +19,7 @@ step) is generated once per module, written to disk and read back through the ge
 from __future__ import annotations
 
 import ast
+import functools
 import sys
 from pathlib import Path
 
@@ -75,10 +76,18 @@ def test_references_pass_qpbenchmarks_own_checks(small_set):
                                                                      ref.duality_gap())
 
 
+@functools.lru_cache(maxsize=None)
+def _record(name):
+    """``(scene, record)`` of the small set's case ``name``: its scene marched with Newton at 1e-12 (once)."""
+    case = next(c for c in qts.cases(small=True) if c.name == name)
+    scene = case.scene().replace(**{"solver.tolerance": 1e-12})
+    return scene, qts.march_states(scene, [case.k])[case.k]
+
+
 def _step_problems(case):
     """``(half, qp problem)`` of a case, rebuilt from its scene: the collocation half-step and the
     (shifted, symmetrized) step whose KKT system the exported QP is."""
-    rec = qts.march_states(case.scene(), [case.k])[case.k]
+    rec = _record(case.name)[1]
     half, sol, prev = qts.halves(rec)[case.half]
     frozen = qts.traction(half, sol) if case.stage == "step" else prev
     return half, qts.qp_problem(half, frozen)[0]
@@ -114,8 +123,7 @@ def test_the_exported_qp_is_the_one_rollqp_solves(small_set):
     out, exported, test_set = small_set
     problems = _problems(test_set)
     for e in (e for e in exported if e.case.stage == "step"):
-        scene = e.case.scene().replace(**{"solver.tolerance": 1e-12})
-        rec = qts.march_states(scene, [e.case.k])[e.case.k]
+        scene, rec = _record(e.case.name)
         _, _, ops = prepare(scene, "newton")
         form = from_record(scene, ops, "newton", rec).qp_forms()[e.case.half]
         pb = problems[e.case.name]
