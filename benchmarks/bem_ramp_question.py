@@ -25,7 +25,6 @@ from __future__ import annotations
 from harness import machine_table, pyplot, table  # noqa: F401  (pins BLAS first)
 
 import argparse  # noqa: E402
-import contextlib  # noqa: E402
 import dataclasses  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
@@ -33,8 +32,7 @@ import sys  # noqa: E402
 import numpy as np  # noqa: E402
 
 import rollqp  # noqa: E402
-import rollqp.operators as _ops  # noqa: E402
-from rollqp.influence import build_influence  # noqa: E402
+from rollqp.influence import get_model, register_model  # noqa: E402
 
 ALUMINIUM = {"E": 2 * 23000.0 * 1.31, "nu": 0.31}   # tests/test_steady.py
 RAMP_END = 8.0 / 3.0                                 # q/a_H where the built-in ramp ends
@@ -60,7 +58,7 @@ def windup_compliance(scene) -> float:
     On the BEM this is the rigid rotation of both rims on their shafts plus the local
     deformation; on the half-space the constant of its log kernel, set by ``d_ref``.
     """
-    ops = _ops.SceneOperators.build(scene)
+    ops = rollqp.SceneOperators.build(scene)
     x, f = ops.strip.x, ops.f
     t = (np.abs(x) <= scene.a_H).astype(float)
     w = ops.Att @ t
@@ -75,40 +73,40 @@ def torsion_compliance(scene) -> float:
     return sum((b.radius ** 2 / b.shaft_radius ** 2 - 1.0) / (4.0 * math.pi * b.G) for b in (scene.A, scene.B))
 
 
-@contextlib.contextmanager
-def patched_influence(edit):
-    """Build every influence as usual, then pass it through ``edit(infl, strip, kw)``."""
-    original = _ops.build_influence
+#: (model name, edit) → the name of the model registered for them (:func:`edited`)
+_EDITED: dict = {}
 
-    def build(model, strip, **kw):
-        return edit(original(model, strip, **kw), strip, kw)
 
-    _ops.build_influence = build
-    try:
-        yield
-    finally:
-        _ops.build_influence = original
+def edited(scene, edit):
+    """``scene`` with its influence model's matrices passed through ``edit(infl, strip, scene)``: a model registered
+    once per (model, edit) through the public extension point (rollqp.influence.register_model)."""
+    base = get_model(scene.contact.model)
+    if (base.name, edit) not in _EDITED:
+        name = f"{base.name}-edited-{len(_EDITED)}"
+        register_model(dataclasses.replace(base, name=name, operators=None,
+                                           build=lambda sc, strip: edit(base.build(sc, strip), strip, sc)))
+        _EDITED[base.name, edit] = name
+    return scene.replace(**{"contact.model": _EDITED[base.name, edit]})
 
 
 def add_windup(dc):
     """Edit: ``A_tt + dc·e fᵀ`` (a rigid tangential shift of the rims of dc per unit Q)."""
-    def edit(infl, strip, kw):
+    def edit(infl, strip, scene):
         Att = np.array(infl.Att) + dc * np.outer(np.ones(strip.n), strip.weights)
         return dataclasses.replace(infl, Att=Att)
     return edit
 
 
-def halfspace_coupling(infl, strip, kw):
+def halfspace_coupling(infl, strip, scene):
     """Edit: the BEM's A_tn, A_nt replaced by the half-space's (same coupling level)."""
-    hs = build_influence("halfspace", strip, **{k: v for k, v in kw.items()
-                                                if k not in ("A", "B", "n_outer", "n_inner")})
+    hs = get_model("halfspace").build(scene, strip)
     return dataclasses.replace(infl, Atn=hs.Atn, Ant=hs.Ant)
 
 
 def creepage(scene, edit=None):
     """``(q/a_H, Q, ξ)`` of a Newton run of ``scene`` (influence edited by ``edit``)."""
-    with patched_influence(edit) if edit else contextlib.nullcontext():
-        a = rollqp.run(scene.replace(**{"solver.method": "newton"}), method="newton").arrays()
+    s = edited(scene, edit) if edit else scene
+    a = rollqp.run(s.replace(**{"solver.method": "newton"}), method="newton").arrays()
     return a["q"] / scene.a_H, a["Q"], a["creepage"]
 
 
@@ -151,8 +149,7 @@ def study(aluminium, shaft, distance):
 
 
 def steady_creepage_edited(scene, edit, ratio=0.75):
-    with patched_influence(edit):
-        return steady_creepage(scene, ratio)
+    return steady_creepage(edited(scene, edit), ratio)
 
 
 def tables(results, distance) -> str:

@@ -36,6 +36,7 @@ steady state for constant elements with Δq = Le: tests/test_steady.py).
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import time
 
@@ -253,7 +254,9 @@ def section_newton():
 class PlainMarch(Alternation):
     """The rolling start without Anderson acceleration: one N–T sweep per marching step, then converged steps."""
 
-    accelerated_start = False
+    def __init__(self, *args, **kw):
+        super().__init__(*args, **kw)
+        self.capabilities = dataclasses.replace(self.capabilities, accelerated_start=False)
 
 
 def unpredicted(name, tolerance):
@@ -267,13 +270,17 @@ def unpredicted(name, tolerance):
 class AndersonOnly(Alternation):
     """The accelerated start without its Newton phase: plain steps, then Anderson (before the phase)."""
 
-    quasi_newton = False
+    def __init__(self, *args, **kw):
+        super().__init__(*args, **kw)
+        self.capabilities = dataclasses.replace(self.capabilities, quasi_newton=False)
 
 
 class FullAlternation(PlainMarch):
     """The plain march with the alternation converged at every step (rollqp before issue 18)."""
 
-    single_sweeps = None  # rollqp.march then never switches to one sweep per step
+    def __init__(self, *args, **kw):
+        super().__init__(*args, **kw)  # rollqp.march then never switches to one sweep per step
+        self.capabilities = dataclasses.replace(self.capabilities, single_sweeps=False)
 
 
 def timed_cpu_run(s, method):

@@ -250,7 +250,7 @@ def variants(scene, repeats):
 
         def __init__(self, inner):
             self.inner, self.tolerance, self.name = inner, inner.tolerance, "cold halves"
-            self.solves, self.operator = inner.solves, inner.operator
+            self.capabilities = inner.capabilities
 
         def setup(self, operators):
             self.inner.setup(operators)

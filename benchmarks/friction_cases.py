@@ -6,28 +6,75 @@ docs/friction.md.
 * :func:`veldep_scene`: CONTACT's ``veldep_fric`` example (tests/data/contact/examples/veldep_fric.inp;
   Vollebregt & Schuttelaars, J. Sound Vib. 331 (2012) 2141): wheel R = 460 mm on a flat rail (here two
   cylinders of 920 mm: the same R), G = 82000, ν = 0.28, FN = 622216 N on DY = 200 mm (3111.08 N/mm),
-  92 constant elements of DX = 0.1 mm on ±4.6 mm, creepage CKSI = −0.0009999, V = 45000 mm/s,
-  exponential law μ = 0.18 + 0.12 exp(−v/100 mm/s); CHI = 0, i.e. rollqp's d = −1 (docs/validation.md).
+  92 constant elements of DX = 0.1 mm, creepage CKSI = −0.0009999, V = 45000 mm/s, exponential law
+  ``FKIN + FEXP1·exp(−ln 2·v/SABSH1)`` = 0.18 + 0.12 exp(−ln 2·v/100 mm/s); CHI = 0, i.e. rollqp's d = −1
+  (docs/validation.md). CONTACT's grid has its first element *centre* at XC1 = −4.6 mm: it covers
+  −4.65 … 4.55 mm, half an element off the wheel's centre; ``grid="contact"`` (the default) puts the
+  wheel half an element off rollqp's symmetric strip likewise (:func:`offset_profile`).
+* :func:`contact_velocity`: CONTACT's SABSH1 (the slip velocity at which the falling term is *halved*)
+  as rollqp's ``velocity`` ``v_h`` of each law (docs/friction.md).
 * :func:`patch_scene`: CONTACT's Carter problem (refcases.contact_scene) with a patch of low
   friction carried by the material through the contact.
 """
 from __future__ import annotations
 
+import math
+
+import numpy as np
 from refcases import E_CONTACT, NU_CONTACT, contact_scene
+
+from rollqp.errors import InputError
 from rollqp.scene import scene_from_dict
 
-__all__ = ["VELDEP", "veldep_scene", "patch_scene"]
+__all__ = ["VELDEP", "veldep_scene", "patch_scene", "contact_velocity", "offset_profile"]
 
 #: CONTACT's veldep_fric case 1 (its inputs, and its steady result FX/(FSTAT FN)).
 VELDEP = dict(FN=622216.0 / 200.0, R=460.0, CKSI=-0.0009999, V=45000.0, FKIN=0.18, FEXP1=0.12, SABSH1=100.0,
               MX=92, XL=4.6, ratio_case1=0.5941)
 
 
+def contact_velocity(law, sabsh1):
+    """rollqp's ``velocity`` ``v_h`` for CONTACT's SABSH1 of the law (L = 2, 3, 4 with one term).
+
+    CONTACT's terms are halved at ``v = SABSH1``: linear ``max(0, 1 − v/(2 SABSH1))``, rational
+    ``1/(1 + v/SABSH1)``, exponential ``exp(−ln 2 · v/SABSH1)``; rollqp's are ``max(0, 1 − v/v_h)``,
+    ``1/(1 + v/v_h)``, ``exp(−v/v_h)``, so ``v_h`` = 2 SABSH1, SABSH1 and SABSH1/ln 2.
+
+    Examples
+    --------
+    >>> round(contact_velocity("exponential", 100.0), 4), contact_velocity("linear", 100.0)
+    (144.2695, 200.0)
+    """
+    factors = {"linear": 2.0, "rational": 1.0, "exponential": 1.0 / math.log(2.0)}
+    if law not in factors:
+        raise InputError("law", f"CONTACT's SABSH1 maps to 'linear', 'rational' or 'exponential', not {law!r}")
+    return factors[law] * float(sabsh1)
+
+
+def offset_profile(offset, radius=VELDEP["R"], half_width=VELDEP["XL"] + 0.1, points=9401):
+    """A contact-frame table for body A that, with body B's circle of ``2 radius``, gives the gap of a wheel of
+    ``radius`` on a flat rail centred at ``x = offset`` (``z(x − offset)``; circle heights of
+    :func:`rollqp.profiles.circle_height`, linear between ``points`` points on ``±half_width``: 2e-9 mm at
+    most from the circle, 1e-7 of the gap at the contact's edge)."""
+    from rollqp.profiles import circle_height
+    x = np.linspace(-half_width, half_width, points)
+    h = circle_height(x - offset, radius) - circle_height(x, 2.0 * radius)
+    return {"kind": "table", "x": x.tolist(), "h": h.tolist()}
+
+
 def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponential", static=None, kinetic=None,
-                 velocity=VELDEP["SABSH1"], memory=0.0, start="rolling", distance=0.0, method="newton",
-                 zone_mm=VELDEP["XL"], step=1.0, tangential=None):
-    """CONTACT's falling-friction problem (module docstring); ``tangential`` (Q/(μ_s P̄)) instead of the creepage."""
+                 velocity=None, memory=0.0, start="rolling", distance=0.0, method="newton",
+                 zone_mm=VELDEP["XL"], step=1.0, tangential=None, grid="contact"):
+    """CONTACT's falling-friction problem (module docstring); ``tangential`` (Q/(μ_s P̄)) instead of the creepage.
+
+    ``velocity``: rollqp's ``v_h`` (default CONTACT's SABSH1 = 100 mm/s mapped by :func:`contact_velocity`);
+    ``grid``: ``"contact"`` (the wheel half an element off the strip's centre, as on CONTACT's grid whose
+    first element centre is at XC1 = −XL) or ``"symmetric"`` (the wheel at the strip's centre)."""
     from rollqp.closedforms import hertz_half_width
+    if grid not in ("contact", "symmetric"):
+        raise InputError("grid", f"must be 'contact' or 'symmetric', got {grid!r}")
+    if velocity is None:
+        velocity = contact_velocity(law, VELDEP["SABSH1"])
     Estar = E_CONTACT / (2.0 * (1.0 - NU_CONTACT ** 2))
     a = hertz_half_width(VELDEP["FN"], VELDEP["R"], Estar)
     st = VELDEP["FKIN"] + VELDEP["FEXP1"] if static is None else static
@@ -40,11 +87,13 @@ def veldep_scene(elements=VELDEP["MX"], creepage=VELDEP["CKSI"], law="exponentia
         load["creepage"] = {"kind": "constant", "value": creepage}
     else:
         load["tangential"] = tangential if isinstance(tangential, dict) else {"kind": "constant", "value": tangential}
+    A = {"radius": 2 * VELDEP["R"], "E": E_CONTACT, "nu": NU_CONTACT}
+    if grid == "contact":  # CONTACT's element centres at XC1 + i DX: the wheel half an element off the strip's centre
+        A["profile"] = offset_profile(zone_mm / elements, half_width=zone_mm + 2.0 * zone_mm / elements)
     return scene_from_dict({
         "name": "contact-veldep",
         "description": "CONTACT's veldep_fric: falling (exponential) friction, wheel on rail, 45 m/s",
-        "bodies": {"A": {"radius": 2 * VELDEP["R"], "E": E_CONTACT, "nu": NU_CONTACT},
-                   "B": {"radius": 2 * VELDEP["R"], "E": E_CONTACT, "nu": NU_CONTACT}},
+        "bodies": {"A": A, "B": {"radius": 2 * VELDEP["R"], "E": E_CONTACT, "nu": NU_CONTACT}},
         "contact": {"friction": fr},
         "load": load,
         "discretization": {"elements": elements, "element": "constant", "zone": zone_mm / a, "step": step,

@@ -1,24 +1,33 @@
-"""Throughput of ``rollqp sweep`` on a local dask cluster against the same points run serially (issue 15).
+"""Throughput of ``rollqp sweep`` on a local dask cluster against the same points run in one process.
 
 Usage::
 
-    python benchmarks/sweep_throughput.py                  # 24 §6.1.1 points, newton, 3 interleaved repetitions
-    python benchmarks/sweep_throughput.py --method qp-osqp --repeats 1
-    python benchmarks/sweep_throughput.py --elements 80    # heavier points
+    python benchmarks/sweep_throughput.py                 # small and large points, 3 interleaved repetitions
+    python benchmarks/sweep_throughput.py --sizes small --repeats 5
+    python benchmarks/sweep_throughput.py --creep         # also the docs' creep-curve command, whole,
+                                                          # on a local cluster and with --workers 0
+    python benchmarks/sweep_throughput.py --validate      # only: validating a sweep of 100,000 points
 
-The 24 points are the paper's §6.1.1 scene (``cattaneo-carter``: 40 QCE, Δq = Le/2, 6 a_H)
-over Q/(μP) = 0.1 … 0.85 (6 values) × μ = 0.1, 0.15, 0.2, 0.3. **Serial**: the points one after
-another in this process (``rollqp.run``), BLAS on one thread. **Sweep**: ``rollqp.sweep.sweep``
-into a new zarr store on a ``LocalCluster`` of ``--workers`` single-threaded worker processes
-(default 2: one per core), store creation and every write included; the cluster is started
-once, before the repetitions (its start-up is reported apart), and warmed up with one small
-sweep (the workers' first import of rollqp). The two alternate within each repetition
-(:func:`harness.interleaved`); the ratio is of the medians.
+Two kinds of points, both the paper's §6.1.1 scene (``cattaneo-carter``: Δq = Le/2, 6 a_H,
+``newton``) over load ratio × friction:
 
-Per-point overhead of the executor, three ways: a no-op task's round trip through the
-scheduler (200 tasks), the client's write of one point into the store (``StoreWriter.write``),
-and ``(workers × sweep wall − Σ point times)/points`` — what a point costs beyond its own
-computation on a worker, start-up and tail included.
+* **small**: 40 QCE (~0.1 s a point), Q/(μP) = 0.1 … 0.85 (6 values) × μ = 0.1 … 0.45 (8
+  values): 48 points;
+* **large**: 80 QCE (~0.5 s a point), Q/(μP) = 0.1 … 0.85 (6) × μ = 0.1, 0.2: 12 points.
+
+**Serial**: the points one after another in this process (``rollqp.run``), BLAS on one thread.
+**Sweep**: ``rollqp.sweep.sweep`` into a new zarr store on a ``LocalCluster`` of ``--workers``
+single-threaded worker processes (default 2: one per core), the whole call timed (validation,
+the store's creation, every task and every write). The cluster is started once, before the
+repetitions: its start is reported apart, and the ratio with it included too. A warm-up sweep
+first (the workers' first import of rollqp). Serial and sweep alternate within each repetition
+(:func:`harness.interleaved`); the ratios are of the medians.
+
+Overheads, measured on the way: the sweep's fixed part (validation and store), the store
+writes (``StoreWriter.write``, timed in the client, wall and the writing thread's CPU), each
+point's CPU time beside its wall time (in the serial run and on the workers), and
+``(workers × points' wall − Σ point times)/points``: what a point costs beyond its own
+computation on a worker, its share of the writes, the scheduler and the tail included.
 
 Control: the machine's parallelism at the moment (``workers`` pure-Python loops in processes at
 once against one alone; 2× on an idle 2-core machine), measured between the repetitions: on a
@@ -32,15 +41,22 @@ import argparse  # noqa: E402
 import os  # noqa: E402
 import shutil  # noqa: E402
 import statistics  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 
 import rollqp  # noqa: E402
-from rollqp.sweep import build_sweep, sweep  # noqa: E402
-from rollqp.sweep import dataset  # noqa: E402
+from rollqp.sweep import build_sweep, dataset, sweep  # noqa: E402
 from rollqp.sweep.executor import close_client, connect  # noqa: E402
 
-VARY = ("load.tangential=0.1:0.85:6", "contact.friction=0.1,0.15,0.2,0.3")
+SIZES = {
+    "small": ({"discretization.elements": 40},
+              ("load.tangential=0.1:0.85:6", "contact.friction=0.1:0.45:8")),
+    "large": ({"discretization.elements": 80},
+              ("load.tangential=0.1:0.85:6", "contact.friction=0.1,0.2")),
+}
+CREEP = ["creep-curve", "cattaneo-carter", "--friction", "0.1,0.2,0.3"]
 
 
 def _noop(i):
@@ -67,89 +83,142 @@ def _parallelism(workers: int) -> float:
     return workers * alone / together
 
 
-def _serial(scenes) -> float:
-    t0 = time.perf_counter()
+CPU = {}  # size -> CPU seconds of each serial run
+
+
+def _serial(scenes, size) -> float:
+    t0, c0 = time.perf_counter(), time.process_time()
     for s in scenes:
         rollqp.run(s)
+    CPU.setdefault(size, []).append(time.process_time() - c0)
     return time.perf_counter() - t0
 
 
 class _TimedWriter(dataset.StoreWriter):
-    """StoreWriter that records the wall time of each point's write (client side)."""
+    """StoreWriter that records the wall time and point count of each write (client side)."""
 
-    times: list = []
+    writes: list = []
 
-    def write(self, i, out):
-        t0 = time.perf_counter()
-        super().write(i, out)
-        _TimedWriter.times.append(time.perf_counter() - t0)
+    def write(self, points, outs):
+        t0, c0 = time.perf_counter(), time.thread_time()
+        super().write(points, outs)
+        _TimedWriter.writes.append((time.perf_counter() - t0, len(points), time.thread_time() - c0))
 
 
-def _sweep(base, client, folder, summaries) -> float:
+def _sweep(base, vary, client, folder, summaries) -> float:
     store = os.path.join(folder, f"s{len(summaries)}.zarr")
     t0 = time.perf_counter()
-    summary = sweep(base, VARY, store, client=client)
+    summary = sweep(base, vary, store, client=client)
     wall = time.perf_counter() - t0
-    assert summary.done == 24 and not summary.failed, summary.table()
+    assert summary.done == summary.total and not summary.failed, summary.table()
     summaries.append((wall, summary))
     shutil.rmtree(store)
     return wall
 
 
-def _roundtrip(client, n=200) -> float:
+def _creep_command(folder, extra=()) -> float:
+    """Wall seconds of the docs' ``rollqp creep-curve`` command as a user runs it (a new process)."""
+    store = os.path.join(folder, "creep.zarr")
     t0 = time.perf_counter()
-    client.gather([client.submit(_noop, i, pure=False) for i in range(n)])
-    return (time.perf_counter() - t0) / n
+    subprocess.run([sys.executable, "-m", "rollqp.cli", *CREEP, *extra, "--out", store, "--quiet"], check=True)
+    wall = time.perf_counter() - t0
+    shutil.rmtree(store, ignore_errors=True)
+    return wall
+
+
+def _rows(size, walls, summaries, workers, startup):
+    ser, par = statistics.median(walls[f"serial {size}"]), statistics.median(walls[f"sweep {size}"])
+    n = summaries[0][1].total
+    pts = [sum(s.point_times) for _, s in summaries]
+    extra = [(workers * s.wall - p) / n for (_, s), p in zip(summaries, pts)]
+    fixed = [s.prepare for _, s in summaries]
+    return [
+        (f"**{size}**: points", f"{n} ({summaries[0][1].per_chunk} per task and chunk)"),
+        ("serial, one process (median)", f"{ser:.2f} s  ({', '.join(f'{w:.2f}' for w in walls[f'serial {size}'])})"),
+        (f"sweep, {workers} workers (median)", f"{par:.2f} s  ({', '.join(f'{w:.2f}' for w in walls[f'sweep {size}'])})"),
+        ("**throughput ratio serial/sweep**", f"**{ser / par:.2f}×**"),
+        ("ratio with the cluster's start in the sweep", f"{ser / (par + startup):.2f}×"),
+        ("mean point time: serial / on the workers", f"{1e3 * ser / n:.0f} ms / {1e3 * statistics.median(pts) / n:.0f} ms"),
+        ("mean point CPU time: serial / on the workers",
+         f"{1e3 * statistics.median(CPU[size]) / n:.0f} ms / "
+         f"{1e3 * statistics.median(sum(s.point_cpu) for _, s in summaries) / n:.0f} ms"),
+        ("validation and store creation (median)", f"{1e3 * statistics.median(fixed):.0f} ms"),
+        ("(workers × points' wall − Σ point times)/points (median)", f"{1e3 * statistics.median(extra):.1f} ms"),
+    ]
+
+
+def _validate():
+    """Wall and CPU seconds of validating §6.1.1 over 1,000 friction values × 100 load ratios."""
+    import resource
+    vary = ["contact.friction=0.1:0.5:1000", "load.tangential=0.05:0.95:100"]
+    t0, c0 = time.perf_counter(), time.process_time()
+    sw = build_sweep(rollqp.load_scene("cattaneo-carter"), vary)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    print(harness.table(["", "value"], [
+        ("points", f"{sw.size} ({', '.join(vary)})"),
+        ("validation: wall / CPU", f"{wall:.1f} s / {cpu:.1f} s ({1e3 * cpu / sw.size:.2f} ms of CPU a point)"),
+        ("peak memory of the process", f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB"),
+        ("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg()))]))
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
-    ap.add_argument("--method", default="newton")
-    ap.add_argument("--elements", type=int, default=40)
+    ap.add_argument("--sizes", default="small,large", help="comma-separated: small, large")
+    ap.add_argument("--creep", action="store_true", help="also time the docs' creep-curve command (new processes)")
+    ap.add_argument("--validate", action="store_true", help="only time the validation of 100,000 points")
     args = ap.parse_args(argv)
+    if args.validate:
+        return _validate()
+    sizes = [s.strip() for s in args.sizes.split(",") if s.strip()]
     print(harness.machine_table())
-    base = rollqp.load_scene("cattaneo-carter").replace(**{"solver.method": args.method,
-                                                           "discretization.elements": args.elements})
-    sw = build_sweep(base, VARY)
+    base = rollqp.load_scene("cattaneo-carter")
+    scenes = {s: base.replace(**SIZES[s][0]) for s in sizes}
+    points = {s: list(build_sweep(scenes[s], SIZES[s][1]).scenes) for s in sizes}
     dataset.StoreWriter = _TimedWriter  # the executor looks it up at call time
     folder = tempfile.mkdtemp(prefix="rollqp-sweep-bench-")
     t0 = time.perf_counter()
     client = connect(workers=args.workers)
     startup = time.perf_counter() - t0
+    summaries = {s: [] for s in sizes}
     try:
         sweep(base.replace(**{"discretization.distance": 0.5}), ["contact.friction=0.1,0.2"],
               os.path.join(folder, "warm.zarr"), client=client)
-        summaries = []
-        cases = {"serial": lambda: _serial(sw.scenes), "sweep": lambda: _sweep(base, client, folder, summaries),
-                 "control": lambda: _parallelism(args.workers)}
+        _TimedWriter.writes.clear()
+        cases = {}
+        for s in sizes:
+            cases[f"serial {s}"] = lambda s=s: _serial(points[s], s)
+            cases[f"sweep {s}"] = lambda s=s: _sweep(scenes[s], SIZES[s][1], client, folder, summaries[s])
+        cases["control"] = lambda: _parallelism(args.workers)
         walls = harness.interleaved(args.repeats, cases, lambda f: f(),
                                     log=lambda k, i, n: print(f"  {k} {i}/{n}", flush=True))
-        rt = _roundtrip(client)
     finally:
         close_client(client)
-        shutil.rmtree(folder, ignore_errors=True)
-    ser, par = statistics.median(walls["serial"]), statistics.median(walls["sweep"])
-    pts = [sum(s.point_times) for _, s in summaries]
-    extra = [(args.workers * w - p) / 24 for (w, _), p in zip(summaries, pts)]
-    writes = _TimedWriter.times[2:]  # after the warm-up's two points
+    creep = {"": [], " --workers 0": []}
+    for _ in range(args.repeats if args.creep else 0):  # alternating, as the sweeps above
+        for extra in creep:
+            creep[extra].append(_creep_command(folder, extra.split()))
+    shutil.rmtree(folder, ignore_errors=True)
+    rows = [(f"local cluster start ({args.workers} workers; once, not in the sweep times)", f"{startup:.2f} s")]
+    for s in sizes:
+        rows += _rows(s, walls, summaries[s], args.workers, startup)
+    writes = _TimedWriter.writes
+    per_point = sum(k for _, k, _ in writes)
+    rows += [("store write of one chunk in the client: wall / CPU (medians; CPU a point)",
+              f"{1e3 * statistics.median(w for w, _, _ in writes):.1f} ms / "
+              f"{1e3 * statistics.median(c for _, _, c in writes):.1f} ms "
+              f"({1e3 * sum(c for _, _, c in writes) / per_point:.1f} ms a point)")]
+    rows += [(f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
+              f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
+              f"{args.workers}× on an idle machine)")]
+    for extra, walls_ in creep.items():
+        if walls_:
+            rows += [(f"`rollqp {' '.join(CREEP)}{extra}` (whole command, new process; median)",
+                      f"{statistics.median(walls_):.2f} s ({', '.join(f'{w:.2f}' for w in walls_)})")]
+    rows += [("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg()))]
     print()
-    print(harness.table(["", "value"], [
-        ("points", f"24 ({', '.join(VARY)}; {args.elements} {base.discretization.element} elements, {args.method})"),
-        ("serial, one process (median of runs)", f"{ser:.2f} s  ({', '.join(f'{w:.2f}' for w in walls['serial'])})"),
-        (f"sweep, {args.workers} workers (median of runs)", f"{par:.2f} s  ({', '.join(f'{w:.2f}' for w in walls['sweep'])})"),
-        ("**throughput ratio serial/sweep**", f"**{ser / par:.2f}×**"),
-        (f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
-         f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
-         f"{args.workers}× on an idle machine)"),
-        ("Σ point times on the workers (median)", f"{statistics.median(pts):.2f} s"),
-        ("cluster start-up (once, not in the sweep times)", f"{startup:.2f} s"),
-        ("overhead: no-op task round trip", f"{1e3 * rt:.1f} ms per task"),
-        ("overhead: client write of one point (median)", f"{1e3 * statistics.median(writes):.1f} ms"),
-        ("overhead: (workers × wall − Σ point times)/points (median)", f"{1e3 * statistics.median(extra):.1f} ms"),
-        ("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg())),
-    ]))
+    print(harness.table(["", "value"], rows))
 
 
 if __name__ == "__main__":

@@ -25,7 +25,7 @@ from .version import __version__  # noqa: F401
 from . import closedforms
 from .errors import InputError, MissingBackendError, RollqpError, SolverError
 from .influence import Influence, halfspace_influence
-from .methods import available_methods, get_method
+from .methods import STEP_METHOD, available_methods, get_method
 from .problem import (NormalStep, Residuals, Scales, StepSolution, TangentialStep, classify,
                       compare)
 from .result import Result, load_result
@@ -37,7 +37,7 @@ from . import energy, wear  # noqa: E402,F401  (register their result fields)
 from . import stresses  # noqa: E402,F401  (callable: rollqp.stresses(result, step, grid))
 
 
-def solve_step(problem, method: str = "qp-clarabel", warm=None, **settings) -> StepSolution:
+def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> StepSolution:
     """Solve one step problem (:class:`NormalStep` or :class:`TangentialStep`) with ``method``.
 
     ``settings`` go to the method (``tolerance``, ``residual_limit``, …). For many steps of

@@ -255,7 +255,7 @@ def _spot_steps(args, scene):
     if wanted is None:
         n = scene.discretization.elements * {"constant": 1, "linear": 1, "quadratic": 2}[scene.discretization.element] + 1
         wanted = not args.quiet and n <= SPOT_MAX_NODES and scene.solver.method not in SPOT_METHODS
-    if not isinstance(scene.contact.friction, float):  # step files hold one constant μ (a law: docs/friction.md)
+    if scene.contact.friction.kind != "constant":  # step files hold one constant μ (a law: docs/friction.md)
         wanted = False
     if not wanted or args.quiet:
         return {}, None
@@ -373,10 +373,20 @@ def _sweep_parsers(sub):
     _cluster_options(c)
 
 
+def _workers_count(text):
+    """``--workers N``: an integer of a few digits (its range is checked when the cluster starts)."""
+    t = str(text).strip()
+    if not t.isdigit() or len(t) > 6:
+        shown = t if len(t) <= 20 else f"{t[:20]}… ({len(t)} characters)"
+        raise argparse.ArgumentTypeError(f"must be a whole number of worker processes, got {shown!r}")
+    return int(t)
+
+
 def _cluster_options(p):
-    p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786); "
-                   "default: a local cluster")
-    p.add_argument("--workers", type=int, help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786, or "
+                   "tls://host:8786 with a dask TLS configuration); default: a local cluster")
+    p.add_argument("--workers", type=_workers_count, help="worker processes of the local cluster (default: one per core; 0: the points run in this "
+                   "process, no cluster)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -476,6 +486,7 @@ def _stresses_parser(sub):
 
 def cmd_stresses(args) -> int:
     from .errors import InputError
+    from .influence import get_model
     from .result import check_output, load_result
     from .stresses import _source, default_grid, plot_field, save_field, stresses, summary_rows
     try:
@@ -494,8 +505,8 @@ def cmd_stresses(args) -> int:
         raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
     a, p0 = float(arrays["a_H"]), float(arrays["p0"])
     print(f"  state         {sf.step} (q = {sf.q / a:.4f} a_H), body {sf.body}, grid {nx} x {nz}")
-    if scene.contact.model == "bem":
-        print(f"  note          half-space field below the BEM tractions: error about a/(2R) p0 = "
+    if not get_model(scene.contact.model).halfspace_field:
+        print(f"  note          half-space field below the model's tractions: error about a/(2R) p0 = "
               f"{a / (2 * scene.R):.2g} p0 (docs/stresses.md §4)")
     for k, v in summary_rows(sf, p0, a):
         print(f"  {k:<20}  {v}")

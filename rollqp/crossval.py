@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import RollqpError
+from .methods import CROSS_CHECK_METHODS, REFERENCE_METHOD
 from .stepfile import StepFile, export_step, solve_stored
 
 
@@ -47,7 +48,7 @@ class Report:
 
     def __str__(self) -> str:
         head = (f"scene {self.scene}, step {self.step} (q = {self.q:.6g}), {self.kind} step; "
-                "residuals nondimensional (docs/formulation.md §5), differences from newton\n\n"
+                f"residuals nondimensional (docs/formulation.md §5), differences from {REFERENCE_METHOD}\n\n"
                 "| method | Signorini | friction | load P | load Q | iterations | time [ms] "
                 "| max abs Δp [p0] | max abs Δt [μp0] | states ≠ |\n"
                 "|---|---|---|---|---|---|---|---|---|---|")
@@ -75,9 +76,9 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
     from .problem import classify
     sf = scene if isinstance(scene, StepFile) else export_step(scene, 1 if step is None else step)
     names = list(methods) if methods is not None else available_methods()
-    if "newton" in names:
-        names.remove("newton")
-    names.insert(0, "newton")
+    if REFERENCE_METHOD in names:
+        names.remove(REFERENCE_METHOD)
+    names.insert(0, REFERENCE_METHOD)
     sc = sf.scales
     rows, ref, ref_state = [], None, None
     for name in names:
@@ -108,7 +109,7 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
 
 # ---------------------------------------------------------------------------- the run's cross-check
 #: The QP backends a run is cross-checked against (core dependencies only).
-SPOT_METHODS = ("qp-clarabel", "qp-osqp")
+SPOT_METHODS = CROSS_CHECK_METHODS
 #: Largest strip (nodes) cross-checked by default: the QP backends take seconds per step beyond it.
 SPOT_MAX_NODES = 400
 

@@ -7,13 +7,15 @@ A in +x, ``s`` the slip of A relative to B per unit rolled distance, friction op
   (force/length²; times the speed ``|V|`` it is the frictional power per unit area);
 * ``dissipation`` (K+1,): ``D = −∫ t s dx = −fᵀ(t∘s)`` (force/length: energy per unit rolled
   distance and unit axial length);
-* ``friction_work`` (K+1,): the step's frictional work ``D_k Δq`` (0 for the starting state; the
+* ``friction_work`` (K+1,): the step's frictional work ``D_k Δq`` (``D_k Δ``, ``Δ = a_H``, for a step at
+  rest, a stop of ``load.rolled``: its slip is per a_H of shift; 0 for the starting state; the
   accumulated work is its cumulative sum, :func:`balance`);
 * ``elastic_energy`` (K+1,): ``U = ½ pᵀF A_nn p + pᵀF A_nt t + ½ tᵀF A_tt t``, the work of the
   contact tractions on the two bodies, relative to the reference distance ``d_ref`` of the 2D
   half-space (docs/formulation.md §3: ``U`` changes by ``c(P² + Q²)/2`` with ``d_ref``);
 * ``load_work`` (K+1,): the step's work of the applied loads through the rigid motions,
-  ``−Q ξ Δq + P̄ Δδ`` (``P̄`` the mean of the step's two normal loads; 0 for the starting state).
+  ``−Q̄ ξ Δq + P̄ Δδ`` (``Q̄``, ``P̄`` the means of the step's two tangential and normal loads; ``Δ`` for ``Δq`` at rest, the rigid
+  shift being ``ξ Δ``; 0 for the starting state).
 
 The identities (derived in docs/stresses.md §5): from the slip ``s = ξ + d ∂w/∂x`` of steady
 rolling and ``w = A_tn p + A_tt t``, with ``∫ t ∂(A_tt t)/∂x dx = 0`` (the log kernel's derivative is
@@ -33,10 +35,6 @@ from .fields import FORCE, STRESS, Field, register
 __all__ = ["friction_power", "dissipation", "elastic_energy", "load_work", "balance", "steady_identity", "power"]
 
 
-def _rolling(rec) -> bool:
-    return rec.phase == "rolling"
-
-
 def friction_power(rec, ops) -> np.ndarray:
     """``−t·s`` at the nodes: dissipation per unit area and unit rolled distance (≥ 0 up to the
     solver tolerance; the starting state of a braked start: per a_H of static shift)."""
@@ -49,14 +47,17 @@ def dissipation(rec, ops) -> float:
 
 
 def _dq(rec) -> float:
-    """The rolled length ``|Δq_k|`` of a rolling step (its own under ``load.rolled``), 0 otherwise."""
-    if rec.k == 0 or not _rolling(rec) or rec.problem is None:
+    """The length the step's slip is per: ``|Δq_k|`` of a rolling step (its own under ``load.rolled``), ``Δ = a_H``
+    of a static-shift step at rest (a stop of ``load.rolled``: the slip ``s = (w^k − w^{k−1})/Δ + ξ`` is per
+    ``a_H`` of shift, §4.4, so ``s Δ`` is the slip displacement and ``ξ Δ`` the rigid shift); 0 for the
+    starting state (``k = 0``: the braked start's increments are not recorded one by one)."""
+    if rec.k == 0 or rec.problem is None or rec.phase not in ("rolling", "static-shift"):
         return 0.0
     return float(rec.problem.dq)
 
 
 def friction_work(rec, ops) -> float:
-    """The step's frictional work ``D Δq`` (rolling steps; 0 for the starting state and stops)."""
+    """The step's frictional work ``D Δq`` (``D Δ`` at rest, :func:`_dq`; 0 for the starting state)."""
     dq = _dq(rec)
     return dissipation(rec, ops) * dq if dq else 0.0
 
@@ -104,12 +105,19 @@ def _normal_displacement(rec):
 
 
 def load_work(rec, ops) -> float:
-    """``−Q ξ Δq + ½(P_k + P_{k−1})(δ_k − δ_{k−1})`` of a rolling step (0 for the starting state)."""
+    """``−½(Q_k + Q_{k−1}) ξ Δq + ½(P_k + P_{k−1})(δ_k − δ_{k−1})`` of a rolling step or a step at rest (``Δ``
+    for ``Δq``, :func:`_dq`; 0 for the starting state).
+
+    Both loads by the trapezoidal rule over the step: the elastic energy is a function of the state, and
+    the work of a force that changes through the step is its mean times the displacement (with ``Q_k``
+    alone a fretting cycle at rest, ``|ΔQ| = 0.0375 μ P̄`` a step, left 2e-4 N per step unbalanced, the
+    size of the step's frictional work)."""
     dq = _dq(rec)
     if dq == 0.0:
         return 0.0
     st, pr = rec.state, rec.previous
-    W = -rec.Q * float(st.tsol.xi) * dq
+    Q0 = rec.Q if pr is None or pr.t is None else float(ops.f @ pr.t)
+    W = -0.5 * (rec.Q + Q0) * float(st.tsol.xi) * dq
     if pr is not None and pr.nsol is not None and st.nsol is not None and pr.p is not None:
         P0 = float(ops.f @ pr.p)
         W += 0.5 * (rec.P + P0) * (float(st.nsol.delta) - float(pr.nsol.delta))
@@ -131,7 +139,7 @@ for _f in (
           "state); its cumulative sum is the accumulated work", compute=friction_work, needed=_mu),
     Field("elastic_energy", "step", "force", "elastic energy of the contact tractions per unit axial length, "
           "1/2 p.F.Ann.p + p.F.Ant.t + 1/2 t.F.Att.t (relative to d_ref)", compute=elastic_energy),
-    Field("load_work", "step", "force", "work of the applied loads in the step, -Q xi dq + "
+    Field("load_work", "step", "force", "work of the applied loads in the step, -mean(Q) xi dq + "
           "mean(P) d(delta) (0 for the starting state)", compute=load_work),
 ):
     register(_f)

@@ -160,4 +160,4 @@ def _friction_coefficient(rec, operators):
 
 register(Field("friction_coefficient", "state", "1",
                "coefficient of friction mu at each node in the step (scenes with a friction law, docs/friction.md)",
-               compute=_friction_coefficient, needed=lambda scene: not isinstance(scene.contact.friction, float)))
+               compute=_friction_coefficient, needed=lambda scene: scene.contact.friction.kind != "constant"))

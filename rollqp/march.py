@@ -12,13 +12,15 @@ benchmarks, post-processing — consumes the records; it needs no private call. 
     similar bodies), then the tangential load by static shift in ``load.start_steps``
     increments (Cattaneo for similar bodies, §4.4): ``s = (w^k − w^{k−1})/Δ + ξ`` with
     ``Δ = a_H`` and ``ξ·Δ`` the rigid shift;
-  - ``start = "rolling"``: steady rolling at the initial loads. A method that declares
+  - ``start = "rolling"``: steady rolling at the initial loads, the fixed point of the rolling
+    steps that follow. From the loads' normal half at zero shear (:meth:`_March.pressed`; no
+    braked start: the steady state does not depend on the loading path), a method that declares
     ``"steady"`` (:attr:`Method.solves <rollqp.methods.base.Method.solves>`) solves the
-    steady problem directly (phase ``"steady"``; slip ``s = ξ e + d·D_up w``,
+    steady problem directly (phase ``"steady"``; slip ``s = ξ e + T w``, ``T = (I − M)/Δq``,
     :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`); the others
     (the QP backends: the steady operator is far from symmetric and their splitting does not
-    converge on it) reach it by marching the transient at constant loads from the braked
-    state until the tractions stop changing (phase ``"rolling"``).
+    converge on it) reach it by marching the transient at constant loads until the tractions
+    stop changing (phase ``"rolling"``).
 * **rolling steps** ``k = 1..K`` at ``q_k = k Δq`` (phase ``"rolling"``): the history vector
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
   ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step. With
@@ -175,6 +177,7 @@ class _March:
         self.moving = ops.profiles_move
         self.cache = HistoryCache(ops) if self.plan.rolled else None
         self.frictionless = ops.frictionless  # the scene's law: the same at every step
+        self.constant_friction = ops.friction.kind == "constant"  # one μ: the step problems' fast path
         self.at = self._loads_at(self.plan.tau)
         self.fixed = self._normal_fixed()
 
@@ -214,7 +217,7 @@ class _March:
         if self.frictionless:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
-        if not isinstance(ops.friction, float):  # a law: this step's μ (Coulomb keeps the old path)
+        if not self.constant_friction:  # a law: this step's μ (Coulomb keeps the fast path)
             prev = None if state.tsol is None else state.tsol.info.get("mu")
             fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
@@ -258,7 +261,7 @@ class _March:
     def record(self, k, phase, q, state, previous, problem, sol, cnt, *, P, shift, t0) -> StepRecord:
         ops = self.ops
         tsol = state.tsol
-        mu = ops.mu if problem is None or isinstance(ops.friction, float) else problem.coefficient(tsol.s)
+        mu = ops.mu if problem is None or self.constant_friction else problem.coefficient(tsol.s, tsol.p)
         bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
         nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound)
         count = np.bincount(nodes, minlength=3)
@@ -310,34 +313,68 @@ class _March:
         ops.check_inside(state.p, 0)
         return self.record(0, "static-shift", 0.0, state, previous, problem, sol, cnt, P=P, shift=shift, t0=t0)
 
-    def rolling_start(self, braked: StepRecord) -> StepRecord:
-        """Rolling start from the braked state: the direct steady solve for a method that declares
-        ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says
-        why in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`)."""
-        if "steady" not in self.method.solves:
-            return self.steady_by_marching(braked)
+    def pressed(self) -> State:
+        """The starting guess of a rolling start: the loads' normal half at zero shear, nothing else.
+
+        The steady rolling state does not depend on how the loads were applied (the rolling wipes
+        the contact's memory), so a rolling start needs no braked start (``load.start_steps``
+        static increments, each a coupled step on coupled scenes): the normal half at ``P(0)`` (or
+        ``δ(0)``) with ``t = 0`` (one solve; ``w = A_tn p``) is where the direct steady solve and
+        the march to the steady state set out from.
+        """
+        ops = self.ops
+        _, _, P, _, xi, D = self.at[0]
+        if P is not None and P <= 0.0:
+            return _unloaded(ops, xi)
+        zero = np.zeros(ops.n)
+        npb = ops.normal_step(P, zero, delta=D, validate=False)
+        nsol = self.method.solve(npb, warm=None)
+        return State(nsol.p, zero, ops.w(nsol.p, zero), nsol, None, None if ops.coupled else npb)
+
+    def guess(self) -> State:
+        """Where a rolling start sets out from: :meth:`pressed`, or, with a slip-dependent friction law,
+        the braked state (:meth:`braked_start`). A falling law can have two steady states at one force, and
+        the guess decides which one the start returns: from the braked state it is the one that grows
+        from Coulomb's (docs/friction.md, "Which steady state a rolling start returns")."""
+        if self.ops.friction.kind == "slip":
+            return self.braked_start().state
+        return self.pressed()
+
+    def rolling_start(self, start: State) -> StepRecord:
+        """Rolling start from the guess ``start`` (:meth:`guess`): the direct steady solve for a method
+        that declares ``"steady"``, else, or if that solve fails, the march to the steady state (its
+        record then says why in ``note``: the march reaches the same discrete state, to
+        :data:`STEADY_TOL`)."""
+        if "steady" not in self.method.capabilities.solves:
+            return self.steady_by_marching(start)
         try:
-            return self.steady_direct(braked)
+            return self.steady_direct(start)
         except SolverError as err:
-            rec = self.steady_by_marching(braked)
+            rec = self.steady_by_marching(start)
             rec.note = f"the direct steady solve failed ({err}); the steady state was reached by marching"
             return rec
 
-    def steady_direct(self, start: StepRecord) -> StepRecord:
-        """Rolling start: the steady rolling problem ``s = ξ e + d·D_up w`` solved directly.
+    def steady_direct(self, start: State) -> StepRecord:
+        """Rolling start: the steady rolling problem ``s = ξ e + T w`` solved directly (``T``: the
+        fixed point of the scene's transient step, :meth:`SceneOperators.steady
+        <rollqp.operators.SceneOperators.steady>`).
 
-        Not symmetric (``D_up A`` is not), so only methods that declare ``"steady"`` pose it;
-        warm-started from the braked state.
+        Not symmetric (``T A`` is not), so only methods that declare ``"steady"`` pose it;
+        set out from the guess ``start``.
         """
         t0 = time.perf_counter()
         _, _, P, Q, xi, D = self.at[0]
         cnt = Counters()
-        state, problem, sol = self.step(start.state, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
+        state, problem, sol = self.step(start, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
                                         Q=Q, xi=xi, steady=True, delta=D)
         self.ops.check_inside(state.p, 0)
-        return self.record(0, "steady", 0.0, state, start.state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+        rec = self.record(0, "steady", 0.0, state, start, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+        if problem is not None and problem.law is not None and Q is not None:
+            from .friction.bound import steady_branches
+            rec.note = steady_branches(problem.law.law, Q, rec.P, rec.gross_sliding)
+        return rec
 
-    def steady_by_marching(self, start: StepRecord) -> StepRecord:
+    def steady_by_marching(self, start: State) -> StepRecord:
         """Rolling start: roll at the initial loads until the tractions stop changing.
 
         For methods that cannot pose the non-symmetric steady problem (``STEADY_TOL``,
@@ -355,9 +392,10 @@ class _March:
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
         from .methods.steady_start import accelerated_start, predicting
         change = np.inf
-        state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
-                                  delta=D, tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
-        sweeps = getattr(self.method, "single_sweeps", None)  # N–T alternation: one sweep a step until near steady
+        state = accelerated_start(self.method, ops, start, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
+                                  delta=D, tol=STEADY_TOL)  # QP methods: Newton on the march's map, Anderson
+        # N–T alternation: one sweep a step until near steady
+        sweeps = self.method.single_sweeps if self.method.capabilities.single_sweeps else None
         if sweeps is not None:
             sweeps(True)
         was = predicting(self.method, True)  # QP methods: each QP on its predicted active set first, until steady
@@ -436,14 +474,14 @@ def prepare(scene, method=None):
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
-    from .friction import law_kind
     coupled = scene.coupling_level == "full"
-    kind = law_kind(scene.contact.friction)
+    kind = scene.contact.friction.kind
     if method is None or isinstance(method, str):
         meth = scene_method(scene.solver, coupled=coupled, friction=kind)
     else:
         meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
-    ops = SceneOperators.build(scene, symmetrized=getattr(meth, "operator", "exact") == "symmetrized")
+    caps = meth.capabilities
+    ops = SceneOperators.build(scene, symmetrized=caps.operator == "symmetrized", capabilities=caps)
     meth.setup(ops)
     return scene, meth, ops
 
@@ -481,9 +519,7 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         state, first = resumed_state(scene, ops, resume), len(resume["q"])
     else:
         try:
-            start = m.braked_start()
-            if scene.load.start == "rolling":
-                start = m.rolling_start(start)
+            start = m.rolling_start(m.guess()) if scene.load.start == "rolling" else m.braked_start()
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
@@ -586,7 +622,10 @@ def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
             "versions": _versions(), "rollqp": __version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
             "step_problem": "coupled" if ops.coupled else "normal + tangential",
-            "slip_note": "step 0 of a braked start: static-shift slip per a_H of shift"}
+            "slip_note": ("step 0 of a braked start: static-shift slip per a_H of shift" if scene.load.start == "braked"
+                          else "step 0 of a rolling start: steady-rolling slip per unit rolled distance")
+                         + ("; stops of load.rolled: static-shift slip per a_H of shift" if scene.load.rolled is not None
+                            else "")}
     scalars = {"a_H": scene.a_H, "p0": scene.p0, "R": scene.R, "Estar": scene.Estar, "beta": scene.beta,
                "leading_edge": scene.leading_edge}
     return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta, extra=fields_for(scene))
@@ -643,4 +682,4 @@ def _keep_mu(problem, sol) -> None:
     """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
     the result field ``friction_coefficient``); Coulomb steps are left as they were."""
     if problem.law is not None or (type(problem.mu) is not float and np.ndim(problem.mu) != 0):
-        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s), (problem.n,)).astype(float)
+        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)

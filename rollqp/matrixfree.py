@@ -48,16 +48,26 @@ THRESHOLD = {"constant": 200, "linear": 200, "quadratic": 200}
 BYTES_PER_NODE = 8 * 200
 
 
-def mode(scene) -> str:
-    """``"dense"`` or ``"matrix-free"``: the scene's ``solver.operator`` with ``"auto"`` resolved."""
-    asked = getattr(scene.solver, "operator", None) or "auto"
+def mode(scene, capabilities=None) -> str:
+    """``"dense"`` or ``"matrix-free"``: the scene's ``solver.operator`` with ``"auto"`` resolved.
+
+    ``capabilities``: the :class:`~rollqp.methods.base.Capabilities` of the method that runs the scene
+    (default: those its ``solver.method`` declares, :attr:`Scene.method_capabilities
+    <rollqp.scene.Scene.method_capabilities>`)."""
+    asked = scene.solver.operator or "auto"
     if asked != "auto":
         return asked
-    from .methods import matrix_free
-    if (matrix_free(scene.solver.method) and scene.contact.model == "halfspace"
+    caps = scene.method_capabilities if capabilities is None else capabilities
+    if (caps.matrix_free and _model(scene).matrix_free
             and scene.n_nodes >= THRESHOLD[scene.discretization.element]):
         return "matrix-free"
     return "dense"
+
+
+def _model(scene):
+    """The scene's influence model (:class:`rollqp.influence.Model`)."""
+    from .influence import get_model
+    return get_model(scene.contact.model)
 
 
 def memory_estimate(scene) -> float:
@@ -67,8 +77,9 @@ def memory_estimate(scene) -> float:
     return float(BYTES_PER_NODE * n + 8.0 * 6 * states * n)
 
 
-def check_scene(scene, dense_max_nodes: int) -> str:
-    """The scene's operator mode, after refusing what cannot run (before any work).
+def check_scene(scene, dense_max_nodes: int, capabilities=None) -> str:
+    """The scene's operator mode, after refusing what cannot run (before any work); ``capabilities`` as
+    for :func:`mode`.
 
     Raises
     ------
@@ -77,21 +88,21 @@ def check_scene(scene, dense_max_nodes: int) -> str:
         other than the half-space; ``discretization.elements`` when a method that needs the matrix
         is asked for more than ``dense_max_nodes`` nodes (naming ``mf-newton``).
     """
-    from .methods import matrix_free
-    m = mode(scene)
+    caps = scene.method_capabilities if capabilities is None else capabilities
+    m = mode(scene, caps)
     method = scene.solver.method
     if m == "matrix-free":
-        if not matrix_free(method):
+        if not caps.matrix_free:
             raise InputError("solver.operator", f"'matrix-free' needs a method that works with products only "
                                                 f"(mf-newton); {method!r} needs the "
                                                 f"n × n matrix: use solver.method = 'mf-newton' or "
                                                 f"solver.operator = 'dense'")
-        if scene.contact.model != "halfspace":
-            raise InputError("solver.operator", f"'matrix-free' needs contact.model = 'halfspace' (a uniform "
+        if not _model(scene).matrix_free:
+            raise InputError("solver.operator", f"'matrix-free' needs a contact.model with FFT operators (a uniform "
                                                 f"strip's Toeplitz kernels), got {scene.contact.model!r}")
     elif scene.n_nodes > dense_max_nodes:
         gb = 8.0 * 6 * scene.n_nodes ** 2 / 2 ** 30
-        alt = ("solver.method = 'mf-newton' (matrix-free, O(n) memory)" if scene.contact.model == "halfspace"
+        alt = ("solver.method = 'mf-newton' (matrix-free, O(n) memory)" if _model(scene).matrix_free
                else "fewer elements")
         raise InputError("discretization.elements",
                          f"{scene.discretization.elements} {scene.discretization.element} elements make "
@@ -154,15 +165,28 @@ def sparse_history(strip, formulation: str, dq: float, direction: int) -> sparse
     raise InputError("formulation", f"must be one of material, convective-local, static; got {formulation!r}")
 
 
-def sparse_steady(strip, direction: int) -> sparse.csr_matrix:
-    """``d·D_up`` sparse: the steady-rolling slip ``s = ξ e + d·D_up w`` (docs/formulation.md §9)."""
-    return direction * _upwind(strip, direction)
+def sparse_steady(strip, direction: int, formulation: str = "convective-local",
+                  dq: float | None = None) -> sparse.csr_matrix:
+    """Sparse :meth:`~rollqp.strip.Strip.steady_operator`: ``T`` of the steady slip ``s = ξ e + T w``,
+    the fixed point of the transient step of ``formulation`` (docs/formulation.md §9): ``d·D_up``
+    (convective-local), ``(I − R)/Δq`` (material)."""
+    from scipy import sparse  # at first use: `import rollqp` stays free of scipy.sparse
+    if direction not in (-1, 1):
+        raise InputError("direction", f"must be -1 or +1, got {direction!r}")
+    if formulation == "material":
+        if dq is None or not float(dq) > 0.0:
+            raise InputError("dq", f"the material steady operator needs the step Δq > 0, got {dq!r}")
+        eye = sparse.identity(strip.n, format="csr")
+        return ((eye - sparse_history(strip, "material", dq, direction)) / float(dq)).tocsr()
+    if formulation == "convective-local":
+        return direction * _upwind(strip, direction)
+    raise InputError("formulation", f"must be material or convective-local; got {formulation!r}")
 
 
 class SteadyOperator(Operator):
     """``c·T·A``: a sparse slip operator ``T`` times an FFT influence operator ``A``, never a matrix.
 
-    The steady slip operators ``Δ·d·D_up·A_tt`` and ``Δ·d·D_up·A_tn`` (eq. 48; docs/formulation.md
+    The steady slip operators ``Δ·T·A_tt`` and ``Δ·T·A_tn`` (:func:`sparse_steady`; docs/formulation.md
     §9) of a matrix-free scene: products ``O(n log n)``, memory ``O(n)``; the operator interface
     of :class:`~rollqp.influence.operator.Operator` (``@``, ``x @ A``, ``diagonal()``,
     ``column(j)``, ``dense()``, ``memo``) so that step problems and ``mf-newton`` take it unchanged
@@ -210,9 +234,10 @@ class SteadyOperator(Operator):
 
 
 def steady_operators(ops):
-    """``(Δ·d·D_up·A_tn or None, Δ·d·D_up·A_tt)`` of a matrix-free scene as :class:`SteadyOperator` objects
+    """``(Δ·T·A_tn or None, Δ·T·A_tt)`` (``T`` the scene's :func:`sparse_steady`) of a matrix-free scene as :class:`SteadyOperator` objects
     (``Δ = a_H``; the dense path's :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`)."""
-    T = sparse_steady(ops.strip, ops.scene.load.direction)
+    sc = ops.scene
+    T = sparse_steady(ops.strip, sc.load.direction, sc.discretization.formulation, sc.dq)
     delta = ops.scales.length
     Atn = None if ops.Atn is None else SteadyOperator(T, ops.Atn, delta, "steady A_tn")
     return Atn, SteadyOperator(T, ops.Att, delta, "steady A_tt")
@@ -220,30 +245,7 @@ def steady_operators(ops):
 
 # ------------------------------------------------------------------------------ operators
 def build(scene, strip):
-    """``(A_nn, A_tt, A_tn, A_nt, h, info)`` of a matrix-free scene (half-space, eq. 25–30).
-
-    ``d_ref`` must exceed the discretization's threshold
-    (:func:`~rollqp.influence.toeplitz.positive_definite_threshold`), else an
-    :class:`InputError` on ``contact.reference_distance`` as on the dense path.
-    """
-    from .influence.halfspace import undeformed_gap
-    from .influence.toeplitz import halfspace_operators, positive_definite_threshold
-    t0 = time.perf_counter()
-    coupling = scene.coupling_level
-    d_ref = scene.reference_distance_value
-    L = float(strip.half_width)
-    d_min = positive_definite_threshold(strip)
-    if not d_ref > d_min:
-        raise InputError("contact.reference_distance",
-                         f"d_ref = {d_ref:.6g} makes the normal influence operator indefinite; it must exceed "
-                         f"L/2 = {L / 2:.6g} (continuous bound), the smallest admissible value for this mesh "
-                         f"is {d_min:.6g}; the default is the relative radius R")
-    Ann, Att, Atn, Ant = halfspace_operators(strip, Estar=scene.Estar, beta=scene.beta, d_ref=d_ref,
-                                             coupling=coupling)
-    h = undeformed_gap(strip.x, scene.A.radius, scene.B.radius)
-    h.setflags(write=False)
-    info = {"d_ref": d_ref, "d_ref_min": d_min, "d_ref_min_continuous": 0.5 * L, "coupling": coupling,
-            "beta": scene.beta, "kappa": 2.0 * scene.beta, "Estar": scene.Estar, "R": scene.R,
-            "R_A": float(scene.A.radius), "R_B": float(scene.B.radius), "operator_mode": "matrix-free",
-            "operator_seconds": time.perf_counter() - t0}
-    return Ann, Att, Atn, Ant, h, info
+    """``(A_nn, A_tt, A_tn, A_nt, h, info)`` of a matrix-free scene: its influence model's FFT operators
+    (:attr:`Model.operators <rollqp.influence.Model.operators>`; the half-space's: eq. 25–30)."""
+    from .influence import get_model
+    return get_model(scene.contact.model).operators(scene, strip)

@@ -11,6 +11,7 @@ steady operators only for a direct steady rolling start, each history operator o
 """
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field
@@ -19,7 +20,7 @@ import numpy as np
 
 from . import matrixfree
 from .errors import InputError
-from .influence import build_influence
+from .influence import get_model
 from .influence.operator import Operator, asymmetry
 from .problem import CoupledStep, NormalStep, Scales, TangentialStep, _check_sliding_limit, _trusted
 from .strip import RowSparse, Strip
@@ -65,19 +66,19 @@ class SceneOperators:
     _memo: dict = field(default_factory=dict, repr=False)
 
     @classmethod
-    def build(cls, scene, symmetrized: bool = False) -> "SceneOperators":
-        """Discretize ``scene``; ``symmetrized`` selects the QP operator ``F⁻¹ sym(F A)``."""
+    def build(cls, scene, symmetrized: bool = False, capabilities=None) -> "SceneOperators":
+        """Discretize ``scene``; ``symmetrized`` selects the QP operator ``F⁻¹ sym(F A)``.
+
+        ``capabilities``: the :class:`~rollqp.methods.base.Capabilities` of the method object that runs the
+        scene (:func:`rollqp.march.prepare` passes them; default: those the scene's ``solver.method``
+        declares): dense matrices, or FFT operators for a method that works with products only on a
+        large half-space strip (:func:`rollqp.matrixfree.mode`)."""
         d = scene.discretization
         strip = Strip(scene.half_width, d.elements, d.element)
-        if matrixfree.mode(scene) == "matrix-free":
+        if matrixfree.mode(scene, capabilities) == "matrix-free":
             return cls._build_matrix_free(scene, strip).with_profiles()
         t0 = time.perf_counter()
-        kw = {}
-        if scene.contact.model == "bem":  # true geometry: the rollers and their BEM meshes
-            kw = dict(A=scene.A, B=scene.B, n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1])
-        infl = build_influence(scene.contact.model, strip, Estar=scene.Estar, beta=scene.beta,
-                               R_A=scene.A.radius, R_B=scene.B.radius, coupling=scene.coupling_level,
-                               d_ref=scene.reference_distance_value, **kw)
+        infl = get_model(scene.contact.model).build(scene, strip)  # (rollqp.influence.Model)
         f = strip.weights
         info = dict(infl.info)
         info["asymmetry_Ann"] = asymmetry(infl.Ann, f)
@@ -155,14 +156,16 @@ class SceneOperators:
         """Full coupling (``A_nt`` present): each step is one :class:`CoupledStep`."""
         return self.Ant is not None
 
-    @property
+    @functools.cached_property
     def mu(self) -> float:
-        """The reference coefficient (Coulomb's ``μ`` itself; :attr:`Contact.mu <rollqp.scene.Contact.mu>`)."""
+        """The reference coefficient (Coulomb's ``μ`` itself; :attr:`Contact.mu <rollqp.scene.Contact.mu>`), one
+        float object for the whole scene (a step problem's bound is kept while its ``p`` and ``μ`` are the same
+        objects: :meth:`tangential_step`)."""
         return self.scene.contact.mu
 
     @property
     def friction(self):
-        """The scene's friction law (a number for Coulomb; :mod:`rollqp.friction`)."""
+        """The scene's friction law (:class:`rollqp.friction.FrictionLaw`)."""
         return self.scene.contact.friction
 
     @property
@@ -208,15 +211,21 @@ class SceneOperators:
         return RowSparse.from_dense(self.strip.history_operator(formulation, dq, direction))
 
     def steady(self) -> tuple[Operator | None, Operator]:
-        """``(Δ·d·D_up·A_tn, Δ·d·D_up·A_tt)`` with ``Δ = a_H``: the steady slip operators, built once.
+        """``(Δ·T·A_tn, Δ·T·A_tt)`` with ``Δ = a_H``: the steady slip operators, built once.
 
-        With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt t)/dq``
-        is then the steady-rolling slip ``ξ e + d·D_up w`` (docs/formulation.md §4, §9).
+        ``T`` (:meth:`Strip.steady_operator <rollqp.strip.Strip.steady_operator>`) is the fixed point of
+        the scene's own transient step, ``(I − M)/Δq`` with the history operator ``M`` of its
+        formulation, ``Δq`` and direction: ``d·D_up`` for ``convective-local``, ``(I − R)/Δq`` for
+        ``material``. With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt
+        t)/dq`` is then the steady slip ``ξ e + T w`` (docs/formulation.md §4, §9), and a march from the
+        steady state stays there.
         """
         if "steady" not in self._memo and self.matrix_free:   # products, no matrix (rollqp.matrixfree)
             self._memo["steady"] = matrixfree.steady_operators(self)
         if "steady" not in self._memo:
-            T = self.scales.length * self.strip.steady_operator(self.scene.load.direction)
+            sc = self.scene
+            T = self.scales.length * self.strip.steady_operator(sc.load.direction, sc.discretization.formulation,
+                                                                sc.dq)
             Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")
             self._memo["steady"] = (Atn, Operator(T @ self.Att.dense(), "steady A_tt"))
         return self._memo["steady"]
@@ -266,7 +275,7 @@ class SceneOperators:
 
     def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None, h=None,
                      friction=None) -> CoupledStep:
-        """The coupled step (docs/formulation.md §10); ``steady``: slip ``s = ξ e + d·D_up w``; ``h`` as
+        """The coupled step (docs/formulation.md §10); ``steady``: the steady slip ``s = ξ e + T w`` (:meth:`steady`); ``h`` as
         for :meth:`normal_step`; ``friction`` as for :meth:`tangential_step`."""
         Atn, Att = self.steady() if steady else (self.Atn, self.Att)
         mu, law = (self.mu, None) if friction is None else friction

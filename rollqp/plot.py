@@ -75,7 +75,7 @@ def transient_figure(res: dict, scene, path: str, title: str | None = None) -> s
     ax[0].plot(x / a, res["pn"][0] / p0, ":", color="0.5", lw=1, label="p/p0 (q = 0)")
     ax[2].plot(clock / a, res["creepage"] * scene.R / a, "-", lw=1.2, label="rollqp")
     xf = np.linspace(-1, 1, 801) * a
-    closed = scene.coupling_level == "off" and scene.load.tangential is not None and isinstance(scene.contact.friction, float) and scene.contact.friction > 0
+    closed = scene.coupling_level == "off" and scene.load.tangential is not None and scene.contact.friction.kind == "constant" and scene.contact.mu > 0
     marks = []
     if closed:
         P0, Q0 = float(res["P"][0]), float(res["Q"][0])

@@ -66,12 +66,19 @@ def circle_height(x, radius: float) -> np.ndarray:
 class Feature:
     """One part of a profile: a base shape (``frame = "contact"``) or a material feature.
 
-    Subclasses are frozen dataclasses with ``kind``, ``to_dict()`` and ``height(s)``; material
-    features (``material = True``) are evaluated at the material coordinate ``s = x − d·q``.
+    Subclasses are frozen dataclasses with ``kind``, ``to_dict()``, ``height(s)`` and ``extent()``; material
+    features (``material = True``) are evaluated at the material coordinate ``s = x − d·q``. The scene
+    checks a feature through :meth:`extent` only (:func:`check_cover`): a feature that is zero outside its
+    extent (``covers = False``, the default) must be narrower than the potential contact zone; one that is
+    defined only on its extent (``covers = True``, a table) must cover what the strip sees.
     """
 
     kind: ClassVar[str] = ""
     material: ClassVar[bool] = True
+    #: ``True``: defined on :meth:`extent` only, which must cover the strip; ``False``: zero outside it.
+    covers: ClassVar[bool] = False
+    #: The key named when the extent is too wide (``"width"``, ``"length"``, …).
+    extent_key: ClassVar[str] = "width"
 
     def height(self, s) -> np.ndarray:  # pragma: no cover - abstract
         """Height (base) or deviation from the circle (material feature) at ``s``, length units."""
@@ -100,6 +107,8 @@ class Table(Feature):
     h: tuple
     frame: str = "contact"
     kind: ClassVar[str] = "table"
+    covers: ClassVar[bool] = True
+    extent_key: ClassVar[str] = "x"
 
     @property
     def material(self):  # type: ignore[override]
@@ -127,6 +136,11 @@ class Flat(Feature):
     position: float
     radius: float
     kind: ClassVar[str] = "flat"
+    extent_key: ClassVar[str] = "length"
+
+    def __post_init__(self):
+        if not self.length < self.radius:
+            raise InputError("length", f"a flat must be shorter than the radius {self.radius!r}, got {self.length!r}")
 
     def height(self, s):
         u = np.asarray(s, dtype=float) - self.position
@@ -320,8 +334,10 @@ def _parse_table(key, values, radius, folder):
 
 def _parse_flat(key, values, radius, folder):
     _need(key, values, ("length", "position"), "flat")
-    return Flat(positive_real(f"{key}.length", values["length"]),
-                finite_real(f"{key}.position", values["position"]), float(radius))
+    length = positive_real(f"{key}.length", values["length"])
+    if not length < radius:
+        raise InputError(f"{key}.length", f"must be below the radius {radius!r}, got {length!r}")
+    return Flat(length, finite_real(f"{key}.position", values["position"]), float(radius))
 
 
 def _parse_defect(key, values, radius, folder):
@@ -371,33 +387,30 @@ def read_profile_file(name: Any, key: str, folder=None) -> tuple[np.ndarray, np.
 
 
 # =========================================================================== scene checks
-def check_cover(profile: Profile, key: str, strip_half: float, shifts: tuple[float, float],
-                model: str) -> None:
-    """A profile against its scene: circles only on the BEM model; tables cover what the strip sees;
-    a flat or defect narrower than the zone (``2L``).
+def check_cover(profile: Profile, key: str, strip_half: float, shifts: tuple[float, float], model) -> None:
+    """A profile against its scene: only on a model that takes profiles; a feature defined on its extent
+    (a table) covers what the strip sees; one that is zero outside its extent (a flat, a defect) is narrower
+    than the zone (``2L``) — every feature asked through :meth:`Feature.extent` only.
 
     ``shifts`` is the range of ``d·q`` over the run: a material coordinate ``s = x − d·q`` with
-    ``|x| ≤ L`` then lies in ``[−L − max, L − min]``.
+    ``|x| ≤ L`` then lies in ``[−L − max, L − min]``. ``model``: the scene's influence model
+    (:class:`rollqp.influence.Model`).
     """
     if profile.is_circle:
         return
-    if model != "halfspace":
-        raise InputError(key, f"must be a circle (absent) with contact.model = {model!r}: the BEM mesh is the "
-                              "round roller's; profiles need contact.model = 'halfspace'")
+    if not model.profiles:
+        raise InputError(key, f"must be a circle (absent) with contact.model = {model.name!r}: its mesh is the "
+                              "round roller's; profiles need a model that takes them (the half-space)")
     L = strip_half
     for i, f in enumerate(profile.features):
         k = key if len(profile.features) == 1 else f"{key}[{i}]"
-        if isinstance(f, Table):
+        lo, hi = f.extent()
+        if f.covers:
             need = (-L, L) if not f.material else (-L - shifts[1], L - shifts[0])
-            if f.x[0] > need[0] or f.x[-1] < need[1]:
+            if lo > need[0] or hi < need[1]:
                 what = "the strip" if not f.material else "the material that passes through the strip"
-                raise InputError(f"{k}.x", f"the table covers [{f.x[0]:.6g}, {f.x[-1]:.6g}] but {what} needs "
-                                           f"[{need[0]:.6g}, {need[1]:.6g}] (length units)")
-        else:
-            width = f.length if isinstance(f, Flat) else f.width
-            name = "length" if isinstance(f, Flat) else "width"
-            if not width < 2 * L:
-                raise InputError(f"{k}.{name}", f"must be in (0, {2 * L:.6g}) (narrower than the potential contact "
-                                                f"zone 2L = 2·zone·a_H), got {width!r}")
-            if isinstance(f, Flat) and not f.length < f.radius:
-                raise InputError(f"{k}.length", f"must be below the radius {f.radius!r}, got {f.length!r}")
+                raise InputError(f"{k}.{f.extent_key}", f"the {f.kind} covers [{lo:.6g}, {hi:.6g}] but {what} needs "
+                                                        f"[{need[0]:.6g}, {need[1]:.6g}] (length units)")
+        elif not hi - lo < 2 * L:
+            raise InputError(f"{k}.{f.extent_key}", f"must be in (0, {2 * L:.6g}) (narrower than the potential "
+                                                    f"contact zone 2L = 2·zone·a_H), got {hi - lo!r}")

@@ -23,11 +23,12 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     within 0.1 % of steady from 2.6 a_H).
     """
     out = []
-    if scene.coupling_level != "off" or scene.contact.model != "halfspace":
+    from .influence import get_model
+    if scene.coupling_level != "off" or not get_model(scene.contact.model).halfspace_field:
         return out
     x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
     mu = scene.contact.mu
-    if not isinstance(scene.contact.friction, float):  # a friction law: no closed form to compare with
+    if scene.contact.friction.kind != "constant":  # a friction law: no closed form to compare with
         mu = 0.0
     P0 = float(res["P"][0])
     a0 = cf.hertz_half_width(P0, R, scene.Estar)
@@ -94,8 +95,9 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
                           f"median {1e3 * float(np.median(res['step_time'])):.2f} ms per step)"),
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
-    rows += _bem_rows(res, scene)
+    rows += _model_rows(res, scene)
     rows += _start_rows(res)
+    rows += _gross_rows(res)
     rows += energy_rows(res, scene, stresses)
     for name, val, what in closed_form_errors(res, scene):
         rows.append((f"error: {name}", f"{val:.4f}  {what}"))
@@ -116,19 +118,18 @@ def _start_rows(res: dict) -> list[tuple[str, str]]:
     return [] if note is None else [("starting state", str(note))]
 
 
-def _bem_rows(res: dict, scene) -> list[tuple[str, str]]:
-    """``model = "bem"``: assembly cost, the geometric coupling and the asymmetry of F·A (docs/bem.md)."""
-    if scene.contact.model != "bem":
-        return []
-    m = _meta(res).get("model", {})
-    cost = ("cached (same geometry built before)" if m.get("bem_cached") else
-            f"{m.get('bem_seconds', float('nan')):.3f} s assembly + condensation")
-    return [("BEM", f"{cost}, {m.get('bem_memory_bytes', 0) / 2 ** 20:.1f} MiB per body system; "
-                    f"{m.get('bem_outer_elements')} outer + {m.get('bem_inner_elements')} shaft elements"),
-            ("BEM coupling", f"geometric A_nt/A_tn {m.get('geometric_coupling')} "
-                             f"(|F A_nt|/|F A_nn| = {m.get('coupling_size', float('nan')):.2e})"),
-            ("BEM asymmetry", f"|FA - (FA)^T|/|FA| = {m.get('asymmetry_FA', float('nan')):.2e} (A_nn), "
-                              f"{m.get('asymmetry_FAtt', float('nan')):.2e} (A_tt); operator {m.get('operator')}")]
+def _model_rows(res: dict, scene) -> list[tuple[str, str]]:
+    """The influence model's own rows (:attr:`Model.report <rollqp.influence.Model.report>`; the BEM's: assembly
+    cost, the geometric coupling and the asymmetry of F·A, docs/bem.md)."""
+    from .influence import get_model
+    rows = get_model(scene.contact.model).report
+    return [] if rows is None else rows(_meta(res).get("model", {}))
+
+
+def _gross_rows(res: dict) -> list[tuple[str, str]]:
+    """States where every contact node slips (``meta["gross_sliding"]``, rollqp.result): said in words."""
+    ks = _meta(res).get("gross_sliding") or []
+    return [] if not ks else [("gross sliding", f"every contact node slips at {len(ks)} state(s) (first: state {ks[0]})")]
 
 
 def energy_rows(res: dict, scene, stresses=None) -> list[tuple[str, str]]:

@@ -225,8 +225,7 @@ class Delegate:
 
     def __init__(self, inner):
         self.inner = inner
-        self.name, self.operator, self.tolerance = inner.name, inner.operator, inner.tolerance
-        self.solves = inner.solves
+        self.name, self.capabilities, self.tolerance = inner.name, inner.capabilities, inner.tolerance
 
     def setup(self, operators):
         self.inner.setup(operators)

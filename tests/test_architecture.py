@@ -4,7 +4,8 @@
   whose name starts with ``_`` is imported or reached into.
 * No function in ``rollqp/`` is longer than 80 lines (one screen: a reader sees all of it).
 * Method names are looked at only by the registry: the transient, the step files and the
-  scenes never compare them.
+  scenes never compare them; no method name, influence model name or ``isinstance(…, float)``
+  friction test appears as code outside the registry or record that owns it.
 * No cache in ``rollqp/`` is keyed on ``id()`` (set-up happens once per scene instead).
 """
 from __future__ import annotations
@@ -79,6 +80,53 @@ def test_method_names_only_in_the_registry(module):
     hits = [f"{p.relative_to(ROOT)}:{i}: {line.strip()}" for p in paths if p.exists()
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if pattern.search(line)]
     assert not hits, f"method names compared outside the registry: {hits}"
+
+
+def _code_strings(path: Path) -> list[tuple[int, str]]:
+    """``(line, value)`` of the string constants of a module that are code, not docstrings."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    docs = {id(n.body[0].value) for n in ast.walk(tree)
+            if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)) and n.body
+            and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+    return [(n.lineno, n.value) for n in ast.walk(tree)
+            if isinstance(n, ast.Constant) and isinstance(n.value, str) and id(n) not in docs]
+
+
+def _owned(names, owner: str) -> list[str]:
+    """String constants equal to one of ``names`` in rollqp's code outside the package ``owner``."""
+    return [f"{p.relative_to(ROOT)}:{line}: {value!r}" for p in _sources("rollqp")
+            if not str(p.relative_to(PACKAGE)).startswith(owner) for line, value in _code_strings(p) if value in names]
+
+
+def test_method_names_only_in_the_method_registry():
+    from rollqp.methods import METHOD_NAMES
+    hits = _owned(set(METHOD_NAMES), "methods")
+    assert not hits, f"method names in code outside rollqp.methods: {hits}"
+
+
+def test_model_names_only_in_the_influence_records():
+    from rollqp.influence import model_names
+    hits = _owned(set(model_names()), "influence")
+    assert not hits, f"influence model names in code outside rollqp.influence: {hits}"
+
+
+def test_no_float_test_of_friction_outside_the_friction_package():
+    pattern = re.compile(r"isinstance\([^()]*(?:friction|\bmu\b|law)[^()]*,\s*\(?[^)]*\bfloat\b")
+    hits = [f"{p.relative_to(ROOT)}:{i}: {line.strip()}" for p in _sources("rollqp")
+            if not str(p.relative_to(PACKAGE)).startswith("friction")
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if pattern.search(line)]
+    assert not hits, f"friction tested for a float outside rollqp.friction (ask the law's kind): {hits}"
+
+
+def test_the_name_checks_find_what_they_look_for(tmp_path):
+    """The checks above on a module that breaks each rule: they are not blind."""
+    bad = tmp_path / "bad.py"
+    bad.write_text('"""doc: \'newton\' in a docstring is prose."""\n'
+                   'def f(scene, ops):\n'
+                   '    if scene.solver.method == "newton" or scene.contact.model == "bem":\n'
+                   '        return isinstance(ops.friction, float)\n', encoding="utf-8")
+    assert [v for _, v in _code_strings(bad)] == ["newton", "bem"]
+    assert re.search(r"isinstance\([^()]*(?:friction|\bmu\b|law)[^()]*,\s*\(?[^)]*\bfloat\b", bad.read_text())
 
 
 def test_no_id_keyed_caches():

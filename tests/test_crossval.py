@@ -60,6 +60,6 @@ def test_docs_tables(name, step, coupled):
         # coupled: the alternations stop at the coupled residual 1e-10 (measured 1e-9 from Newton)
         assert max(r.dp, r.dt) <= (1e-8 if coupled else 1e-10), r.method
         # (a method with its own coupled_limit, mf-newton's 0.01 tol, stops its alternation later)
-        if coupled and r.method != "newton" and getattr(get_method(r.method), "coupled_limit", None) is None:
+        if coupled and r.method != "newton" and get_method(r.method).capabilities.coupled_limit is None:
             outer.add(r.iterations.split()[0])
     assert len(outer) <= 1, f"all alternations at the same limit take the same outer iterations: {outer}"

@@ -89,12 +89,15 @@ def test_fixed_point_failure_is_a_solver_error():
 
 
 def test_contact_veldep_steady():
-    """CONTACT's veldep_fric case 1 on its grid: rollqp's direct steady Newton solution (docs/friction.md)."""
+    """CONTACT's veldep_fric case 1 on its grid (element centres from XC1 = −4.6 mm) with its law mapped
+    (v_h = SABSH1/ln 2): rollqp's direct steady Newton solution against CONTACT's printed case 1."""
     r = run(veldep_scene(), "newton").arrays()
     ratio = r["Q"][-1] / (0.30 * VELDEP["FN"])
-    # CONTACT's steady case 1: 0.5941; its transient cases settle near 0.58 (0.5822 at case 52); rollqp 0.58188
-    assert abs(ratio / VELDEP["ratio_case1"] - 1) < 0.025, ratio
-    assert abs(ratio - 0.5818766656) < 1e-8  # regression of the measured value (solver tolerance 1e-10)
+    # CONTACT prints FX/(FSTAT FN) to 4 digits (0.5941: ±8e-5 relative) and stops its outer iteration at
+    # |S_k − S_k−1| <= 1e-3 |S_k|; the same grid and law agree within 0.1 % (measured 3.9e-4)
+    assert abs(ratio / VELDEP["ratio_case1"] - 1) < 1e-3, ratio
+    counts = np.bincount(r["state"][-1], minlength=3)
+    assert (92 - counts[0], counts[1], counts[2]) == (81, 45, 36)  # CONTACT's NCON, NADH, NSLIP
 
 
 def test_newton_refuses_a_law_on_a_coupled_step():

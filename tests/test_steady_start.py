@@ -12,6 +12,8 @@
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -108,7 +110,9 @@ def test_coupled_rolling_start_is_newtons_steady_state():
     assert meth.inner.predicting(False) is False, "prediction off after the start"
 
     class WithoutNewton(Alternation):
-        quasi_newton = False
+        def __init__(self, *args, **kw):
+            super().__init__(*args, **kw)
+            self.capabilities = dataclasses.replace(self.capabilities, quasi_newton=False)
 
     plain = rollqp.run(scene, method=WithoutNewton(rollqp.get_method("qp-osqp", tolerance=scene.solver.tolerance)))
     sweeps, without = int(r["iterations"][0]), int(plain["iterations"][0])
@@ -119,7 +123,7 @@ def _recording(base, predict=True):
     """``base``'s class with the accelerated start off (the march does all the work) and a log of whether
     each QP solve was predicted; ``predict=False``: the active-set prediction never switched on."""
     class Recording(type(base)):
-        accelerated_start = False
+        capabilities = dataclasses.replace(type(base).capabilities, accelerated_start=False)
 
         def solve(self, problem, warm=None):
             sol = super().solve(problem, warm)

@@ -1,14 +1,17 @@
-"""Sweeps on a real dask.distributed cluster (issue 15): points equal to the scenes run alone,
-a killed sweep process and a killed worker, the creep curve against Carter, bad input.
+"""Sweeps on a real dask.distributed cluster: points equal to the scenes run alone, several
+points per task and per chunk of the store, a killed sweep process and a killed worker, the
+creep curve against Carter (and where Carter's relative error is undefined), bad input.
 
 One 2-worker ``LocalCluster`` (two single-threaded worker processes; not a mock, not the
 synchronous scheduler) is shared by the module's tests (``client`` fixture): starting it costs
-a few seconds, the sweeps themselves well under a second each.
+a few seconds, the sweeps themselves well under a second each. The bad input that needs no
+cluster is in ``test_sweep_hardening.py``.
 """
 from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -27,7 +30,7 @@ from rollqp import closedforms as cf  # noqa: E402
 from rollqp.errors import InputError  # noqa: E402
 from rollqp.sweep import build_sweep, parse_vary, prepare, sweep  # noqa: E402
 from rollqp.sweep.dataset import create_store, open_result  # noqa: E402
-from rollqp.sweep.executor import connect  # noqa: E402
+from rollqp.sweep.executor import close_client, connect  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 #: A §6.1.1 scene small enough for the fast suite: 20 quadratic elements, 2 a_H of rolling.
@@ -262,18 +265,6 @@ def test_store_of_another_sweep_is_refused_and_left_alone(tmp_path):
         prepare(_small(), ["contact.friction=0.1,0.2"], tmp_path / "s.nc")
 
 
-def test_unreachable_scheduler_is_a_one_line_error_within_the_timeout(tmp_path):
-    t0 = time.perf_counter()
-    with pytest.raises(InputError, match=r"--scheduler: cannot reach a dask scheduler at 'tcp://127.0.0.1:9' within 1 s"):
-        connect("tcp://127.0.0.1:9", timeout=1.0)
-    assert time.perf_counter() - t0 < 15  # the timeout, plus dask's own retry granularity
-    for bad in (0, -1, 1000, 2.0, True):
-        with pytest.raises(InputError, match=r"--workers: must be an integer in \[1, "):
-            connect(workers=bad)
-    with pytest.raises(InputError, match="--workers: applies to the local cluster only"):
-        connect("tcp://127.0.0.1:9", workers=2)
-
-
 def test_cli_errors_are_one_line(capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert cli.main(["sweep", "cattaneo-carter", "--vary", "contact.fricton=0.1"]) == cli.EXIT_INPUT
@@ -303,3 +294,79 @@ def test_failed_point_is_stored_with_its_error_and_tried_again_by_a_rerun(client
     computed = []
     again = sweep(_small(), vary, store, client=client, on_point=lambda i, out: computed.append(i))
     assert again.kept == 1 and computed == [0] and len(again.failed) == 1
+
+
+def test_several_points_per_task_are_written_as_one_chunk_and_equal_each_scene_run_alone(client, tmp_path):
+    """24 points on 2 workers: ⌈√(24/8)⌉ = 2 points per task and per chunk of the store, each point
+    bitwise equal to its scene run alone; the store is read back as one dataset."""
+    store = tmp_path / "c.zarr"
+    vary = ["load.tangential=0.1:0.85:6", "contact.friction=0.1,0.15,0.2,0.3"]
+    base = _small().replace(**{"discretization.distance": 1.0})
+    summary = sweep(base, vary, store, client=client)
+    assert summary.done == 24 and not summary.failed and summary.per_chunk == 2 and summary.workers == 2
+    group = zarr.open_group(str(store), mode="r")
+    assert group["status"].chunks == (1, 2) and group["pt"].chunks[:2] == (1, 2)
+    assert group["pt"].chunks[2:] == group["pt"].shape[2:]  # every state and node of a point in its chunk
+    ds = xr.open_zarr(store, chunks=None).load()
+    sw = build_sweep(base, vary)
+    assert np.all(ds["status"].values == 1) and np.all(ds["point_time"].values > 0)
+    for i in (0, 4, 5, 14, 23):  # first and last of chunks, and the last point
+        _assert_point_equals_run(ds, sw, i)
+
+
+def test_rerun_of_a_chunk_with_a_failed_point_recomputes_it_alone_and_keeps_the_others(client, tmp_path):
+    """Two points in one chunk, one fails: the re-run computes only the failed one and writes it
+    into the chunk read back from the store; the other point keeps its bits (its wall times too)."""
+    store = tmp_path / "f2.zarr"
+    vary = ["solver.max_iterations=1,200"]
+    first = sweep(_small(), vary, store, client=client, per_chunk=2)
+    assert first.per_chunk == 2 and first.done == 1 and len(first.failed) == 1
+    before = xr.open_zarr(store, chunks=None).load()
+    computed = []
+    again = sweep(_small(), vary, store, client=client, on_point=lambda i, out: computed.append(i))
+    assert computed == [0] and again.kept == 1 and len(again.failed) == 1
+    after = xr.open_zarr(store, chunks=None).load()
+    for name in ("pt", "step_time", "point_time", "creepage"):
+        np.testing.assert_array_equal(after[name].values[1], before[name].values[1])
+    assert list(after["status"].values) == [2, 1] and after["error"].values[0].startswith("SolverError")
+    assert after["point_time"].values[0] != before["point_time"].values[0]  # point 0 was run again
+
+
+def test_creep_curve_through_zero_load_prints_no_nan(client, tmp_path):
+    """Q/(μP) = 0 is free rolling (ξ = 0 for similar bodies): Carter's relative error is undefined
+    there and shows as "—" with a note, as does the slope of a one-point curve; no "nan"."""
+    from rollqp.sweep.creep import creep_curve
+    scene = rollqp.load_scene("cattaneo-carter")
+    curve = creep_curve(scene, "0,0.5", None, tmp_path / "z.zarr", client=client)
+    assert curve.summary.done == 2 and abs(curve.xi[0, 0]) < 1e-12  # free rolling: no creepage (round-off)
+    table = curve.table()
+    assert "nan" not in table.lower() and "inf" not in table.lower()
+    assert "| 0.1 | 0.0000 |" in table and "| — |" in table and "undefined where Carter's ξ is 0" in table
+    one = creep_curve(scene, "0.3", None, tmp_path / "o.zarr", client=client).table()
+    assert "nan" not in one.lower() and "no slope" in one
+    bad = scene.replace(**{"solver.max_iterations": 1})
+    failed = creep_curve(bad, "0.2,0.4", None, tmp_path / "b.zarr", client=client)
+    assert len(failed.summary.failed) == 2
+    assert "nan" not in failed.table().lower() and failed.table().count("failed") >= 2
+
+
+def test_dashboard_port_in_use_gives_no_warning(recwarn):
+    """Another program on 127.0.0.1:8787 (dask's dashboard port): the local cluster starts with
+    no dashboard and its HTTP server on a port the system picks, so nothing is printed."""
+    import warnings
+    holder = socket.socket()
+    try:
+        holder.bind(("127.0.0.1", 8787))
+        holder.listen(1)
+    except OSError:  # already taken by another program: the case itself
+        pass
+    try:
+        warnings.simplefilter("always")
+        c = connect(workers=1)
+        try:
+            assert c.submit(int, "7").result() == 7
+        finally:
+            close_client(c)
+    finally:
+        holder.close()
+    assert not [w for w in recwarn if "8787" in str(w.message) or "already in use" in str(w.message)]

@@ -13,6 +13,12 @@ speed, ``w = L/(L + Δq)`` the memory weight (implicit Euler of ``L dμ/dq = μ�
 material) and ``μ̄`` the coefficient the material at node ``i`` carried at the previous step
 (transported by ``d Δq`` and interpolated; material entering the strip brings the static value).
 Without memory ``w = 0``.
+
+**Outside the contact** (``p_i <= 0``) there is no sliding interface: the slip ``s_i`` there is only
+the kinematic relative motion of two surfaces apart. The coefficient a step hands on as the memory
+(:meth:`~rollqp.problem.TangentialStep.coefficient`) therefore takes ``v = 0`` there, as CONTACT
+does: separated material relaxes towards ``μ∞(0) = μ_s`` over the memory length and enters the
+contact at (nearly) the static value. The bound itself is ``μ p⁺ = 0`` there either way.
 """
 from __future__ import annotations
 
@@ -22,7 +28,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["SlipBound", "step_coefficient"]
+__all__ = ["SlipBound", "step_coefficient", "steady_branches"]
 
 
 @dataclass(frozen=True)
@@ -34,9 +40,13 @@ class SlipBound:
     weight: float = 0.0              # memory weight w
     previous: np.ndarray | None = None  # μ̄ at the nodes (memory); None: w = 0
 
-    def mu(self, s) -> np.ndarray:
-        """``μ_i(s_i)``."""
-        m, _ = self.law.steady(self.law.rolling_speed * np.abs(s))
+    def mu(self, s, contact=None) -> np.ndarray:
+        """``μ_i(s_i)``; ``contact`` (a mask, optional): outside it the slip velocity is taken as 0, CONTACT's
+        semantics (module docstring), so that the memory of separated material relaxes towards the static value."""
+        v = self.law.rolling_speed * np.abs(s)
+        if contact is not None:
+            v = np.where(contact, v, 0.0)
+        m, _ = self.law.steady(v)
         return m if self.previous is None else (1.0 - self.weight) * m + self.weight * self.previous
 
     def dmu(self, s) -> np.ndarray:
@@ -65,8 +75,8 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
 
     Parameters
     ----------
-    law : float or friction law
-        ``scene.contact.friction``.
+    law : FrictionLaw
+        ``scene.contact.friction`` (:class:`rollqp.friction.FrictionLaw`).
     x_hat : (n,) array
         The nodes in ``a_H`` units.
     q_hat : float
@@ -82,9 +92,9 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
     steady : bool
         A direct steady solve: a law with memory cannot be posed there (InputError).
     """
-    kind = getattr(law, "kind", "constant")
+    kind = law.kind
     if kind == "constant":
-        return law, None  # the number itself: the old code path
+        return law.mu, None  # the number itself (a plain float): the old code path
     if kind == "spatial":
         return law.coefficient(x_hat, q_hat, direction), None
     static = law.steady(0.0)[0]
@@ -101,3 +111,21 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
                              left=float(static), right=float(static))
     w = law.weight(dq_hat if dq_hat is not None else 1.0)
     return float(static), SlipBound(law, w, np.asarray(previous, dtype=float))
+
+
+def steady_branches(law, Q, P, gross) -> str | None:
+    """What a direct steady solve with the force ``Q`` prescribed should tell about the other steady states of a
+    falling ``law`` (docs/friction.md, "Which steady state"), or None.
+
+    At large slip ``μ → μ_k``: with ``μ_k P < |Q| < μ_s P`` a *gross-sliding* steady state exists besides the
+    branch that grows continuously from Coulomb at ``μ_s`` (every node slipping, at the creepage where the mean
+    of ``μ(V|s|)`` carries ``|Q|``); the Newton start from the braked state returns the latter. ``gross``: the
+    state returned is gross sliding."""
+    lo, hi = law.kinetic * P, law.static * P
+    if gross:
+        return (f"gross sliding: every contact node slips (|Q| = {abs(Q) / P:.4g} P between mu_k P = {lo / P:.4g} P "
+                f"and mu_s P = {hi / P:.4g} P); a state with stick may exist too (docs/friction.md)")
+    if lo < abs(Q) < hi and law.static > law.kinetic:
+        return (f"a gross-sliding steady state exists too (|Q| = {abs(Q) / P:.4g} P > mu_k P = {lo / P:.4g} P); "
+                "this one has stick, the branch continuous with Coulomb at mu_s (docs/friction.md)")
+    return None

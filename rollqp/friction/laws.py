@@ -2,7 +2,8 @@ r"""The friction laws: what the coefficient ``μ`` of the bound ``|t| <= μ p`` 
 
 Three families, each a small frozen record whose fields are the keys of ``[contact.friction]``:
 
-* :class:`Coulomb` — one constant ``μ`` (``contact.friction = 0.3`` is this law);
+* :class:`Coulomb` — one constant ``μ`` (``contact.friction = 0.3`` is this law; the law object is
+  also the number ``μ``, a ``float``, so that a scene's ``contact.friction`` reads as before);
 * :class:`Patch`, :class:`Table` — ``μ(x)`` varying along the surface, fixed in the contact
   frame (``frame = "fixed"``) or carried by a body's material through the contact
   (``frame = "material"``: the material point at ``x`` at rolled distance ``q`` was at
@@ -47,25 +48,51 @@ def _mu(name, v):
     return number(f"{KEY}.{name}", v, f">= 0 (and <= {MAX_FRICTION:g})", lambda x: 0 <= x <= MAX_FRICTION)
 
 
-@dataclass(frozen=True)
-class Coulomb:
-    """Constant Coulomb coefficient ``μ`` (paper eq. 57–60)."""
+class Coulomb(float):
+    """Constant Coulomb coefficient ``μ`` (paper eq. 57–60): a law object that is also the number ``μ``.
 
-    mu: float
-    law: str = "coulomb"
+    A ``float`` subclass: arithmetic, comparisons, ``repr``, JSON and TOML see the number itself (a scene
+    written out says ``friction = 0.3``), while rollqp reads it as a law (``kind``, ``reference``,
+    ``largest``); each step takes the plain ``float`` ``μ`` (:attr:`mu`), the step problems' fast path.
+
+    Examples
+    --------
+    >>> from rollqp.friction import Coulomb
+    >>> law = Coulomb(0.3)
+    >>> law.kind, law.mu, 2 * law
+    ('constant', 0.3, 0.6)
+    >>> law
+    0.3
+    """
+
+    law = "coulomb"
     kind = "constant"
+    #: The table's keys (``[contact.friction]`` with ``law = "coulomb"``).
+    keys = ("mu", "law")
+    __slots__ = ()
+    __repr__ = float.__repr__
 
-    def __post_init__(self):
-        object.__setattr__(self, "mu", _mu("mu", self.mu))
+    def __new__(cls, mu, law: str = "coulomb"):
+        if law != "coulomb":
+            raise InputError(f"{KEY}.law", f"must be 'coulomb' for a Coulomb law, got {law!r}")
+        return super().__new__(cls, _mu("mu", mu))
+
+    def __reduce__(self):
+        return Coulomb, (float(self),)
+
+    @property
+    def mu(self) -> float:
+        """``μ`` as a plain ``float`` (what a step problem takes)."""
+        return float(self)
 
     @property
     def reference(self) -> float:
         """The ``μ`` of ``load.tangential = Q/(μ P̄)`` and of the reports."""
-        return self.mu
+        return float(self)
 
     @property
     def largest(self) -> float:
-        return self.mu
+        return float(self)
 
 
 class _Spatial:
@@ -217,7 +244,7 @@ class SlipVelocity:
             return self.kinetic + dm * np.where(inside, 1.0 - v / vh, 0.0), np.where(inside, -dm / vh, 0.0)
         if self.law == "rational":
             u = 1.0 + v / vh
-            return self.kinetic + dm / u, -dm / (vh * u * u)
+            return self.kinetic + dm / u, -(dm / vh) / u / u  # not vh·u·u: it overflows for u > 1e154
         if self.law == "exponential":
             e = np.exp(-v / vh)
             return self.kinetic + dm * e, -dm * e / vh

@@ -1,12 +1,23 @@
 """Influence matrices of the two bodies at the strip nodes (paper eq. 23–30; docs/formulation.md §3).
 
-``MODELS`` maps a scene's ``contact.model`` to a builder ``f(strip, **kw) -> Influence``;
-:func:`build_influence` dispatches on it.
+Each model is a declared record, a :class:`Model` (:mod:`.model`): its builder from a scene, the scene
+keys it reads, its checks, whether it has matrix-free operators and takes body profiles, its rows in a
+run's summary. :func:`register_model` adds one — ``contact.model`` then accepts its name everywhere;
+:func:`get_model` finds one. The built-in ``halfspace`` and ``bem`` are in :mod:`.builtin`.
+
+``MODELS`` maps a model's name to its array builder ``f(strip, **kw) -> Influence`` and
+:func:`build_influence` dispatches on it (the builders with their own keyword arguments, without a scene).
 """
 from __future__ import annotations
 
 from ..errors import InputError
+from . import builtin
 from .halfspace import Influence, halfspace_influence, min_eigenvalue
+from .model import DEFAULT as DEFAULT_MODEL
+from .model import Model
+from .model import get as get_model
+from .model import names as model_names
+from .model import register as register_model
 
 
 def bem_influence(strip, **kw) -> Influence:
@@ -16,7 +27,8 @@ def bem_influence(strip, **kw) -> Influence:
     from .bem import bem_influence as build
     return build(strip, **kw)
 
-__all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence"]
+__all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence", "Model",
+           "register_model", "get_model", "model_names", "DEFAULT_MODEL"]
 
 #: Available influence models (``contact.model``).
 MODELS = {"halfspace": halfspace_influence, "bem": bem_influence}
@@ -36,3 +48,7 @@ def build_influence(model: str, strip, **kw) -> Influence:
         raise InputError("contact.model",
                          f"must be one of {', '.join(sorted(MODELS))}, got {model!r}") from None
     return builder(strip, **kw)
+
+
+register_model(builtin.HALFSPACE)
+register_model(builtin.BEM)

@@ -13,20 +13,31 @@
 
 Optional backends are always registered by name; one whose package is not installed
 raises :class:`~rollqp.errors.MissingBackendError` naming the pip extra, and
-:func:`available_methods` leaves it out. Modules are imported on first use.
+:func:`available_methods` leaves it out. Modules are imported on first use. :func:`register` adds a
+method class under a new name (the one call a method written outside rollqp needs).
 
 :func:`get_method` makes one method from its name and settings; :func:`scene_method` makes the
-method a scene runs with, composed from what the named method declares it solves
-(:attr:`~rollqp.methods.base.Method.solves`): on a coupled scene a method that does not solve
-coupled steps runs inside the N–T alternation. This module is the only place where method
-names are looked at.
+method a scene runs with, composed from what the named method declares
+(:class:`~rollqp.methods.base.Capabilities`): on a coupled scene a method that does not solve
+coupled steps runs inside the N–T alternation, and one that does not pose slip-dependent bounds
+inside the fixed point on the bound. This module is the only place where method names are looked
+at: the defaults and the reference methods below are named here.
+
+Examples
+--------
+>>> from rollqp.methods import get_method, capabilities
+>>> get_method("newton", tolerance=1e-9).tolerance
+1e-09
+>>> sorted(capabilities("qp-clarabel").solves)
+['normal', 'tangential']
 """
 from __future__ import annotations
 
 import importlib
 
 from ..errors import InputError, MissingBackendError
-from .base import KINDS, Method, check_kind, check_options  # noqa: F401 - the protocol, re-exported
+from .base import (FRICTION_KINDS, KINDS, Capabilities, Method, check_kind,  # noqa: F401 - the protocol, re-exported
+                   check_options)
 
 # name -> (module, class, pip extra that provides it or None)
 _REGISTRY = {
@@ -43,8 +54,55 @@ _REGISTRY = {
 
 METHOD_NAMES = tuple(_REGISTRY)
 #: The methods that pose convex QPs (each half of a step one QP; coupled steps by the N–T
-#: alternation): for listings and benchmarks. What a method can do is its ``solves``.
+#: alternation): for listings and benchmarks. What a method can do is its ``capabilities``.
 QP_METHODS = tuple(k for k in _REGISTRY if k.startswith(("qp-", "qps-")))
+#: The method of a scene without ``solver.method``.
+DEFAULT_METHOD = "newton"
+#: The reference method: step files are marched with it, and the cross-validation and the step checker
+#: report differences from its solution (the residual of every method is rollqp's own all the same).
+REFERENCE_METHOD = "newton"
+#: The methods a candidate solution of a stored step is compared with (:func:`rollqp.stepfile.check_step`).
+COMPARE_METHODS = ("newton", "qp-clarabel")
+#: The QP backends a run is cross-checked against (core dependencies only: :func:`rollqp.crossval.spot_check`).
+CROSS_CHECK_METHODS = ("qp-clarabel", "qp-osqp")
+#: The method :func:`rollqp.solve_step` poses one step with by default (a convex QP, interior point).
+STEP_METHOD = "qp-clarabel"
+
+
+def register(name: str, cls: type, extra: str | None = None) -> None:
+    """Register a method class under ``name`` (a scene's ``solver.method``, :func:`get_method`).
+
+    ``cls`` follows the protocol of :mod:`rollqp.methods.base`: ``name``, a class attribute
+    ``capabilities`` (:class:`Capabilities`), ``from_settings``, ``setup`` and ``solve``. ``extra``: the
+    pip extra that installs what it needs, named when its import fails.
+
+    Raises
+    ------
+    InputError
+        ``name`` is already registered, or ``cls`` declares no :class:`Capabilities`.
+    """
+    if not isinstance(name, str) or not name or name in _REGISTRY:
+        raise InputError("name", f"must be a new method name (registered: {', '.join(_REGISTRY)}), got {name!r}")
+    declared = next((vars(k)["capabilities"] for k in cls.__mro__ if "capabilities" in vars(k)), None)
+    if not isinstance(declared, Capabilities):
+        raise InputError("cls", f"a method class declares its Capabilities as the class attribute "
+                                f"'capabilities' ({cls!r} does not)")
+    _REGISTRY[name] = (cls, None, extra)
+
+
+def capabilities(name: str) -> Capabilities:
+    """What the method ``name`` declares (its class's ``capabilities``), without making it; the
+    declaration of a method that needs the matrix and solves nothing if its package is not installed.
+
+    Raises
+    ------
+    InputError
+        ``solver.method`` for an unknown name.
+    """
+    try:
+        return method_class(name).capabilities
+    except MissingBackendError:
+        return Capabilities()
 
 
 def available_methods() -> list[str]:
@@ -81,6 +139,8 @@ def method_class(name: str) -> type:
     """
     check_name(name)
     module, cls, extra = _REGISTRY[name]
+    if isinstance(module, type):  # registered as a class (register)
+        return module
     try:
         mod = importlib.import_module(module)
     except ModuleNotFoundError as exc:
@@ -130,32 +190,26 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
     whose coupled step takes a constant coefficient only (``newton``) refuses a law on a coupled
     scene up front, naming the alternatives.
     """
-    if friction != "constant" and coupled and "coupled" in method.solves and not isinstance(method, _Alternation()):
-        raise InputError("solver.method", f"method {method.name!r} solves coupled steps with a constant friction "
-                                          f"coefficient only; with a {friction} friction law on a coupled scene use "
+    caps = method.capabilities
+    if coupled and "coupled" in caps.solves and friction not in caps.coupled_friction:
+        raise InputError("solver.method", f"method {method.name!r} solves coupled steps with "
+                                          f"{' or '.join(sorted(caps.coupled_friction))} friction only; with a "
+                                          f"{friction} friction law on a coupled scene use "
                                           "'nt-newton' (Newton halves in the N–T alternation) or a qp-* method")
-    if friction == "slip" and not getattr(method, "slip_dependent", False):
+    if friction == "slip" and not caps.slip_dependent:
         from .fixedpoint import BoundFixedPoint
         method = BoundFixedPoint(method)
-    if coupled and "coupled" not in method.solves:
-        if not {"normal", "tangential"} <= method.solves:
+    if coupled and "coupled" not in caps.solves:
+        if not {"normal", "tangential"} <= caps.solves:
             raise InputError("solver.method", f"method {method.name!r} solves neither coupled steps nor both "
                                               "halves of them")
         from .alternation import Alternation
-        return Alternation(method, max_outer=max_outer, limit=getattr(method, "coupled_limit", None))
+        return Alternation(method, max_outer=max_outer, limit=caps.coupled_limit)
     return method
 
 
-def _Alternation():
-    from .alternation import Alternation
-    return Alternation
-
-
 def matrix_free(name: str) -> bool:
-    """Whether method ``name`` works with operator products only (its class's ``matrix_free``),
+    """Whether method ``name`` works with operator products only (:attr:`Capabilities.matrix_free`),
     so that a scene may give it FFT operators (:mod:`rollqp.matrixfree`); False for a method whose
     package is not installed."""
-    try:
-        return bool(getattr(method_class(name), "matrix_free", False))
-    except MissingBackendError:
-        return False
+    return capabilities(name).matrix_free

@@ -9,13 +9,14 @@ asymmetry ``‖FA − (FA)ᵀ‖/‖FA‖`` travels with the solution (``info["a
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
 
 from ..errors import InputError, SolverError
 from ..problem import StepSolution
-from .base import check_kind, check_options
+from .base import Capabilities, check_kind, check_options
 
 
 class QPMethod:
@@ -73,7 +74,10 @@ class QPMethod:
     """
 
     name = "qp"
-    solves = frozenset({"normal", "tangential"})
+    #: Each half a convex QP; on request the QPs are solved on their predicted active sets first
+    #: (:meth:`predicting`), and the accelerated rolling start takes it (:mod:`.steady_start`).
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), predicting=True,
+                                accelerated_start=True, quasi_newton=True)
     extra = None  # pip extra that installs the backend, if optional
     #: Active-set refinement of the solver's answer (:func:`active_set_refine`); on for the
     #: interior-point backends, whose complementarity stops at ``sqrt(gap tolerance)``.
@@ -98,6 +102,8 @@ class QPMethod:
         self.residual_limit = float(residual_limit) if residual_limit is not None else max(100 * tolerance, 1e-12)
         self.max_iterations = max_iterations
         self.operator = operator
+        self.capabilities = dataclasses.replace(type(self).capabilities, operator=operator,
+                                                residual_limit=self.residual_limit)
         self.options = options
         self._solvers = {}
         self._kkt = KKTCache()
@@ -143,7 +149,7 @@ class QPMethod:
         (``q + ∂q/∂e · F⁻¹S x_{k−1}``), and rollqp's residual is evaluated once, on the answer.
         """
         check_kind(self, problem)
-        if getattr(problem, "law", None) is not None:
+        if problem.law is not None:
             raise InputError("problem", f"method {self.name!r} solves steps with a fixed friction bound; this one depends on "
                                         "the slip: use rollqp.methods.fixedpoint.BoundFixedPoint around it (scenes do) "
                                         "or method 'newton'")

@@ -26,11 +26,13 @@ iterations) or diverges (``Alternation._check_progress``).
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
 
 from ..errors import InputError, SolverError
+from .base import FRICTION_KINDS
 
 
 def sweep(method, problem, t, warm_n=None, warm_t=None):
@@ -77,16 +79,19 @@ class Alternation:
         if int(max_outer) != max_outer or max_outer < 1:
             raise InputError("max_outer", f"must be an integer >= 1, got {max_outer!r}")
         self.inner = inner
-        # coupled steps by alternation; the steady (non-symmetric) problem only if the halves pose it
-        self.solves = frozenset({"coupled"}) | inner.solves
+        inner_caps = inner.capabilities
         self.max_outer = int(max_outer)
         self.limit = float(limit) if limit is not None else float(inner.tolerance)
-        self.stall_limit = max(self.limit, float(getattr(inner, "residual_limit", 0.0) or 0.0))
-        self.name = getattr(inner, "name", "alternation")
-        self.operator = getattr(inner, "operator", "exact")
+        self.stall_limit = max(self.limit, float(inner_caps.residual_limit or 0.0))
+        self.name = inner.name
         self.tolerance = inner.tolerance
-        #: the halves' own capability (rollqp.methods.compose): a slip-dependent bound reaches them unchanged
-        self.slip_dependent = bool(getattr(inner, "slip_dependent", False))
+        #: coupled steps by alternation, with any friction law its halves take; the steady (non-symmetric)
+        #: problem only if the halves pose it; the halves' operators, slip-dependent bounds (a bound reaches
+        #: them unchanged), QP prediction and accelerated start; one sweep a step on request
+        #: (:meth:`single_sweeps`)
+        self.capabilities = dataclasses.replace(inner_caps, solves=frozenset({"coupled"}) | inner_caps.solves,
+                                                coupled_friction=FRICTION_KINDS, coupled_limit=None,
+                                                residual_limit=None, single_sweeps=True)
         self._single = False  # single_sweeps
 
     def single_sweeps(self, on: bool) -> bool:
@@ -103,6 +108,11 @@ class Alternation:
         """
         was, self._single = self._single, bool(on)
         return was
+
+    def predicting(self, on: bool) -> bool:
+        """The halves' active-set prediction on or off (:attr:`Capabilities.predicting
+        <rollqp.methods.base.Capabilities.predicting>` of the inner method); whether it was on."""
+        return self.inner.predicting(on)
 
     def setup(self, operators) -> None:
         """A new scene: the inner method's set-up (and the one-sweep mode off)."""

@@ -27,6 +27,7 @@ names the residual. Coupled steps run inside the N–T alternation (``solves`` h
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -34,7 +35,7 @@ import scipy.fft
 import scipy.sparse.linalg as spla
 
 from ..errors import InputError, SolverError
-from .base import check_kind, check_options
+from .base import Capabilities, check_kind, check_options
 
 __all__ = ["KrylovNewton"]
 
@@ -145,16 +146,9 @@ class KrylovNewton:
     """
 
     name = "mf-newton"
-    solves = frozenset({"normal", "tangential", "steady"})
-    operator = "exact"
-    #: works with operator products only (``A @ x``, ``x @ A``, ``diagonal()``): no stored matrix
-    matrix_free = True
-
-    @property
-    def coupled_limit(self) -> float:
-        """The coupled residual at which the N–T alternation around this method stops
-        (:func:`rollqp.methods.compose`): :data:`COUPLED_FACTOR` times the tolerance."""
-        return COUPLED_FACTOR * self.tolerance
+    #: Operator products only (``A @ x``, ``x @ A``, ``diagonal()``): no stored matrix. Coupled steps by the
+    #: N–T alternation, which stops at :data:`COUPLED_FACTOR` times the tolerance (:attr:`capabilities`).
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True)
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, preconditioner: str = "circulant"):
         if preconditioner not in PRECONDITIONERS:
@@ -162,6 +156,7 @@ class KrylovNewton:
         self.tolerance = float(tolerance)
         self.max_iterations = int(max_iterations)
         self.preconditioner = preconditioner
+        self.capabilities = dataclasses.replace(type(self).capabilities, coupled_limit=COUPLED_FACTOR * self.tolerance)
         self._warm = {"normal": {}, "tangential": {}}      # reduced solutions of the last step
         self.stats = {"products": 0, "solves": 0}
 

@@ -1,8 +1,10 @@
 """``nt-newton``: the normal–tangential alternation (:mod:`.alternation`) with generalized Newton halves (:mod:`.newton`)."""
 from __future__ import annotations
 
+import dataclasses
+
 from .alternation import Alternation
-from .base import check_options
+from .base import FRICTION_KINDS, check_options
 from .newton import NewtonMethod
 
 __all__ = ["AlternationNewton"]
@@ -12,6 +14,8 @@ class AlternationNewton(Alternation):
     """``nt-newton``: the N–T alternation with Newton (GNMls) halves (paper §6.3)."""
 
     name = "nt-newton"
+    #: Newton's, with coupled steps of any friction law (by the alternation) and one sweep a step on request
+    capabilities = dataclasses.replace(NewtonMethod.capabilities, coupled_friction=FRICTION_KINDS, single_sweeps=True)
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
         super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),

@@ -1,6 +1,6 @@
-r"""The QP methods' rolling start: the march toward steady rolling, accelerated (issue 18).
+r"""The QP methods' rolling start: the march toward steady rolling, accelerated.
 
-A QP method cannot pose the steady rolling problem (its slip operator ``d·D_up·A`` has an
+A QP method cannot pose the steady rolling problem (its slip operator ``T·A``, docs/formulation.md §9, has an
 indefinite weighted symmetric part: no convex QP has it as Hessian), so :func:`rollqp.march`
 reaches the steady state by rolling at constant loads until the tractions stop changing. One
 marching step, as a function of the shear it starts from, is a map ``t ↦ G(t)``: the normal half
@@ -37,8 +37,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from ..problem import State
-from ._qp import QPMethod, _chol_solve, _kkt_factor
-from .alternation import Alternation
+from ._qp import _chol_solve, _kkt_factor
 
 #: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this (without the Newton phase,
 #: or after it stopped short). Measured on the
@@ -72,22 +71,23 @@ MAX_JACOBIANS = 10
 
 
 def applies(method, ops) -> bool:
-    """Whether :func:`accelerated_start` handles this method and scene: a QP backend (or the N–T
-    alternation of one) whose ``accelerated_start`` attribute is not False (benchmarks switch it off to
-    measure the plain march), with Coulomb friction (a fixed μ), friction, and a fixed profile."""
-    inner = method.inner if isinstance(method, Alternation) else method
-    return (isinstance(inner, QPMethod) and getattr(method, "accelerated_start", True) and isinstance(ops.friction, float) and not ops.frictionless
-            and not ops.profiles_move and ops.coupled == isinstance(method, Alternation))
+    """Whether :func:`accelerated_start` handles this method and scene: a method that declares
+    :attr:`~rollqp.methods.base.Capabilities.accelerated_start` (a QP backend, or the N–T alternation of
+    one; benchmarks switch it off to measure the plain march) and solves the scene's steps as they are
+    posed (coupled steps on a coupled scene, the halves on the others), with a constant friction
+    coefficient, friction, and a fixed profile."""
+    caps = method.capabilities
+    return (caps.accelerated_start and ops.friction.kind == "constant" and not ops.frictionless
+            and not ops.profiles_move and ops.coupled == ("coupled" in caps.solves))
 
 
 def predicting(method, on: bool) -> bool | None:
     """Switch the active-set prediction of ``method``'s QPs on or off (:meth:`QPMethod.predicting
-    <rollqp.methods._qp.QPMethod.predicting>`; a QP backend or the N–T alternation of one); return
-    whether it was on, or None for a method without it. rollqp.march's rolling start keeps it on while
-    it marches to the steady state and takes its last steps with it off, so that the state it keeps
-    is the backend's."""
-    inner = method.inner if isinstance(method, Alternation) else method
-    return inner.predicting(on) if isinstance(inner, QPMethod) else None
+    <rollqp.methods._qp.QPMethod.predicting>`, for a method that declares
+    :attr:`~rollqp.methods.base.Capabilities.predicting`); return whether it was on, or None for a
+    method without it. rollqp.march's rolling start keeps it on while it marches to the steady state
+    and takes its last steps with it off, so that the state it keeps is the backend's."""
+    return method.predicting(on) if method.capabilities.predicting else None
 
 
 def sweep_map(method, ops, state, counters=None, *, P, Q, xi, dq, M, delta=None):
@@ -95,7 +95,7 @@ def sweep_map(method, ops, state, counters=None, *, P, Q, xi, dq, M, delta=None)
     half warm-started from the previous evaluation (first from ``state``); its solves are counted in
     ``counters`` if given (rollqp.march's ``Counters`` of the starting state: a coupled evaluation is
     one N–T outer iteration, as in the alternation)."""
-    inner = method.inner if isinstance(method, Alternation) else method
+    inner = method  # its halves' solver (the N–T alternation hands the halves to its inner method as they are)
     warm = {"n": state.nsol, "t": state.tsol}
     zero = np.zeros(ops.n)
 
@@ -173,26 +173,25 @@ class Anderson:
 def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=None, tol=1e-8,
                       max_evaluations=1000):
     """The state to continue rollqp.march's rolling start from: ``state`` itself unless :func:`applies`,
-    else the best map output (smallest ``max|G(t) − t|``) of the accelerated iteration from the braked
+    else the best map output (smallest ``max|G(t) − t|``) of the accelerated iteration from the
     starting ``state`` (module docstring), as a march ``State``.
 
     ``tol``: the march's tolerance on the change of ``t`` per step, in μp0; the iteration stops at
     :data:`TARGET`·tol, after :data:`PATIENCE` evaluations without progress, or ``max_evaluations``.
-    A method whose ``quasi_newton`` attribute is False skips the Newton phase (benchmarks measure
-    Anderson alone so).
+    A method that does not declare :attr:`~rollqp.methods.base.Capabilities.quasi_newton` skips the Newton
+    phase (benchmarks measure Anderson alone so).
     """
     if not applies(method, ops):
         return state
     G = sweep_map(method, ops, state, counters, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
-    inner = method.inner if isinstance(method, Alternation) else method
-    was = inner.predicting(True)  # the map's QPs: active-set prediction first (module docstring)
+    was = method.predicting(True)  # the map's QPs: active-set prediction first (module docstring)
     try:
         best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
                                  max_evaluations=max_evaluations,
                                  jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
-                                 if getattr(method, "quasi_newton", True) else None)
+                                 if method.capabilities.quasi_newton else None)
     finally:
-        inner.predicting(was)
+        method.predicting(was)
     return state if best is None else _state(ops, state, best, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
 
 

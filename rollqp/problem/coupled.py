@@ -50,8 +50,9 @@ class CoupledStep:
     Notes
     -----
     ``Atn`` and ``Att`` are the *slip* operators: for transient steps the influence matrices
-    themselves; for steady rolling (``s = ξ e + d·D_up w``) rollqp.march passes
-    ``Δ·d·D_up·A_tn`` and ``Δ·d·D_up·A_tt`` with ``dq = Δ`` and ``c = 0``.
+    themselves; for steady rolling (``s = ξ e + T w``, :meth:`SceneOperators.steady
+    <rollqp.operators.SceneOperators.steady>`) rollqp.march passes ``Δ·T·A_tn`` and ``Δ·T·A_tt`` with
+    ``dq = Δ`` and ``c = 0``.
     """
 
     Ann: np.ndarray               # eq. 25–26
@@ -129,9 +130,12 @@ class CoupledStep:
         _check_sliding_limit(half)
         return half
 
-    def coefficient(self, s=None):
-        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""
-        return self.mu if self.law is None or s is None else self.law.mu(s)
+    def coefficient(self, s=None, p=None):
+        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``; with the pressure
+        ``p``, outside the contact (``p <= 0``) a law takes the slip velocity as 0 (docs/friction.md)."""
+        if self.law is None or s is None:
+            return self.mu
+        return self.law.mu(s, contact=None if p is None else p > 0.0)
 
     def residuals(self, p, t, delta, xi, g=None, s=None) -> "Residuals":
         """rollqp's residuals of the coupled step: Signorini, friction (bound ``μp⁺``), loads (eq. 70–71);

@@ -43,6 +43,7 @@ class NormalStep:
     offset: np.ndarray | None = None
     scales: Scales = field(default_factory=Scales)
     kind = "normal"
+    law = None  # no friction bound (the tangential and coupled steps' slip-dependent ``law``)
 
     def __post_init__(self):
         _check_arrays(self, ("A",), ("h",), ("offset",))

@@ -90,9 +90,12 @@ class TangentialStep:
         """The bound at the slip ``s``: ``μ(s)·max(p̄, 0)`` (``law``), else :attr:`bound`."""
         return self.bound if self.law is None else self.law.mu(s) * np.maximum(self.p, 0.0)
 
-    def coefficient(self, s=None):
-        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``."""
-        return self.mu if self.law is None or s is None else self.law.mu(s)
+    def coefficient(self, s=None, p=None):
+        """``μ`` of this step: the number or per-node array, or ``law.mu(s)`` at the slip ``s``; ``p`` (default the
+        step's pressure): outside the contact (``p <= 0``) a law takes the slip velocity as 0 (docs/friction.md)."""
+        if self.law is None or s is None:
+            return self.mu
+        return self.law.mu(s, contact=(self.p if p is None else p) > 0.0)
 
     def frozen(self, s) -> "TangentialStep":
         """The same step with the bound frozen at the slip ``s`` (``μ = law.mu(s)`` per node): a convex QP."""

@@ -18,10 +18,11 @@ import numpy as np
 
 from ..errors import InputError
 from ..histories import Constant, Harmonic, parse_history
+from ..influence import get_model
 from ..methods import check_name as check_method
 from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, COUPLINGS, EDGE_ELEMENTS,
                      ELEMENT_TYPES, FORMULATION_TYPES, MAX_ELEMENTS, MAX_NODES, MAX_START_STEPS, MAX_STEPS,
-                     MODELS, OPERATOR_MODES, STARTS,
+                     OPERATOR_MODES, STARTS,
                      Body, Contact, Discretization, Load, SolverSettings)
 from ..validate import choice, integer, number, string
 
@@ -72,8 +73,8 @@ def check_contact(c: Any) -> Contact:
     if not isinstance(c, Contact):
         raise InputError("contact", f"must be a Contact, got {c!r}")
     from ..friction import parse_friction
-    mu = parse_friction(c.friction)  # a number (Coulomb, as before) or a law record
-    model = choice("contact.model", c.model, MODELS)
+    mu = parse_friction(c.friction)  # a law (Coulomb's is also its number)
+    model = get_model(c.model).name
     coupling = choice("contact.coupling", c.coupling, COUPLINGS)
     d = c.reference_distance
     if d is not None:
@@ -139,7 +140,7 @@ def check_solver(s: Any) -> SolverSettings:
             "solver.augmentation", s.augmentation,
             f"in [{AUGMENTATION_MIN:g}, {AUGMENTATION_MAX:g}] or absent (automatic)",
             lambda x: AUGMENTATION_MIN <= x <= AUGMENTATION_MAX),
-        operator=None if getattr(s, "operator", None) is None else choice("solver.operator", s.operator,
+        operator=None if s.operator is None else choice("solver.operator", s.operator,
                                                                           OPERATOR_MODES))
 
 
@@ -151,7 +152,7 @@ def check_whole(scene) -> None:
     check_work(scene)
     check_loads(scene)
     check_convective_step(scene)
-    check_bem(scene)
+    check_model(scene)
     check_zone(scene)
     check_tangential(scene)
     check_sampling(scene)
@@ -177,7 +178,8 @@ def check_kinematics(scene) -> None:
                                             f"rolls {big:.6g} Le: use a smaller discretization.step")
     for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
         if body.profile is not None:
-            check_cover(body.profile, f"{key}.profile", scene.half_width, pl.shift_range(), scene.contact.model)
+            check_cover(body.profile, f"{key}.profile", scene.half_width, pl.shift_range(),
+                        get_model(scene.contact.model))
 
 
 def check_derived(scene) -> None:
@@ -238,7 +240,7 @@ def check_work(scene) -> None:
     what they would need."""
     from ..matrixfree import check_scene, memory_estimate
     n, K = scene.n_nodes, scene.n_steps
-    dense = check_scene(scene, MAX_NODES) == "dense"
+    dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
     need, memory = (scene.memory_estimate() if dense else memory_estimate(scene)), available_memory()
     if need > 0.8 * memory:
         per_node = n * n * 8 * 6 if dense else n * 8.0 * 200    # the operators' share of the need
@@ -319,32 +321,11 @@ def check_sampling(scene) -> None:
                              f"smaller discretization.step")
 
 
-#: Smallest strip element length over the smaller radius for ``model = "bem"``: the BEM nodes are
-#: points ``R (cos θ, sin θ)`` and its collocation integrals need their separations resolved far
-#: above round-off (1e-7 R is 1e9 ulps of R). Contacts this small are half-space contacts: the
-#: BEM's departure from the half-space is of order a/R (docs/bem.md).
-MIN_BEM_ELEMENT_RATIO = 1e-7
-
-
-def check_bem(scene) -> None:
-    """``model = "bem"``: both shafts given, the strip shorter than half a circumference, its
-    elements resolvable on the circles."""
-    if scene.contact.model != "bem":
-        return
-    smaller = min(scene.A.radius, scene.B.radius)
-    if not scene.element_length >= MIN_BEM_ELEMENT_RATIO * smaller:
-        raise InputError("contact.model", f"'bem' needs strip elements of at least {MIN_BEM_ELEMENT_RATIO:g} × the "
-                                          f"smaller radius, got {scene.element_length:.3g} on radius {smaller:g} "
-                                          f"(a_H/R = {scene.a_H / scene.R:.3g}); a contact this small is a half-space "
-                                          f"contact: use model = 'halfspace'")
-    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
-        if body.shaft_radius is None:
-            raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' (the "
-                                                    f"rigid shaft's radius, in (0, {body.radius!r}))")
-        if not 2.0 * scene.half_width < math.pi * body.radius:
-            raise InputError("discretization.zone",
-                             f"the strip (2L = {2 * scene.half_width:.6g}) must be shorter than half the "
-                             f"circumference of {key} (radius {body.radius!r}) for model = 'bem'")
+def check_model(scene) -> None:
+    """The influence model's own checks of the scene (:attr:`Model.check <rollqp.influence.Model.check>`)."""
+    check = get_model(scene.contact.model).check
+    if check is not None:
+        check(scene)
 
 
 def check_convective_step(scene) -> None:
@@ -372,7 +353,7 @@ def check_convective_step(scene) -> None:
 def check_friction(scene) -> None:
     """A friction law varying along the surface meets the strip during the run (:mod:`rollqp.friction`)."""
     law = scene.contact.friction
-    if hasattr(law, "check_strip"):
+    if law.kind == "spatial":  # (rollqp.friction.FrictionLaw: a spatial law checks that it meets the strip)
         q = scene.q_end / scene.a_H
         if scene.load.rolled is not None:  # a load path: the range of q it covers (stops, reversals)
             from ..kinematics import plan

@@ -36,6 +36,13 @@ class Derived:
         return max(self.discretization.distance, self.n_steps * self.dq / self.a_H)
 
     @property
+    def method_capabilities(self):
+        """What the scene's ``solver.method`` declares (:class:`~rollqp.methods.base.Capabilities`, asked of the
+        method registry by name): whether it needs the influence matrix, what it solves."""
+        from ..methods import capabilities
+        return capabilities(self.solver.method)
+
+    @property
     def bem_mesh(self) -> tuple[int, int]:
         """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
         from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER  # one place for the paper's counts

@@ -9,10 +9,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..histories import Constant, History
-from ..methods import METHOD_NAMES
+from ..influence import DEFAULT_MODEL, model_names
+from ..methods import DEFAULT_METHOD, METHOD_NAMES
 
-METHODS = METHOD_NAMES  # the method registry's names (rollqp.methods; names are checked there)
-MODELS = ("halfspace", "bem")
+METHODS = METHOD_NAMES  # the method registry's built-in names (rollqp.methods; names are checked there)
+MODELS = model_names()  # the built-in influence models (rollqp.influence; names are checked there)
 COUPLINGS = ("auto", "full", "goodman", "off")
 STARTS = ("braked", "rolling")
 ELEMENT_TYPES = ("constant", "linear", "quadratic")
@@ -83,11 +84,13 @@ class Contact:
 
     Parameters
     ----------
-    friction : float or friction law
+    friction : float or FrictionLaw
         Coulomb coefficient μ, finite and ``>= 0``; or a law of :mod:`rollqp.friction`
-        (``[contact.friction]`` table: a patch, a table μ(x), a slip-velocity law).
-    model : {"halfspace", "bem"}
-        Half-space influence (docs/formulation.md §3) or true geometry by BEM (docs/bem.md).
+        (``[contact.friction]`` table: a patch, a table μ(x), a slip-velocity law). A validated scene holds
+        a :class:`~rollqp.friction.FrictionLaw` (Coulomb's law is also its number).
+    model : str
+        A registered influence model (:func:`rollqp.influence.model_names`): ``"halfspace"``, half-space
+        influence (docs/formulation.md §3), or ``"bem"``, true geometry by BEM (docs/bem.md).
     coupling : {"auto", "full", "goodman", "off"}
         Normal–tangential coupling level (§3); "auto" is "full" iff β ≠ 0, else "off".
     reference_distance : float or None
@@ -99,7 +102,7 @@ class Contact:
     """
 
     friction: float
-    model: str = "halfspace"
+    model: str = DEFAULT_MODEL
     coupling: str = "auto"
     reference_distance: float | None = None
     bem_outer_elements: int | None = None
@@ -109,7 +112,7 @@ class Contact:
     def mu(self) -> float:
         """The reference coefficient (the number itself for Coulomb; :func:`rollqp.friction.reference`):
         ``load.tangential`` is ``Q/(μ P̄)`` with it."""
-        return self.friction if isinstance(self.friction, float) else float(self.friction.reference)
+        return float(self.friction.reference)
 
 
 @dataclass(frozen=True)
@@ -215,7 +218,7 @@ class SolverSettings:
         work with products only (``mf-newton``) from :data:`rollqp.matrixfree.THRESHOLD` nodes.
     """
 
-    method: str = "newton"
+    method: str = DEFAULT_METHOD
     tolerance: float = 1e-10
     max_iterations: int | None = None
     augmentation: float | None = None

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, SolverError
+from ..methods import COMPARE_METHODS
 from ..npzfile import read_npz, real_array, real_scalar
 from ..problem import SEPARATION, SLIP, STICK, StepSolution, classify, friction_residual
 from .file import FORMAT, StepFile
@@ -163,7 +164,7 @@ def validate_solution(sol: dict, n: int, arg: str = "solution") -> dict:
     return out
 
 
-def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton", "qp-clarabel")) -> CheckReport:
+def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=COMPARE_METHODS) -> CheckReport:
     """Evaluate a candidate solution of a stored step with rollqp's residuals.
 
     Parameters
@@ -179,7 +180,8 @@ def check_step(step, solution, tol: float = DEFAULT_TOL, compare_with=("newton",
     tol : float
         Pass/fail limit on each residual (:data:`DEFAULT_TOL`).
     compare_with : methods
-        rollqp methods whose solution of the step the candidate is compared with.
+        rollqp methods whose solution of the step the candidate is compared with (default
+        :data:`rollqp.methods.COMPARE_METHODS`).
     """
     if not (np.isfinite(tol) and tol > 0):
         raise InputError("--tol", f"must be a finite number > 0, got {tol!r}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..methods import REFERENCE_METHOD
 from ..problem import CoupledStep
 from .file import StepFile
 
@@ -20,8 +21,9 @@ def export_step(scene, k: int, method: str | None = None) -> "StepFile":
     k : int
         Step number, ``0 <= k <= scene.n_steps`` (module docstring).
     method : str, optional
-        Method that marches the scene to step ``k`` (default ``"newton"``, whatever the
-        scene's ``[solver].method``); its solution of step ``k`` is stored as ``ref_*``.
+        Method that marches the scene to step ``k`` (default the reference method,
+        :data:`rollqp.methods.REFERENCE_METHOD`, whatever the scene's ``[solver].method``); its solution of
+        step ``k`` is stored as ``ref_*``.
     """
     from ..march import march, prepare
     from ..scene import Scene, load_scene
@@ -29,7 +31,7 @@ def export_step(scene, k: int, method: str | None = None) -> "StepFile":
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene "
                                    f"{scene.name!r}, got {k!r}")
-    method = method or "newton"
+    method = method or REFERENCE_METHOD
     prepared = prepare(scene, method)
     for rec in march(scene, prepared=prepared):
         if rec.k == k:
@@ -47,7 +49,7 @@ def from_record(scene, ops, method, rec) -> "StepFile":
 def _from_record(scene, ops, k, method, rec):
     n = ops.n
     problem, sol = rec.problem, rec.solution
-    if getattr(problem, "law", None) is not None or np.ndim(problem.mu) != 0:
+    if problem.law is not None or np.ndim(problem.mu) != 0:
         raise InputError("contact.friction", "a step file holds one constant coefficient of friction; this scene's "
                                              "friction law (docs/friction.md) cannot be exported")
     if problem.kind == "coupled":

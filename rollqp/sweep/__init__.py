@@ -12,32 +12,37 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError, RollqpError
+from ..errors import InputError
 from .dataset import open_result
-from .spec import Axis, Sweep, build_sweep, parse_vary
+from .spec import MAX_POINTS, Axis, Sweep, build_sweep, parse_vary
 
-__all__ = ["sweep", "prepare", "Axis", "Sweep", "build_sweep", "parse_vary", "open_result"]
+__all__ = ["sweep", "prepare", "Axis", "Sweep", "build_sweep", "parse_vary", "open_result", "VALIDATION_PROGRESS_AFTER"]
 
 
-def prepare(scene, vary, out):
+def prepare(scene, vary, out, quiet=True):
     """``(sweep, store path)``: every point and the store checked before any work.
 
-    The store is refused if it holds another sweep; the point's method must be installed.
+    The store is refused if it holds another sweep; the points' methods must be installed.
+    Unless ``quiet``, a sweep whose validation takes more than a second shows its progress.
     """
-    from ..methods import method_class
     from .dataset import check_store_path, open_store
-    sw = build_sweep(scene, vary)
-    for i, s in enumerate(sw.scenes):
-        try:
-            method_class(s.solver.method)
-        except RollqpError as err:
-            raise InputError("--vary", f"point {i} ({sw.label(i)}): {err}") from None
+    from .executor import Progress
+    bar = Progress(0, "validated point", quiet, after=VALIDATION_PROGRESS_AFTER)
+    try:
+        sw = build_sweep(scene, vary, progress=bar)
+    finally:
+        bar.close()
     path = check_store_path(out)
     open_store(path, sw)  # refuses a store of another sweep, before the cluster starts
     return sw, path
 
 
-def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=True, on_point=None):
+#: Seconds of validation after which a large sweep shows its progress (unless quiet).
+VALIDATION_PROGRESS_AFTER = 1.0
+
+
+def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=True, on_point=None,
+          per_chunk=None):
     """Run a sweep into the zarr store ``out``; return the :class:`~.executor.Summary`.
 
     Parameters
@@ -52,21 +57,43 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
     scheduler, workers, client
         Where to run: an existing ``distributed.Client``, a scheduler address, or a new
         ``LocalCluster`` of ``workers`` processes (default one per core).
+    quiet : bool
+        No progress lines (validation of a large sweep, points computed).
+    on_point : callable, optional
+        ``on_point(i, out)`` after point ``i`` is stored.
+    per_chunk : int, optional
+        Points per chunk of a new store, and so per task (default
+        :func:`~.dataset.points_per_chunk`: ⌈√(N/(4·workers))⌉ of N points, at most 32); a
+        store that exists keeps its own.
     """
+    import time
+
     from ..result import OutputLock
-    from .dataset import create_store, open_store
+    from .dataset import create_store, open_store, points_per_chunk
     from .executor import close_client, connect, run_sweep
-    sw, path = prepare(scene, vary, out)
+    if per_chunk is not None and (not isinstance(per_chunk, int) or isinstance(per_chunk, bool)
+                                  or not 1 <= per_chunk <= MAX_POINTS):
+        raise InputError("per_chunk", f"must be an integer in [1, {MAX_POINTS}], got {per_chunk!r}")
+    t0 = time.perf_counter()
+    sw, path = prepare(scene, vary, out, quiet=quiet)
+    prepared = time.perf_counter() - t0
     with OutputLock(path):
         own = client is None
+        t1 = time.perf_counter()
         client = client or connect(scheduler, workers)  # an unreachable scheduler: nothing written
+        startup = time.perf_counter() - t1 if own else 0.0
         try:
+            t2 = time.perf_counter()
             opened = open_store(path, sw)
             if opened is None:
-                group, status = create_store(path, sw), np.zeros(len(sw.scenes), dtype="int8")
+                n = per_chunk or points_per_chunk(sw, max(len(client.scheduler_info()["workers"]), 1))
+                group, status = create_store(path, sw, n), np.zeros(sw.size, dtype="int8")
             else:
                 group, status = opened
-            return run_sweep(sw, group, status, client, quiet=quiet, on_point=on_point)
+            prepared += time.perf_counter() - t2
+            summary = run_sweep(sw, group, status, client, quiet=quiet, on_point=on_point)
+            summary.startup, summary.prepare = startup, prepared
+            return summary
         finally:
             if own:
                 close_client(client)

@@ -24,25 +24,34 @@ import numpy as np
 
 from .. import closedforms as cf
 from ..errors import InputError
-from .spec import Axis, parse_values
+from .spec import Axis, describe, parse_values
 
 __all__ = ["CreepCurve", "creep_curve", "creep_sweep"]
 
 
+def _numbers(values, arg: str, what: str, ok) -> tuple:
+    """``values`` (a ``VALUES`` string or a sequence of numbers) as floats with ``ok(v)``, else an
+    InputError naming ``arg`` and the allowed range ``what``."""
+    values = parse_values(values, None, arg) if isinstance(values, str) else tuple(values)
+    try:
+        out = tuple(float(v) for v in values if not isinstance(v, (str, bool)))
+    except (TypeError, ValueError, OverflowError):
+        out = ()
+    if not out or len(out) != len(values) or not all(ok(v) for v in out):
+        shown = ", ".join(describe(v, 20) for v in values[:6])
+        raise InputError(arg, f"{what}, got {shown}{', …' if len(values) > 6 else ''}")
+    return out
+
+
 def _ratios(text) -> tuple:
-    values = parse_values(text, "--ratios") if isinstance(text, str) else tuple(float(v) for v in text)
-    if any(isinstance(v, str) or not -1.0 < float(v) < 1.0 for v in values):
-        raise InputError("--ratios", f"load ratios Q/(mu P) must be numbers in (-1, 1), got {text!r}")
-    return tuple(float(v) for v in values)
+    return _numbers(text, "--ratios", "load ratios Q/(mu P) must be numbers in (-1, 1)", lambda v: -1.0 < v < 1.0)
 
 
 def _frictions(text, scene) -> tuple:
     if text is None:
         return (scene.contact.friction,)
-    values = parse_values(text, "--friction") if isinstance(text, str) else tuple(text)
-    if any(isinstance(v, str) or not float(v) > 0 for v in values):
-        raise InputError("--friction", f"friction coefficients must be numbers > 0, got {text!r}")
-    return tuple(float(v) for v in values)
+    return _numbers(text, "--friction", "friction coefficients must be finite numbers > 0",
+                    lambda v: 0.0 < v < float("inf"))
 
 
 def creep_sweep(scene, ratios="0.05:0.95:19", friction=None):
@@ -55,6 +64,11 @@ def creep_sweep(scene, ratios="0.05:0.95:19", friction=None):
     return base, (Axis("contact.friction", mu), Axis("load.tangential", r))
 
 
+def _fmt(value, spec: str, defined: bool) -> str:
+    """``value`` formatted, or ``—`` where it is undefined or not finite."""
+    return format(value, spec) if defined and np.isfinite(value) else "—"
+
+
 @dataclass
 class CreepCurve:
     """The computed curve (arrays over ``(friction, ratio)``) and its closed-form overlays."""
@@ -65,6 +79,7 @@ class CreepCurve:
     xi: np.ndarray             # computed creepage (NaN where a point failed)
     P: np.ndarray
     summary: object = None
+    prescribed: tuple = None   # the ratios asked for (--ratios)
 
     @property
     def similar(self) -> bool:
@@ -73,12 +88,23 @@ class CreepCurve:
     def carter_xi(self) -> np.ndarray:
         """Carter's creepage at each computed ratio (similar bodies)."""
         s = self.scene
-        return np.array([[cf.carter_creepage(s.a_H, s.R, m, r) for r in row] for m, row in zip(self.mu, self.ratio)])
+        return np.array([[cf.carter_creepage(s.a_H, s.R, m, r) if np.isfinite(r) else np.nan for r in row]
+                         for m, row in zip(self.mu, self.ratio)])
 
     def slope(self) -> np.ndarray:
-        """dQ/dξ of the computed curve (force/length per unit creepage), by finite differences."""
+        """dQ/dξ of the computed curve (force/length per unit creepage), by finite differences.
+
+        NaN where it is undefined: a curve of one computed point, a failed neighbour, or two
+        neighbours at the same creepage.
+        """
         Q = self.ratio * self.mu[:, None] * self.P
-        return np.array([np.gradient(q, x) if x.size > 1 else np.full(x.size, np.nan) for q, x in zip(Q, self.xi)])
+        out = np.full(Q.shape, np.nan)
+        for i, (q, x) in enumerate(zip(Q, self.xi)):
+            ok = np.isfinite(q) & np.isfinite(x)
+            if ok.sum() > 1:
+                with np.errstate(all="ignore"):
+                    out[i, ok] = np.gradient(q[ok], x[ok])
+        return np.where(np.isfinite(out), out, np.nan)
 
     def carter_slope(self) -> np.ndarray:
         """Carter's ``dQ/dξ = −2PR(1 − |ξ|R/(μa))/a`` at the computed creepages."""
@@ -92,25 +118,42 @@ class CreepCurve:
         return s.load.direction * np.sign(s.beta) * cf.bentall_johnson_creepage(2.0 * s.beta, s.a_H, s.R)
 
     def table(self) -> str:
-        """Markdown table: ratio, ξ, the closed form, relative error, dQ/dξ and Carter's."""
-        rows = []
+        """Markdown table: ratio, ξ, the closed form, relative error, dQ/dξ and Carter's.
+
+        A value that is undefined is shown as ``—`` (never ``nan``): the relative error where
+        Carter's ξ is 0 (Q = 0), the slope of a curve of one point or beside a failed point;
+        a failed point's row says ``failed``. A note under the table says which.
+        """
+        rows, notes = [], set()
         slope = self.slope()
+        with np.errstate(all="ignore"):
+            xc = self.carter_xi() if self.similar else None
+            rel = self.xi / xc - 1.0 if self.similar else None
         if self.similar:
-            xc, sc = self.carter_xi(), self.carter_slope()
-            rows.append("| μ | Q/(μP) | ξ | ξ_Carter | ξ/ξ_Carter − 1 | dQ/dξ | dQ/dξ Carter |")
-            rows.append("|---|---|---|---|---|---|---|")
-            for i, m in enumerate(self.mu):
-                for j, r in enumerate(self.ratio[i]):
-                    rows.append(f"| {m:g} | {r:.4f} | {self.xi[i, j]:.5e} | {xc[i, j]:.5e} | "
-                                f"{self.xi[i, j] / xc[i, j] - 1:+.3e} | {slope[i, j]:.4e} | {sc[i, j]:.4e} |")
-            return "\n".join(rows)
-        rows.append(f"Bentall–Johnson limit (μ → 0, Q = 0): ξ = {self.bentall_johnson_xi():.5e}\n")
-        rows.append("| μ | Q/(μP) | ξ | dQ/dξ |")
-        rows.append("|---|---|---|---|")
+            sc = self.carter_slope()
+            rows += ["| μ | Q/(μP) | ξ | ξ_Carter | ξ/ξ_Carter − 1 | dQ/dξ | dQ/dξ Carter |", "|---|---|---|---|---|---|---|"]
+        else:
+            rows += [f"Bentall–Johnson limit (μ → 0, Q = 0): ξ = {self.bentall_johnson_xi():.5e}\n",
+                     "| μ | Q/(μP) | ξ | dQ/dξ |", "|---|---|---|---|"]
         for i, m in enumerate(self.mu):
-            for j, r in enumerate(self.ratio[i]):
-                rows.append(f"| {m:g} | {r:.4f} | {self.xi[i, j]:.5e} | {slope[i, j]:.4e} |")
-        return "\n".join(rows)
+            for j, r in enumerate(self._prescribed()):
+                if not np.isfinite(self.xi[i, j]):
+                    rows.append(f"| {m:g} | {r:.4f} | failed |" + " |" * (4 if self.similar else 1))
+                    notes.add("failed: the point's error is in the summary below and in the store")
+                    continue
+                cells = [f"{m:g}", f"{self.ratio[i, j]:.4f}", f"{self.xi[i, j]:.5e}"]
+                if self.similar:
+                    cells += [f"{xc[i, j] + 0.0:.5e}", _fmt(rel[i, j], "+.3e", xc[i, j] != 0.0)]
+                    notes.update(["—: undefined where Carter's ξ is 0 (Q = 0)"] if xc[i, j] == 0.0 else [])
+                cells.append(_fmt(slope[i, j], ".4e", True))
+                notes.update(["—: no slope (one point, a failed neighbour or equal creepages)"]
+                             if not np.isfinite(slope[i, j]) else [])
+                cells += [f"{sc[i, j]:.4e}"] if self.similar else []
+                rows.append("| " + " | ".join(cells) + " |")
+        return "\n".join(rows + ([""] if notes else []) + sorted(notes))
+
+    def _prescribed(self) -> np.ndarray:
+        return self.ratio[0] if self.prescribed is None else np.asarray(self.prescribed)
 
     def plot(self, path) -> str:
         """The classic creep-force figure: Q/(μP) against ξ (left) and against ξR/(μa) (right)."""
@@ -153,18 +196,20 @@ class CreepCurve:
 
 def creep_curve(scene, ratios="0.05:0.95:19", friction=None, out="creep.zarr", **run) -> CreepCurve:
     """Run the creep-curve sweep into the store ``out`` (``run``: :func:`rollqp.sweep.sweep`'s
-    ``scheduler``, ``workers``, ``client``, ``quiet``) and read the curve back."""
-    import xarray as xr
+    ``scheduler``, ``workers``, ``client``, ``quiet``) and read the curve back.
+
+    The store is read with zarr (the four arrays the curve needs, state 0): xarray and pandas
+    are not imported by the command, ~1 s of CPU on this machine.
+    """
+    import zarr
 
     from . import sweep
     base, axes = creep_sweep(scene, ratios, friction)
     summary = sweep(base, axes, out, **run)
-    ds = xr.open_zarr(out, chunks=None)
-    done = (ds["status"] == 1).values
-    first = {"step": 0}
-    P = np.where(done, ds["P"].isel(first).values, np.nan)
-    Q = np.where(done, ds["Q"].isel(first).values, np.nan)
-    mu = np.asarray(ds["contact.friction"].values, dtype=float)
-    ratio = Q / (mu[:, None] * P)
-    xi = np.where(done, ds["creepage"].isel(first).values, np.nan)
-    return CreepCurve(base, mu, ratio, xi, P, summary)
+    group = zarr.open_group(str(out), mode="r")
+    done = np.asarray(group["status"][...]) == 1
+    P, Q, xi = (np.where(done, np.asarray(group[name][..., 0], dtype=float), np.nan) for name in ("P", "Q", "creepage"))
+    mu = np.asarray(group["contact.friction"][...], dtype=float)
+    with np.errstate(all="ignore"):  # a failed point's NaN stays NaN
+        ratio = Q / (mu[:, None] * P)
+    return CreepCurve(base, mu, ratio, xi, P, summary, axes[1].values)

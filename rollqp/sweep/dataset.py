@@ -19,18 +19,29 @@ during a write can leave unreadable. The per-point ``status`` variable (0 not co
 """
 from __future__ import annotations
 
+import itertools
 import json
+import math
 import os
+import re
 
 import numpy as np
 
 from ..errors import InputError
 from ..fields import FIELDS, dtype_of, fields_for
 
-__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "write_point", "result_fields", "STATUS"]
+__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "write_point", "result_fields", "STATUS",
+           "points_per_chunk", "chunk_shape", "FINGERPRINT"]
 
 #: Values of the per-point ``status`` variable.
 STATUS = {"missing": 0, "done": 1, "failed": 2}
+#: The global attribute that holds the sweep's fingerprint (:meth:`rollqp.sweep.Sweep.fingerprint`).
+FINGERPRINT = "rollqp_sweep_fingerprint"
+#: Most points in one chunk (one task): past ~16 points the per-chunk cost of a write (~20 ms for
+#: ~30 variables, one file each) is already small beside the points' own.
+MAX_POINTS_PER_CHUNK = 32
+#: Most bytes of one chunk of the largest (per-state float) variable: a bound on a task's memory.
+CHUNK_BYTES = 32 * 2**20
 #: Characters kept of a failed point's one-line error.
 ERROR_CHARS = 200
 _SCALAR_NAMES = ("a_H", "p0", "R", "Estar", "beta", "leading_edge")
@@ -83,47 +94,53 @@ def open_result(path):
     return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
-def result_fields(scenes) -> list:
+def result_fields(sweep) -> list:
     """The fields a sweep's points hold: the core fields and every computed field any point needs."""
-    names = [f.name for f in FIELDS.values() if f.compute is None]
-    for scene in scenes:
-        names += [f.name for f in fields_for(scene) if f.name not in names]
+    names = {f.name for f in FIELDS.values() if f.compute is None} | set(sweep.facts.fields)
     return [FIELDS[n] for n in FIELDS if n in names and n not in ("q", "x")]
 
 
-def _grids(sweep):
-    """``(q rows, x rows)`` of every point, from the scenes (no solve)."""
-    from ..strip import Strip
-    qs, xs = [], []
-    for s in sweep.scenes:
-        d = s.discretization
-        qs.append(s.q_steps)
-        xs.append(Strip(s.half_width, d.elements, d.element).x)
-    return qs, xs
+def points_per_chunk(sweep, workers: int = 1) -> int:
+    """Points in one chunk of the store (and in one task of the sweep): ``⌈√(N/(4·workers))⌉``.
+
+    A task costs a round trip through the scheduler and a write of ~30 files whatever its
+    points, and the last tasks leave workers idle while the others finish: for N points of
+    cost c each, a per-task cost o and B points a task, the wall time is about
+    ``(N·c + (N/B)·o)/workers + B·c/2``, least at ``B = √(2·N·o/(workers·c))`` — the formula
+    above for o/c ≈ 1/8 (a §6.1.1 point of ~0.1 s against ~10 ms a task on a loaded machine).
+    At most :data:`MAX_POINTS_PER_CHUNK`, and at most :data:`CHUNK_BYTES` of the largest field
+    per chunk; at least one.
+    """
+    f = sweep.facts
+    per_point = int(f.states.max()) * int(f.nodes.max()) * 8
+    balance = math.ceil(math.sqrt(sweep.size / (4 * max(workers, 1))))
+    return max(1, min(MAX_POINTS_PER_CHUNK, CHUNK_BYTES // max(per_point, 1), balance))
 
 
-def _shared(rows) -> bool:
-    return all(r.shape == rows[0].shape and np.array_equal(r, rows[0]) for r in rows)
+def chunk_shape(shape: tuple, per_chunk: int) -> tuple:
+    """A chunk of at most ``per_chunk`` points over the swept dimensions, filled from the last
+    (fastest) one: rows of the last key, then whole rows of the next, …"""
+    out, left = [], max(1, int(per_chunk))
+    for n in reversed(shape):
+        c = min(n, left)
+        out.append(c)
+        left = max(1, left // c) if c == n else 1
+    return tuple(reversed(out))
 
 
-def _padded(rows, shape, keys_shape):
-    out = np.full(keys_shape + (max(r.size for r in rows),), np.nan)
-    flat = out.reshape(-1, out.shape[-1])
-    for i, r in enumerate(rows):
-        flat[i, :r.size] = r
-    return out
-
-
-def _coords(sweep) -> dict:
-    """``name -> (dims, values, attrs)`` of the coordinates: the swept values, ``q`` and ``x``."""
-    keys, shape = sweep.keys, sweep.shape
-    coords = {a.key: ((a.key,), np.array(a.values), {}) for a in sweep.axes}
-    qs, xs = _grids(sweep)
-    for name, rows, dim in (("q", qs, "step"), ("x", xs, "node")):
-        if _shared(rows):
-            coords[name] = ((dim,), rows[0], _attrs(FIELDS[name]))
-        else:
-            coords[name] = (keys + (dim,), _padded(rows, None, shape), _attrs(FIELDS[name]))
+def _coords(sweep, chunks) -> dict:
+    """``name -> (dims, values, attrs, chunks)`` of the coordinates: the swept values, ``q`` and ``x``."""
+    f, keys, shape = sweep.facts, sweep.keys, sweep.shape
+    coords = {a.key: ((a.key,), np.array(a.values), {}, None) for a in sweep.axes}
+    for name, rows, index, dim in (("q", f.q, f.q_index, "step"), ("x", f.x, f.x_index, "node")):
+        if len(rows) == 1:
+            coords[name] = ((dim,), np.asarray(rows[0]), _attrs(FIELDS[name]), None)
+            continue
+        table = np.full((len(rows), max(r.size for r in rows)), np.nan)
+        for j, r in enumerate(rows):
+            table[j, :r.size] = r
+        coords[name] = (keys + (dim,), table[index].reshape(shape + table.shape[1:]), _attrs(FIELDS[name]),
+                        chunks + table.shape[1:])
     return coords
 
 
@@ -146,16 +163,18 @@ def _coord_names(dims) -> str:
     return " ".join(n for n, d in (("q", "step"), ("x", "node")) if d in dims)
 
 
-def _global_attrs(sweep, fields) -> dict:
+def _global_attrs(sweep) -> dict:
+    import importlib.metadata as md
+
     from ..march import _versions
     from ..version import __version__
     versions = dict(_versions(), rollqp=__version__)
     for pkg in ("dask", "distributed", "xarray", "zarr"):
         try:
-            versions[pkg] = __import__(pkg).__version__
-        except ImportError:  # pragma: no cover
+            versions[pkg] = md.version(pkg)
+        except md.PackageNotFoundError:  # pragma: no cover
             versions[pkg] = None
-    return {"title": f"rollqp sweep of {sweep.base.name}", "rollqp_sweep_fingerprint": sweep.fingerprint(),
+    return {"title": f"rollqp sweep of {sweep.base.name}", FINGERPRINT: sweep.fingerprint(),
             "scene": json.dumps(sweep.base.to_dict(), sort_keys=True),
             "vary": json.dumps([[a.key, list(a.values)] for a in sweep.axes]),
             "versions": json.dumps(versions, sort_keys=True),
@@ -176,97 +195,230 @@ def check_store_path(path) -> str:
     return path.rstrip("/")
 
 
+def _schema(sweep) -> dict:
+    """``name -> (dims, shape, dtype)`` of every array of the store of ``sweep`` (coordinates and variables)."""
+    sizes = dict(zip(sweep.keys, sweep.shape), step=int(sweep.facts.states.max()), node=int(sweep.facts.nodes.max()))
+    out = {name: (dims, np.shape(values), np.asarray(values).dtype) for name, (dims, values, _, _) in
+           _coords(sweep, sweep.shape).items()}
+    for name, (dims, dt, _, _) in _variables(sweep, result_fields(sweep)).items():
+        out[name] = (dims, tuple(sizes[d] for d in dims), dt)
+    return out
+
+
 def open_store(path, sweep):
     """The zarr group of an existing store of ``sweep`` and its per-point status (flat), or ``None``.
 
     Raises
     ------
     InputError
-        ``--out``: a folder that is not a rollqp sweep store, or the store of a different sweep
-        (another base scene or other swept values: the fingerprints differ).
+        ``--out``: a folder that is not a rollqp sweep store, the store of a different sweep
+        (another base scene or other swept values: the fingerprints differ), or a store whose
+        arrays are not those of this sweep's schema (shape, type or chunks changed since).
     """
     import zarr
     if not os.path.exists(path):
         return None
     try:
         group = zarr.open_group(path, mode="r+")
-        fp = group.attrs.get("rollqp_sweep_fingerprint")
+        fp = group.attrs.get(FINGERPRINT)
     except Exception as exc:  # zarr raises several types for a folder that is not a group
         raise InputError("--out", f"{path!r} exists and is not a rollqp sweep store ({type(exc).__name__})") from None
     if fp is None:
         raise InputError("--out", f"{path!r} exists and is not a rollqp sweep store (no fingerprint)")
+    if not isinstance(fp, str) or not re.fullmatch(r"[0-9a-f]{64}", fp):
+        raise InputError("--out", f"{path!r} is not a rollqp sweep store: its {FINGERPRINT} attribute is "
+                                  f"{_short(fp)}, not a SHA-256 hex digest")
     if fp != sweep.fingerprint():
         raise InputError("--out", f"{path!r} holds a different sweep (another scene or other --vary values: "
                                   f"fingerprint {fp[:12]} != {sweep.fingerprint()[:12]}); choose another --out")
-    return group, np.asarray(group["status"][...]).reshape(-1)
+    _check_schema(path, group, sweep)
+    status = np.asarray(group["status"][...]).reshape(-1)
+    if not np.isin(status, tuple(STATUS.values())).all():
+        raise InputError("--out", f"{path!r}: its status variable holds values other than 0, 1, 2")
+    return group, status
 
 
-def create_store(path, sweep):
+def _short(value) -> str:
+    text = repr(value)
+    return f"{type(value).__name__} {text[:40]}{'…' if len(text) > 40 else ''}"
+
+
+def _check_schema(path, group, sweep) -> None:
+    """Every array of this sweep's store is there with its shape and type, chunked alike over the points."""
+    try:
+        arrays = {k: group[k] for k in group.array_keys()}
+    except Exception as exc:
+        raise InputError("--out", f"{path!r}: unreadable arrays ({type(exc).__name__})") from None
+    chunks, d = None, len(sweep.keys)
+    for name, (dims, shape, dt) in _schema(sweep).items():
+        a = arrays.get(name)
+        if a is None or tuple(a.shape) != tuple(shape) or np.dtype(a.dtype) != dt:
+            got = "missing" if a is None else f"shape {tuple(a.shape)} of {np.dtype(a.dtype)}"
+            raise InputError("--out", f"{path!r}: array {name!r} is {got}, not shape {tuple(shape)} of {dt} as this "
+                                      "sweep writes it; the store was changed since: choose another --out")
+        if name not in sweep.keys and tuple(dims[:d]) == sweep.keys:  # a variable over the points: every point's states and nodes in its chunk
+            mine = tuple(a.chunks)
+            if chunks is not None and mine[:d] != chunks or mine[d:] != tuple(shape[d:]):
+                raise InputError("--out", f"{path!r}: array {name!r} is chunked {mine}, unlike the others; "
+                                          "the store was changed since: choose another --out")
+            chunks = mine[:d]
+
+
+def create_store(path, sweep, per_chunk: int = 1):
     """Create the empty store of ``sweep`` (metadata and coordinates only) and return its zarr group.
 
-    Written with zarr directly in xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes,
-    consolidated metadata), chunked one point per chunk; ``xarray.open_zarr`` reads it.
+    Written with zarr in xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes,
+    consolidated metadata), chunked ``per_chunk`` points per chunk (:func:`chunk_shape`), every
+    state and node of a point in its chunk; ``xarray.open_zarr`` reads it. zarr builds the store
+    in memory, whose files are then written into a new folder renamed to ``path`` at the end:
+    a store is there whole or not at all, and ~70 small files cost milliseconds, not zarr's
+    asynchronous round trip per file.
     """
     import zarr
-    fields = result_fields(sweep.scenes)
-    sizes = dict(zip(sweep.keys, sweep.shape), step=max(s.n_steps + 1 for s in sweep.scenes),
-                 node=max(s.n_nodes for s in sweep.scenes))
-    group = zarr.open_group(path, mode="w-", zarr_format=2)
-    group.attrs.update(_global_attrs(sweep, fields))
-    for name, (dims, values, attrs) in _coords(sweep).items():
+    from zarr.storage import MemoryStore
+    chunks = chunk_shape(sweep.shape, per_chunk)
+    sizes = dict(zip(sweep.keys, sweep.shape), step=int(sweep.facts.states.max()), node=int(sweep.facts.nodes.max()))
+    files = {}
+    memory = MemoryStore(store_dict=files)
+    group = zarr.open_group(memory, mode="w-", zarr_format=2, attributes=_global_attrs(sweep))
+    point = dict(zip(sweep.keys, chunks))
+    for name, (dims, values, attrs, chunk) in _coords(sweep, chunks).items():
         fill = None if values.dtype.kind == "U" else np.nan if values.dtype.kind == "f" else 0
-        arr = group.create_array(name, shape=values.shape, chunks=values.shape, dtype=values.dtype, fill_value=fill,
-                                 attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
+        arr = group.create_array(name, shape=values.shape, chunks=chunk or values.shape, dtype=values.dtype,
+                                 fill_value=fill, attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
         arr[...] = values
-    point = dict(zip(sweep.keys, (1,) * len(sweep.keys)))
-    for name, (dims, dt, fill, attrs) in _variables(sweep, fields).items():
+    for name, (dims, dt, fill, attrs) in _variables(sweep, result_fields(sweep)).items():
         group.create_array(name, shape=tuple(sizes[d] for d in dims), chunks=tuple(point.get(d, sizes[d]) for d in dims),
                            dtype=dt, fill_value=fill, attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
-    zarr.consolidate_metadata(path, zarr_format=2)
+    zarr.consolidate_metadata(memory, zarr_format=2)
+    tmp = f"{path}.creating-{os.getpid()}"
+    for key, buf in files.items():
+        _write_file(os.path.join(tmp, *key.split("/")), buf.to_bytes(), atomic=False)
+    os.rename(tmp, path)
     return zarr.open_group(path, mode="r+", zarr_format=2)
 
 
-class StoreWriter:
-    """Writes points into a sweep's store: each point's region of every variable, ``status`` last.
+def _write_file(target: str, data: bytes, atomic: bool = True) -> None:
+    """``data`` into the file ``target`` (its folder made); ``atomic``: through a temporary file
+    renamed over it, so that a reader or a kill never meets half a file."""
+    folder = os.path.dirname(target)
+    if not os.path.isdir(folder):
+        os.makedirs(folder, exist_ok=True)
+    tmp = os.path.join(folder, f".{os.path.basename(target)}.{os.getpid()}.tmp") if atomic else target
+    with open(tmp, "wb") as fh:
+        fh.write(data)
+    if atomic:
+        os.replace(tmp, target)
 
-    The arrays are opened once; the variables of one point are written concurrently (zarr's
-    asynchronous API: one file per chunk, so the writes are independent), then ``status``.
+
+def _chunk_files(group, a):
+    """``(folder, codec, separator, dtype)`` to write whole chunks of the zarr-2 array ``a`` as
+    files, or ``None`` when zarr must write them (another format, filters, a store not on disk)."""
+    from zarr.storage import LocalStore
+    m = a.metadata
+    if getattr(m, "zarr_format", None) != 2 or not isinstance(group.store, LocalStore) or m.filters or m.order != "C":
+        return None
+    folder = os.path.join(str(group.store.root), *[p for p in a.path.split("/") if p])
+    return folder, m.compressor, m.dimension_separator, np.dtype(m.dtype.to_native_dtype())
+
+
+class StoreWriter:
+    """Writes points into a sweep's store, one chunk at a time: every variable's chunk, ``status`` last.
+
+    A write is the points of one chunk (one task of the sweep): each variable's block of that
+    chunk is filled in memory and written whole. In a zarr-2 store on disk (what
+    :func:`create_store` makes) a block is encoded with the array's own compressor and written
+    as its chunk file (zarr-2's key ``i.j.k``) through a temporary file renamed over it, so a
+    kill never leaves half a chunk; zarr's asynchronous path costs ~1 ms of thread hops per
+    array, ~30 arrays a chunk, and far more on a loaded machine. Otherwise zarr writes the
+    blocks. Points of the chunk not in the write keep what the store holds (a re-run that
+    computes only a chunk's failed points reads the chunk first).
     """
 
     def __init__(self, group, sweep):
         self.sweep = sweep
         self.arrays = {k: group[k] for k in group.array_keys()}
-        self.per_point_grid = {k for k in ("q", "x") if self.arrays[k].ndim > 1}
+        self.chunks = tuple(self.arrays["status"].chunks)
+        self.names = [k for k in self.arrays if k not in sweep.keys and (k not in ("q", "x") or self.arrays[k].ndim > 1)]
+        self.files = {k: _chunk_files(group, self.arrays[k]) for k in self.names + ["status"]}
 
-    def _items(self, idx, out: dict) -> list:
-        if out.get("error") is not None:
-            return [("error", idx, out["error"][:ERROR_CHARS]), ("point_time", idx, out["time"])]
-        items = [("error", idx, ""), ("point_time", idx, out["time"])]
-        for name, value in out["arrays"].items():
-            if name not in self.arrays or name in ("q", "x") and name not in self.per_point_grid:
+    def tasks(self, status) -> list:
+        """The points to compute, grouped by chunk: lists of flat indices whose ``status`` is not done."""
+        index = np.arange(self.sweep.size).reshape(self.sweep.shape)
+        todo = (np.asarray(status).reshape(self.sweep.shape) != STATUS["done"])
+        out = []
+        for region in itertools.product(*(range(0, n, c) for n, c in zip(self.sweep.shape, self.chunks))):
+            sel = tuple(slice(s, s + c) for s, c in zip(region, self.chunks))
+            points = index[sel][todo[sel]]
+            if points.size:
+                out.append([int(i) for i in points])
+        return out
+
+    def _region(self, points) -> tuple:
+        """The chunk of the first of ``points``, as slices (clipped at the arrays' ends)."""
+        first = self.sweep.index(points[0])
+        return tuple(slice(j - j % c, min(j - j % c + c, n)) for j, c, n in zip(first, self.chunks, self.sweep.shape))
+
+    def points_in_chunk(self, points) -> bool:
+        """``points`` all lie in one chunk (what :meth:`write` takes)."""
+        region = self._region(points)
+        return all(s.start <= j < s.stop for i in points for j, s in zip(self.sweep.index(i), region))
+
+    def _blocks(self, region, points, outs) -> dict:
+        """``name -> block`` of the whole chunk at ``region`` with ``outs`` (one per point) filled in."""
+        clipped = tuple(s.stop - s.start for s in region)
+        whole = len(points) == int(np.prod(clipped))
+        blocks = {}
+        for name in self.names + ["status"]:
+            a = self.arrays[name]
+            fill = a.fill_value if a.fill_value is not None else np.zeros((), a.dtype)[()]
+            block = np.full(self.chunks + tuple(a.shape[len(region):]), fill, dtype=a.dtype)
+            if not whole:  # keep the chunk's other points
+                block[tuple(slice(0, n) for n in clipped)] = a[region]
+            blocks[name] = block
+        for i, out in zip(points, outs):
+            local = tuple(j - s.start for j, s in zip(self.sweep.index(i), region))
+            for name, value in _point_items(out):
+                if name in blocks:
+                    value = np.asarray(value)
+                    blocks[name][local + tuple(slice(0, n) for n in value.shape)] = value
+            blocks["status"][local] = STATUS["done" if out.get("error") is None else "failed"]
+        return blocks
+
+    def _put(self, names, region, blocks) -> None:
+        """Write the chunk at ``region`` of each array in ``names``."""
+        clipped = tuple(slice(0, s.stop - s.start) for s in region)
+        chunk = tuple(s.start // c for s, c in zip(region, self.chunks))
+        slow = []
+        for name in names:
+            spec = self.files[name]
+            if spec is None:
+                slow.append(name)
                 continue
-            value = np.asarray(value)
-            items.append((name, idx + tuple(slice(0, s) for s in value.shape), value))
-        return items
+            folder, codec, sep, dt = spec
+            data = np.ascontiguousarray(blocks[name], dtype=dt)
+            key = sep.join(str(c) for c in chunk + (0,) * (data.ndim - len(chunk)))
+            _write_file(os.path.join(folder, *key.split("/")), codec.encode(data) if codec is not None else data.tobytes())
+        for name in slow:
+            self.arrays[name][region] = blocks[name][clipped]
 
-    def write(self, i: int, out: dict) -> None:
-        """Store point ``i``'s result (``out`` of :func:`rollqp.sweep.executor.compute_point`)."""
-        idx = self.sweep.index(i)
-        items = [(self.arrays[name], sel, value) for name, sel, value in self._items(idx, out)]
-        try:
-            import asyncio
+    def write(self, points, outs) -> None:
+        """Store the points ``points`` (flat indices, all in one chunk) with their results ``outs``
+        (:func:`rollqp.sweep.executor.compute_points`), ``status`` last."""
+        region = self._region(points)
+        blocks = self._blocks(region, points, outs)
+        self._put(self.names, region, blocks)
+        self._put(["status"], region, blocks)
 
-            from zarr.core.sync import sync
 
-            async def _all():
-                await asyncio.gather(*(a._async_array.setitem(sel, v) for a, sel, v in items))
-            sync(_all())
-        except (ImportError, AttributeError):  # pragma: no cover - another zarr: one array at a time
-            for a, sel, v in items:
-                a[sel] = v
-        self.arrays["status"][idx] = STATUS["done" if out.get("error") is None else "failed"]
+def _point_items(out: dict):
+    """``(name, value)`` of one point's result to store: its arrays (none if it failed), error and time."""
+    yield "error", (out.get("error") or "")[:ERROR_CHARS]
+    yield "point_time", out["time"]
+    if out.get("error") is None:
+        yield from out["arrays"].items()
 
 
 def write_point(group, sweep, i: int, out: dict) -> None:
     """Write point ``i``'s result into its region (:class:`StoreWriter`, for one point)."""
-    StoreWriter(group, sweep).write(i, out)
+    StoreWriter(group, sweep).write([i], [out])

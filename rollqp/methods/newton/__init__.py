@@ -86,13 +86,13 @@ import numpy as np
 
 from ...errors import InputError, SolverError
 from ...problem import StepSolution
-from ..base import check_options
+from ..base import Capabilities, check_options
 from . import linear
 from .coupled import solve_coupled
 from .creepage import tangential_by_creepage
 from .linear import CoupledFactors, ReducedSystem, coupled_system, coupled_vectors
 from .ncp import NormalNCP, TangentialNCP, coupled_cases, coupled_jacobian, coupled_labels, coupled_phi
-from .slip import solve_slip
+from .slip_step import solve_slip_step
 from .uncoupled import solve_uncoupled
 
 __all__ = ["NewtonMethod"]
@@ -128,11 +128,11 @@ class NewtonMethod:
     """
 
     name = "newton"
-    solves = frozenset({"normal", "tangential", "coupled", "steady"})
-    #: Solves steps whose friction bound depends on the slip (:mod:`.slip`); the others are wrapped in
-    #: the fixed point on the bound (:class:`rollqp.methods.fixedpoint.BoundFixedPoint`).
-    slip_dependent = True
-    operator = "exact"  # the collocation operator itself, not F⁻¹ sym(F A)
+    #: Every kind of step, the steady one included, on the collocation operator itself (not
+    #: F⁻¹ sym(F A)); steps whose friction bound depends on the slip too (:mod:`.slip`), but coupled
+    #: steps with a constant coefficient only.
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential", "coupled", "steady"}), slip_dependent=True,
+                                coupled_friction=frozenset({"constant"}))
     #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
     #: (:class:`~.linear.CoupledFactors`); ``False`` solves a new reduced system every iteration
     #: (:func:`~.linear.direct_coupled_direction`, the reference the tests compare with).
@@ -182,12 +182,12 @@ class NewtonMethod:
         """Solve a normal, tangential or coupled step; raise :class:`SolverError` short of the tolerance."""
         t0 = time.perf_counter()
         if problem.kind == "coupled":
-            if getattr(problem, "law", None) is not None or np.ndim(problem.mu) != 0:
+            if problem.law is not None or np.ndim(problem.mu) != 0:
                 raise InputError("solver.method", "newton's coupled step takes a constant friction coefficient "
                                                   "only; for a friction law on a coupled scene use 'nt-newton' "
                                                   "(Newton halves in the N–T alternation) or a qp-* method")
             return solve_coupled(self, problem, warm, t0)
-        if problem.kind == "tangential" and getattr(problem, "law", None) is not None:
+        if problem.kind == "tangential" and problem.law is not None:
             return self._solve_slip(problem, warm, t0)
         if problem.kind not in ("normal", "tangential"):
             raise InputError("problem", f"the Newton method solves normal, tangential or coupled steps, "
@@ -201,23 +201,9 @@ class NewtonMethod:
         return self.checked(sol)
 
     def _solve_slip(self, problem, warm, t0):
-        """A slip-dependent tangential step (:mod:`.slip`): from the warm start; if that fails, once from zero
-        shear (``info["restarts"]``); with ``Q`` prescribed and both failing, by the creepage search
-        (:func:`~.creepage.tangential_by_creepage`, the ξ-prescribed solves being slip-dependent too)."""
-        try:
-            return self.checked(solve_slip(self, problem, warm, t0))
-        except SolverError as err:
-            first = err
-        try:
-            if warm is None:
-                raise first
-            sol = self.checked(solve_slip(self, problem, None, t0))  # the warm start's branch lost
-            sol.info["restarts"] = 1
-            return sol
-        except SolverError as err:
-            if problem.Q is None:
-                raise
-            return self.checked(tangential_by_creepage(self, problem, warm, t0, err))
+        """A slip-dependent tangential step (:func:`.slip_step.solve_slip_step`: Newton from the warm start, safeguarded
+        by the fixed point on the bound, a cold start and, with ``Q`` prescribed, the creepage search)."""
+        return solve_slip_step(self, problem, warm, t0)
 
     def augmentation(self, problem) -> float:
         """The nondimensional ``r`` used for ``problem`` (package docstring)."""

@@ -18,9 +18,32 @@ and the pseudo-Jacobian keeps the node cases of eq. 85–88 with one change, at 
 identity row of eq. 88 and the iteration is the constant-bound one. The slip rows are no longer
 identity rows, so the reduced system of :mod:`.linear` does not apply: ``J`` is formed and solved
 densely (``n`` is at most a few hundred nodes on the meshes this law is used with). Armijo line
-search as in :mod:`.uncoupled` (eq. 75–79); a failed search takes the full step
-(``info["nonmonotone"]``). Falling friction can make the step non-unique (docs/theory.md): the
-iteration finds the solution its start leads to — the previous step's, else zero shear.
+search as in :mod:`.uncoupled` (eq. 75–79).
+
+**The degenerate iterate, and why it matters more here.** With ``Q`` prescribed the load row
+``f̂ᵀt̂ = Q̂`` reaches ``ξ̂`` only through the rows of sticking nodes (``∂(r ŝ_i)/∂ξ̂ = r``). At an
+iterate where no node sticks, a constant bound leaves the ``ξ̂`` column empty and the constant path
+repairs it (the nearest node onto its kink, package docstring). With a falling law the column is
+not empty but holds only ``σ_i ∂b_i/∂(r ŝ_i) r`` of the slipping nodes, small wherever ``μ`` is
+flat: the Newton direction then moves ``ξ̂`` by ``(load residual)/(that small number)`` — it asks
+the linearized law to carry the load below ``μ_k`` — and throws the iterate into gross sliding,
+where ``μ' → 0``, ``J`` becomes singular and the merit ``θ`` has a valley at infinity
+(``θ → ½(f̂ᵀμ_k p̂ − Q̂)²``). Measured on a ramped transient (rational law, ``v_h = 3 mm/s``,
+``V = 10 m/s``): the warm start of step 21 had every node slipping, ``ξ̂`` went −1.2 → −12 → −607
+→ −1.8e6 and the matrix became singular. So the repair is the constant path's, on the slip law's
+bound: ``ξ̂`` shifted until the node nearest to sticking reaches its kink, and that node gets the
+stick row (``info["shifts"]``).
+
+**When the Newton iteration still fails** (a singular matrix, or an Armijo search that finds no
+decrease: the direction of a non-monotone law need not descend on a kink), the step is not
+given up: :func:`~.slip_step.solve_slip_step` runs the fixed point on the bound
+(:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`) with Newton's own constant-bound solves as
+its inner method, trying this iteration from each fixed-point iterate that improved (a few
+iterations from near a solution, quadratic), then a cold start, then the creepage search. A step
+none of them solves is a :class:`~rollqp.errors.SolverError` naming the residual.
+
+Falling friction can make the step non-unique (docs/theory.md): the iteration finds the solution
+its start leads to — the previous step's, and then the fixed point's from the previous slip.
 """
 from __future__ import annotations
 
@@ -30,7 +53,11 @@ from ...errors import SolverError
 from ...problem import friction_residual
 from .common import ALPHA_MIN, not_converged
 
-__all__ = ["solve_slip"]
+__all__ = ["solve_slip", "POLISH_ITERATIONS"]
+
+#: Newton iterations allowed when polishing a fixed-point iterate (quadratic convergence from near a
+#: solution takes a handful; more means the iterate is not near enough yet).
+POLISH_ITERATIONS = 25
 
 
 class _SlipRows:
@@ -55,14 +82,16 @@ class _SlipRows:
             phi = np.append(phi, self.sys.fhat @ x - self.load)
         return x, y, s, b, phi
 
-    def jacobian(self, x, y, s, b):
-        """The pseudo-Jacobian (module docstring: eq. 85, 86/87, 88s)."""
+    def stick(self, x, y, b):
+        """Nodes in stick (eq. 86/87: ``|t̂ − r ŝ| <= b``, ``b > 0``)."""
+        return (np.abs(x - y) <= b) & (b > 0.0)
+
+    def jacobian(self, x, y, s, b, stick):
+        """The pseudo-Jacobian (module docstring: eq. 85, 86/87, 88s) with the stick nodes ``stick``."""
         n, K = self.n, self.K
         N = K.shape[1]
         u = x - y
-        zero = b <= 0.0
-        stick = (np.abs(u) <= b) & ~zero
-        slip = ~stick & ~zero
+        slip = ~stick & (b > 0.0)
         J = np.zeros((N, N))
         J[:n] = np.eye(n, N)
         ist = np.flatnonzero(stick)
@@ -72,11 +101,36 @@ class _SlipRows:
         J[isl] -= (np.sign(u[isl]) * db[isl])[:, None] * K[isl]
         if self.with_load:
             J[n, :n] = self.sys.fhat
-        return J, stick
+        return J
+
+    def repair(self, z, x, y, b):
+        """No node sticks while the load row is there (module docstring): ``ξ̂`` shifted so that the node
+        nearest to sticking reaches its kink ``|t̂ − r ŝ| = b``. Returns ``(z, j)``, or ``(z, None)`` if
+        every bound is zero. The bound moves with the slip, so the kink is found by a few secant
+        steps on ``|u_j| − b_j`` in the shift (exact for a constant bound: one step)."""
+        n = self.n
+        excess = np.abs(x - y) - b
+        excess[b <= 0.0] = np.inf
+        j = int(np.argmin(excess))
+        if not np.isfinite(excess[j]):
+            return z, None
+        col = self.K[j, n]  # ∂(r ŝ_j)/∂ξ̂
+        z = z.copy()
+        for _ in range(8):
+            u = x[j] - y[j]
+            gap = abs(u) - b[j]
+            if gap <= 0.0:
+                break
+            z[n] += np.sign(u) * gap / col  # y_j moves towards x_j by the excess at the current bound
+            _, y, _, b, _ = self.at(z)
+        return z, j
 
 
-def solve_slip(meth, pb, warm, t0):
-    """GNMls on the slip-dependent tangential step (module docstring); ``meth`` is the Newton method."""
+def solve_slip(meth, pb, warm, t0, max_iterations=None):
+    """GNMls on the slip-dependent tangential step (module docstring) from ``warm`` (else zero shear).
+
+    ``meth`` is the Newton method; ``max_iterations`` (default the method's) bounds the iterations.
+    Raises :class:`~rollqp.errors.SolverError` on a singular matrix, a failed search or the limit."""
     sc = pb.scales
     dqh = pb.dq / sc.length
     sys_ = meth.system(pb, dqh)
@@ -90,50 +144,64 @@ def solve_slip(meth, pb, warm, t0):
         t, start = np.asarray(warm.t, dtype=float) / sc.stress, "warm"
         xi0 = warm.xi / sc.slip if warm.xi is not None else 0.0
     z = np.append(t, xi0) if with_load else t.copy()
-    z, it, info = _iterate(meth, pb, rows, z)
+    z, it, info = _iterate(meth, pb, rows, z, meth.max_iterations if max_iterations is None else max_iterations)
     info["start"] = start
     tt = z[:n] * sc.stress
     xi = z[n] * sc.slip if with_load else pb.xi
     return meth.finish(pb.solution(tt, xi), it, info, t0)
 
 
-def _iterate(meth, pb, rows, z):
+def _iterate(meth, pb, rows, z, max_iterations):
     """Newton directions on the dense pseudo-Jacobian with the Armijo search (eq. 74–79)."""
     stop = meth.tolerance * min(1.0, rows.r)
     x, y, s, b, phi = rows.at(z)
     history, merits, steps = [], [], []
-    backtracks = nonmono = it = 0
+    backtracks = shifts = it = 0
     while True:
         nrm = float(np.max(np.abs(phi)))
         history.append(nrm)
         merits.append(0.5 * float(phi @ phi))
         if nrm <= stop:
             break
-        if it >= meth.max_iterations:
+        if it >= max_iterations:
             raise not_converged(meth, "slip-dependent tangential", merits, it, nrm, stop)
         it += 1
-        J, _ = rows.jacobian(x, y, s, b)
-        try:
-            d = np.linalg.solve(J, -phi)
-        except np.linalg.LinAlgError:
-            d = None
-        if d is None or not np.all(np.isfinite(d)):
+        stick = rows.stick(x, y, b)
+        if rows.with_load and not stick.any():  # the degenerate iterate (module docstring)
+            z, j = rows.repair(z, x, y, b)
+            if j is not None:
+                x, y, s, b, phi = rows.at(z)
+                stick = rows.stick(x, y, b)
+                stick[j] = True
+                shifts += 1
+        d = _direction(rows.jacobian(x, y, s, b, stick), phi)
+        if d is None:
             raise SolverError("the slip-dependent tangential Newton matrix is singular", method=meth.name,
                               status="singular", iterations=it, residual=nrm)
+        theta = 0.5 * float(phi @ phi)
         alpha = 1.0
         while True:
             cand = rows.at(z + alpha * d)
-            if 0.5 * float(cand[4] @ cand[4]) <= (1.0 - 2.0 * meth.sigma * alpha) * merits[-1]:
+            if 0.5 * float(cand[4] @ cand[4]) <= (1.0 - 2.0 * meth.sigma * alpha) * theta:
                 break
             alpha *= meth.rho
             backtracks += 1
-            if alpha < ALPHA_MIN:
-                alpha, nonmono = 1.0, nonmono + 1
-                cand = rows.at(z + d)
-                break
+            if alpha < ALPHA_MIN:  # no decrease along the direction: not a descent direction here
+                raise SolverError(f"the slip-dependent tangential Newton line search found no decrease "
+                                  f"(merit θ = {theta:.3e})", method=meth.name, status="line search",
+                                  iterations=it, residual=nrm)
         steps.append(alpha)
         z = z + alpha * d
         x, y, s, b, phi = cand
     info = {"r": rows.r, "backtracks": backtracks, "merit": merits[-1], "history": history, "merits": merits,
-            "steps": steps, "nonmonotone": nonmono, "shifts": 0, "tolerance_phi": stop, "dense": True}
+            "steps": steps, "nonmonotone": 0, "shifts": shifts, "tolerance_phi": stop, "dense": True}
     return z, it, info
+
+
+def _direction(J, phi):
+    """``d = −J⁻¹Φ``, or None if ``J`` is singular or the direction not finite."""
+    try:
+        d = np.linalg.solve(J, -phi)
+    except np.linalg.LinAlgError:
+        return None
+    return d if np.isfinite(d).all() else None

@@ -1,0 +1,237 @@
+"""rollqp's extension points, used from outside the package with public names only (docs/architecture.md,
+"How to add …"): a friction law, a profile feature, an influence model and a step method, each written
+here as a contributor would write it in their own file, registered with the one public call, and run
+in a scene. Each case runs in a fresh interpreter (the registries are process-wide: a dummy registered
+here must not reach the other tests), and each is held to what an equivalent built-in gives.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+import pytest
+
+import rollqp
+from rollqp.methods import Capabilities, check_kind, check_options
+from rollqp.profiles import Feature, circle_height
+
+HERE = Path(__file__).resolve().parent
+
+#: The short run of the cases: the paper's §6.1.1 rollers, a braked start and 3 a_H of rolling.
+SHORT = {"discretization.elements": 30, "discretization.distance": 3.0}
+
+
+def _fresh(case: str) -> None:
+    """Run ``case()`` of this module in a new interpreter; its failure (an AssertionError) fails the test."""
+    code = f"import sys; sys.path[:0] = {[str(HERE), str(HERE.parent / 'benchmarks')]!r}; import test_extensions as t; t.{case}()"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, f"{case}:\n{out.stdout[-3000:]}\n{out.stderr[-5000:]}"
+
+
+def _largest_difference(a, b) -> float:
+    """The largest difference of the tractions, gaps and creepages of two results, in p0 and p0/E* (the
+    nondimensional units of rollqp's residuals)."""
+    a, b = a.arrays(), b.arrays()
+    p0, slip = float(a["p0"]), float(a["p0"]) / float(a["Estar"])
+    return max(float(np.max(np.abs(a["pn"] - b["pn"]))) / p0, float(np.max(np.abs(a["pt"] - b["pt"]))) / p0,
+               float(np.max(np.abs(a["creepage"] - b["creepage"]))) / slip)
+
+
+# ------------------------------------------------------------------------------ a friction law
+@dataclass(frozen=True)
+class LinearFriction:
+    """``μ(x) = mu + slope·x`` along the contact frame (``a_H`` units) over ``|x| <= reach``: a spatial law
+    (rollqp.friction.FrictionLaw); its reference (``load.tangential = Q/(μ P̄)``) is its largest value."""
+
+    mu: float
+    slope: float
+    reach: float
+    law: str = "linear-in-x"
+    kind: ClassVar[str] = "spatial"
+
+    @property
+    def reference(self) -> float:
+        return self.largest
+
+    @property
+    def largest(self) -> float:
+        return self.mu + abs(self.slope) * self.reach
+
+    def coefficient(self, x_hat, q_hat, direction):
+        return self.mu + self.slope * np.asarray(x_hat, dtype=float)
+
+    def check_strip(self, half_width_hat, q_end_hat, direction):
+        """It varies everywhere: it meets every strip."""
+
+
+def case_friction_law():
+    from rollqp.friction import register
+    register("linear-in-x", LinearFriction)
+    scene = rollqp.load_scene("cattaneo-carter").replace(**SHORT)
+    L = scene.discretization.zone  # the strip is |x| <= L a_H: a two-point table over it is the same law
+    mine = scene.replace(**{"contact.friction": {"law": "linear-in-x", "mu": 0.1, "slope": 0.01, "reach": L}})
+    table = scene.replace(**{"contact.friction": {"law": "table", "x": [-L, L], "values": [0.1 - 0.01 * L,
+                                                                                            0.1 + 0.01 * L]}})
+    assert mine.contact.friction.kind == "spatial"
+    a, b = rollqp.run(mine), rollqp.run(table)
+    # the same μ at every node up to round-off of the interpolation (1e-16), so the same transient to the
+    # solver's tolerance 1e-10 (each step converged to rollqp's residual 1e-10 from the same start)
+    assert _largest_difference(a, b) <= 1e-9
+    arr = a.arrays()
+    assert np.allclose(arr["friction_coefficient"][-1], 0.1 + 0.01 * arr["x"] / float(arr["a_H"]), rtol=0, atol=1e-15)
+
+
+def test_a_friction_law_from_outside():
+    _fresh("case_friction_law")
+
+
+# ------------------------------------------------------------------------------ a profile feature
+@dataclass(frozen=True)
+class Ripple(Feature):
+    """``waves`` cosine dents of ``depth`` side by side, each ``wavelength`` wide, centred at material
+    coordinate ``position``: zero outside its extent."""
+
+    depth: float
+    wavelength: float
+    position: float
+    waves: int = 1
+    kind: ClassVar[str] = "ripple"
+
+    def height(self, s):
+        u = (np.asarray(s, dtype=float) - self.position) / self.wavelength
+        inside = np.abs(u) < 0.5 * self.waves
+        return np.where(inside, self.depth * 0.5 * (1.0 + np.cos(2.0 * math.pi * u)), 0.0)
+
+    def extent(self):
+        half = 0.5 * self.waves * self.wavelength
+        return self.position - half, self.position + half
+
+    def to_dict(self):
+        return {"kind": "ripple", "depth": self.depth, "wavelength": self.wavelength, "position": self.position,
+                "waves": self.waves}
+
+
+def parse_ripple(key, values, radius, folder):
+    return Ripple(float(values["depth"]), float(values["wavelength"]), float(values["position"]),
+                  int(values.get("waves", 1)))
+
+
+def case_profile_feature():
+    from rollqp.errors import InputError
+    from rollqp.profiles import register
+    register("ripple", Ripple, ("depth", "wavelength", "position", "waves"), parse_ripple)
+    dent = rollqp.load_scene("dent").replace(**SHORT)
+    defect = dent.A.profile.features[0]
+    one = dent.replace(**{"bodies.A.profile": {"kind": "ripple", "depth": defect.depth, "wavelength": defect.width,
+                                               "position": defect.position}})
+    a, b = rollqp.run(one), rollqp.run(dent)
+    # one wave is the cosine dent (its height to round-off, 1e-19 mm): the same transient to the solver's tolerance
+    assert _largest_difference(a, b) <= 1e-9
+    three = dent.replace(**{"bodies.A.profile": {"kind": "ripple", "depth": 0.001, "wavelength": 0.3,
+                                                 "position": 1.0, "waves": 3}})
+    r = rollqp.run(three)
+    assert r.arrays()["pn"].shape[0] == three.n_steps + 1
+    ops = rollqp.SceneOperators.build(three)
+    x, d = ops.strip.x, three.load.direction
+    q = 1.0 * three.a_H
+    circle = circle_height(x, three.A.radius) + circle_height(x, three.B.radius)
+    assert np.allclose(ops.gap(q), circle + three.A.profile.features[0].height(x - d * q), rtol=0, atol=1e-15)
+    with pytest.raises(InputError, match=r"bodies\.A\.profile\.width"):  # wider than the zone: refused by extent()
+        dent.replace(**{"bodies.A.profile": {"kind": "ripple", "depth": 0.001, "wavelength": 0.3, "position": 1.0,
+                                             "waves": 40}})
+
+
+def test_a_profile_feature_from_outside():
+    _fresh("case_profile_feature")
+
+
+# ------------------------------------------------------------------------------ an influence model
+def case_influence_model():
+    from rollqp.errors import InputError
+    from rollqp.influence import Model, halfspace_influence, register_model
+
+    def build(scene, strip):
+        return halfspace_influence(strip, Estar=scene.Estar, beta=scene.beta, R_A=scene.A.radius, R_B=scene.B.radius,
+                                   coupling=scene.coupling_level, d_ref=scene.reference_distance_value)
+
+    def check(scene):
+        if scene.coupling_level == "full":
+            raise InputError("contact.coupling", "the copied half-space takes uncoupled scenes only")
+
+    register_model(Model("halfspace-copy", build, "the half-space, built by a contributor", check=check,
+                         profiles=False))
+    scene = rollqp.load_scene("cattaneo-carter").replace(**SHORT)
+    mine = scene.replace(**{"contact.model": "halfspace-copy"})
+    a, b = rollqp.run(mine), rollqp.run(scene)
+    assert _largest_difference(a, b) == 0.0, "the same matrices: the same numbers"
+    assert a.meta["model"]["operator"] == "collocation"
+    with pytest.raises(InputError, match="contact.coupling"):  # its own check runs with the scene's
+        rollqp.load_scene("goodman-bentall").replace(**{"contact.model": "halfspace-copy"})
+    with pytest.raises(InputError, match=r"bodies\.A\.profile"):  # it declares no profiles
+        rollqp.load_scene("dent").replace(**{"contact.model": "halfspace-copy"})
+
+
+def test_an_influence_model_from_outside():
+    _fresh("case_influence_model")
+
+
+# ------------------------------------------------------------------------------ a method
+class Halves:
+    """Newton on the normal and tangential halves only (no coupled, no steady problem): the registry
+    composes it with the N–T alternation on a coupled scene and the march reaches a rolling start by
+    marching. Counts its solves."""
+
+    name = "halves"
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}))
+
+    def __init__(self, tolerance=1e-10, max_iterations=200):
+        self.tolerance = tolerance
+        self.newton = rollqp.get_method("newton", tolerance=tolerance, max_iterations=max_iterations)
+        self.solved = 0
+
+    @classmethod
+    def from_settings(cls, settings, **options):
+        check_options(cls.name, options, ())
+        return cls(settings.tolerance, settings.max_iterations or 200)
+
+    def setup(self, operators):
+        self.newton.setup(operators)
+
+    def solve(self, problem, warm=None):
+        check_kind(self, problem)
+        self.solved += 1
+        return self.newton.solve(problem, warm)
+
+
+def case_method():
+    from rollqp.march import prepare
+    from rollqp.methods import register
+    register("halves", Halves)
+    scene = rollqp.load_scene("cattaneo-carter").replace(**SHORT)
+    a, b = rollqp.run(scene, method="halves"), rollqp.run(scene, method="newton")
+    assert a.meta["method"] == "halves"
+    assert _largest_difference(a, b) == 0.0, "Newton's solves of the same step problems"
+    coupled = rollqp.load_scene("goodman-bentall").replace(**SHORT)
+    _, meth, _ = prepare(coupled, "halves")
+    assert "coupled" in meth.capabilities.solves and meth.inner.capabilities == Halves.capabilities
+    c, d = rollqp.run(coupled, method="halves"), rollqp.run(coupled, method="nt-newton")
+    assert _largest_difference(c, d) == 0.0, "the N–T alternation of the same Newton halves"
+    rolling = scene.replace(**{"load.start": "rolling", "discretization.distance": 0.0})
+    assert rollqp.run(rolling, method="halves").meta["rolling_start"] == "marching to steady state"
+
+
+def test_a_method_from_outside():
+    _fresh("case_method")
+
+
+def test_the_capabilities_are_checked():
+    """A record that declares a problem kind rollqp does not have is refused, naming it."""
+    with pytest.raises(rollqp.InputError, match="capabilities.solves"):
+        Capabilities(solves=frozenset({"normal", "sideways"}))
+    assert dataclasses.replace(Halves.capabilities, dimension=3).traction_components == 1
