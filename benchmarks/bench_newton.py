@@ -105,8 +105,8 @@ def time_steps(name, scene, steps):
         info = sol.info
         dp = float(np.max(np.abs(sol.p - st.p_ref))) / p0 if sol.p is not None and st.problem.kind == "coupled" else 0.0
         rows.append(dict(wall=wall, cpu=cpu, it=sol.iterations, qps=info.get("qp_solves", np.nan),
-                         n=info.get("inner_normal", np.nan), t=info.get("inner_tangential", np.nan),
-                         bt=info.get("backtracks", 0), residual=sol.residual,
+                         n=sol.inner_normal if sol.outer else np.nan, t=sol.inner_tangential if sol.outer else np.nan,
+                         bt=sol.backtracks, residual=sol.residual,
                          dt=float(np.max(np.abs(sol.t - st.t_ref))) / (mu * p0), dp=dp))
     return rows
 

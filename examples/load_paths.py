@@ -1,4 +1,4 @@
-"""Load paths and profiles (issue 13): stop and reverse, a fretting cycle at rest, a dent rolling through.
+"""Load paths and profiles: stop and reverse, a fretting cycle at rest, a dent rolling through.
 
 Three built-in scenes (docs/kinematics.md):
 

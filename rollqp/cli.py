@@ -236,7 +236,7 @@ def cmd_run(args) -> int:
     if not args.quiet:
         peaks = None
         if getattr(args, "stresses", False):
-            from .stresses import stress_history
+            from .subsurface import stress_history
             peaks = stress_history(result)
         print(summary(res, scene, scene.solver.method, wall, peaks))
         if keep:
@@ -470,7 +470,7 @@ def main(argv=None) -> int:
             limiter.unregister() if hasattr(limiter, "unregister") else None
 
 
-# ----------------------------------------------------------------------------- stresses (issue 12)
+# ----------------------------------------------------------------------------- stresses
 def _stresses_parser(sub):
     t = sub.add_parser("stresses", help="subsurface stresses of one state of a result file (docs/stresses.md)")
     t.add_argument("result", metavar="RESULT.npz")
@@ -488,7 +488,7 @@ def cmd_stresses(args) -> int:
     from .errors import InputError
     from .influence import get_model
     from .result import check_output, load_result
-    from .stresses import _source, default_grid, plot_field, save_field, stresses, summary_rows
+    from .subsurface import _source, default_grid, plot_field, save_field, stresses, summary_rows
     try:
         nx, nz = (int(v) for v in args.grid.split(","))
     except ValueError:

@@ -92,11 +92,10 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
         state = classify(sol.p, sol.t, sol.s, sf.mu, sc)
         if ref is None:
             ref, ref_state = sol, state
-        info = sol.info
-        inner = f"{info.get('inner_normal', 0)}+{info.get('inner_tangential', 0)}"
-        if not info.get("iterations_reported", True):
+        inner = f"{sol.inner_normal}+{sol.inner_tangential}"
+        if not sol.extras.get("iterations_reported", True):
             inner = "—"  # DAQP and HiGHS do not report iterations through qpsolvers
-        its = f"{sol.iterations} ({inner})" if "outer" in info else (inner if sf.kind == "uncoupled" else str(sol.iterations))
+        its = f"{sol.iterations} ({inner})" if sol.outer else (inner if sf.kind == "uncoupled" else str(sol.iterations))
         rows.append(Row(name, True, residuals=dict(signorini=sol.residuals.signorini, friction=sol.residuals.friction,
                                                    load_normal=sol.residuals.load_normal,
                                                    load_tangential=sol.residuals.load_tangential),

@@ -80,7 +80,7 @@ def _rolled_tail(scene, need: float):
 
 
 def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
-    """The table ``rollqp run`` prints; ``stresses`` (a :class:`rollqp.stresses.StressHistory`, from
+    """The table ``rollqp run`` prints; ``stresses`` (a :class:`rollqp.subsurface.StressHistory`, from
     ``rollqp run --stresses``) adds the peak von Mises and τ1 over the run with their place and state."""
     K = len(res["q"]) - 1
     rows = [("scene", f"{scene.name} ({scene.source})"),

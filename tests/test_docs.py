@@ -179,7 +179,7 @@ def test_readme_snippet_runs():
 
 def test_every_cited_formulation_section_exists():
     """Code, docs, tests, examples and benchmarks cite the equations as ``docs/formulation.md §N``
-    (the one source; issue 11): every cited N must be a numbered section of that page."""
+    (the one source): every cited N must be a numbered section of that page."""
     page = (ROOT / "docs" / "formulation.md").read_text(encoding="utf-8")
     sections = set(re.findall(r"^## (\d+)\. ", page, flags=re.M))
     cited = {}

@@ -95,6 +95,19 @@ def load_scene(source: Any) -> Scene:
     InputError
         ``SCENE`` if no such file or built-in scene exists; the file's path on a TOML syntax
         error; the dotted key on invalid input.
+
+    Examples
+    --------
+    >>> from rollqp import load_scene
+    >>> scene = load_scene("cattaneo-carter")
+    >>> scene.n_nodes, scene.solver.method, scene.contact.friction
+    (81, 'newton', 0.1)
+    >>> scene.replace(**{"discretization.elements": 20}).n_nodes
+    41
+    >>> load_scene("catano-carter")
+    Traceback (most recent call last):
+    ...
+    rollqp.errors.InputError: SCENE: no such file or built-in scene 'catano-carter'; did you mean 'cattaneo-carter'?...
     """
     if isinstance(source, Scene):
         return source
