@@ -470,10 +470,13 @@ def prepare(scene, method=None):
         A method name (overrides ``[solver].method``) or a method object (used as it is, composed
         with the N–T alternation if the scene is coupled and it does not solve coupled steps).
     """
+    from .advice import fast_path
     from .methods import compose, scene_method
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
+    if method is None or isinstance(method, str):
+        scene = fast_path(scene).scene  # matrix-free where the dense path is large or slow (rollqp.advice)
     coupled = scene.coupling_level == "full"
     kind = scene.contact.friction.kind
     if method is None or isinstance(method, str):
@@ -593,8 +596,14 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
     KeyboardInterrupt
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
-    scene, meth, ops = prepared = prepare(scene, method)
-    result = new_result(scene, ops, meth.name)
+    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    if isinstance(method, str) and method != asked.solver.method:
+        asked = asked.replace(**{"solver.method": method})
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
+    result = new_result(asked, ops, meth.name)  # meta: the scene as given, the method that ran it
+    if scene.solver.method != asked.solver.method:
+        from .advice import fast_path
+        result.meta["method_note"] = fast_path(asked).note
     if resume is not None:
         result.extend(resume)
         result.meta["resumed_from"] = len(result) - 1
