@@ -6,6 +6,7 @@ Usage::
     python benchmarks/sweep_throughput.py --sizes small --repeats 5
     python benchmarks/sweep_throughput.py --creep         # also the docs' creep-curve command, whole,
                                                           # on a local cluster and with --workers 0
+    python benchmarks/sweep_throughput.py --validate      # only: validating a sweep of 100,000 points
 
 Two kinds of points, both the paper's §6.1.1 scene (``cattaneo-carter``: Δq = Le/2, 6 a_H,
 ``newton``) over load ratio × friction:
@@ -146,13 +147,30 @@ def _rows(size, walls, summaries, workers, startup):
     ]
 
 
+def _validate():
+    """Wall and CPU seconds of validating §6.1.1 over 1,000 friction values × 100 load ratios."""
+    import resource
+    vary = ["contact.friction=0.1:0.5:1000", "load.tangential=0.05:0.95:100"]
+    t0, c0 = time.perf_counter(), time.process_time()
+    sw = build_sweep(rollqp.load_scene("cattaneo-carter"), vary)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    print(harness.table(["", "value"], [
+        ("points", f"{sw.size} ({', '.join(vary)})"),
+        ("validation: wall / CPU", f"{wall:.1f} s / {cpu:.1f} s ({1e3 * cpu / sw.size:.2f} ms of CPU a point)"),
+        ("peak memory of the process", f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB"),
+        ("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg()))]))
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--sizes", default="small,large", help="comma-separated: small, large")
     ap.add_argument("--creep", action="store_true", help="also time the docs' creep-curve command (new processes)")
+    ap.add_argument("--validate", action="store_true", help="only time the validation of 100,000 points")
     args = ap.parse_args(argv)
+    if args.validate:
+        return _validate()
     sizes = [s.strip() for s in args.sizes.split(",") if s.strip()]
     print(harness.machine_table())
     base = rollqp.load_scene("cattaneo-carter")

@@ -15,7 +15,7 @@ benchmarks, post-processing — consumes the records; it needs no private call. 
   - ``start = "rolling"``: steady rolling at the initial loads, the fixed point of the rolling
     steps that follow. From the loads' normal half at zero shear (:meth:`_March.pressed`; no
     braked start: the steady state does not depend on the loading path), a method that declares
-    ``"steady"`` (:attr:`Method.solves <rollqp.methods.base.Method.solves>`) solves the
+    ``"steady"`` (:attr:`Capabilities.solves <rollqp.methods.base.Capabilities.solves>`) solves the
     steady problem directly (phase ``"steady"``; slip ``s = ξ e + T w``, ``T = (I − M)/Δq``,
     :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`); the others
     (the QP backends: the steady operator is far from symmetric and their splitting does not
@@ -82,15 +82,15 @@ class Counters:
             self.inner_normal += sol.iterations
         elif half == "tangential":
             self.inner_tangential += sol.iterations
-        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.backtracks += sol.backtracks
         self._residual(sol.residual)
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
         self.iterations += sol.iterations
-        self.inner_normal += int(sol.info.get("inner_normal", 0))
-        self.inner_tangential += int(sol.info.get("inner_tangential", 0))
-        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.inner_normal += sol.inner_normal
+        self.inner_tangential += sol.inner_tangential
+        self.backtracks += sol.backtracks
         self._residual(sol.residual)
 
     def _residual(self, r: float) -> None:
@@ -218,7 +218,7 @@ class _March:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
         if not self.constant_friction:  # a law: this step's μ (Coulomb keeps the fast path)
-            prev = None if state.tsol is None else state.tsol.info.get("mu")
+            prev = None if state.tsol is None else state.tsol.mu
             fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
             pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta, h=h, friction=fr)
@@ -478,10 +478,13 @@ def prepare(scene, method=None):
         A method name (overrides ``[solver].method``) or a method object (used as it is, composed
         with the N–T alternation if the scene is coupled and it does not solve coupled steps).
     """
+    from .advice import fast_path
     from .methods import compose, scene_method
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
+    if method is None or isinstance(method, str):
+        scene = fast_path(scene).scene  # matrix-free where the dense path is large or slow (rollqp.advice)
     coupled = scene.coupling_level == "full"
     kind = scene.contact.friction.kind
     if method is None or isinstance(method, str):
@@ -601,8 +604,14 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
     KeyboardInterrupt
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
-    scene, meth, ops = prepared = prepare(scene, method)
-    result = new_result(scene, ops, meth.name)
+    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    if isinstance(method, str) and method != asked.solver.method:
+        asked = asked.replace(**{"solver.method": method})
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
+    result = new_result(asked, ops, meth.name)  # meta: the scene as given, the method that ran it
+    if scene.solver.method != asked.solver.method:
+        from .advice import fast_path
+        result.meta["method_note"] = fast_path(asked).note
     if resume is not None:
         result.extend(resume)
         result.meta["resumed_from"] = len(result) - 1
@@ -677,9 +686,9 @@ def _unloaded(ops: SceneOperators, xi=None) -> State:
 
 
 def _product(sol, problem, A):
-    """``A t`` of the tangential solution ``sol``, if its method handed it back (``info["At"]``, a pair
+    """``A t`` of the tangential solution ``sol``, if its method handed it back (``sol.At``, a pair
     ``(t, A t)``) for this very operator ``A`` (not a steady slip operator), else None."""
-    got = sol.info.get("At")
+    got = sol.At
     if got is None or problem.A is not A:
         return None
     t, At = got
@@ -687,7 +696,7 @@ def _product(sol, problem, A):
 
 
 def _keep_mu(problem, sol) -> None:
-    """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
+    """With a friction law, the step's ``μ`` at the nodes in ``sol.mu`` (the next step's memory,
     the result field ``friction_coefficient``); Coulomb steps are left as they were."""
     if problem.law is not None or (type(problem.mu) is not float and np.ndim(problem.mu) != 0):
-        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)
+        sol.mu = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)

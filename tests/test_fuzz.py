@@ -1,4 +1,4 @@
-"""Fuzz (issue 17): seeded mutations of scene files, step and solution files, result files and the
+"""Fuzz: seeded mutations of scene files, step and solution files, result files and the
 one-step API.
 
 The property, for every case: a result, or one rollqp error — ``InputError`` or ``SolverError``
@@ -305,6 +305,7 @@ def _cli_property(seed, bases, tmp_path):
         assert out.stderr.count("\n") == 1 and out.stderr.startswith("rollqp: "), f"{case}: {out.stderr!r}"
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize("seed", _seeds("cli"))
 def test_fuzzed_cli(seed, bases, tmp_path):
     _cli_property(seed, bases, tmp_path)
