@@ -340,11 +340,19 @@ class _March:
             return self.braked_start().state
         return self.pressed()
 
-    def rolling_start(self, start: State) -> StepRecord:
-        """Rolling start from the guess ``start`` (:meth:`guess`): the direct steady solve for a method
-        that declares ``"steady"``, else, or if that solve fails, the march to the steady state (its
-        record then says why in ``note``: the march reaches the same discrete state, to
-        :data:`STEADY_TOL`)."""
+    def rolling_start(self) -> StepRecord:
+        """Rolling start from the guess (:meth:`guess`): the direct steady solve for a method that declares
+        ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says why
+        in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`). A QP method solves
+        the guess's QPs with the active-set prediction on (:meth:`QPMethod.predicting
+        <rollqp.methods._qp.QPMethod.predicting>`: a guess, not a state that is kept)."""
+        from .methods.steady_start import predicting
+        was = predicting(self.method, True)
+        try:
+            start = self.guess()
+        finally:
+            if was is not None:
+                predicting(self.method, was)
         if "steady" not in self.method.capabilities.solves:
             return self.steady_by_marching(start)
         try:
@@ -470,10 +478,13 @@ def prepare(scene, method=None):
         A method name (overrides ``[solver].method``) or a method object (used as it is, composed
         with the N–T alternation if the scene is coupled and it does not solve coupled steps).
     """
+    from .advice import fast_path
     from .methods import compose, scene_method
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
+    if method is None or isinstance(method, str):
+        scene = fast_path(scene).scene  # matrix-free where the dense path is large or slow (rollqp.advice)
     coupled = scene.coupling_level == "full"
     kind = scene.contact.friction.kind
     if method is None or isinstance(method, str):
@@ -519,7 +530,7 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         state, first = resumed_state(scene, ops, resume), len(resume["q"])
     else:
         try:
-            start = m.rolling_start(m.guess()) if scene.load.start == "rolling" else m.braked_start()
+            start = m.rolling_start() if scene.load.start == "rolling" else m.braked_start()
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
@@ -593,8 +604,14 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
     KeyboardInterrupt
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
-    scene, meth, ops = prepared = prepare(scene, method)
-    result = new_result(scene, ops, meth.name)
+    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    if isinstance(method, str) and method != asked.solver.method:
+        asked = asked.replace(**{"solver.method": method})
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
+    result = new_result(asked, ops, meth.name)  # meta: the scene as given, the method that ran it
+    if scene.solver.method != asked.solver.method:
+        from .advice import fast_path
+        result.meta["method_note"] = fast_path(asked).note
     if resume is not None:
         result.extend(resume)
         result.meta["resumed_from"] = len(result) - 1

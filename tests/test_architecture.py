@@ -136,6 +136,7 @@ def test_no_id_keyed_caches():
     assert not hits, f"id()-keyed lookups in rollqp/: {hits}"
 
 
+@pytest.mark.integration
 def test_import_rollqp_loads_no_optional_or_heavy_module():
     """``import rollqp`` (and so ``rollqp --help``) loads neither scipy nor the BEM module nor
     any optional extra: each is imported when a scene or command first needs it (

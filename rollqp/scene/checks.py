@@ -35,6 +35,15 @@ NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
 
 
 # =========================================================================== names
+def check_units(key: str, v: Any) -> str:
+    """The declared unit system (:data:`rollqp.units.UNIT_SYSTEMS`), or ``""`` for none."""
+    from ..units import UNIT_SYSTEMS
+    if isinstance(v, str) and (v == "" or v in UNIT_SYSTEMS):  # a list or table is no name (and not hashable)
+        return v
+    raise InputError(key, f"must be one of {', '.join(map(repr, UNIT_SYSTEMS))} (the units the scene's numbers "
+                          f"are in; leave it out if none fits), got {v!r}")
+
+
 def check_scene_name(key: str, v: Any) -> str:
     """A scene's name (:data:`NAME_PATTERN`)."""
     v = string(key, v)
@@ -238,7 +247,10 @@ def check_work(scene) -> None:
     """The work a scene asks for fits: nodes within :data:`MAX_NODES`, and the dense influence
     matrices and the result arrays within this machine's memory — refused before any work, with
     what they would need."""
+    from ..advice import fast_path
     from ..matrixfree import check_scene, memory_estimate
+    if fast_path(scene).note is not None:
+        return  # it runs matrix-free (rollqp.advice): the scene it runs as is checked when it is built
     n, K = scene.n_nodes, scene.n_steps
     dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
     need, memory = (scene.memory_estimate() if dense else memory_estimate(scene)), available_memory()

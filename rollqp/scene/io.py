@@ -5,7 +5,7 @@ structure — unknown and missing keys, named with their dotted path and the clo
 and hands the values to :class:`~rollqp.scene.Scene`, which checks them. Nothing read is ever
 executed or used as a path (a scene's name is restricted, docs/scenes.md). Writing
 (:func:`scene_to_dict`, :func:`scene_to_toml`) gives the full scene with its defaults; the TOML
-goes through the ``tomli-w`` library (optional extra ``toml``), floats with ``repr`` precision so
+goes through the ``tomli-w`` library (a core dependency), floats with ``repr`` precision so
 that reading the text back gives an equal scene.
 """
 from __future__ import annotations
