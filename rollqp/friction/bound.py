@@ -37,7 +37,7 @@ class SlipBound:
     rolled distance (the step problems' ``s``, a pure number).
 
     With ``frozen`` (coefficients at the nodes, those of the previous state) the bound is a point of the path
-    from the frozen bound to the law, ``μ_λ(s) = (1 − λ) μ_f + λ μ(s)`` with ``λ = blend`` (docs/theory.md,
+    from the frozen bound to the law, ``μ_λ(s) = (1 − λ) μ_f + λ μ(s)`` with ``λ = blend`` (docs/friction.md,
     "Which solution of a step"): a step with such a bound asks for the solution near its warm start
     (:attr:`on_path`). ``frozen = None``: the law itself.
     """

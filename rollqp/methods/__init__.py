@@ -188,7 +188,7 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
     ``slip_dependent`` runs inside the fixed point on the bound
     (:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`: each iteration one of its QPs), and every method
     inside :class:`~rollqp.methods.continuation.SlipContinuation`, which selects the solution of a step that a
-    steep law makes non-unique (the end of the path from the frozen bound, docs/theory.md). A method
+    steep law makes non-unique (the end of the path from the frozen bound, docs/friction.md "Which solution of a step"). A method
     whose coupled step takes a constant coefficient only (``newton``) refuses a law on a coupled
     scene up front, naming the alternatives.
     """

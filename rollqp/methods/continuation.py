@@ -1,6 +1,6 @@
 r"""Which solution of a slip-dependent step every method returns: the end of the path from the frozen bound.
 
-A falling friction law can give one step several solutions (docs/theory.md, "Which solution of a step").
+A falling friction law can give one step several solutions (docs/friction.md, "Which solution of a step").
 Which one a method finds would then depend on the method — measured: Newton and the fixed point around
 ``qp-clarabel`` returned solutions 0.38 μ_s p0 apart, both with rollqp's residual below 1e-12, on ramped
 transients at ``v_h = 1`` and 10 mm/s. :class:`SlipContinuation` makes the choice once, for every method
@@ -31,8 +31,7 @@ traction over the slip zone above one (docs/theory.md); the per-node estimate :f
 ``κ = max_i |∂μ/∂s|_max p_i⁺ A_ii/Δq``, misses the response of the zone as a whole — measured on the ramped
 transient of docs/friction.md: steps with several solutions from κ = 0.55 on 80 elements and from κ = 0.35 on
 160 (none at 0.33 on 80), so no threshold on it holds on every mesh. On a mild law the path is short (one to a
-few points: measured 3.5 times the direct solve's time at v_h = 100 mm/s, where the two agree to 2e-12 μ_s
-p0). A law that does not fall (``μ_s = μ_k``: a constant coefficient through the law's path) and every other
+few points: docs/friction.md's sweep table, column "path points"). A law that does not fall (``μ_s = μ_k``: a constant coefficient through the law's path) and every other
 step take the method's own path unchanged. ``threshold`` sets another limit on κ (``inf``: never select, the
 methods' own choice).
 

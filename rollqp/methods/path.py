@@ -1,4 +1,4 @@
-r"""The path of a slip-dependent step's solutions from the frozen bound (docs/theory.md, "Which solution of a step").
+r"""The path of a slip-dependent step's solutions from the frozen bound (docs/friction.md, "Which solution of a step").
 
 A step whose friction coefficient falls with the slip velocity can have several solutions. The one a
 method returns is the end, at ``λ = 1``, of the curve of solutions of
