@@ -47,6 +47,7 @@ class SlipBound:
     previous: np.ndarray | None = None  # μ̄ at the nodes (memory); None: w = 0
     frozen: np.ndarray | None = None    # μ_f of the path from the frozen bound (None: the law itself)
     blend: float = 1.0                  # λ on that path
+    steady: bool = False                # the bound of a direct steady solve (its operator is not symmetric)
 
     def mu(self, s, contact=None) -> np.ndarray:
         """``μ_i(s_i)``; ``contact`` (a mask, optional): outside it the slip velocity is taken as 0, CONTACT's
@@ -73,7 +74,8 @@ class SlipBound:
 
     def homotopy(self, frozen, blend) -> "SlipBound":
         """This bound as the point ``λ = blend`` of the path from the frozen coefficients ``frozen``."""
-        return SlipBound(self.law, self.weight, self.previous, np.asarray(frozen, dtype=float), float(blend))
+        return SlipBound(self.law, self.weight, self.previous, np.asarray(frozen, dtype=float), float(blend),
+                         self.steady)
 
     @property
     def steepness(self) -> float:
@@ -136,7 +138,7 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
         return law.coefficient(x_hat, q_hat, direction), None
     static = law.steady(0.0)[0]
     if law.memory == 0.0:
-        return float(static), SlipBound(law)
+        return float(static), SlipBound(law, steady=bool(steady))
     if steady:
         raise InputError("contact.friction.memory", "a direct steady solve cannot carry the friction memory "
                                                     "along the material; use load.start = 'braked' (marching) or "

@@ -35,8 +35,13 @@ few points: docs/friction.md's sweep table, column "path points"). A law that do
 step take the method's own path unchanged. ``threshold`` sets another limit on κ (``inf``: never select, the
 methods' own choice).
 
-**Failure.** A path that cannot be followed to ``λ = 1`` (it runs into gross sliding, or a corrector does
-not converge) is a :class:`~rollqp.errors.SolverError` naming the residual and the ``λ`` reached.
+**Steady solves** are not selected: their operator is far from symmetric, the step at ``λ = 0`` is no convex
+QP and need not have one solution; the branch of a direct steady solve is chosen by its braked start
+(docs/friction.md, "Which steady state a rolling start returns").
+
+**Where the path stops.** A path that cannot be followed to ``λ = 1`` (it runs into gross sliding, or a
+corrector does not converge) leaves the step to the method's own solution (or its ``SolverError``), and
+says so: ``info["path"]`` is then ``{"stopped": message, "lam": λ reached}``.
 """
 from __future__ import annotations
 
@@ -44,7 +49,6 @@ import time
 
 import numpy as np
 
-from ..errors import SolverError
 from .path import FrozenBoundPath, PathStop, follow
 
 __all__ = ["SlipContinuation", "steepness", "frozen_coefficients", "STEEP"]
@@ -96,7 +100,10 @@ class SlipContinuation:
 
     def solve(self, problem, warm=None):
         law = problem.law
-        if problem.kind != "tangential" or law is None or law.on_path:
+        if problem.kind != "tangential" or law is None or law.on_path or law.steady:
+            # a steady solve's operator T·A is far from symmetric: its step at λ = 0 is no convex QP and need
+            # not have one solution (measured: from Coulomb's steady state at Q = 0.746 μ_s P on CONTACT's
+            # veldep_fric problem the curve turned back below λ = 0); its branch is chosen by the braked start
             return self.inner.solve(problem, warm=warm)
         kappa = steepness(problem)
         if not (kappa > 0.0 and kappa >= self.threshold):
@@ -114,11 +121,10 @@ class SlipContinuation:
         path = FrozenBoundPath(problem, frozen)
         try:
             u, stats = follow(path, x0)
-        except PathStop as err:
-            raise SolverError(f"{err.message}: the step's solution continuous with the frozen bound (the previous "
-                              "state's friction coefficients) does not reach the law (docs/friction.md, \"Which "
-                              "solution of a step\")", method=self.name, status=err.status, residual=err.residual,
-                              iterations=err.iterations) from None
+        except PathStop as err:  # the method's own solution, saying that it was not selected
+            sol = self.inner.solve(problem, warm=warm)
+            sol.info.update(path={"stopped": err.message, "lam": err.lam}, steepness=kappa)
+            return sol
         end = path.solution(u)
         sol = self.inner.solve(problem.derived(law=problem.law.homotopy(frozen, 1.0)), warm=end)
         sol.info.update(path=stats, steepness=kappa)
