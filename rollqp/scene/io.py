@@ -23,13 +23,42 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 from ..errors import InputError
 from ..validate import suggestion
 from .checks import safe_name
-from .core import Scene, scene_from_dict
+from .core import Scene, SceneBase
+from .core import scene_from_dict as scene_from_dict_2d
 from .plain import part_dict, plain, scene_to_dict, scene_to_toml  # noqa: F401 - re-exported
 
 __all__ = ["load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes", "scene_to_dict", "scene_to_toml"]
 
 #: Largest scene file read (bytes): scenes are a few hundred bytes; tables of 10^5 points fit.
 MAX_FILE_BYTES = 16 << 20
+
+
+def _parse_3d(d: dict, source: str, default_name: str):
+    from ..three.scene import scene_from_dict as parse  # imported on first use: import rollqp stays light
+    return parse(d, source=source, default_name=default_name)
+
+
+#: The parser of each scene dimension (``[contact] dimension``).
+_PARSERS = {2: scene_from_dict_2d, 3: _parse_3d}
+
+
+def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene"):
+    """Build and validate a scene from its nested dict, of the dimension its ``[contact] dimension``
+    names (default 2: :class:`~rollqp.scene.Scene`; 3: :class:`~rollqp.three.scene.Scene3D`).
+
+    Raises
+    ------
+    InputError
+        ``contact.dimension`` if it is not 2 or 3; else as the scene of that dimension.
+    """
+    contact = d.get("contact") if isinstance(d, dict) else None
+    dimension = contact.get("dimension", 2) if isinstance(contact, dict) else 2
+    if isinstance(dimension, bool) or dimension not in _PARSERS:
+        raise InputError("contact.dimension", f"must be one of {', '.join(map(str, _PARSERS))} (default 2), got "
+                                              f"{dimension!r}")
+    if dimension == 2 and "dimension" in contact:  # the 2D schema has no such key: 2 is its default
+        d = {**d, "contact": {k: v for k, v in contact.items() if k != "dimension"}}
+    return _PARSERS[dimension](d, source=source, default_name=default_name)
 
 
 def scene_from_toml(text: str, source: str = "<string>", default_name: str = "scene") -> Scene:
@@ -109,7 +138,7 @@ def load_scene(source: Any) -> Scene:
     ...
     rollqp.errors.InputError: SCENE: no such file or built-in scene 'catano-carter'; did you mean 'cattaneo-carter'?...
     """
-    if isinstance(source, Scene):
+    if isinstance(source, SceneBase):
         return source
     if isinstance(source, dict):
         return scene_from_dict(source)
