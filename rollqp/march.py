@@ -340,11 +340,19 @@ class _March:
             return self.braked_start().state
         return self.pressed()
 
-    def rolling_start(self, start: State) -> StepRecord:
-        """Rolling start from the guess ``start`` (:meth:`guess`): the direct steady solve for a method
-        that declares ``"steady"``, else, or if that solve fails, the march to the steady state (its
-        record then says why in ``note``: the march reaches the same discrete state, to
-        :data:`STEADY_TOL`)."""
+    def rolling_start(self) -> StepRecord:
+        """Rolling start from the guess (:meth:`guess`): the direct steady solve for a method that declares
+        ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says why
+        in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`). A QP method solves
+        the guess's QPs with the active-set prediction on (:meth:`QPMethod.predicting
+        <rollqp.methods._qp.QPMethod.predicting>`: a guess, not a state that is kept)."""
+        from .methods.steady_start import predicting
+        was = predicting(self.method, True)
+        try:
+            start = self.guess()
+        finally:
+            if was is not None:
+                predicting(self.method, was)
         if "steady" not in self.method.capabilities.solves:
             return self.steady_by_marching(start)
         try:
@@ -522,7 +530,7 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         state, first = resumed_state(scene, ops, resume), len(resume["q"])
     else:
         try:
-            start = m.rolling_start(m.guess()) if scene.load.start == "rolling" else m.braked_start()
+            start = m.rolling_start() if scene.load.start == "rolling" else m.braked_start()
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
