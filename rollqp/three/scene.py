@@ -227,7 +227,7 @@ class Scene3D(SceneBase):
     >>> from rollqp import load_scene
     >>> s = load_scene("kalker-circular")
     >>> s.dimension, s.grid.nx, s.grid.ny, round(s.ellipse.a, 4), s.n_steps
-    (3, 40, 40, 0.5857, 0)
+    (3, 40, 40, 0.5857, 64)
     >>> s.replace(**{"bodies.A.radius": -1.0})
     Traceback (most recent call last):
     ...
