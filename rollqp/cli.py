@@ -81,7 +81,7 @@ def _parser():
     r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
                    help="solve three steps again with qp-clarabel and qp-osqp (3D: qp-clarabel, or newton for a "
                         "conic run) and show the differences (default: on for strips of at most 400 nodes run by "
-                        "a method other than those; 3D: up to 1000 contact elements)")
+                        "a method other than those; 3D: the steps that fit about 12 s)")
     sub.add_parser("scenes", help="list the built-in scenes")
     s = sub.add_parser("show", help="print a scene's TOML with defaults filled in")
     s.add_argument("scene")
@@ -98,7 +98,7 @@ def _parser():
                    "(default 1e-6: see docs/stepfiles.md)")
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
     x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
-    x.add_argument("--step", type=int, default=None, help="step K (default 1)")
+    x.add_argument("--step", type=int, default=None, help="step K (default 1; a 3D scene: every step of its run)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
     _stresses_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
@@ -234,7 +234,8 @@ class Family:
     ``summary(arrays, scene, method, wall, stresses)``; ``plot(arrays, scene, path)``; ``advise(scene)``
     the notes before a run; ``spot(args, scene)`` → ``(kept, observe)`` of the cross-check and ``check(kept,
     scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
-    ``commands``: the other subcommands that take its scenes.
+    ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
+    ``rollqp crossval``'s report and returns the exit code.
     """
 
     run: Callable
@@ -245,6 +246,7 @@ class Family:
     check: Callable
     stresses: Callable | None
     commands: frozenset
+    crossval: Callable
 
 
 def _family_2d() -> Family:
@@ -253,7 +255,7 @@ def _family_2d() -> Family:
     from .report import summary
     from .subsurface import stress_history
     return Family(run, summary, plot_result, _advise, _spot_steps, _spot_lines, stress_history,
-                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}))
+                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d)
 
 
 def _family_3d() -> Family:
@@ -266,7 +268,8 @@ def _family_3d() -> Family:
         for note in notes(scene):
             print(f"rollqp: {note}", file=sys.stderr, flush=True)
 
-    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset())
+    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
+                  _crossval_3d)
 
 
 #: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
@@ -349,16 +352,34 @@ def _spot_lines(keep, scene) -> str:
 
 
 def _spot_3d(args, scene):
-    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check (on by
-    default up to :data:`~rollqp.three.crosscheck.SPOT_MAX_CONTACT` contact elements)."""
-    from .three.crosscheck import SPOT_MAX_CONTACT, SpotObserver, spot_steps
-    wanted = args.cross_check
-    if wanted is None:
-        wanted = not args.quiet and scene.contact_elements() <= SPOT_MAX_CONTACT
-    if not wanted or args.quiet:
+    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check — by
+    default as many as fit :data:`~rollqp.three.crosscheck.SPOT_BUDGET` (the last first), all three with
+    ``--cross-check``."""
+    from .three.crosscheck import SpotObserver, spot_steps
+    if args.quiet or args.cross_check is False:
         return {}, None
-    observer = SpotObserver(spot_steps(scene.n_steps))
+    steps = spot_steps(scene.n_steps, None if args.cross_check else scene.contact_elements())
+    if not steps:
+        return {}, None
+    observer = SpotObserver(steps)
     return observer, observer
+
+
+def _crossval_2d(scene, step, methods) -> int:
+    """``rollqp crossval`` of a 2D scene: every method on one step (:func:`rollqp.crossval.report`)."""
+    from .crossval import report
+    print(report(scene, step=step, methods=methods))
+    return 0
+
+
+def _crossval_3d(scene, step, methods) -> int:
+    """``rollqp crossval`` of a 3D scene: every step (or ``--step K``) of its run solved again by the SOCP
+    backends and Newton (:func:`rollqp.three.crosscheck.crossval`); exit 1 if they disagree."""
+    from .three.crosscheck import crossval
+    check = crossval(scene, step, methods, tolerance=scene.solver.tolerance)
+    print(check.table())
+    print(str(check))
+    return 0 if check.agrees() else 1
 
 
 def _check_3d(observer, scene) -> str:
@@ -482,15 +503,14 @@ def cmd_crossval(args) -> int:
             from .errors import InputError
             raise InputError("--methods", f"unknown method(s) {', '.join(bad) or '(none given)'}; "
                                           f"choose from {', '.join(METHOD_NAMES)}")
-    if not args.scene.endswith(".npz"):
-        from .scene import load_scene
-        _takes(load_scene(args.scene), "crossval")
     if args.scene.endswith(".npz"):
         from .stepfile import StepFile
         print(report(StepFile.load(args.scene, arg="SCENE"), methods=methods))
-    else:
-        print(report(args.scene, step=args.step, methods=methods))
-    return 0
+        return 0
+    from .scene import load_scene
+    scene = load_scene(args.scene)
+    _takes(scene, "crossval")
+    return family(scene).crossval(scene, args.step, methods)
 
 
 def benchmarks_folder():

@@ -481,6 +481,9 @@ def prepare(scene, method=None):
     from .advice import fast_path
     from .methods import compose, scene_method
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
+    if not isinstance(scene, Scene):   # another dimension's scene (docs/architecture.md, three dimensions)
+        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.three.run.run and "
+                                  "rollqp.three.run.march run it (on the command line: rollqp run)")
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     if method is None or isinstance(method, str):

@@ -25,12 +25,13 @@ import numpy as np
 from ..errors import RollqpError
 from .march import coupled_step
 
-__all__ = ["SpotObserver", "CrossCheck", "cross_check", "spot_steps", "SPOT_MAX_CONTACT", "AGREEMENT"]
+__all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SPOT_BUDGET", "AGREEMENT"]
 
-#: Largest number of contact elements cross-checked by default: one Clarabel SOCP has twice as many
-#: variables and a dense Hessian (measured here: 0.35 s at 300 contact elements, 5.3 s at 812, growing
-#: like their cube); ``--cross-check`` forces it beyond.
-SPOT_MAX_CONTACT = 1000
+#: Wall time the default cross-check of ``rollqp run`` may take (seconds, estimated from the scene by
+#: :func:`rollqp.three.advice.conic_step_seconds`: one Clarabel SOCP has twice as many variables as the
+#: contact has elements and a dense Hessian, its cost grows like their cube — 0.35 s at 300 contact
+#: elements, 5.3 s at 812 measured here). ``--cross-check`` forces the three steps whatever they cost.
+SPOT_BUDGET = 12.0
 #: The refined answers of two routes that solve the same step to rollqp's residual 1e-10 agree to about
 #: that times the conditioning of the stick block (measured ≤ 5e-11 μp0, docs/validation3d.md §6); a
 #: different stick/slip partition would differ by 1e-3 or more. Differences above this are reported as
@@ -38,9 +39,17 @@ SPOT_MAX_CONTACT = 1000
 AGREEMENT = 1e-7
 
 
-def spot_steps(K: int) -> list[int]:
-    """The steps a run of ``K`` rolling steps keeps for its cross-check: 0, K/2, K."""
-    return sorted({0, K // 2, K})
+def spot_steps(K: int, contact_elements: int | None = None, budget: float | None = None) -> list[int]:
+    """The steps a run of ``K`` rolling steps keeps for its cross-check: 0, K/2, K — or, with
+    ``contact_elements`` and a ``budget`` (default :data:`SPOT_BUDGET`), as many of them as fit the
+    budget at the estimated cost of one conic step, the last state first (the one the summary
+    reports); ``[]`` if not even one fits."""
+    steps = sorted({0, K // 2, K})
+    if contact_elements is None:
+        return steps
+    from .advice import conic_step_seconds
+    fit = int((SPOT_BUDGET if budget is None else budget) // conic_step_seconds(contact_elements))
+    return sorted(steps[::-1][:max(fit, 0)])
 
 
 class SpotObserver:
@@ -70,6 +79,21 @@ class CrossCheck:
     steps: list
     rows: dict = field(default_factory=dict)
     steady: bool = False
+    #: ``(method, step) -> differences`` of each step (:meth:`table`).
+    per_step: dict = field(default_factory=dict)
+    ran: str = ""
+
+    def table(self) -> str:
+        """One line per step and method: the differences from the run's solution and rollqp's residual."""
+        head = (f"{'step':>5}  {'method':<14} {'max|dp|/p0':>10} {'max|dt|/mu p0':>13} {'|d creep|':>9} "
+                f"{'residual':>9} {'raw |dp|':>9} {'raw |dt|':>9}")
+        lines = [f"reference: {self.ran} (its solution of each step); each step posed again from the state "
+                 "before it, at its loads", head]
+        for (m, k), d in sorted(self.per_step.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+            raw = (f"{d['dp_raw']:9.1e} {d['dt_raw']:9.1e}" if "dp_raw" in d else f"{'-':>9} {'-':>9}")
+            lines.append(f"{k:>5}  {m:<14} {d['dp']:10.1e} {d['dt']:13.1e} {d['dcreep']:9.1e} {d['residual']:9.1e} "
+                         f"{raw}")
+        return "\n".join(lines)
 
     def agrees(self) -> bool:
         return all("error" not in r and max(r["dp"], r["dt"]) <= AGREEMENT for r in self.rows.values())
@@ -100,7 +124,7 @@ def _pose(scene, contact, rec, before):
     return "rolling", scene.loads_at(rec.q), before, scene.dq
 
 
-def _compare(row, contact, rec, nsol, tsol):
+def _compare(row, contact, rec, nsol, tsol) -> dict:
     sc, mu = contact.scales, contact.mu
     d = {"dp": np.max(np.abs(nsol.p - rec.p)) / sc.stress, "dt": np.max(np.abs(tsol.t - rec.t)) / (mu * sc.stress),
          "dcreep": max(abs(tsol.xi - rec.xi), abs(tsol.eta - rec.eta)) / sc.slip,
@@ -112,6 +136,7 @@ def _compare(row, contact, rec, nsol, tsol):
         d["dt_raw"] = np.max(np.abs((rt or {"t": tsol.t})["t"] - rec.t)) / (mu * sc.stress)
     for k, v in d.items():
         row[k] = max(row.get(k, 0.0), float(v))
+    return {k: float(v) for k, v in d.items()}
 
 
 def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance: float = 1e-10) -> CrossCheck:
@@ -120,7 +145,7 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
     from ..methods import CROSS_CHECK_METHODS_3D, get_method
     names = [m for m in (methods or CROSS_CHECK_METHODS_3D) if m != ran]
     contact, kept = observer.contact, observer.kept
-    out = CrossCheck(sorted(kept), steady=any(rec.phase == "steady" for rec, _ in kept.values()))
+    out = CrossCheck(sorted(kept), steady=any(rec.phase == "steady" for rec, _ in kept.values()), ran=ran)
     for name in names:
         row, k = {}, None
         t0 = time.perf_counter()
@@ -132,9 +157,37 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
                 kind, loads, previous, dq = _pose(scene, contact, rec, before)
                 nsol, tsol, _ = coupled_step(contact, method, scene.load.normal, kind, loads, previous, dq,
                                              scene.load.direction)
-                _compare(row, contact, rec, nsol, tsol)
+                out.per_step[name, k] = _compare(row, contact, rec, nsol, tsol)
         except RollqpError as err:
             row = {"error": f"step {k}: {err}" if k is not None else str(err)}
         row["time"] = time.perf_counter() - t0
         out.rows[name] = row
     return out
+
+
+def crossval(scene, step: int | None = None, methods=None, tolerance: float = 1e-10) -> CrossCheck:
+    """``rollqp crossval`` of a 3D scene: run it with its method (``solver.method``), then solve every
+    stored step (or only ``step``) again with each of ``methods`` (default: the installed ones of
+    :data:`rollqp.methods.CROSSVAL_METHODS_3D` other than the run's), each posed from the run's state
+    before it and compared with the run's solution; every residual is rollqp's (module docstring).
+
+    Raises
+    ------
+    InputError
+        ``--step`` outside ``0 … K``, or a method that cannot solve the scene's steps.
+    """
+    from ..errors import InputError
+    from ..methods import CROSSVAL_METHODS_3D, available_methods, require_3d
+    from .run import run
+    K = scene.n_steps
+    if step is not None and not (isinstance(step, int) and 0 <= step <= K):
+        raise InputError("--step", f"must be an integer in [0, {K}] ({scene.name!r} has {K} rolling steps), got "
+                                   f"{step!r}")
+    if methods is None:
+        installed = set(available_methods(3))
+        methods = [m for m in CROSSVAL_METHODS_3D if m in installed]
+    for name in methods:
+        require_3d(name, "--methods")
+    observer = SpotObserver(range(K + 1) if step is None else [step])
+    run(scene, observe=observer)
+    return cross_check(scene, observer, scene.solver.method, methods=methods, tolerance=tolerance)

@@ -74,7 +74,7 @@ def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
     ref = np.sign(Fx) * cattaneo_traction(np.hypot(X, Y), e.a, e.p0, mu, r)
     rms = float(np.sqrt(np.mean((res["px"][0] - ref) ** 2))) / (mu * e.p0)
     shift = -np.sign(Fx) * cattaneo_shift(FN, e.a, mu, r, m.G, m.nu)
-    got = float(res["shift"][0][0]) if "shift" in res else float("nan")
+    got = float(_meta(res).get("static_shift", [float("nan")])[0])
     exact = "exact for nu = 0; for nu > 0 it neglects the lateral traction of the nu XY/rho³ kernel"
     return [("error: cattaneo", f"rms(px - Cattaneo)/(mu p0) = {rms:.3g}, shift {100 * (got / shift - 1):+.3f} % of "
                                 f"Mindlin's {shift:.5g} (state 0; Cattaneo–Mindlin is {exact}: docs/validation3d.md §2)")]
@@ -154,6 +154,11 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
     note = _meta(res).get("rolling_start")
     if note:
         rows.append(("starting state", note))
+    raw = _meta(res).get("raw_distance")
+    if raw:
+        rows.append(("raw conic", f"the solver's own answers (before the active-set refinement) differ from the "
+                                  f"refined ones kept by max |dp| {raw['dp']:.1e} p0, |dt| {raw['dt']:.1e} mu p0 "
+                                  f"over {raw['steps']} steps (interior point: about sqrt(gap); docs/theory3d.md §5)"))
     rows += closed_form_errors(res, scene)
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)

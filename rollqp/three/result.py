@@ -40,8 +40,6 @@ FIELDS_3D: dict[str, Field] = {f.name: f for f in (
     Field("creepage", "step", "1", "(K+1, 3): xi, eta (rigid slip of A relative to B over |V|) and phi "
                                    "(spin, 1/length)", contract=True),
     Field("approach", "step", LENGTH, "rigid approach delta", contract=True),
-    Field("shift", "step", LENGTH, "(K+1, 2): rigid static shift of A relative to B accumulated by a braked "
-                                   "start (0 for rolling states)"),
     Field("iterations", "step", "1", "solver iterations of the step (N-T: sweeps times the tangential ones)",
           dtype="int64", contract=True),
     Field("step_time", "step", "s", "wall seconds of the step", contract=True),
@@ -54,7 +52,7 @@ FIELDS_3D: dict[str, Field] = {f.name: f for f in (
 )}
 
 _GRID = ("pn", "px", "py", "sx", "sy", "state")
-_COLUMNS = {"creepage": 3, "shift": 2}
+_COLUMNS = {"creepage": 3}
 
 
 class Result3D:
@@ -77,7 +75,7 @@ class Result3D:
         values = dict(q=rec.q, pn=g.field(rec.p), px=g.field(t[0]), py=g.field(t[1]), sx=g.field(s[0]),
                       sy=g.field(s[1]), state=g.field(rec.state), FN=rec.FN, Fx=rec.Fx, Fy=rec.Fy, Mz=rec.Mz,
                       creepage=(rec.xi, rec.eta, rec.phi), approach=rec.delta,
-                      shift=rec.info.get("shift", (0.0, 0.0)), iterations=rec.iterations, step_time=rec.time,
+                      iterations=rec.iterations, step_time=rec.time,
                       residual=rec.residual)
         self.append(values)
 
@@ -145,8 +143,9 @@ def markdown_table() -> str:
         units = "–" if f.units == "1" else f.units
         note = "" if f.contract else " *(beyond the contract)*"
         rows.append(f"| `{f.name}` | {shape} | {units} | {f.description.replace('|', chr(92) + '|')}{note} |")
-    rows.append("| `meta` | () | – | JSON string: the full scene with defaults, the method, package versions, the "
-                "cross-check and notes |")
+    rows.append("| `meta` | () | – | JSON string: the full scene with defaults, the method, package versions, "
+                "`static_shift` (the braked start's rigid shift of A relative to B, x and y), `raw_distance` (a conic "
+                "method's raw answers against the refined ones) and notes |")
     return "\n".join(rows)
 
 

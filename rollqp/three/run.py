@@ -17,6 +17,7 @@ own halves (:func:`rollqp.three.march.coupled_step`).
 from __future__ import annotations
 
 import functools
+import json
 from typing import Iterator
 
 import numpy as np
@@ -131,6 +132,23 @@ def _versions() -> tuple:
     return tuple(out)
 
 
+def _raw_distance(meta: dict, rec: StepRecord, contact) -> None:
+    """A conic method's raw answers (the solver's own, before the active-set refinement,
+    :mod:`rollqp.three.refine`) against the refined ones the run keeps: the largest distance over the
+    run in ``meta["raw_distance"]`` (``dp`` in p0, ``dt`` in μp0, ``steps`` compared); nothing for a
+    method without a raw answer (Newton)."""
+    sc = contact.scales
+    rp, rt = (rec.info.get(part, {}).get("raw") for part in ("normal", "tangential"))
+    if rp is None and rt is None:
+        return
+    row = meta.setdefault("raw_distance", {"dp": 0.0, "dt": 0.0, "steps": 0})
+    if rp is not None:
+        row["dp"] = max(row["dp"], float(np.max(np.abs(rp["p"] - rec.p))) / sc.stress)
+    if rt is not None:
+        row["dt"] = max(row["dt"], float(np.max(np.abs(rt["t"] - rec.t))) / (contact.mu * sc.stress))
+    row["steps"] += 1
+
+
 def run(scene, method=None, progress=None, resume=None, observe=None) -> Result3D:
     """Run a 3D scene and return its :class:`~rollqp.three.result.Result3D` (arguments as
     :func:`rollqp.march.run`: ``progress(k, K)`` after each rolling step, ``observe(record, contact)``
@@ -147,12 +165,19 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result3
     if resume is not None:
         result.extend(resume)
         result.meta["resumed_from"] = len(result) - 1
+        earlier = json.loads(str(resume["meta"])) if "meta" in resume else {}
+        for key in ("static_shift", "rolling_start", "raw_distance"):   # what state 0 and the earlier steps said
+            if key in earlier:
+                result.meta[key] = earlier[key]
     K = scene.n_steps
     try:
         for rec in march(scene, prepared=prepared, resume=resume):
             result.add(rec)
             if rec.k == 0 and "marched" in rec.info:
                 result.meta["rolling_start"] = f"marched to the steady state in {rec.info['marched']} steps"
+            if rec.k == 0 and "shift" in rec.info:
+                result.meta["static_shift"] = [float(v) for v in rec.info["shift"]]
+            _raw_distance(result.meta, rec, contact)
             if observe is not None:
                 observe(rec, contact)
             if progress is not None and rec.k > 0:
