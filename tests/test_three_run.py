@@ -233,3 +233,30 @@ def test_the_2d_api_refuses_a_3d_scene_in_one_line():
     import rollqp
     with pytest.raises(InputError, match=r"^scene: 'kalker-elliptic' is a 3D scene: rollqp.three.run.run"):
         rollqp.run("kalker-elliptic")
+
+
+def test_load_result_reads_a_3d_file_and_the_cli_resumes_it(braked, tmp_path, capsys, monkeypatch):
+    import rollqp
+    scene, result = braked
+    monkeypatch.chdir(tmp_path)
+    full = result.arrays()
+    back = rollqp.load_result(result.save(tmp_path / "full.npz"))
+    assert back["meta"]["method"] == "newton" and np.array_equal(back["px"], full["px"])
+    part = {k: (v[:2] if np.ndim(v) and k not in ("x", "y") else v) for k, v in full.items()}
+    np.savez(tmp_path / "part.npz", **part)
+    assert cli.main(["run", "--resume", "part.npz", "--quiet"]) == 0
+    again = rollqp.load_result(tmp_path / "part.npz")
+    assert again["q"].shape == full["q"].shape
+    assert np.max(np.abs(again["px"] - full["px"])) <= 1e-9 * scene.mu * scene.ellipse.p0
+    bad = dict(part, px=part["px"][:, :3])                   # a field of the wrong shape
+    np.savez(tmp_path / "bad.npz", **bad)
+    with pytest.raises(InputError, match=r"^R: key 'px' must have shape"):
+        rollqp.load_result(tmp_path / "bad.npz", "R")
+
+
+def test_docs_results_table_is_the_registry_s():
+    from pathlib import Path
+    from rollqp.three.result import markdown_table
+    text = (Path(__file__).resolve().parents[1] / "docs" / "results.md").read_text(encoding="utf-8")
+    table = text.split("<!-- fields3d table: begin -->\n", 1)[1].split("<!-- fields3d table: end -->", 1)[0]
+    assert table.strip() == markdown_table().strip()

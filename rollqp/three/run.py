@@ -165,7 +165,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result3
     if resume is not None:
         result.extend(resume)
         result.meta["resumed_from"] = len(result) - 1
-        earlier = json.loads(str(resume["meta"])) if "meta" in resume else {}
+        earlier = resume.get("meta", {})
+        earlier = earlier if isinstance(earlier, dict) else json.loads(str(earlier))
         for key in ("static_shift", "rolling_start", "raw_distance"):   # what state 0 and the earlier steps said
             if key in earlier:
                 result.meta[key] = earlier[key]
