@@ -1,4 +1,4 @@
-"""Fuzz (issue 17): seeded mutations of scene files, step and solution files, result files and the
+"""Fuzz: seeded mutations of scene files, step and solution files, result files and the
 one-step API.
 
 The property, for every case: a result, or one rollqp error — ``InputError`` or ``SolverError``
