@@ -1,4 +1,4 @@
-"""Half-space assembly time and peak memory on uniform strips (issue 18 item; docs/matrix-free.md).
+"""Half-space assembly time and peak memory on uniform strips (docs/matrix-free.md).
 
 One fresh process per size (peak RSS is per process): ``halfspace_influence`` on ``N`` quadratic
 elements (``2N + 1`` nodes), similar materials. Run from a source tree; ``--source`` times

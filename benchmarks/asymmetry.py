@@ -1,4 +1,4 @@
-"""Newton against the QP backends beside the measured asymmetry of F·A (issue 3).
+"""Newton against the QP backends beside the measured asymmetry of F·A.
 
 On piecewise-constant elements on a uniform grid F·A is exactly symmetric and the
 collocation step problem *is* a convex QP: Newton and the QP backends must agree to solver

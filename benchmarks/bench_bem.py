@@ -10,7 +10,7 @@ A. **Assembly and condensation** of the paper's meshes (§2.3): R_A = 150 mm on 
    81 nodes) plus 19 graded outer and 16 shaft elements per roller:
    :func:`rollqp.influence.bem.contact_compliance` per body (``H``, ``G`` assembly, LU of the
    body system, the 162 strip load cases), and the whole :func:`~rollqp.influence.bem.bem_influence`
-   (both bodies, uncached). Target (the issue's): both bodies within 2 s.
+   (both bodies, uncached). Target: both bodies within 2 s.
 B. **Per-step cost of the transient**: ``rollqp.run`` of ``cattaneo-carter`` with
    ``contact.model = "halfspace"`` and ``"bem"`` (Newton and OSQP), median ``step_time`` of the
    rolling steps. The two models run alternately within each repetition and the ratio

@@ -18,7 +18,7 @@ Sections (``--only`` names):
 * ``friction`` |ξ|/ξ_BJ against μ = 1e-4 … 0.3, both couplings;
 * ``signs``    A ↔ B and d = ±1: the signs of β, ξ and t;
 * ``newton``   where the Newton direct steady solve fails (free rolling at μ = 1e-4);
-* ``start``    the coupled rolling start with the QP methods (issue 18): CONTACT's grid, μ = 0.05,
+* ``start``    the coupled rolling start with the QP methods: CONTACT's grid, μ = 0.05,
                full coupling; time against ``newton``'s direct steady solve, the answer against it,
                and the ways to reach the steady state that were measured (one N–T sweep per marching
                step, Anderson acceleration, the splitting of the steady operator).
@@ -276,7 +276,7 @@ class AndersonOnly(Alternation):
 
 
 class FullAlternation(PlainMarch):
-    """The plain march with the alternation converged at every step (rollqp before issue 18)."""
+    """The plain march with the alternation converged at every step (the march before the accelerated start)."""
 
     def __init__(self, *args, **kw):
         super().__init__(*args, **kw)  # rollqp.march then never switches to one sweep per step
@@ -327,7 +327,7 @@ def section_start():
           "tolerance), then marching steps with the alternation converged, solved by the backend, until max|Δt| per "
           "step < 1e-8 μp0. `without the Newton phase`: plain steps, then Anderson; `without the active-set "
           "prediction`: every QP by the backend; `plain march`: neither Newton nor Anderson (one sweep per step, then "
-          "converged steps); `full alternation`: the alternation converged at every step (rollqp before issue 18). "
+          "converged steps); `full alternation`: the alternation converged at every step (the march before the accelerated start). "
           "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
           "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
     ref, cpu_ref, wall_ref = timed_cpu_run(s, "newton")

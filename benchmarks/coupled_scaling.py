@@ -2,7 +2,7 @@
 
     python benchmarks/coupled_scaling.py            # newton and nt-newton, 41 … 1281 nodes
 
-The issue-5 scaling study (``rollqp bench --parts scaling``) times the uncoupled §6.1.1
+The suite's scaling study (``rollqp bench --parts scaling``) times the uncoupled §6.1.1
 transient, where Newton works on one n-sized reduced system per half and reuses its
 factorization. The coupled step of ``goodman-bentall`` (β = 0.5, μ = 0.3) has 2n unknowns
 (p and t, minus separated nodes), couples them through the friction bound μ·max(0, p − r g),

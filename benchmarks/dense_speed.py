@@ -1,4 +1,4 @@
-"""The dense path's speed with ``newton`` (issue 18): the three figures and the step/product ratio in one run.
+"""The dense path's speed with ``newton``: the three figures and the step/product ratio in one run.
 
 Usage, from the repository root::
 

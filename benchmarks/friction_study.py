@@ -12,7 +12,12 @@ Sections:
 * ``falling``    the falling law's steady Q at ξ = −1e-3 as the mesh doubles (no closed form: successive
                  differences and their observed order);
 * ``march``      a fine-mesh marching run (Q prescribed on the rising branch) against the direct steady solve;
-* ``fixedpoint`` Newton against the fixed point on the bound around qp-clarabel, step by step (V = 450 mm/s).
+* ``fixedpoint`` Newton against the fixed point on the bound around qp-clarabel, step by step (V = 450 mm/s);
+* ``sweep``      a ramped falling-friction transient (tests/test_friction_falling.py's scene: V = 10 m/s, 80
+                 constant elements, Q ramped to 0.5 μ_s P over 0.9 a_H, 4.5 a_H) for the exponential and
+                 linear laws over v_h = 1 … 1e12 mm/s: each method's run, the two runs against each other, and
+                 every step of Newton's run re-solved from the same state by the fixed point around
+                 qp-clarabel (both at tolerance 1e-12; about 10 min).
 """
 from __future__ import annotations
 
@@ -35,7 +40,7 @@ def slope_section():
     """static = kinetic = 0.3: |ξ/ξ_Carter − 1| as the mesh doubles (the law's path against a closed form)."""
     rows, errs = [], []
     for n in MESHES:
-        sc = veldep_scene(elements=n, static=0.3, kinetic=0.3, tangential=0.5)
+        sc = veldep_scene(elements=n, static=0.3, kinetic=0.3, tangential=0.5, grid="symmetric")
         t0 = time.perf_counter()
         xi = float(run(sc, "newton").arrays()["creepage"][-1])
         ref = cf.carter_creepage(sc.a_H, sc.R, 0.3, 0.5)
@@ -48,7 +53,7 @@ def slope_section():
 def falling_section():
     rows, vals = [], []
     for n in MESHES:
-        r = run(veldep_scene(elements=n), "newton").arrays()
+        r = run(veldep_scene(elements=n, grid="symmetric"), "newton").arrays()
         vals.append(r["Q"][-1] / (0.3 * VELDEP["FN"]))
         d = "" if len(vals) < 2 else f"{abs(vals[-1] - vals[-2]):.2e}"
         order = "" if len(vals) < 3 else f"{np.log2(abs(vals[-2] - vals[-3]) / abs(vals[-1] - vals[-2])):.2f}"
@@ -94,8 +99,65 @@ def fixedpoint_section(elements=92, distance=2.0, speed=450.0):
                  [[f"{speed:g}", elements, len(its), f"{worst:.1e}", f"{np.median(its):g}, {max(its)}"]])
 
 
+SWEEP_SCENE = {
+    "name": "falling-sweep",
+    "bodies": {"A": {"radius": 500.0, "E": 209920.0, "nu": 0.28}, "B": {"radius": 500.0, "E": 209920.0, "nu": 0.28}},
+    "contact": {"friction": {"law": "rational", "static": 0.32, "kinetic": 0.20, "velocity": 3.0,
+                             "rolling_speed": 10000.0}},
+    "load": {"normal": 357.79249665883754, "tangential": {"kind": "ramp", "start": 0.0, "end": 0.5, "over": 0.9},
+             "start": "braked", "direction": -1},
+    "discretization": {"elements": 80, "element": "constant", "zone": 1.2, "step": 1.0, "formulation": "material",
+                       "distance": 4.5},
+    "solver": {"method": "newton", "tolerance": 1e-12},
+}
+SWEEP = [("rational", 3.0, 0.75)] + [(law, v, 4.5) for law in ("exponential", "linear")
+                                    for v in (1.0, 10.0, 100.0, 1e3, 1e4, 1e6, 1e8, 1e10, 1e12)]
+
+
+def _marched(sc, method):
+    """``(tractions of the states, records, message)`` of a run that may stop with a SolverError."""
+    from rollqp.errors import SolverError
+    ts, recs = [], []
+    try:
+        for rec in march(sc, method):
+            ts.append(rec.state.t.copy())
+            recs.append(rec)
+        return ts, recs, "ran"
+    except SolverError as err:
+        return ts, recs, f"step {err.step}: {err.status}, residual {err.residual:.1e}"
+
+
+def sweep_section():
+    """Newton and the QP fixed point on the ramped falling-friction transient over the velocity scale."""
+    from rollqp.scene import scene_from_dict
+    rows = []
+    for law, vh, dist in SWEEP:
+        sc = scene_from_dict(SWEEP_SCENE).replace(**{"contact.friction.law": law, "contact.friction.velocity": vh,
+                                                     "discretization.distance": dist})
+        mp0 = 0.32 * sc.p0
+        tn, recs, msg_n = _marched(sc, "newton")
+        tq, _, msg_q = _marched(sc, "qp-clarabel")
+        k = min(len(tn), len(tq))
+        traj = max(float(np.max(np.abs(a - b))) for a, b in zip(tn[:k], tq[:k])) / mp0
+        fp = BoundFixedPoint(get_method("qp-clarabel", tolerance=1e-12))
+        fp.setup(prepare(sc, "qp-clarabel")[2])
+        worst, other, failed = 0.0, 0, 0
+        for rec in recs[1:]:
+            try:
+                sol = fp.solve(rec.problem, warm=rec.previous.tsol)
+            except Exception:  # noqa: BLE001 - a SolverError of the fixed point: counted
+                failed += 1
+                continue
+            d = float(np.max(np.abs(sol.t - rec.solution.t))) / mp0
+            worst, other = max(worst, d), other + (d > 1e-8)
+        rows.append([law, f"{vh:g}", f"{dist:g}", f"{len(tn) - 1} ({msg_n})", f"{len(tq) - 1} ({msg_q})",
+                     f"{traj:.1e}", f"{worst:.1e}", other, failed])
+    return table(["law", "v_h [mm/s]", "a_H", "newton steps", "qp-clarabel steps", "runs: max |Δt|/(μ_s p0)",
+                  "same step: max |Δt|/(μ_s p0)", "steps > 1e-8", "fixed point failed"], rows)
+
+
 SECTIONS = {"slope": slope_section, "falling": falling_section, "march": march_section,
-            "fixedpoint": fixedpoint_section}
+            "fixedpoint": fixedpoint_section, "sweep": sweep_section}
 
 
 def main(argv=None):

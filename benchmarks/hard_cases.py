@@ -1,4 +1,4 @@
-"""Hard cases for every method: the table of docs/stability.md (issue 5, item 2).
+"""Hard cases for every method: the table of docs/stability.md.
 
 Usage::
 

@@ -1,4 +1,4 @@
-"""The QP paths' own overhead: the share of a step spent outside the solver's solve calls (issue 18).
+"""The QP paths' own overhead: the share of a step spent outside the solver's solve calls.
 
 Usage (from the repository root)::
 

@@ -1,4 +1,4 @@
-"""The speed targets of issues 16 and 18 in one run: each target, what it requires, what this machine measures.
+"""The speed targets (docs/performance.md, "Targets") in one run: each target, what it requires, what this machine measures.
 
 One command writes the table into docs/performance.md (between ``<!-- bench:speed -->`` markers)::
 

@@ -33,7 +33,7 @@ from harness import interleaved, table  # (pins BLAS first)
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.energy import balance, steady_identity
-from rollqp.stresses import invariants, stress_components, stress_history
+from rollqp.subsurface import invariants, stress_components, stress_history
 
 MESHES = (20, 40, 80, 160)
 

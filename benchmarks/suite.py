@@ -61,7 +61,7 @@ SCALING_ELEMENTS = (20, 40, 80, 160, 320, 640, 1280)
 SCALING_STEPS = 12
 #: Intermediate state compared with the fine reference (q/a_H).
 Q_MID = 1.0
-#: Issue targets (docs/performance.md, "Targets").
+#: Targets (docs/performance.md, "Targets").
 TARGET_CHOL_RATIO = 3.0     # Newton step / cho_factor, n >= 321, at most
 TARGET_CLARABEL_RATIO = 10.0  # Clarabel step / Newton step, n <= 321, at least
 TARGET_EXPONENT = 3.0       # Newton step cost exponent up to n = 2561, at most
@@ -459,7 +459,7 @@ def figure_tolerance(res, path):
         curves = {m: [(r.stepping, max(r.errors.get("solver") or 0.0, FLOOR)) for r in runs
                       if r.ok and r.errors.get("solver") is not None] for m, runs in d["runs"].items()}
         _curves(ax, curves, "stepping time Σ step_time [s]", "max distance from reference (p0, μp0)",
-                re.sub(r"`", "", label.split(" (")[0]) + "\n(one point per tolerance 1e-4 … 1e-12)")
+                label.split(" (")[0].replace("`", "") + "\n(one point per tolerance 1e-4 … 1e-12)")
     return _save(fig, plt, path)
 
 
@@ -473,7 +473,7 @@ def figure_discretization(res, path, columns=CC_COLUMNS):
     for ax, (k, title) in zip(axes, columns):
         curves = {m: [(r.stepping, r.errors[k]) for r in runs if r.ok and r.errors.get(k)] for m, runs in per.items()}
         _curves(ax, curves, "stepping time Σ step_time [s]", "rms error / (μp0), p: / p0",
-                f"{title}\n{re.sub('`', '', fam.split(' (')[0])}; one point per mesh")
+                f"{title}\n{fam.split(' (')[0].replace('`', '')}; one point per mesh")
     return _save(fig, plt, path)
 
 
@@ -558,57 +558,67 @@ def main(argv: list[str] | None = None) -> int:
     command = "rollqp bench " + " ".join(argv if argv is not None else sys.argv[1:])
     sections = {"machine": machine_table(command.strip())}
     print("## Machine\n\n" + sections["machine"] + "\n", flush=True)
+    out = Outputs(fig_dir, log)
     t_all = time.perf_counter()
+    try:
+        run_parts(parts, methods, quick, repeats, run_budget, step_budget, sections, out, log)
+    finally:  # what was computed is kept, also when a later part or figure fails
+        total = time.perf_counter() - t_all
+        print(f"<!-- measured in {total:.0f} s -->")
+        if args.json:
+            Path(args.json).write_text(json.dumps(out.raw, indent=1, default=float))
+            log(f"raw numbers: {args.json}")
+        if args.docs:
+            written = write_sections(DOC, sections)
+            log(f"wrote {', '.join(written) or 'no'} section(s) of {DOC}")
+        if out.figures:
+            log("figures: " + ", ".join(map(str, out.figures)))
+    if out.failed:
+        log(f"rollqp bench: {len(out.failed)} figure(s) failed (above); the tables and raw numbers are complete")
+    return 1 if out.failed else 0
+
+
+class Outputs:
+    """The figures and raw numbers of a study as its parts finish; a figure that fails is logged and
+    recorded (``failed``), never the end of the study: its tables are printed and written anyway."""
+
+    def __init__(self, fig_dir, log):
+        self.fig_dir, self.log = fig_dir, log
+        self.figures, self.failed, self.raw = [], [], {}
+
+    def figure(self, fn, *args, name):
+        if self.fig_dir is None:
+            return
+        try:
+            path = fn(*args, self.fig_dir / name)
+        except Exception as err:  # noqa: BLE001 - any plotting error: the numbers stay
+            self.failed.append((name, f"{type(err).__name__}: {err}"))
+            self.log(f"rollqp bench: figure {name} failed: {type(err).__name__}: {err}")
+            return
+        if path:
+            self.figures.append(path)
+
+
+def run_parts(parts, methods, quick, repeats, run_budget, step_budget, sections, out, log):
+    """Run the chosen parts in order; each prints its tables and draws its figures as soon as it ends."""
     tol_res = scal = chol = expo = None
-    raw = {}
-    figs = []
     if "tolerance" in parts:
         t0 = time.perf_counter()
         tols = (1e-4, 1e-8, 1e-12) if quick else TOLERANCES
         tol_res = part_tolerance(methods, tols, repeats, quick, log)
+        out.raw["tolerance"] = {lb: {m: [_raw(r) for r in rs] for m, rs in d["runs"].items()}
+                                for lb, d in tol_res.items()}
         sections["tolerance"] = tolerance_tables(tol_res, tols)
         print("## Work–precision: solver tolerance\n\n" + sections["tolerance"] + "\n", flush=True)
-        if fig_dir is not None:
-            figs.append(figure_tolerance(tol_res, fig_dir / "perf-wp-tolerance.png"))
-        raw["tolerance"] = {lb: {m: [_raw(r) for r in rs] for m, rs in d["runs"].items()} for lb, d in tol_res.items()}
+        out.figure(figure_tolerance, tol_res, name="perf-wp-tolerance.png")
         log(f"tolerance part: {time.perf_counter() - t0:.0f} s")
     if "discretization" in parts:
-        t0 = time.perf_counter()
-        meshes = (10, 20, 40) if quick else MESHES
-        fams = [Family()]
-        if not quick:
-            fams += [Family(e, f, s) for e in ("quadratic", "linear", "constant")
-                     for f in ("material", "convective-local") for s in (0.5, 0.125)
-                     if (e, f, s) != ("quadratic", "material", 0.5)]
-        fam_meshes = meshes if quick else (10, 20, 40, 80, 160)
-        main_res, ref = part_discretization(methods, fams[:1], meshes, repeats, run_budget, quick, log)
-        fam_res = {}
-        if len(fams) > 1:
-            fam_res, _ = part_discretization(methods, fams[1:], fam_meshes, 1, run_budget / 4, quick, log)
-        sections["discretization"] = (discretization_tables(main_res, ref) + "\n\nLeast stepping time [s] at which "
-                                      "each method reaches an error level (its runs above, any mesh):\n\n"
-                                      + equal_accuracy(main_res, "carter", (3e-2, 1e-2, 3e-3, 1e-3)) + "\n\n"
-                                      + equal_accuracy(main_res, "mid", (3e-2, 1e-2, 3e-3, 1e-3)))
-        print("## Work–precision: discretization\n\n" + sections["discretization"] + "\n", flush=True)
-        if fam_res:
-            sections["families"] = discretization_tables(fam_res, ref)
-            print("## Work–precision: element types, formulations, steps\n\n" + sections["families"] + "\n", flush=True)
-        coupled_res, cref = part_coupled(methods, (10, 20) if quick else (10, 20, 40, 80), repeats, run_budget,
-                                         quick, log)
-        sections["coupled"] = coupled_tables(coupled_res, cref)
-        print("## Work–precision: discretization, coupled scene\n\n" + sections["coupled"] + "\n", flush=True)
-        if fig_dir is not None:
-            figs.append(figure_discretization(main_res, fig_dir / "perf-wp-discretization.png"))
-            figs.append(figure_discretization(coupled_res, fig_dir / "perf-wp-coupled.png", COUPLED_COLUMNS))
-            if fam_res:
-                figs.append(figure_families({**main_res, **fam_res}, fig_dir / "perf-wp-families.png"))
-        raw["discretization"] = {lb: {m: [_raw(r) for r in rs] for m, rs in per.items()}
-                                 for lb, per in {**main_res, **fam_res, **coupled_res}.items()}
-        log(f"discretization part: {time.perf_counter() - t0:.0f} s")
+        run_discretization(methods, quick, repeats, run_budget, sections, out, log)
     if "scaling" in parts:
         t0 = time.perf_counter()
         elements = (20, 40, 80, 160) if quick else SCALING_ELEMENTS
         scal, chol = part_scaling(methods, elements, repeats, step_budget, log)
+        out.raw["scaling"] = {"cho_factor": chol, **{m: [_raw(r) for r in rs] for m, rs in scal.items()}}
         text, expo = scaling_table(scal, chol)
         sections["scaling"] = (f"Median `step_time` of rolling steps 2…{SCALING_STEPS + 1} of `cattaneo-carter` "
                                f"(QCE, Δq = Le/2: the first steps of the transient, where the stick zone moves every "
@@ -617,24 +627,47 @@ def main(argv: list[str] | None = None) -> int:
                                f"exceeds {step_budget:g} s. `solver.max_iterations` = 2000: the braked start "
                                f"(Cattaneo from zero traction) takes Newton ~200 iterations at 2561 nodes.\n\n" + text)
         print("## Scaling\n\n" + sections["scaling"] + "\n", flush=True)
-        if fig_dir is not None:
-            figs.append(figure_scaling(scal, chol, expo, fig_dir / "perf-scaling.png"))
-        raw["scaling"] = {"cho_factor": chol, **{m: [_raw(r) for r in rs] for m, rs in scal.items()}}
+        out.figure(figure_scaling, scal, chol, expo, name="perf-scaling.png")
         log(f"scaling part: {time.perf_counter() - t0:.0f} s")
     if scal is not None or tol_res is not None:
         sections["targets"], _ = targets(tol_res, scal or {}, chol or {}, expo or {})
         print("## Targets\n\n" + sections["targets"] + "\n")
-    total = time.perf_counter() - t_all
-    print(f"<!-- measured in {total:.0f} s -->")
-    if args.json:
-        Path(args.json).write_text(json.dumps(raw, indent=1, default=float))
-    if args.docs:
-        written = write_sections(DOC, sections)
-        log(f"wrote {', '.join(written) or 'no'} section(s) of {DOC}; figures: "
-            + ", ".join(str(f) for f in figs if f))
-    elif figs:
-        log("figures: " + ", ".join(str(f) for f in figs if f))
-    return 0
+
+
+def run_discretization(methods, quick, repeats, run_budget, sections, out, log):
+    """The discretization part: the main family, the other families (full study), the coupled scene."""
+    t0 = time.perf_counter()
+    meshes = (10, 20, 40) if quick else MESHES
+    fams = [Family()]
+    if not quick:
+        fams += [Family(e, f, s) for e in ("quadratic", "linear", "constant")
+                 for f in ("material", "convective-local") for s in (0.5, 0.125)
+                 if (e, f, s) != ("quadratic", "material", 0.5)]
+    fam_meshes = meshes if quick else (10, 20, 40, 80, 160)
+    main_res, ref = part_discretization(methods, fams[:1], meshes, repeats, run_budget, quick, log)
+    out.raw["discretization"] = {lb: {m: [_raw(r) for r in rs] for m, rs in per.items()} for lb, per in main_res.items()}
+    sections["discretization"] = (discretization_tables(main_res, ref) + "\n\nLeast stepping time [s] at which "
+                                  "each method reaches an error level (its runs above, any mesh):\n\n"
+                                  + equal_accuracy(main_res, "carter", (3e-2, 1e-2, 3e-3, 1e-3)) + "\n\n"
+                                  + equal_accuracy(main_res, "mid", (3e-2, 1e-2, 3e-3, 1e-3)))
+    print("## Work–precision: discretization\n\n" + sections["discretization"] + "\n", flush=True)
+    out.figure(figure_discretization, main_res, name="perf-wp-discretization.png")
+    fam_res = {}
+    if len(fams) > 1:
+        fam_res, _ = part_discretization(methods, fams[1:], fam_meshes, 1, run_budget / 4, quick, log)
+        out.raw["discretization"].update({lb: {m: [_raw(r) for r in rs] for m, rs in per.items()}
+                                          for lb, per in fam_res.items()})
+        sections["families"] = discretization_tables(fam_res, ref)
+        print("## Work–precision: element types, formulations, steps\n\n" + sections["families"] + "\n", flush=True)
+        out.figure(figure_families, {**main_res, **fam_res}, name="perf-wp-families.png")
+    coupled_res, cref = part_coupled(methods, (10, 20) if quick else (10, 20, 40, 80), repeats, run_budget,
+                                     quick, log)
+    out.raw["discretization"].update({lb: {m: [_raw(r) for r in rs] for m, rs in per.items()}
+                                      for lb, per in coupled_res.items()})
+    sections["coupled"] = coupled_tables(coupled_res, cref)
+    print("## Work–precision: discretization, coupled scene\n\n" + sections["coupled"] + "\n", flush=True)
+    out.figure(lambda r, path: figure_discretization(r, path, COUPLED_COLUMNS), coupled_res, name="perf-wp-coupled.png")
+    log(f"discretization part: {time.perf_counter() - t0:.0f} s")
 
 
 def _raw(r: Run) -> dict:

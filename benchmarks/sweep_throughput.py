@@ -4,7 +4,9 @@ Usage::
 
     python benchmarks/sweep_throughput.py                 # small and large points, 3 interleaved repetitions
     python benchmarks/sweep_throughput.py --sizes small --repeats 5
-    python benchmarks/sweep_throughput.py --creep         # also time the docs' creep-curve command, whole
+    python benchmarks/sweep_throughput.py --creep         # also the docs' creep-curve command, whole,
+                                                          # on a local cluster and with --workers 0
+    python benchmarks/sweep_throughput.py --validate      # only: validating a sweep of 100,000 points
 
 Two kinds of points, both the paper's §6.1.1 scene (``cattaneo-carter``: Δq = Le/2, 6 a_H,
 ``newton``) over load ratio × friction:
@@ -22,7 +24,8 @@ first (the workers' first import of rollqp). Serial and sweep alternate within e
 (:func:`harness.interleaved`); the ratios are of the medians.
 
 Overheads, measured on the way: the sweep's fixed part (validation and store), the store
-writes (``StoreWriter.write``, timed in the client, per chunk and per point), and
+writes (``StoreWriter.write``, timed in the client, wall and the writing thread's CPU), each
+point's CPU time beside its wall time (in the serial run and on the workers), and
 ``(workers × points' wall − Σ point times)/points``: what a point costs beyond its own
 computation on a worker, its share of the writes, the scheduler and the tail included.
 
@@ -80,10 +83,14 @@ def _parallelism(workers: int) -> float:
     return workers * alone / together
 
 
-def _serial(scenes) -> float:
-    t0 = time.perf_counter()
+CPU = {}  # size -> CPU seconds of each serial run
+
+
+def _serial(scenes, size) -> float:
+    t0, c0 = time.perf_counter(), time.process_time()
     for s in scenes:
         rollqp.run(s)
+    CPU.setdefault(size, []).append(time.process_time() - c0)
     return time.perf_counter() - t0
 
 
@@ -93,9 +100,9 @@ class _TimedWriter(dataset.StoreWriter):
     writes: list = []
 
     def write(self, points, outs):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.thread_time()
         super().write(points, outs)
-        _TimedWriter.writes.append((time.perf_counter() - t0, len(points)))
+        _TimedWriter.writes.append((time.perf_counter() - t0, len(points), time.thread_time() - c0))
 
 
 def _sweep(base, vary, client, folder, summaries) -> float:
@@ -109,11 +116,11 @@ def _sweep(base, vary, client, folder, summaries) -> float:
     return wall
 
 
-def _creep_command(folder) -> float:
+def _creep_command(folder, extra=()) -> float:
     """Wall seconds of the docs' ``rollqp creep-curve`` command as a user runs it (a new process)."""
     store = os.path.join(folder, "creep.zarr")
     t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-m", "rollqp.cli", *CREEP, "--out", store, "--quiet"], check=True)
+    subprocess.run([sys.executable, "-m", "rollqp.cli", *CREEP, *extra, "--out", store, "--quiet"], check=True)
     wall = time.perf_counter() - t0
     shutil.rmtree(store, ignore_errors=True)
     return wall
@@ -132,9 +139,26 @@ def _rows(size, walls, summaries, workers, startup):
         ("**throughput ratio serial/sweep**", f"**{ser / par:.2f}×**"),
         ("ratio with the cluster's start in the sweep", f"{ser / (par + startup):.2f}×"),
         ("mean point time: serial / on the workers", f"{1e3 * ser / n:.0f} ms / {1e3 * statistics.median(pts) / n:.0f} ms"),
+        ("mean point CPU time: serial / on the workers",
+         f"{1e3 * statistics.median(CPU[size]) / n:.0f} ms / "
+         f"{1e3 * statistics.median(sum(s.point_cpu) for _, s in summaries) / n:.0f} ms"),
         ("validation and store creation (median)", f"{1e3 * statistics.median(fixed):.0f} ms"),
         ("(workers × points' wall − Σ point times)/points (median)", f"{1e3 * statistics.median(extra):.1f} ms"),
     ]
+
+
+def _validate():
+    """Wall and CPU seconds of validating §6.1.1 over 1,000 friction values × 100 load ratios."""
+    import resource
+    vary = ["contact.friction=0.1:0.5:1000", "load.tangential=0.05:0.95:100"]
+    t0, c0 = time.perf_counter(), time.process_time()
+    sw = build_sweep(rollqp.load_scene("cattaneo-carter"), vary)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    print(harness.table(["", "value"], [
+        ("points", f"{sw.size} ({', '.join(vary)})"),
+        ("validation: wall / CPU", f"{wall:.1f} s / {cpu:.1f} s ({1e3 * cpu / sw.size:.2f} ms of CPU a point)"),
+        ("peak memory of the process", f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB"),
+        ("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg()))]))
 
 
 def main(argv=None):
@@ -143,7 +167,10 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--sizes", default="small,large", help="comma-separated: small, large")
     ap.add_argument("--creep", action="store_true", help="also time the docs' creep-curve command (new processes)")
+    ap.add_argument("--validate", action="store_true", help="only time the validation of 100,000 points")
     args = ap.parse_args(argv)
+    if args.validate:
+        return _validate()
     sizes = [s.strip() for s in args.sizes.split(",") if s.strip()]
     print(harness.machine_table())
     base = rollqp.load_scene("cattaneo-carter")
@@ -161,28 +188,34 @@ def main(argv=None):
         _TimedWriter.writes.clear()
         cases = {}
         for s in sizes:
-            cases[f"serial {s}"] = lambda s=s: _serial(points[s])
+            cases[f"serial {s}"] = lambda s=s: _serial(points[s], s)
             cases[f"sweep {s}"] = lambda s=s: _sweep(scenes[s], SIZES[s][1], client, folder, summaries[s])
         cases["control"] = lambda: _parallelism(args.workers)
         walls = harness.interleaved(args.repeats, cases, lambda f: f(),
                                     log=lambda k, i, n: print(f"  {k} {i}/{n}", flush=True))
     finally:
         close_client(client)
-    creep = [_creep_command(folder) for _ in range(args.repeats)] if args.creep else []
+    creep = {"": [], " --workers 0": []}
+    for _ in range(args.repeats if args.creep else 0):  # alternating, as the sweeps above
+        for extra in creep:
+            creep[extra].append(_creep_command(folder, extra.split()))
     shutil.rmtree(folder, ignore_errors=True)
     rows = [(f"local cluster start ({args.workers} workers; once, not in the sweep times)", f"{startup:.2f} s")]
     for s in sizes:
         rows += _rows(s, walls, summaries[s], args.workers, startup)
     writes = _TimedWriter.writes
-    rows += [("store write of one chunk (median; client)", f"{1e3 * statistics.median(w for w, _ in writes):.1f} ms, "
-                                                          f"{1e3 * sum(w for w, _ in writes) / sum(k for _, k in writes):.1f}"
-                                                          " ms a point")]
+    per_point = sum(k for _, k, _ in writes)
+    rows += [("store write of one chunk in the client: wall / CPU (medians; CPU a point)",
+              f"{1e3 * statistics.median(w for w, _, _ in writes):.1f} ms / "
+              f"{1e3 * statistics.median(c for _, _, c in writes):.1f} ms "
+              f"({1e3 * sum(c for _, _, c in writes) / per_point:.1f} ms a point)")]
     rows += [(f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
               f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
               f"{args.workers}× on an idle machine)")]
-    if creep:
-        rows += [(f"`rollqp {' '.join(CREEP)}` (whole command, new process; median)",
-                  f"{statistics.median(creep):.2f} s ({', '.join(f'{w:.2f}' for w in creep)})")]
+    for extra, walls_ in creep.items():
+        if walls_:
+            rows += [(f"`rollqp {' '.join(CREEP)}{extra}` (whole command, new process; median)",
+                      f"{statistics.median(walls_):.2f} s ({', '.join(f'{w:.2f}' for w in walls_)})")]
     rows += [("load average at the end", " / ".join(f"{v:.2f}" for v in os.getloadavg()))]
     print()
     print(harness.table(["", "value"], rows))

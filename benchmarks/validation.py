@@ -45,7 +45,7 @@ from refcases import (E_CONTACT, FN_CONTACT, G_CONTACT, MU_CONTACT, NU_CONTACT, 
 from rollqp.report import rms_in_contact  # noqa: E402
 
 QP_BACKENDS = ("qp-osqp", "qp-clarabel", "qp-cvxpy")
-#: The generalized Newton method (issue 3), run beside the QPs as a cross-check where present.
+#: The generalized Newton method, run beside the QPs as a cross-check where present.
 NEWTON = ("newton",) if "newton" in rollqp.available_methods() else ()
 
 

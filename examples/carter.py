@@ -72,31 +72,32 @@ def measure(scene, res):
 
 def figure(runs, curve, path):
     """Tractions against Carter's, and the creep curve against Carter's law."""
-    from rollqp.plot import pyplot
+    from rollqp.plot import LABELS, pyplot
+    from rollqp.plot.style import legend_below, reference
     plt = pyplot()
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4.4), constrained_layout=True)
+    fig, ax = plt.subplots(1, 2, figsize=(12, 5.0), constrained_layout=True)
     scene = runs[0][0]
     d = scene.load.direction
     xs = np.linspace(-1.25, 1.25, 1001)
-    colors = plt.cm.viridis(np.linspace(0, 0.85, len(runs)))
+    colors = plt.cm.viridis(np.linspace(0.78, 0.0, len(runs)))
     for color, (_, res, m) in zip(colors, runs):
         a, p0, mu = float(res["a_H"]), float(res["p0"]), scene.contact.friction
         ax[0].plot(xs, cf.carter_traction(xs, 1.0, 1.0, 1.0, m["ratio"], d), "-", color=color, lw=0.9)
         ax[0].plot(res["x"] / a, res["pt"][0] / (mu * p0), "o", ms=3, color=color,
-                   label=f"Q/(mu P) = {m['ratio']:.2f}")
-    ax[0].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), "k:", lw=0.8, label="bound mu p")
+                   label=f"$Q/(\\mu P) = {m['ratio']:.2f}$")
+    ax[0].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), ":", color="0.5", lw=0.8, label=r"bound $\mu p$")
     ax[0].annotate("leading edge", xy=(-d * 1.0, 0.0), xytext=(-d * 0.7, 0.1), ha="center", fontsize=8,
                    arrowprops={"arrowstyle": "->", "lw": 0.6})
-    ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)",
+    ax[0].set(xlabel=LABELS["x"], ylabel=LABELS["t"],
               title=f"steady traction: rollqp (dots), Carter (lines); material moves in {'+' if d > 0 else '-'}x")
     k = np.linspace(0, 1, 400)
-    ax[1].plot(k, 1 - (1 - k) ** 2, "k-", lw=0.9, label="Carter: Q/(mu P) = 1 - (1 - |xi| R/(mu a))^2")
+    reference(ax[1], k, 1 - (1 - k) ** 2, "carter", ls="-", label=r"Carter: $Q/(\mu P) = 1 - (1 - |\xi| R/(\mu a))^2$")
     xi_n = [abs(m["xi"]) * m["R"] / (m["mu"] * m["a"]) for m in curve]
-    ax[1].plot(xi_n, [m["ratio"] for m in curve], "o", ms=4, label="rollqp, direct steady solve")
-    ax[1].set(xlabel="|xi| R / (mu a_H)", ylabel="Q / (mu P)", title="creep-force law")
+    ax[1].plot(xi_n, [m["ratio"] for m in curve], "o", ms=4, color="C0", label="rollqp, direct steady solve")
+    ax[1].set(xlabel=r"$|\xi|\,R/(\mu a_H)$", ylabel=LABELS["Q"], title="creep-force law")
     for axis in ax:
         axis.grid(alpha=0.3)
-        axis.legend(fontsize=8)
+        legend_below(axis)
     fig.suptitle("Carter: steady rolling of similar rollers, 40 QCE (paper §6.1.1, the end state)")
     fig.savefig(path, dpi=110)
     plt.close(fig)

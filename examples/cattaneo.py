@@ -63,31 +63,32 @@ def measure(scene, res):
 
 def figure(runs, path):
     """Pressure against Hertz, tractions against Cattaneo, stick zones against c/a = √(1 − r)."""
-    from rollqp.plot import pyplot
+    from rollqp.plot import LABELS, pyplot
+    from rollqp.plot.style import legend_below, reference
     plt = pyplot()
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.4), constrained_layout=True)
+    fig, ax = plt.subplots(1, 3, figsize=(15, 5.0), constrained_layout=True)
     scene, res, _ = runs[0]
     a, p0, mu = float(res["a_H"]), float(res["p0"]), scene.contact.friction
     xs = np.linspace(-1.25, 1.25, 1001)
-    ax[0].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), "k-", lw=0.9, label="Hertz")
-    ax[0].plot(res["x"] / a, res["pn"][0] / p0, "o", ms=3, label="rollqp")
-    ax[0].set(xlabel="x / a_H", ylabel="p / p0", title="pressure (every braked start)")
-    colors = plt.cm.viridis(np.linspace(0, 0.85, len(runs)))
+    reference(ax[0], xs, cf.hertz_pressure(xs, 1.0, 1.0), "hertz", ls="-")
+    ax[0].plot(res["x"] / a, res["pn"][0] / p0, "o", ms=3, color="C0", label="rollqp")
+    ax[0].set(xlabel=LABELS["x"], ylabel=LABELS["p"], title="pressure (every braked start)")
+    colors = plt.cm.viridis(np.linspace(0.78, 0.0, len(runs)))
     for color, (_, res, m) in zip(colors, runs):
         ax[1].plot(xs, cf.cattaneo_traction(xs, 1.0, 1.0, 1.0, m["ratio"]), "-", color=color, lw=0.9)
         ax[1].plot(res["x"] / a, res["pt"][0] / (mu * p0), "o", ms=3, color=color,
-                   label=f"Q/(mu P) = {m['ratio']:.2f}")
-    ax[1].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), "k:", lw=0.8, label="bound mu p")
-    ax[1].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="traction: rollqp (dots), Cattaneo (lines)")
+                   label=f"$Q/(\\mu P) = {m['ratio']:.2f}$")
+    ax[1].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), ":", color="0.5", lw=0.8, label=r"bound $\mu p$")
+    ax[1].set(xlabel=LABELS["x"], ylabel=LABELS["t"], title="traction: rollqp (dots), Cattaneo (lines)")
     rs = np.linspace(0, 0.999, 400)
-    ax[2].plot(rs, np.sqrt(1 - rs), "k-", lw=0.9, label="c/a = sqrt(1 - Q/(mu P))")
+    reference(ax[2], rs, np.sqrt(1 - rs), "cattaneo", ls="-", label=r"Cattaneo: $c/a = \sqrt{1 - Q/(\mu P)}$")
     for color, (_, _, m) in zip(colors, runs):
         ax[2].plot([m["ratio"]] * 2, m["stick"], "s", color=color, ms=4)
-    ax[2].plot(rs, -np.sqrt(1 - rs), "k-", lw=0.9)
-    ax[2].set(xlabel="Q / (mu P)", ylabel="x / a_H", title="stick zone: outermost stick nodes (squares)")
+    reference(ax[2], rs, -np.sqrt(1 - rs), "cattaneo", ls="-", label=None)
+    ax[2].set(xlabel=LABELS["Q"], ylabel=LABELS["x"], title="stick zone: outermost stick nodes (squares)")
     for axis in ax:
         axis.grid(alpha=0.3)
-        axis.legend(fontsize=8)
+        legend_below(axis)
     fig.suptitle("Cattaneo: braked start of similar rollers, 40 QCE (paper §6.1.1, q = 0)")
     fig.savefig(path, dpi=110)
     plt.close(fig)

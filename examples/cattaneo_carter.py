@@ -42,39 +42,38 @@ def transient(res, scene):
 
 def figure(res, scene, path, title):
     """Tractions (with Cattaneo and Carter), slip and creepage over the transient."""
-    from rollqp.plot import pyplot
+    from rollqp.plot import LABELS, REFERENCES, pyplot
+    from rollqp.plot.style import legend_below, reference
     plt = pyplot()
     x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
     mu, d = scene.contact.friction, scene.load.direction
     ratio = float(res["Q"][-1]) / (mu * float(res["P"][-1]))
     q = res["q"] / a
     idx = [int(np.argmin(np.abs(q - w))) for w in SNAPSHOTS if w <= q[-1] + 1e-9]
-    fig, ax = plt.subplots(1, 3, figsize=(16, 4.6), constrained_layout=True)
-    colors = plt.cm.viridis(np.linspace(0, 0.9, len(idx)))
+    fig, ax = plt.subplots(1, 3, figsize=(16, 5.2), constrained_layout=True)
+    colors = plt.cm.viridis(np.linspace(0.78, 0.0, len(idx)))
     xs = np.linspace(-1.25, 1.25, 1001)
     for color, k in zip(colors, idx):
-        label = f"q = {q[k]:.2f} a_H"
+        label = f"$q = {q[k]:.2f}\\,a_H$"
         ax[0].plot(x / a, res["pt"][k] / (mu * p0), "o-", ms=2.5, lw=0.8, color=color, label=label)
         if k > 0:  # state 0 carries the static shift's increment, not a rolling slip
             slip = np.where(res["state"][k] == 0, np.nan, res["slip"][k])
             ax[1].plot(x / a, slip * R / (mu * a), "-", lw=1.0, color=color, label=label)
-    ax[0].plot(xs, cf.cattaneo_traction(xs, 1.0, 1.0, 1.0, ratio), "k--", lw=0.9, label="Cattaneo")
-    ax[0].plot(xs, cf.carter_traction(xs, 1.0, 1.0, 1.0, ratio, d), "k-.", lw=0.9, label="Carter")
-    ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="traction on body A")
-    ax[1].set(xlabel="x / a_H", ylabel="s R / (mu a_H)", title="slip per unit rolled distance")
+    reference(ax[0], xs, cf.cattaneo_traction(xs, 1.0, 1.0, 1.0, ratio), "cattaneo")
+    reference(ax[0], xs, cf.carter_traction(xs, 1.0, 1.0, 1.0, ratio, d), "carter")
+    ax[0].set(xlabel=LABELS["x"], ylabel=LABELS["t"], title="traction on body A")
+    ax[1].set(xlabel=LABELS["x"], ylabel=r"$s\,R/(\mu a_H)$", title="slip per unit rolled distance")
     xi_c = cf.carter_creepage(a, R, mu, ratio)
-    ax[2].plot(q[1:], res["creepage"][1:] / xi_c, "-", lw=1.2, label="rollqp")
-    ax[2].axhline(1.0, color="k", ls="-.", lw=0.9, label="Carter")
+    ax[2].plot(q[1:], res["creepage"][1:] / xi_c, "-", lw=1.2, color="C0", label="rollqp")
+    ax[2].axhline(1.0, **{**REFERENCES["carter"], "label": "Carter (steady)"})
     m = transient(res, scene)
     ax[2].annotate(f"peak {m['peak']:+.1%} at q = {m['q_peak']:.2f} a_H",
                    xy=(m["q_peak"], 1 + m["peak"] * res["creepage"][-1] / xi_c), xytext=(2.0, 1.1),
                    arrowprops={"arrowstyle": "->", "lw": 0.6}, fontsize=8)
-    ax[2].set(xlabel="q / a_H", ylabel="xi / xi_Carter", title="creepage after the brake is released")
+    ax[2].set(xlabel=LABELS["q"], ylabel=r"$\xi/\xi_{Carter}$", title="creepage after the brake is released")
     for axis in ax:
         axis.grid(alpha=0.3)
-    ax[0].legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3)
-    for axis in ax[1:]:
-        axis.legend(fontsize=7)
+        legend_below(axis)
     fig.suptitle(title)
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -1,4 +1,4 @@
-"""Load paths and profiles (issue 13): stop and reverse, a fretting cycle at rest, a dent rolling through.
+"""Load paths and profiles: stop and reverse, a fretting cycle at rest, a dent rolling through.
 
 Three built-in scenes (docs/kinematics.md):
 
@@ -15,8 +15,9 @@ Run it::
 
     python examples/load_paths.py [METHOD] [--figures DIR]
 
-prints the measured errors; ``--figures DIR`` draws ``stop-reverse.png``, ``fretting.png`` and
-``dent.png`` into DIR.
+prints the measured errors; ``--figures DIR`` draws ``fretting.png`` and ``dent.png`` into DIR:
+the figures ``rollqp run SCENE --plot`` draws (:mod:`rollqp.plot`), the fretting loop with the
+BEM rollers' beside the half-space's and the dent's creepage with the round rollers'.
 """
 from __future__ import annotations
 
@@ -72,58 +73,32 @@ def dent(method):
     return s, a, circle, out
 
 
-def _zones(ax, a, yscale, ylabel):
-    ax.pcolormesh(a["x"] / float(a["a_H"]), yscale, a["state"], cmap="viridis", shading="nearest", vmin=0, vmax=2)
-    ax.set_xlabel("x / a_H")
-    ax.set_ylabel(ylabel)
-    ax.set_title("zones (0 separation, 1 stick, 2 slip)")
-
-
-def figures(folder, sr, fr, dn):
-    from rollqp.plot import pyplot
-    plt = pyplot()
-    s, a, _ = sr
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-    tau = a["time"] / s.a_H
-    for t in (0.0, 3.0, 4.0, 5.0, 10.0):
-        k = int(np.argmin(np.abs(tau - t)))
-        ax[0].plot(a["x"] / s.a_H, a["pt"][k] / (0.1 * s.p0), label=f"tau = {t:g} a_H, q = {a['q'][k] / s.a_H:.2g} a_H")
-    ax[0].plot(a["x"] / s.a_H, cf.carter_traction(a["x"], s.a_H, s.p0, 0.1, 0.75, +1) / (0.1 * s.p0), "k:", label="Carter, reversed")
-    ax[0].set_xlabel("x / a_H"), ax[0].set_ylabel("t / (mu p0)"), ax[0].legend(fontsize=7)
-    _zones(ax[1], a, tau, "tau / a_H")
-    fig.tight_layout(), fig.savefig(os.path.join(folder, "stop-reverse.png"), dpi=110), plt.close(fig)
-
+def figures(folder, fr, dn):
+    """The figures ``rollqp run SCENE --plot`` draws for fretting and the dent (rollqp.plot), with what this
+    example adds: the BEM rollers' Q–u loop beside the half-space's, and the round rollers' creepage.
+    (``rollqp run stop-reverse --plot F.png`` draws the stop and the reversal as they are.)"""
+    from rollqp import plot
     s, a, _, loops = fr
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
-    tau = a["time"] / s.a_H
-    TQ, TV = s.load.tangential.q, s.load.tangential.value
-    for t in (0.0, 0.5, 1.0, 2.0, 3.0):
-        k = int(np.argmin(np.abs(tau - t)))
-        path = [v for q, v in zip(TQ, TV) if q < tau[k]] + [float(np.interp(tau[k], TQ, TV))]
-        line, = ax[0].plot(a["x"] / s.a_H, a["pt"][k] / (0.1 * s.p0), "o", ms=3, label=f"tau = {t:g}, Q/(mu P) = {path[-1]:+.2f}")
-        ax[0].plot(a["x"] / s.a_H, cf.mindlin_traction(a["x"], s.a_H, s.p0, 0.1, path) / (0.1 * s.p0), "-", color=line.get_color(), lw=0.8)
-    ax[0].set_xlabel("x / a_H"), ax[0].set_ylabel("t / (mu p0)"), ax[0].legend(fontsize=7)
-    ax[0].set_title("rollqp (dots), Mindlin-Deresiewicz (lines)")
-    for model, h in loops.items():
-        i, j = int(np.argmax(h["Q"])), int(np.argmin(h["Q"]))
-        k = (h["u"][i] - h["u"][j]) / (h["Q"][i] - h["Q"][j])          # the secant compliance
-        ax[1].plot((h["u"] - k * h["Q"]) * 1e3, h["Q"] / (0.1 * s.load.normal), label=f"{model}: W = {h['energy']:.4g} N")
-    ax[1].set_xlabel("u - (secant compliance) Q  (um)"), ax[1].set_ylabel("Q / (mu P)")
-    ax[1].legend(fontsize=7), ax[1].set_title(f"hysteresis; Mindlin 2D: W = {fr[2]['W_closed']:.4g} N per mm")
-    fig.tight_layout(), fig.savefig(os.path.join(folder, "fretting.png"), dpi=110), plt.close(fig)
+    fig = plot.rest_figure(a, s)
+    ax = fig.axes[1]                                   # the Q–u loop panel, in units of μP/(πE*)
+    scale = np.pi * s.Estar / (0.1 * s.load.normal)
+    h = loops["bem"]
+    i, j = int(np.argmax(h["Q"])), int(np.argmin(h["Q"]))
+    k = (h["u"][i] - h["u"][j]) / (h["Q"][i] - h["Q"][j])          # the secant compliance
+    ax.plot((h["u"] - h["u"][i] - k * (h["Q"] - h["Q"][i])) * scale, h["Q"] / (0.1 * s.load.normal), "--",
+            color="#8c564b", lw=1.2, label=f"BEM rollers on rigid shafts: $W$ = {h['energy']:.4g} N·mm/mm")
+    plot.style.legend_below(ax, ncol=1)
+    fig.savefig(os.path.join(folder, "fretting.png"), dpi=120)
+    plot.pyplot().close(fig)
 
     s, a, circle, _ = dn
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4))
-    q = a["q"] / s.a_H
-    for qq in (0.0, 2.5, 3.3, 4.0):
-        k = int(np.argmin(np.abs(q - qq)))
-        ax[0].plot(a["x"] / s.a_H, a["pn"][k] / s.p0, label=f"q = {qq:g} a_H")
-    ax[0].set_xlabel("x / a_H"), ax[0].set_ylabel("p / p0"), ax[0].legend(fontsize=7)
-    _zones(ax[1], a, q, "q / a_H")
-    ax[2].plot(q[1:], a["creepage"][1:] / abs(circle["creepage"][-1]), label="dent")
-    ax[2].plot(q[1:], circle["creepage"][1:] / abs(circle["creepage"][-1]), "k:", label="circle")
-    ax[2].set_xlabel("q / a_H"), ax[2].set_ylabel("xi / |xi_steady|"), ax[2].legend(fontsize=7)
-    fig.tight_layout(), fig.savefig(os.path.join(folder, "dent.png"), dpi=110), plt.close(fig)
+    fig = plot.profile_figure(a, s)
+    ax = fig.axes[-1]                                  # the creepage panel
+    xi = np.asarray(circle["creepage"], dtype=float) * s.R / s.a_H
+    ax.plot(circle["q"][1:] / s.a_H, xi[1:], ":", color="0.3", lw=1.2, label="round rollers (no dent)")
+    plot.style.legend_below(ax, ncol=3)
+    fig.savefig(os.path.join(folder, "dent.png"), dpi=120)
+    plot.pyplot().close(fig)
 
 
 def main(argv=None):
@@ -138,7 +113,7 @@ def main(argv=None):
           f"energy per cycle {fr[2]['W_halfspace']:.5g} (half-space), {fr[2]['W_bem']:.5g} (BEM) vs {fr[2]['W_closed']:.5g} N")
     print(f"dent: peak pressure {dn[3]['peak']:.3f} p0; creepage swing {dn[3]['creepage_swing']:.3f} of the steady creepage")
     if args.figures:
-        figures(args.figures, sr, fr, dn)
+        figures(args.figures, fr, dn)
     return sr, fr, dn
 
 

@@ -79,37 +79,36 @@ def measure(ramp, ramp_scene, ref, ref_scene, other):
 
 def figure(ramp, ramp_scene, ref, other, path, title):
     """Tractions of the ramp (paper Fig. 5) and the creepage of both histories."""
-    from rollqp.plot import pyplot
+    from rollqp.plot import LABELS, REFERENCES, pyplot
+    from rollqp.plot.style import legend_below, reference
     plt = pyplot()
     x, a, p0, R = ramp["x"], float(ramp["a_H"]), float(ramp["p0"]), float(ramp["R"])
     mu, d = ramp_scene.contact.friction, ramp_scene.load.direction
     q = ramp["q"] / a
-    fig, ax = plt.subplots(1, 2, figsize=(13, 4.6), constrained_layout=True)
+    fig, ax = plt.subplots(1, 2, figsize=(13, 5.4), constrained_layout=True)
     idx = [int(np.argmin(np.abs(q - w))) for w in SNAPSHOTS if w <= q[-1] + 1e-9]
-    colors = plt.cm.viridis(np.linspace(0, 0.9, len(idx)))
+    colors = plt.cm.viridis(np.linspace(0.78, 0.0, len(idx)))
     for color, k in zip(colors, idx):
         r = ramp["Q"][k] / (mu * ramp["P"][k])
         ax[0].plot(x / a, ramp["pt"][k] / (mu * p0), "o-", ms=2.5, lw=0.8, color=color,
-                   label=f"q = {q[k]:.3g} a_H, Q/(mu P) = {r:.3f}")
+                   label=f"$q = {q[k]:.3g}\\,a_H$, $Q/(\\mu P) = {r:.3f}$")
     xs = np.linspace(-1.25, 1.25, 1001)
-    ax[0].plot(xs, cf.carter_traction(xs, 1.0, 1.0, 1.0, 0.75, d), "k-.", lw=0.9, label="Carter, 0.75")
-    ax[0].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), "k:", lw=0.8, label="bound mu p")
-    ax[0].set(xlabel="x / a_H", ylabel="t / (mu p0)", title="traction on body A during and after the ramp")
+    reference(ax[0], xs, cf.carter_traction(xs, 1.0, 1.0, 1.0, 0.75, d), "carter", label="Carter, 0.75")
+    ax[0].plot(xs, cf.hertz_pressure(xs, 1.0, 1.0), ":", color="0.5", lw=0.8, label=r"bound $\mu p$")
+    ax[0].set(xlabel=LABELS["x"], ylabel=LABELS["t"], title="traction on body A during and after the ramp")
     scale = R / (mu * a)
     ax[1].plot(q[1:], -ramp["creepage"][1:] * scale, "-", lw=1.2, label="ramp (§6.1.2), d_ref = R")
     ax[1].plot(q[1:], -other["creepage"][1:] * scale, "--", lw=1.0,
                label=f"ramp, d_ref = {DREF_FACTOR:g} R (same tractions)")
     xi_c = cf.carter_creepage(a, R, mu, 0.75)
-    ax[1].axhline(-xi_c * scale, color="k", ls="-.", lw=0.9, label="Carter, Q/(mu P) = 0.75")
+    ax[1].axhline(-xi_c * scale, **{**REFERENCES["carter"], "label": r"Carter, $Q/(\mu P) = 0.75$"})
     qr = ref["q"] / a
     ax[1].plot(qr[1:], -ref["creepage"][1:] * scale, "-", lw=1.0, alpha=0.7, label="braked start (§6.1.1)")
     ax[1].axvline(8 / 3, color="0.6", lw=0.8, ls=":")
-    ax[1].set(xlabel="q / a_H", ylabel="-xi R / (mu a_H)", title="creepage")
+    ax[1].set(xlabel=LABELS["q"], ylabel=r"$-\xi R/(\mu a_H)$", title="creepage")
     for axis in ax:
         axis.grid(alpha=0.3)
-    ax[0].legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3)
-    for axis in ax[1:]:
-        axis.legend(fontsize=7)
+        legend_below(axis, ncol=2)
     fig.suptitle(title)
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -1,4 +1,4 @@
-"""A rough cylinder rolling through a transient on the matrix-free path (issue 16; docs/matrix-free.md).
+"""A rough cylinder rolling through a transient on the matrix-free path (docs/matrix-free.md).
 
 The rollers of §6.1.1 (similar steel, R_A = 150 mm, R_B = 300 mm, P = 1000 N/mm, μ = 0.1), but
 roller A carries a seeded random roughness on its circle: a ``table`` profile with

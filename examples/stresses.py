@@ -25,7 +25,7 @@ import numpy as np
 
 import rollqp
 from rollqp import closedforms as cf
-from rollqp.stresses import plot_field, stress_history
+from rollqp.subsurface import plot_field, stress_history
 
 
 def hertz_check(scene):

@@ -18,7 +18,7 @@ solve_step                               solve one step with any method
 get_method, available_methods            the method registry
 open_result                              a result file as an xarray Dataset (extra ``sweep``)
 closedforms                              Hertz, Cattaneo, Carter, creep law, McEwen
-stresses                                 subsurface stresses of a state (rollqp.stresses module)
+stresses                                 subsurface stresses of a state (rollqp.subsurface)
 """
 from .version import __version__  # noqa: F401
 
@@ -34,7 +34,7 @@ from .strip import Strip
 from .operators import SceneOperators
 from .march import StepRecord, march, run
 from . import energy, wear  # noqa: E402,F401  (register their result fields)
-from . import stresses  # noqa: E402,F401  (callable: rollqp.stresses(result, step, grid))
+from .subsurface import stresses  # noqa: E402  (rollqp.stresses(result, step, grid))
 
 
 def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> StepSolution:

@@ -35,9 +35,34 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_INPUT, f"rollqp: error: {message} (see 'rollqp --help')\n")
 
 
+def version_text() -> str:
+    """``rollqp X (Python …, numpy …, scipy …, clarabel …, osqp …)``: what a bug report needs."""
+    import platform
+    from importlib import metadata
+    from .version import __version__
+    deps = []
+    for name in ("numpy", "scipy", "clarabel", "osqp"):
+        try:
+            deps.append(f"{name} {metadata.version(name)}")
+        except metadata.PackageNotFoundError:  # pragma: no cover - core dependencies
+            deps.append(f"{name} missing")
+    return f"rollqp {__version__} (Python {platform.python_version()}, {', '.join(deps)})"
+
+
+class _Version(argparse.Action):
+    """``--version``: print :func:`version_text` and exit 0 (computed only when asked)."""
+
+    def __init__(self, option_strings, dest, **kw):
+        super().__init__(option_strings, dest, nargs=0, help="print rollqp's version (and its solvers') and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        parser.exit(0, version_text() + "\n")
+
+
 def _parser():
     from .methods import METHOD_NAMES
     p = _Parser(prog="rollqp", description="2D transient rolling contact: convex QP steps and generalized Newton.")
+    p.add_argument("--version", action=_Version)
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     r = sub.add_parser("run", help="run a scene and write its result file")
     r.add_argument("scene", nargs="?", help="a TOML scene file or the name of a built-in scene "
@@ -226,6 +251,9 @@ def cmd_run(args) -> int:
               file=sys.stderr)
         return 0
     cb, close = _progress(args.quiet)
+    if not args.quiet:
+        _advise(scene)
+        cb = estimate_progress(cb, scene.n_steps - (0 if resume is None else len(resume["q"]) - 1))
     keep, observe = _spot_steps(args, scene)
     t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
@@ -254,16 +282,59 @@ def cmd_run(args) -> int:
     if not args.quiet:
         peaks = None
         if getattr(args, "stresses", False):
-            from .stresses import stress_history
+            from .subsurface import stress_history
             peaks = stress_history(result)
-        print(summary(res, scene, scene.solver.method, wall, peaks))
+        print(summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
         if keep:
             from .crossval import spot_check
             t1 = time.perf_counter()
-            check = spot_check(list(keep.values()))
-            print(f"  cross-check   {check} ({time.perf_counter() - t1:.2f} s)")
+            head, *failures = str(spot_check(list(keep.values()))).splitlines()
+            print(f"  cross-check   {head} ({time.perf_counter() - t1:.2f} s)")
+            for line in failures:  # each in full, on a line of its own
+                print(f"                {line}")
         print(f"  result        {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
     return 0
+
+
+#: A run's remaining time above which ``rollqp run`` prints its estimate after the first steps (seconds).
+ANNOUNCE_SECONDS = 60.0
+
+
+def _advise(scene) -> None:
+    """Before a run: what rollqp chose for the user (the matrix-free path), or what the dense path or the N–T
+    alternation will cost and what runs faster (:mod:`rollqp.advice`), one line each on stderr."""
+    from .advice import alternation_note, estimate_note, fast_path
+    plan = fast_path(scene)
+    notes = [plan.note] if plan.note else [estimate_note(scene)]
+    notes.append(alternation_note(plan.scene))
+    for note in filter(None, notes):
+        print(f"rollqp: {note}", file=sys.stderr, flush=True)
+
+
+def estimate_progress(cb, steps: int):
+    """``cb`` that also prints, once, the estimated remaining time when it exceeds :data:`ANNOUNCE_SECONDS`:
+    measured on the first rolling steps (after at least 10 s of them, or 5 steps), the start excluded."""
+    state = {"t": None, "k": 0, "said": False}
+
+    def progress(k, K):
+        now = time.perf_counter()
+        if state["t"] is None:  # the first rolling step is done: the clock starts here
+            state["t"], state["k"] = now, k
+        elif not state["said"] and (now - state["t"] >= 10.0 or k - state["k"] >= 5):
+            per = (now - state["t"]) / (k - state["k"])
+            left = per * (K - k)
+            state["said"] = True
+            if left > ANNOUNCE_SECONDS:
+                print(f"rollqp: about {_minutes(left)} to go: {K - k} of {steps} steps left at {per:.3g} s a step "
+                      f"(measured on steps {state['k'] + 1}..{k})", file=sys.stderr, flush=True)
+        if cb is not None:
+            cb(k, K)
+
+    return progress
+
+
+def _minutes(seconds: float) -> str:
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.0f} min" if seconds < 7200 else f"{seconds / 3600:.1f} h"
 
 
 def _spot_steps(args, scene):
@@ -412,7 +483,8 @@ def _workers_count(text):
 def _cluster_options(p):
     p.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler (tcp://host:8786, or "
                    "tls://host:8786 with a dask TLS configuration); default: a local cluster")
-    p.add_argument("--workers", type=_workers_count, help="worker processes of the local cluster (default: one per core)")
+    p.add_argument("--workers", type=_workers_count, help="worker processes of the local cluster (default: one per core; 0: the points run in this "
+                   "process, no cluster)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -518,7 +590,7 @@ def cmd_stresses(args) -> int:
     from .errors import InputError
     from .influence import get_model
     from .result import check_output, load_result
-    from .stresses import _source, default_grid, plot_field, save_field, stresses, summary_rows
+    from .subsurface import _source, default_grid, plot_field, save_field, stresses, summary_rows
     try:
         nx, nz = (int(v) for v in args.grid.split(","))
     except ValueError:

@@ -6,7 +6,11 @@ native QP backends (Clarabel, OSQP, cvxpy), each qpsolvers backend, Newton and t
 alternation — warm-started from the same previous state, and lists for each rollqp's
 residuals per condition (docs/formulation.md §5), iterations, wall time, and the largest
 difference from Newton's solution in ``p0`` (pressure) and ``μ p0`` (traction). On a coupled
-step (``A_nt ≠ 0``, §6.2.1) the QP backends run the N–T alternation (paper §6.3).
+step (``A_nt ≠ 0``, §6.2.1) the QP backends run the N–T alternation (paper §6.3). A steady
+rolling step (the direct rolling start, docs/theory.md §5) is not a convex QP: a method that
+does not solve it directly reaches it the way ``rollqp run`` does, by marching the scene at its
+starting loads to the steady state (:func:`solve_step_file`), and its state is then evaluated
+on the same stored steady step.
 
 Times are one solve each, on whatever machine runs the report: read them as ratios within
 one table, not as benchmarks (``benchmarks/`` has those).
@@ -45,6 +49,7 @@ class Report:
     q: float
     kind: str
     rows: list
+    kind_note: str = ""
 
     def __str__(self) -> str:
         head = (f"scene {self.scene}, step {self.step} (q = {self.q:.6g}), {self.kind} step; "
@@ -53,6 +58,8 @@ class Report:
                 "| max abs Δp [p0] | max abs Δt [μp0] | states ≠ |\n"
                 "|---|---|---|---|---|---|---|---|---|---|")
         lines = [head]
+        if self.kind_note:
+            lines[0] = head.replace("\n\n|", f"\n{self.kind_note}\n\n|", 1)
         for r in self.rows:
             if not r.ok:
                 lines.append(f"| {r.method} | failed: {r.error} |||||||||")
@@ -84,7 +91,7 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
     for name in names:
         t0 = time.perf_counter()
         try:
-            sol = solve_stored(sf, name, tolerance=tolerance)
+            sol = solve_step_file(sf, name, tolerance=tolerance)
         except RollqpError as err:
             rows.append(Row(name, False, error=str(err)))
             continue
@@ -92,11 +99,12 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
         state = classify(sol.p, sol.t, sol.s, sf.mu, sc)
         if ref is None:
             ref, ref_state = sol, state
-        info = sol.info
-        inner = f"{info.get('inner_normal', 0)}+{info.get('inner_tangential', 0)}"
-        if not info.get("iterations_reported", True):
+        inner = f"{sol.inner_normal}+{sol.inner_tangential}"
+        if not sol.extras.get("iterations_reported", True):
             inner = "—"  # DAQP and HiGHS do not report iterations through qpsolvers
-        its = f"{sol.iterations} ({inner})" if "outer" in info else (inner if sf.kind == "uncoupled" else str(sol.iterations))
+        its = f"{sol.iterations} ({inner})" if sol.outer else (inner if sf.kind == "uncoupled" else str(sol.iterations))
+        if sol.extras.get("marched"):
+            its = f"{sol.iterations} (march to steady)"
         rows.append(Row(name, True, residuals=dict(signorini=sol.residuals.signorini, friction=sol.residuals.friction,
                                                    load_normal=sol.residuals.load_normal,
                                                    load_tangential=sol.residuals.load_tangential),
@@ -104,7 +112,42 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
                         dt=float(np.max(np.abs(sol.t - ref.t)) / (sc.stress * (sf.mu or 1.0))),
                         states=int(np.count_nonzero(state != ref_state))))
     name = sf.scene.get("name", "?") if isinstance(sf.scene, dict) else "?"
-    return Report(scene=name, step=sf.step, q=sf.q, kind=sf.kind, rows=rows)
+    note = STEADY_NOTE if sf.step_type == "steady" else ""
+    return Report(scene=name, step=sf.step, q=sf.q, kind=sf.kind + (" steady" if sf.step_type == "steady" else ""), rows=rows, kind_note=note)
+
+
+#: What the report says of a steady step (the rows marked "marched").
+STEADY_NOTE = ("A steady rolling step is not a convex QP (its slip operator makes the symmetric part indefinite, "
+               "docs/theory.md §5): methods that do not solve it directly reach it by marching the scene at its "
+               "starting loads, as `rollqp run --method` does; their state is evaluated on this step.")
+
+
+def solve_step_file(sf: StepFile, name: str, tolerance: float = 1e-10):
+    """Solve a stored step with method ``name`` as a run with that method would.
+
+    A rolling or static-shift step is solved as stored (:func:`rollqp.stepfile.solve_stored`).
+    A steady rolling step (``step_type == "steady"``) is solved directly by a method that declares
+    ``"steady"``; any other method (the QP backends: the steady problem is no convex QP) reaches it
+    the way ``rollqp run`` does, by the scene's march at its starting loads to steady rolling
+    (:meth:`rollqp.march` state 0), and its state is evaluated on the stored step: the residuals
+    are rollqp's of that same discrete steady problem (``extras["marched"]`` is then True;
+    ``iterations`` counts every solve of the march).
+    """
+    from .methods import capabilities
+    if sf.step_type != "steady" or "steady" in capabilities(name).solves:
+        return solve_stored(sf, name, tolerance=tolerance)
+    from .march import march
+    from .scene import scene_from_dict
+    if not isinstance(sf.scene, dict) or not sf.scene:
+        raise RollqpError(f"step {sf.step} is a steady rolling step, which {name} reaches by marching the "
+                          "scene; the step file holds no scene to march")
+    scene = scene_from_dict(sf.scene).replace(**{"solver.tolerance": tolerance})
+    t0 = time.perf_counter()
+    rec = next(iter(march(scene, name)))  # state 0: the rolling start, marched to steady
+    sol = sf.problem().solution(rec.state.p, rec.state.t, rec.solution.delta, rec.solution.xi, method=name,
+                                iterations=rec.counters.iterations, time=time.perf_counter() - t0)
+    sol.extras["marched"] = True
+    return sol
 
 
 # ---------------------------------------------------------------------------- the run's cross-check
@@ -120,11 +163,12 @@ class SpotCheck:
 
     ``rows`` holds, per method, the largest differences over the steps (``p`` in p0, ``t`` in
     μp0) and the largest rollqp residual of its solutions, or the error it raised. ``str()`` is
-    the summary line of ``rollqp run``.
+    the summary line of ``rollqp run``, each failure on a line of its own, in full.
     """
 
     steps: list
     rows: dict
+    steady: list = field(default_factory=list)
 
     def __str__(self) -> str:
         ok = {m: r for m, r in self.rows.items() if "error" not in r}
@@ -133,8 +177,10 @@ class SpotCheck:
             dp = max(r["p"] for r in ok.values())
             dt = max(r["t"] for r in ok.values())
             head += f": max |dp| {dp:.1e} p0, |dt| {dt:.1e} mu p0 from the run's own solutions"
-        bad = [f"{m} failed ({r['error'][:60]})" for m, r in self.rows.items() if "error" in r]
-        return head + ("; " + "; ".join(bad) if bad else "")
+        if self.steady:
+            head += f" (step {', '.join(map(str, self.steady))} steady: the QP methods march to it, as their runs do)"
+        bad = [f"{m} failed: {r['error']}" for m, r in self.rows.items() if "error" in r]
+        return "\n".join([head] + bad)
 
 
 def spot_check(steps, methods=SPOT_METHODS, tolerance: float = 1e-10) -> SpotCheck:
@@ -150,13 +196,13 @@ def spot_check(steps, methods=SPOT_METHODS, tolerance: float = 1e-10) -> SpotChe
         row = {"p": 0.0, "t": 0.0, "residual": 0.0}
         for sf in steps:
             try:
-                sol = solve_stored(sf, name, tolerance=tolerance)
+                sol = solve_step_file(sf, name, tolerance=tolerance)
             except RollqpError as err:
-                row = {"error": str(err)}
+                row = {"error": f"step {sf.step}: {err}"}
                 break
             sc = sf.scales
             row["p"] = max(row["p"], float(np.max(np.abs(sol.p - sf.ref_p)) / sc.stress))
             row["t"] = max(row["t"], float(np.max(np.abs(sol.t - sf.ref_t)) / (sc.stress * (sf.mu or 1.0))))
             row["residual"] = max(row["residual"], sol.residual)
         rows[name] = row
-    return SpotCheck([sf.step for sf in steps], rows)
+    return SpotCheck([sf.step for sf in steps], rows, [sf.step for sf in steps if sf.step_type == "steady"])

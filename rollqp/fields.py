@@ -206,9 +206,9 @@ register(Field("direction", "step", "1", "direction of the material in the step 
 
 
 def _friction_coefficient(rec, operators):
-    """``μ`` at the nodes of a step with a friction law (kept by the march in ``info["mu"]``)."""
+    """``μ`` at the nodes of a step with a friction law (kept by the march in ``StepSolution.mu``)."""
     sol = rec.solution
-    mu = None if sol is None else sol.info.get("mu")
+    mu = None if sol is None else sol.mu
     return np.full(operators.n, float(operators.mu)) if mu is None else np.asarray(mu, dtype=float)
 
 

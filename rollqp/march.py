@@ -12,13 +12,15 @@ benchmarks, post-processing — consumes the records; it needs no private call. 
     similar bodies), then the tangential load by static shift in ``load.start_steps``
     increments (Cattaneo for similar bodies, §4.4): ``s = (w^k − w^{k−1})/Δ + ξ`` with
     ``Δ = a_H`` and ``ξ·Δ`` the rigid shift;
-  - ``start = "rolling"``: steady rolling at the initial loads. A method that declares
-    ``"steady"`` (:attr:`Method.solves <rollqp.methods.base.Method.solves>`) solves the
-    steady problem directly (phase ``"steady"``; slip ``s = ξ e + d·D_up w``,
+  - ``start = "rolling"``: steady rolling at the initial loads, the fixed point of the rolling
+    steps that follow. From the loads' normal half at zero shear (:meth:`_March.pressed`; no
+    braked start: the steady state does not depend on the loading path), a method that declares
+    ``"steady"`` (:attr:`Capabilities.solves <rollqp.methods.base.Capabilities.solves>`) solves the
+    steady problem directly (phase ``"steady"``; slip ``s = ξ e + T w``, ``T = (I − M)/Δq``,
     :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`); the others
     (the QP backends: the steady operator is far from symmetric and their splitting does not
-    converge on it) reach it by marching the transient at constant loads from the braked
-    state until the tractions stop changing (phase ``"rolling"``).
+    converge on it) reach it by marching the transient at constant loads until the tractions
+    stop changing (phase ``"rolling"``).
 * **rolling steps** ``k = 1..K`` at ``q_k = k Δq`` (phase ``"rolling"``): the history vector
   ``c^{k−1} = −M w^{k−1}`` (:meth:`~rollqp.strip.Strip.history_operator`), the loads
   ``P(q_k)``, ``Q(q_k)``, and each half warm-started from the previous step. With
@@ -81,15 +83,15 @@ class Counters:
             self.inner_normal += sol.iterations
         elif half == "tangential":
             self.inner_tangential += sol.iterations
-        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.backtracks += sol.backtracks
         self._residual(sol.residual)
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
         self.iterations += sol.iterations
-        self.inner_normal += int(sol.info.get("inner_normal", 0))
-        self.inner_tangential += int(sol.info.get("inner_tangential", 0))
-        self.backtracks += int(sol.info.get("backtracks", 0))
+        self.inner_normal += sol.inner_normal
+        self.inner_tangential += sol.inner_tangential
+        self.backtracks += sol.backtracks
         self._residual(sol.residual)
 
     def _residual(self, r: float) -> None:
@@ -217,7 +219,7 @@ class _March:
             return self._frictionless(state, cnt, P=P, c=c, dq=dq, xi=xi, steady=steady, delta=delta, h=h)
         fr = None
         if not self.constant_friction:  # a law: this step's μ (Coulomb keeps the fast path)
-            prev = None if state.tsol is None else state.tsol.info.get("mu")
+            prev = None if state.tsol is None else state.tsol.mu
             fr = ops.step_friction(q, dq=transport, previous=prev, steady=steady)
         if ops.coupled:
             pb = ops.coupled_step(P, c, dq, Q=Q, xi=xi, steady=steady, delta=delta, h=h, friction=fr)
@@ -271,11 +273,8 @@ class _March:
 
     # ------------------------------------------------------------ the phases
     def start(self) -> StepRecord:
-        """State 0: the braked start, or from it the rolling start (``load.start``)."""
-        start = self.braked_start()
-        if self.scene.load.start == "rolling":
-            start = self.rolling_start(start)
-        return start
+        """State 0: the braked start, or the rolling start from its guess (``load.start``)."""
+        return self.rolling_start(self.guess()) if self.scene.load.start == "rolling" else self.braked_start()
 
     def braked_start(self):
         """Step 0 of a braked start (§2.2, §4.4; docs/formulation.md §9), by static shift.
@@ -319,38 +318,68 @@ class _March:
         ops.check_inside(state.p, 0)
         return self.record(0, "static-shift", 0.0, state, previous, problem, sol, cnt, P=P, shift=shift, t0=t0)
 
-    def rolling_start(self, braked: StepRecord) -> StepRecord:
-        """Rolling start from the braked state: the direct steady solve for a method that declares
-        ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says
-        why in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`)."""
+    def pressed(self) -> State:
+        """The starting guess of a rolling start: the loads' normal half at zero shear, nothing else.
+
+        The steady rolling state does not depend on how the loads were applied (the rolling wipes
+        the contact's memory), so a rolling start needs no braked start (``load.start_steps``
+        static increments, each a coupled step on coupled scenes): the normal half at ``P(0)`` (or
+        ``δ(0)``) with ``t = 0`` (one solve; ``w = A_tn p``) is where the direct steady solve and
+        the march to the steady state set out from.
+        """
+        ops = self.ops
+        _, _, P, _, xi, D = self.at[0]
+        if P is not None and P <= 0.0:
+            return _unloaded(ops, xi)
+        zero = np.zeros(ops.n)
+        npb = ops.normal_step(P, zero, delta=D, validate=False)
+        nsol = self.method.solve(npb, warm=None)
+        return State(nsol.p, zero, ops.w(nsol.p, zero), nsol, None, None if ops.coupled else npb)
+
+    def guess(self) -> State:
+        """Where a rolling start sets out from: :meth:`pressed`, or, with a slip-dependent friction law,
+        the braked state (:meth:`braked_start`). A falling law can have two steady states at one force, and
+        the guess decides which one the start returns: from the braked state it is the one that grows
+        from Coulomb's (docs/friction.md, "Which steady state a rolling start returns")."""
+        if self.ops.friction.kind == "slip":
+            return self.braked_start().state
+        return self.pressed()
+
+    def rolling_start(self, start: State) -> StepRecord:
+        """Rolling start from the guess ``start`` (:meth:`guess`): the direct steady solve for a method
+        that declares ``"steady"``, else, or if that solve fails, the march to the steady state (its
+        record then says why in ``note``: the march reaches the same discrete state, to
+        :data:`STEADY_TOL`)."""
         if "steady" not in self.method.capabilities.solves:
-            return self.steady_by_marching(braked)
+            return self.steady_by_marching(start)
         try:
-            return self.steady_direct(braked)
+            return self.steady_direct(start)
         except SolverError as err:
-            rec = self.steady_by_marching(braked)
+            rec = self.steady_by_marching(start)
             rec.note = f"the direct steady solve failed ({err}); the steady state was reached by marching"
             return rec
 
-    def steady_direct(self, start: StepRecord) -> StepRecord:
-        """Rolling start: the steady rolling problem ``s = ξ e + d·D_up w`` solved directly.
+    def steady_direct(self, start: State) -> StepRecord:
+        """Rolling start: the steady rolling problem ``s = ξ e + T w`` solved directly (``T``: the
+        fixed point of the scene's transient step, :meth:`SceneOperators.steady
+        <rollqp.operators.SceneOperators.steady>`).
 
-        Not symmetric (``D_up A`` is not), so only methods that declare ``"steady"`` pose it;
-        warm-started from the braked state.
+        Not symmetric (``T A`` is not), so only methods that declare ``"steady"`` pose it;
+        set out from the guess ``start``.
         """
         t0 = time.perf_counter()
         _, _, P, Q, xi, D = self.at[0]
         cnt = Counters()
-        state, problem, sol = self.step(start.state, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
+        state, problem, sol = self.step(start, cnt, P=P, c=np.zeros(self.ops.n), dq=self.ops.scales.length,
                                         Q=Q, xi=xi, steady=True, delta=D)
         self.ops.check_inside(state.p, 0)
-        rec = self.record(0, "steady", 0.0, state, start.state, problem, sol, cnt, P=P, shift=0.0, t0=t0)
+        rec = self.record(0, "steady", 0.0, state, start, problem, sol, cnt, P=P, shift=0.0, t0=t0)
         if problem is not None and problem.law is not None and Q is not None:
             from .friction.bound import steady_branches
             rec.note = steady_branches(problem.law.law, Q, rec.P, rec.gross_sliding)
         return rec
 
-    def steady_by_marching(self, start: StepRecord) -> StepRecord:
+    def steady_by_marching(self, start: State) -> StepRecord:
         """Rolling start: roll at the initial loads until the tractions stop changing.
 
         For methods that cannot pose the non-symmetric steady problem (``STEADY_TOL``,
@@ -368,8 +397,8 @@ class _March:
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
         from .methods.steady_start import accelerated_start, predicting
         change = np.inf
-        state = accelerated_start(self.method, ops, start.state, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
-                                  delta=D, tol=STEADY_TOL)  # QP methods: Anderson (issue 18)
+        state = accelerated_start(self.method, ops, start, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
+                                  delta=D, tol=STEADY_TOL)  # QP methods: Newton on the march's map, Anderson
         # N–T alternation: one sweep a step until near steady
         sweeps = self.method.single_sweeps if self.method.capabilities.single_sweeps else None
         if sweeps is not None:
@@ -446,10 +475,13 @@ def prepare(scene, method=None):
         A method name (overrides ``[solver].method``) or a method object (used as it is, composed
         with the N–T alternation if the scene is coupled and it does not solve coupled steps).
     """
+    from .advice import fast_path
     from .methods import compose, scene_method
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
+    if method is None or isinstance(method, str):
+        scene = fast_path(scene).scene  # matrix-free where the dense path is large or slow (rollqp.advice)
     coupled = scene.coupling_level == "full"
     kind = scene.contact.friction.kind
     if method is None or isinstance(method, str):
@@ -632,7 +664,10 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
     from .result import ResumeSource, resume_source
-    scene, meth, ops = prepared = prepare(scene, method)
+    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    if isinstance(method, str) and method != asked.solver.method:
+        asked = asked.replace(**{"solver.method": method})
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
     tail = None
@@ -642,7 +677,10 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     if out is None:
         from .scene.checks import check_result_memory
         check_result_memory(scene, keep)
-    result = new_result(scene, ops, meth.name, keep_every=keep, out=out)
+    result = new_result(asked, ops, meth.name, keep_every=keep, out=out)  # meta: the scene as given, the method that ran it
+    if scene.solver.method != asked.solver.method:
+        from .advice import fast_path
+        result.meta["method_note"] = fast_path(asked).note
     from .atomic import stop_once
     with stop_once():  # a second Ctrl-C never interrupts the writing of what the first one saves
         return _run(scene, prepared, result, source, tail, observe, progress)
@@ -749,9 +787,9 @@ def _unloaded(ops: SceneOperators, xi=None) -> State:
 
 
 def _product(sol, problem, A):
-    """``A t`` of the tangential solution ``sol``, if its method handed it back (``info["At"]``, a pair
+    """``A t`` of the tangential solution ``sol``, if its method handed it back (``sol.At``, a pair
     ``(t, A t)``) for this very operator ``A`` (not a steady slip operator), else None."""
-    got = sol.info.get("At")
+    got = sol.At
     if got is None or problem.A is not A:
         return None
     t, At = got
@@ -759,7 +797,7 @@ def _product(sol, problem, A):
 
 
 def _keep_mu(problem, sol) -> None:
-    """With a friction law, the step's ``μ`` at the nodes in ``sol.info["mu"]`` (the next step's memory,
+    """With a friction law, the step's ``μ`` at the nodes in ``sol.mu`` (the next step's memory,
     the result field ``friction_coefficient``); Coulomb steps are left as they were."""
     if problem.law is not None or (type(problem.mu) is not float and np.ndim(problem.mu) != 0):
-        sol.info["mu"] = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)
+        sol.mu = np.broadcast_to(problem.coefficient(sol.s, sol.p), (problem.n,)).astype(float)

@@ -165,15 +165,28 @@ def sparse_history(strip, formulation: str, dq: float, direction: int) -> sparse
     raise InputError("formulation", f"must be one of material, convective-local, static; got {formulation!r}")
 
 
-def sparse_steady(strip, direction: int) -> sparse.csr_matrix:
-    """``d·D_up`` sparse: the steady-rolling slip ``s = ξ e + d·D_up w`` (docs/formulation.md §9)."""
-    return direction * _upwind(strip, direction)
+def sparse_steady(strip, direction: int, formulation: str = "convective-local",
+                  dq: float | None = None) -> sparse.csr_matrix:
+    """Sparse :meth:`~rollqp.strip.Strip.steady_operator`: ``T`` of the steady slip ``s = ξ e + T w``,
+    the fixed point of the transient step of ``formulation`` (docs/formulation.md §9): ``d·D_up``
+    (convective-local), ``(I − R)/Δq`` (material)."""
+    from scipy import sparse  # at first use: `import rollqp` stays free of scipy.sparse
+    if direction not in (-1, 1):
+        raise InputError("direction", f"must be -1 or +1, got {direction!r}")
+    if formulation == "material":
+        if dq is None or not float(dq) > 0.0:
+            raise InputError("dq", f"the material steady operator needs the step Δq > 0, got {dq!r}")
+        eye = sparse.identity(strip.n, format="csr")
+        return ((eye - sparse_history(strip, "material", dq, direction)) / float(dq)).tocsr()
+    if formulation == "convective-local":
+        return direction * _upwind(strip, direction)
+    raise InputError("formulation", f"must be material or convective-local; got {formulation!r}")
 
 
 class SteadyOperator(Operator):
     """``c·T·A``: a sparse slip operator ``T`` times an FFT influence operator ``A``, never a matrix.
 
-    The steady slip operators ``Δ·d·D_up·A_tt`` and ``Δ·d·D_up·A_tn`` (eq. 48; docs/formulation.md
+    The steady slip operators ``Δ·T·A_tt`` and ``Δ·T·A_tn`` (:func:`sparse_steady`; docs/formulation.md
     §9) of a matrix-free scene: products ``O(n log n)``, memory ``O(n)``; the operator interface
     of :class:`~rollqp.influence.operator.Operator` (``@``, ``x @ A``, ``diagonal()``,
     ``column(j)``, ``dense()``, ``memo``) so that step problems and ``mf-newton`` take it unchanged
@@ -221,9 +234,10 @@ class SteadyOperator(Operator):
 
 
 def steady_operators(ops):
-    """``(Δ·d·D_up·A_tn or None, Δ·d·D_up·A_tt)`` of a matrix-free scene as :class:`SteadyOperator` objects
+    """``(Δ·T·A_tn or None, Δ·T·A_tt)`` (``T`` the scene's :func:`sparse_steady`) of a matrix-free scene as :class:`SteadyOperator` objects
     (``Δ = a_H``; the dense path's :meth:`SceneOperators.steady <rollqp.operators.SceneOperators.steady>`)."""
-    T = sparse_steady(ops.strip, ops.scene.load.direction)
+    sc = ops.scene
+    T = sparse_steady(ops.strip, sc.load.direction, sc.discretization.formulation, sc.dq)
     delta = ops.scales.length
     Atn = None if ops.Atn is None else SteadyOperator(T, ops.Atn, delta, "steady A_tn")
     return Atn, SteadyOperator(T, ops.Att, delta, "steady A_tt")

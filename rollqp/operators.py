@@ -211,15 +211,21 @@ class SceneOperators:
         return RowSparse.from_dense(self.strip.history_operator(formulation, dq, direction))
 
     def steady(self) -> tuple[Operator | None, Operator]:
-        """``(Δ·d·D_up·A_tn, Δ·d·D_up·A_tt)`` with ``Δ = a_H``: the steady slip operators, built once.
+        """``(Δ·T·A_tn, Δ·T·A_tt)`` with ``Δ = a_H``: the steady slip operators, built once.
 
-        With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt t)/dq``
-        is then the steady-rolling slip ``ξ e + d·D_up w`` (docs/formulation.md §4, §9).
+        ``T`` (:meth:`Strip.steady_operator <rollqp.strip.Strip.steady_operator>`) is the fixed point of
+        the scene's own transient step, ``(I − M)/Δq`` with the history operator ``M`` of its
+        formulation, ``Δq`` and direction: ``d·D_up`` for ``convective-local``, ``(I − R)/Δq`` for
+        ``material``. With ``dq = Δ`` and ``c = 0`` the step problems' slip ``ξ e + (c + A_tn p + A_tt
+        t)/dq`` is then the steady slip ``ξ e + T w`` (docs/formulation.md §4, §9), and a march from the
+        steady state stays there.
         """
         if "steady" not in self._memo and self.matrix_free:   # products, no matrix (rollqp.matrixfree)
             self._memo["steady"] = matrixfree.steady_operators(self)
         if "steady" not in self._memo:
-            T = self.scales.length * self.strip.steady_operator(self.scene.load.direction)
+            sc = self.scene
+            T = self.scales.length * self.strip.steady_operator(sc.load.direction, sc.discretization.formulation,
+                                                                sc.dq)
             Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")
             self._memo["steady"] = (Atn, Operator(T @ self.Att.dense(), "steady A_tt"))
         return self._memo["steady"]
@@ -269,7 +275,7 @@ class SceneOperators:
 
     def coupled_step(self, P, c, dq, Q=None, xi=None, steady=False, delta=None, h=None,
                      friction=None) -> CoupledStep:
-        """The coupled step (docs/formulation.md §10); ``steady``: slip ``s = ξ e + d·D_up w``; ``h`` as
+        """The coupled step (docs/formulation.md §10); ``steady``: the steady slip ``s = ξ e + T w`` (:meth:`steady`); ``h`` as
         for :meth:`normal_step`; ``friction`` as for :meth:`tangential_step`."""
         Atn, Att = self.steady() if steady else (self.Atn, self.Att)
         mu, law = (self.mu, None) if friction is None else friction

@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import closedforms as cf
+from .units import unit_names
 
 
 def rms_in_contact(x, a, err):
@@ -80,29 +81,85 @@ def _rolled_tail(scene, need: float):
 
 
 def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
-    """The table ``rollqp run`` prints; ``stresses`` (a :class:`rollqp.stresses.StressHistory`, from
-    ``rollqp run --stresses``) adds the peak von Mises and τ1 over the run with their place and state."""
-    K = len(res["q"]) - 1
+    """The table ``rollqp run`` prints; ``stresses`` (a :class:`rollqp.subsurface.StressHistory`, from
+    ``rollqp run --stresses``) adds the peak von Mises and τ1 over the run with their place and state.
+
+    Dimensional values carry the units the scene declares (``units``, :mod:`rollqp.units`), beside
+    the nondimensional ones; ``wall`` is the wall time of this call of the run (a resumed run: of
+    the steps computed since it resumed, which the ``wall time`` row compares with their stepping).
+    """
+    u = unit_names(getattr(scene, "units", ""))
+    a, p0 = float(res["a_H"]), float(res["p0"])
+    ran = _meta(res).get("method") or method
     rows = [("scene", f"{scene.name} ({scene.source})"),
-            ("method", method),
+            ("method", ran if ran == method else f"{ran} (the scene names {method}: see fast path below)"),
             ("nodes", f"{res['x'].size} ({scene.discretization.elements} {scene.discretization.element} elements, "
-                      f"zone ±{scene.discretization.zone} a_H)"),
-            ("steps", f"{K} rolling steps of {scene.dq / scene.a_H:.5g} a_H + starting state"),
-            ("a_H, p0", f"{float(res['a_H']):.6g}, {float(res['p0']):.6g}"),
+                      f"zone ±{scene.discretization.zone} a_H = ±{scene.discretization.zone * a:.4g} {u.length})"),
+            ("steps", steps_row(res, scene, u)),
+            ("a_H, p0", f"{a:.6g} {u.length}, {p0:.6g} {u.stress} (Hertz at P̄ = {scene.load.normal:.6g} {u.load}, "
+                        f"E* = {scene.Estar:.6g} {u.stress}, R = {scene.R:.6g} {u.length})"),
             ("beta (2beta)", f"{float(res['beta']):.6g} ({2 * float(res['beta']):.6g}), coupling {scene.coupling_level}"),
-            ("iterations", f"{int(res['iterations'].sum())} in all, median {np.median(res['iterations'][1:] if K else res['iterations']):.0f} per step"),
-            ("wall time", f"{wall:.3f} s ({float(res['step_time'].sum()):.3f} s stepping, "
-                          f"median {1e3 * float(np.median(res['step_time'])):.2f} ms per step)"),
+            ("iterations", iterations_row(res)),
+            ("wall time", time_row(res, wall)),
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),
             ("final creepage", f"{float(res['creepage'][-1]):.6e}")]
     rows += _model_rows(res, scene)
+    if _meta(res).get("method_note"):
+        rows.append(("fast path", _meta(res)["method_note"]))
     rows += _start_rows(res)
     rows += _gross_rows(res)
     rows += energy_rows(res, scene, stresses)
     for name, val, what in closed_form_errors(res, scene):
-        rows.append((f"error: {name}", f"{val:.4f}  {what}"))
+        rows.append((f"error: {name}", f"{val:.3g}  {what}"))
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
+
+
+def _rolling(res: dict) -> np.ndarray:
+    """Which states ``1..K`` were rolling steps (a load path's stops are static steps: ``direction`` 0)."""
+    d = np.asarray(res["direction"])[1:] if "direction" in res else None
+    return np.ones(len(res["q"]) - 1, dtype=bool) if d is None else d != 0
+
+
+def steps_row(res: dict, scene, u=None) -> str:
+    """``K rolling steps of Δq …`` — or, with stops (``load.rolled``), how many rolled and how many stood still."""
+    u = u or unit_names("")
+    K = len(res["q"]) - 1
+    roll = _rolling(res)
+    a = float(res["a_H"])
+    dq = np.abs(np.diff(np.asarray(res["q"], dtype=float)))[roll]
+    if dq.size and np.ptp(dq) > 1e-9 * dq.max():  # a load path whose speed varies
+        size = f"{dq.min() / a:.4g}…{dq.max() / a:.4g} a_H ({dq.min():.4g}…{dq.max():.4g} {u.length})"
+    else:
+        size = f"{scene.dq / a:.5g} a_H ({scene.dq:.4g} {u.length})"
+    if roll.all():
+        return f"{K} rolling steps of {size} + starting state"
+    n = int(roll.sum())
+    return (f"{K} steps + starting state: {n} rolling of {size}, {K - n} at rest (static steps: a stop, or loads "
+            "that change without rolling)")
+
+
+def iterations_row(res: dict) -> str:
+    """Iterations in all, and the median per rolling step (the start and a load path's stops counted apart)."""
+    it = np.asarray(res["iterations"])
+    roll = _rolling(res)
+    per = it[1:][roll] if roll.any() else it
+    return (f"{int(it.sum())} in all ({int(it[0])} for the starting state), median {np.median(per):.0f} per "
+            "rolling step")
+
+
+def time_row(res: dict, wall: float) -> str:
+    """Wall time against the stepping time of the same steps: a resumed run counts only its own steps."""
+    st = np.asarray(res["step_time"], dtype=float)
+    first = _meta(res).get("resumed_from")
+    if first is None:
+        return (f"{wall:.3f} s ({float(st.sum()):.3f} s stepping, median {1e3 * float(np.median(st)):.2f} ms "
+                "per step)")
+    mine = st[int(first) + 1:]
+    med = 1e3 * float(np.median(mine)) if mine.size else float("nan")
+    return (f"{wall:.3f} s for steps {int(first) + 1}..{st.size - 1} resumed here ({float(mine.sum()):.3f} s "
+            f"stepping, median {med:.2f} ms per step); all {st.size - 1} steps with the earlier run: "
+            f"{float(st.sum()):.3f} s stepping")
 
 
 def _meta(res: dict) -> dict:
@@ -136,11 +193,13 @@ def energy_rows(res: dict, scene, stresses=None) -> list[tuple[str, str]]:
     """Dissipation (docs/stresses.md §5) and, if computed, the peak subsurface stresses (§3)."""
     rows = []
     if "dissipation" in res:
+        u = unit_names(getattr(scene, "units", ""))
         unit = float(res["a_H"]) * float(res["p0"])  # force/length, the load unit
         Wf = float(np.sum(res["friction_work"]))
-        rows.append(("dissipation", f"{float(res['dissipation'][-1]):.6g} per unit rolled distance at the end "
-                                    f"({float(res['dissipation'][-1]) / unit:.4g} a_H p0); friction work "
-                                    f"{Wf:.6g} accumulated over the rolling steps"))
+        rows.append(("dissipation", f"{float(res['dissipation'][-1]):.4g} {u.rate} per unit rolled distance at the "
+                                    f"end ({float(res['dissipation'][-1]) / unit:.4g} a_H p0); friction work "
+                                    f"{Wf:.4g} {u.energy} accumulated over the run ({Wf / (unit * float(res['a_H'])):.4g}"
+                                    " a_H² p0)"))
     if stresses is not None:
         a, p0 = float(res["a_H"]), float(res["p0"])
         for key, label in (("von_mises", "peak von Mises"), ("tau1", "peak tau1")):

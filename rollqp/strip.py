@@ -212,9 +212,30 @@ class Strip:
             return np.eye(self.n)
         raise InputError("formulation", f"must be one of material, convective-local, static; got {formulation!r}")
 
-    def steady_operator(self, direction: int) -> np.ndarray:
-        """``d·D_up``: the steady-rolling slip is ``s = ξ e + d·D_up w`` (docs/formulation.md §9)."""
-        return _direction(direction) * self.upwind_difference(direction)
+    def steady_operator(self, direction: int, formulation: str = "convective-local",
+                        dq: float | None = None) -> np.ndarray:
+        """``T`` of the steady-rolling slip ``s = ξ e + T w``: the fixed point of the transient step of
+        ``formulation`` (docs/formulation.md §9).
+
+        A transient step's slip is ``ξ e + (w^k − M w^{k−1})/Δq`` (:meth:`history_operator`); at
+        its fixed point ``w^k = w^{k−1} = w`` it is ``ξ e + (I − M) w/Δq``, so
+
+        * ``"convective-local"``: ``T = d·D_up`` (eq. 14 without the local term, for every ``Δq``);
+        * ``"material"``: ``T = (I − R)/Δq`` (eq. 33), the material shift's own difference. It is
+          ``d·D_up`` except at the leading node when ``R`` moves nodal values by exactly one node
+          spacing (constant and linear elements with ``Δq ≤ h``; quadratic with ``Δq = h = Le/2``);
+          for other steps it is another consistent difference of ``w``, and the march of that
+          formulation would leave the state of ``d·D_up`` (the difference is a discretization
+          error: both converge to the continuous steady state as the mesh is refined).
+        """
+        d = _direction(direction)
+        if formulation == "material":
+            if dq is None or not float(dq) > 0.0:
+                raise InputError("dq", f"the material steady operator needs the step Δq > 0, got {dq!r}")
+            return (np.eye(self.n) - self.shift_operator(dq, d)) / float(dq)
+        if formulation == "convective-local":
+            return d * self.upwind_difference(d)
+        raise InputError("formulation", f"must be material or convective-local; got {formulation!r}")
 
 
 class RowSparse:

@@ -59,7 +59,7 @@ def profile(result, body: str = "A", coefficient=None, resolution: int = 4):
         Surface coordinate (length, the material's position at q = 0, modulo 2πR) and the
         worn depth there (length).
     """
-    from .stresses import _source
+    from .subsurface import _source
     from .strip import Strip
     arrays, scene = _source(result)
     if body not in ("A", "B"):

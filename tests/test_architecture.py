@@ -136,9 +136,10 @@ def test_no_id_keyed_caches():
     assert not hits, f"id()-keyed lookups in rollqp/: {hits}"
 
 
+@pytest.mark.integration
 def test_import_rollqp_loads_no_optional_or_heavy_module():
     """``import rollqp`` (and so ``rollqp --help``) loads neither scipy nor the BEM module nor
-    any optional extra: each is imported when a scene or command first needs it (issue 18:
+    any optional extra: each is imported when a scene or command first needs it (
     the import went from 0.56 s to ~0.25 s here). A fresh interpreter, so nothing is cached."""
     import subprocess
     import sys

@@ -1,4 +1,4 @@
-"""True geometry by BEM (rollqp.influence.bem; issue 4, docs/bem.md).
+"""True geometry by BEM (rollqp.influence.bem; docs/bem.md).
 
 The BEM alone against Lamé's thick ring, its quadrature against a finer one, its combined
 matrices against the half-space in the small-contact limit (signs), Hertz pressure for

@@ -1,10 +1,12 @@
 """The benchmark harness and suite (benchmarks/harness.py, benchmarks/suite.py): their bookkeeping, not their timings."""
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))
 import suite as bench  # noqa: E402  (benchmarks/suite.py, with harness.py beside it)
@@ -54,3 +56,29 @@ def test_cli_routes_bench(capsys):
     from rollqp import cli
     assert cli.main(["bench", "--parts", "nope"]) == 2
     assert "unknown part nope" in capsys.readouterr().err
+
+
+def test_quick_study_draws_its_figures(tmp_path, capsys):
+    """``rollqp bench --quick --figures DIR`` ends with the figures drawn and the raw numbers written
+    (it once crashed at the first figure, after all the compute)."""
+    pytest.importorskip("matplotlib")
+    rc = bench.main(["--quick", "--parts", "tolerance,discretization", "--methods", "newton",
+                     "--figures", str(tmp_path), "--json", str(tmp_path / "raw.json")])
+    assert rc == 0, capsys.readouterr().err
+    for name in ("perf-wp-tolerance.png", "perf-wp-discretization.png", "perf-wp-coupled.png"):
+        assert (tmp_path / name).stat().st_size > 1000, name
+    assert set(json.loads((tmp_path / "raw.json").read_text())) == {"tolerance", "discretization"}
+
+
+def test_failed_figure_keeps_the_results(tmp_path, capsys, monkeypatch):
+    """A figure that fails is reported (exit 1) after the tables are printed and the raw numbers written."""
+    def broken(res, path):
+        raise RuntimeError("no figure today")
+    monkeypatch.setattr(bench, "figure_tolerance", broken)
+    rc = bench.main(["--quick", "--parts", "tolerance", "--methods", "newton", "--figures", str(tmp_path),
+                     "--json", str(tmp_path / "raw.json")])
+    cap = capsys.readouterr()
+    assert rc == 1
+    assert "## Work–precision: solver tolerance" in cap.out and "| `newton` |" in cap.out
+    assert "figure perf-wp-tolerance.png failed: RuntimeError: no figure today" in cap.err
+    assert "tolerance" in json.loads((tmp_path / "raw.json").read_text())

@@ -203,7 +203,7 @@ def test_newton_steady_free_rolling_at_tiny_friction(elements):
     single node. GNMls with Q prescribed cycles there (merit stuck at 3.9e-6 after 200 iterations
     on 40 elements); the fallback solves with ξ prescribed and searches ξ for fᵀt = Q
     (``NewtonMethod._tangential_by_creepage``). Bound: both stop at residual 1e-10; measured
-    |ξ_newton/ξ_qp − 1| ≤ 4.4e-14 on these 8 meshes (issue 5)."""
+    |ξ_newton/ξ_qp − 1| ≤ 4.4e-14 on these 8 meshes."""
     scene = bentall_scene(1e-4, elements=elements)
     xi_qp, _ = creepage(scene)
     xi_newton, r = creepage(scene.replace(**{"solver.method": "newton"}))

@@ -51,6 +51,7 @@ def one_line_error(proc, code, *words):
 
 
 # ------------------------------------------------------------------------------- run
+@pytest.mark.integration
 def test_run_writes_result_and_figure(tmp_path):
     path, scene = write_scene(tmp_path)
     proc = rollqp_cmd("run", path, "--out", "r.npz", "--plot", "r.png", "--quiet", cwd=tmp_path)
@@ -98,6 +99,7 @@ def test_show_round_trips(name, capsys, tmp_path):
     assert "[solver]" in text and "start_steps" in text, "defaults are filled in"
 
 
+@pytest.mark.integration
 def test_show_a_file_through_the_entry_point(tmp_path):
     path, scene = write_scene(tmp_path)
     proc = rollqp_cmd("show", path, cwd=tmp_path)
@@ -113,6 +115,7 @@ def _edit(path, old, new):
     return path
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize("case", ["nu", "unknown-key", "missing-file", "out-not-npz"])
 def test_bad_input_exits_2_with_one_line(case, tmp_path):
     path, _ = write_scene(tmp_path)
@@ -153,6 +156,7 @@ def test_builtin_name_typo_suggests(capsys):
 
 
 # ------------------------------------------------------------------------------- solver failure
+@pytest.mark.integration
 def test_solver_failure_exits_3_and_writes_partial(tmp_path):
     # A genuine non-convergence after the starting state: the §6.1.2 ramp (Q = 0 at the start,
     # so the braked start is trivial) with Newton allowed 3 iterations per step; the growing

@@ -1,6 +1,8 @@
 """The cross-validation report (rollqp.crossval): every method on one stored step, side by side."""
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from rollqp import cli, load_scene
@@ -63,3 +65,38 @@ def test_docs_tables(name, step, coupled):
         if coupled and r.method != "newton" and get_method(r.method).capabilities.coupled_limit is None:
             outer.add(r.iterations.split()[0])
     assert len(outer) <= 1, f"all alternations at the same limit take the same outer iterations: {outer}"
+
+
+def test_steady_step_is_marched_by_the_qp_methods():
+    """The direct rolling start (§6.2.2) is a steady rolling step, which no convex QP poses: the QP
+    methods reach it by marching the scene at its starting loads, as their runs do, and their state
+    is evaluated on the same stored step — no failure blamed on the influence matrix."""
+    methods = [m for m in ("qp-clarabel", "qp-osqp", "nt-newton") if m in available_methods()]
+    rep = report(load_scene("harmonic"), step=0, methods=methods)
+    assert "steady" in rep.kind and "not a convex QP" in str(rep)
+    for r in rep.rows:
+        assert r.ok, f"{r.method}: {r.error}"
+        # the march stops when a step changes t by < 1e-8 μp0 (rollqp.march.STEADY_TOL, measured 2e-11)
+        assert r.dt <= 1e-8 and r.dp <= 1e-8, f"{r.method}: Δp {r.dp:.1e}, Δt {r.dt:.1e}"
+        assert max(r.residuals.values()) <= 1e-9, f"{r.method}: residuals on the steady step {r.residuals}"
+    assert any("march to steady" in r.iterations for r in rep.rows)
+
+
+def test_run_cross_check_of_a_steady_start_agrees(tmp_path, capsys, monkeypatch):
+    """``rollqp run harmonic``: the cross-check covers the steady start and reports agreement, no failure."""
+    monkeypatch.chdir(tmp_path)
+    scene = tmp_path / "h.toml"
+    scene.write_text(load_scene("harmonic").replace(**{"discretization.distance": 0.5}).to_toml())
+    assert cli.main(["run", str(scene), "--out", "h.npz"]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines() if "cross-check" in ln)
+    assert "failed" not in line and "step 0 steady" in line, line
+    dp, dt = (float(v) for v in re.findall(r"\|d[pt]\| ([0-9.e+-]+)", line))
+    assert dp < 1e-8 and dt < 1e-8, line   # the march's steady tolerance (see above)
+
+
+def test_spot_check_prints_whole_messages():
+    """A failure is printed in full on a line of its own (it was cut at 60 characters)."""
+    from rollqp.crossval import SpotCheck
+    long = "the QP methods need something long enough that a cut at sixty characters loses its end: THE END"
+    text = str(SpotCheck([0, 5], {"qp-osqp": {"error": f"step 0: {long}"}}))
+    assert text.splitlines()[-1] == f"qp-osqp failed: step 0: {long}"

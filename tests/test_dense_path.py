@@ -1,4 +1,4 @@
-"""The dense path's shortcuts give the answers of the plain products (correctness, never timing; issue 18).
+"""The dense path's shortcuts give the answers of the plain products (correctness, never timing).
 
 * :class:`rollqp.strip.RowSparse` (the history operators, at most three non-zeros a row) holds the
   dense operator's values and multiplies like it;

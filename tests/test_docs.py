@@ -179,7 +179,7 @@ def test_readme_snippet_runs():
 
 def test_every_cited_formulation_section_exists():
     """Code, docs, tests, examples and benchmarks cite the equations as ``docs/formulation.md §N``
-    (the one source; issue 11): every cited N must be a numbered section of that page."""
+    (the one source): every cited N must be a numbered section of that page."""
     page = (ROOT / "docs" / "formulation.md").read_text(encoding="utf-8")
     sections = set(re.findall(r"^## (\d+)\. ", page, flags=re.M))
     cited = {}
@@ -191,3 +191,21 @@ def test_every_cited_formulation_section_exists():
                 cited.setdefault(n, path.relative_to(ROOT))
     missing = {n: str(p) for n, p in cited.items() if n not in sections}
     assert cited and not missing, f"cited sections that docs/formulation.md does not have: {missing}"
+
+
+def test_index_lists_every_page():
+    """docs/index.md names every page with a link (one line each), so the docs read as one book."""
+    text = (DOCS / "index.md").read_text(encoding="utf-8")
+    linked = set(re.findall(r"\]\(([\w.-]+\.md)\)", text))
+    missing = sorted(p.name for p in PAGES if p.name != "index.md" and p.name not in linked)
+    assert not missing, f"docs/index.md does not list {missing}"
+
+
+def test_no_internal_issue_numbers():
+    """Docs and code speak of the project, never of its tracker: no "issue N" anywhere users read."""
+    found = []
+    for path in [ROOT / "README.md", *PAGES, *sorted((ROOT / "rollqp").rglob("*.py"))]:
+        for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
+            if re.search(r"[Ii]ssues? [0-9]+|\b[Tt]he issue'?s?\b", line):
+                found.append(f"{path.relative_to(ROOT)}:{n}")
+    assert not found, found

@@ -231,7 +231,14 @@ def test_a_method_from_outside():
 
 
 def test_the_capabilities_are_checked():
-    """A record that declares a problem kind rollqp does not have is refused, naming it."""
+    """A record that declares a problem kind rollqp does not have is refused, naming it; a method of
+    another dimension is refused for a scene before any work (its record, not its name)."""
+    from rollqp.methods import compose
     with pytest.raises(rollqp.InputError, match="capabilities.solves"):
         Capabilities(solves=frozenset({"normal", "sideways"}))
-    assert dataclasses.replace(Halves.capabilities, dimension=3).traction_components == 1
+    three = Halves()
+    three.capabilities = dataclasses.replace(Halves.capabilities, dimension=3, traction_components=2,
+                                             friction_set="disc")
+    with pytest.raises(rollqp.InputError, match="solver.method.*3D steps"):
+        compose(three, coupled=False)
+    assert compose(Halves(), coupled=False).capabilities.dimension == 2

@@ -1,4 +1,4 @@
-"""Friction laws on load paths (issues 13 and 14): stops and reversals (``load.rolled``) with a
+"""Friction laws on load paths: stops and reversals (``load.rolled``) with a
 law that varies along the surface or with the slip velocity (rollqp.friction; docs/friction.md)."""
 from __future__ import annotations
 

@@ -305,6 +305,7 @@ def _cli_property(seed, bases, tmp_path):
         assert out.stderr.count("\n") == 1 and out.stderr.startswith("rollqp: "), f"{case}: {out.stderr!r}"
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize("seed", _seeds("cli"))
 def test_fuzzed_cli(seed, bases, tmp_path):
     _cli_property(seed, bases, tmp_path)

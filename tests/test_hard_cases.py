@@ -1,4 +1,4 @@
-"""Hard cases (issue 5, item 2): every method on every case agrees with the case's reference or
+"""Hard cases: every method on every case agrees with the case's reference or
 stops with a clear rollqp error, never NaN.
 
 The cases are defined once, in ``benchmarks/hard_cases.py`` (:func:`cases`), and judged there

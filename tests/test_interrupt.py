@@ -55,6 +55,7 @@ def long_scene(tmp_path_factory):
     return scene, full
 
 
+@pytest.mark.integration
 @pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
 def test_signal_writes_completed_states_and_resume_reproduces(long_scene, tmp_path, sig, code):
     scene, full = long_scene

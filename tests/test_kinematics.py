@@ -1,4 +1,4 @@
-"""Load paths (issue 13): stops, reversals and variable steps (rollqp.kinematics), and cyclic
+"""Load paths: stops, reversals and variable steps (rollqp.kinematics), and cyclic
 tangential loading at rest against Mindlin–Deresiewicz (closed form with a convergence slope)."""
 from __future__ import annotations
 

@@ -249,7 +249,7 @@ def test_quadratic_convergence_at_the_end(case):
     # from a cold start too (many active-set changes, line search active)
     sol = NewtonMethod().solve(case["shift"])
     hist = sol.info["history"]
-    assert sol.info["backtracks"] > 0 and hist[-1] <= 10.0 * hist[-2] ** 2, hist
+    assert sol.backtracks > 0 and hist[-1] <= 10.0 * hist[-2] ** 2, hist
 
 
 def test_armijo_condition_holds(case):
@@ -385,8 +385,9 @@ def test_solution_is_rollqps(case):
         assert sol.residual <= NewtonMethod().tolerance
         ref = case[key].solution(sol.p, sol.delta) if key == "normal" else case[key].solution(sol.t, sol.xi)
         assert ref.residuals == sol.residuals
-        for k in ("r", "backtracks", "merit", "history", "steps", "nonmonotone", "start"):
-            assert k in sol.info
+        assert sol.backtracks >= 0  # a typed statistic (StepSolution.backtracks); the method's own data in extras:
+        for k in ("r", "merit", "history", "steps", "nonmonotone", "start"):
+            assert k in sol.extras
 
 
 # --------------------------------------------------------------------------- registry, settings

@@ -1,4 +1,4 @@
-"""Body profiles (issue 13, rollqp.profiles): the rounded punch against its closed form with a slope,
+"""Body profiles (rollqp.profiles): the rounded punch against its closed form with a slope,
 the circle reproduced (zero-depth defect, sampled table), a dent and a flat rolling through a
 Carter contact under every method, and bad input."""
 from __future__ import annotations

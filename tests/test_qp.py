@@ -391,7 +391,7 @@ def test_osqp_solves_small_tangential_problems(args):
         "OSQP agrees with Clarabel"
 
 
-# ------------------------------------------------------------------------------- the QP data (issue 18)
+# ------------------------------------------------------------------------------- the QP data
 @pytest.mark.parametrize("element", ["constant", "quadratic"])
 @pytest.mark.parametrize("case", CASES)
 def test_qp_form_residual_is_rollqps_residual(element, case, solved):

@@ -74,11 +74,13 @@ def test_cli_run_with_a_qpsolvers_backend(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "r.npz").is_file()
 
 
+@pytest.mark.integration
 @pytest.mark.skipif("qps-highs" not in INSTALLED, reason="HiGHS not installed")
 def test_highs_banner_stays_off_stdout(tmp_path):
     """HiGHS prints its banner on the C-level stdout when a process builds its first solver
-    object; rollqp routes it to stderr, so the summary (and anything piped from it) starts
-    with rollqp's own table. A real process: the banner is written below Python's sys.stdout."""
+    object; rollqp discards it, so the summary (and anything piped from it) starts with rollqp's
+    own table and the terminal shows no licence text. A real process: the banner is written below
+    Python's sys.stdout."""
     import subprocess
     import sys
     scene = tmp_path / "short.toml"
@@ -88,4 +90,5 @@ def test_highs_banner_stays_off_stdout(tmp_path):
                          capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert out.returncode == 0, out.stderr
     assert "HiGHS" not in out.stdout, out.stdout[:300]
+    assert "HiGHS" not in out.stderr, out.stderr[:300]
     assert out.stdout.lstrip().startswith("scene"), out.stdout[:300]

@@ -308,7 +308,7 @@ def test_tangential_and_creepage_are_exclusive():
 
 
 def test_normal_history_must_stay_nonnegative():
-    """P < 0 is rejected; P = 0 (loss of contact) is allowed with Q = 0 there (issue 5)."""
+    """P < 0 is rejected; P = 0 (loss of contact) is allowed with Q = 0 there."""
     harm = {"kind": "harmonic", "mean": 0.5, "amplitude": 0.6, "wavelength": 40.0}
     d = with_value(base_dict(), "load.normal_history", harm)
     d["load"]["tangential"]["value"] = 0.0

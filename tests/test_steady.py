@@ -105,7 +105,7 @@ def test_direct_steady_is_the_qp_marched_limit():
 
     The two limits are the same discrete problem (module docstring), so they differ only by
     the march's stopping distance (MARCH_TOL). Measured: 7.3e-8 μp0, ξ 1.0e-8, p 1.6e-13 p0 with the
-    plain march; 1.9e-11 μp0, ξ 2.9e-12, p 2.3e-13 p0 with the Anderson-accelerated start (issue 18).
+    plain march; 1.9e-11 μp0, ξ 2.9e-12, p 2.3e-13 p0 with the Anderson-accelerated start.
     """
     scene = similar()
     direct, marched = steady(scene, "newton"), steady(scene, "qp-osqp")

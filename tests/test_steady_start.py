@@ -1,4 +1,4 @@
-"""The QP methods' accelerated rolling start (rollqp.methods.steady_start, issue 18).
+"""The QP methods' accelerated rolling start (rollqp.methods.steady_start).
 
 * The march map's Jacobian from the QPs' active sets (MapJacobian) is the map's derivative:
   against finite differences of the map itself, coupled and uncoupled.

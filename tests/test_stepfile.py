@@ -141,6 +141,7 @@ def test_external_daqp_direct_passes_on_coupled_step(coupled):
     assert max(rep.residuals.values()) < 1e-9, "an active-set solver: residual at the sweeps' stopping change"
 
 
+@pytest.mark.integration
 def test_cvxpy_script_passes(similar):
     step, folder = similar[1], similar[2]
     proc = subprocess.run([sys.executable, str(folder / "s3.cvxpy.py")], capture_output=True, text=True, timeout=120)

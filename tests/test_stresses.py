@@ -1,4 +1,4 @@
-"""Subsurface stresses, energy and wear (issue 12; docs/stresses.md).
+"""Subsurface stresses, energy and wear (docs/stresses.md).
 
 The measured numbers behind each tolerance are in docs/stresses.md (``python
 benchmarks/stresses_validation.py``); the tests re-measure the cheap ones.
@@ -14,7 +14,7 @@ from rollqp import closedforms as cf
 from rollqp.cli import main
 from rollqp.energy import balance, steady_identity
 from rollqp.errors import InputError
-from rollqp.stresses import influence_matrices, invariants, stress_components, stress_history
+from rollqp.subsurface import influence_matrices, invariants, stress_components, stress_history
 
 
 def _quad_field(strip, p, t, x, z):

@@ -72,6 +72,7 @@ def _assert_point_equals_run(ds, sw, i):
     assert np.all(np.isnan(point["pt"].values[K1:, :])) and np.all(np.isnan(point["pt"].values[:, n:]))
 
 
+@pytest.mark.integration
 def test_sweep_on_two_workers_equals_each_scene_run_alone(client, tmp_path):
     """Method × friction × mesh: 8 points on 2 worker processes, each bitwise equal to run(scene)."""
     store = tmp_path / "s.zarr"
@@ -99,6 +100,7 @@ def _status(store):
         return None
 
 
+@pytest.mark.integration
 def test_killed_sweep_keeps_its_points_and_a_rerun_computes_only_the_rest(client, tmp_path):
     """SIGKILL the ``rollqp sweep`` process mid-sweep; the stored points stay and are not recomputed."""
     store = tmp_path / "k.zarr"
@@ -139,6 +141,7 @@ def test_killed_sweep_keeps_its_points_and_a_rerun_computes_only_the_rest(client
         _assert_point_equals_run(after, sw, i)
 
 
+@pytest.mark.integration
 def test_worker_killed_mid_sweep_loses_only_its_point_in_flight(client, tmp_path):
     """SIGKILL a busy worker process: its point is computed again elsewhere, every point ends equal."""
     store = tmp_path / "w.zarr"
@@ -167,6 +170,7 @@ def test_worker_killed_mid_sweep_loses_only_its_point_in_flight(client, tmp_path
     client.wait_for_workers(2, timeout=60)  # the nanny restarts the killed worker for the next tests
 
 
+@pytest.mark.integration
 def test_creep_curve_converges_to_carter_at_first_order(client, tmp_path):
     """Q/μP = 0.05 … 0.95 on 40 and 80 quadratic elements: |ξ/ξ_Carter − 1| ≤ 0.25·Le/a_H (the
     documented creepage error is 5.8e-3 at 0.75 on 40 elements, docs/validation.md §5; measured
@@ -278,6 +282,7 @@ def test_cli_errors_are_one_line(capsys, tmp_path, monkeypatch):
     assert not list(tmp_path.iterdir())  # nothing written
 
 
+@pytest.mark.integration
 def test_failed_point_is_stored_with_its_error_and_tried_again_by_a_rerun(client, tmp_path):
     """A point whose solver fails (one Newton iteration allowed) is stored as failed with its
     one-line error; the other point is done; a re-run computes the failed point only."""

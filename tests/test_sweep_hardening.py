@@ -146,8 +146,8 @@ def test_unreachable_scheduler_is_a_one_line_error_within_the_timeout():
     with pytest.raises(InputError, match=r"--scheduler: cannot reach a dask scheduler at 'tcp://127.0.0.1:9' within 1 s"):
         connect("tcp://127.0.0.1:9", timeout=1.0)
     assert time.perf_counter() - t0 < 5
-    for bad in (0, -1, 1000, 2.0, True, 10**5000):
-        with pytest.raises(InputError, match=r"--workers: must be an integer in \[1, ") as err:
+    for bad in (-1, 1000, 2.0, True, 10**5000):
+        with pytest.raises(InputError, match=r"--workers: must be an integer in \[0, ") as err:
             connect(workers=bad)
         assert len(str(err.value)) < 200
     with pytest.raises(InputError, match="--workers: applies to the local cluster only"):
@@ -268,3 +268,38 @@ def test_sweep_scenes_are_built_on_demand_and_equal_replace():
     with pytest.raises(IndexError):
         sw.scenes[6]
     assert sw.facts.states.shape == (6,) and len(sw.facts.q) == 1 and len(sw.facts.x) == 1
+
+
+# --------------------------------------------------------------------------- in this process
+def test_workers_0_runs_the_points_in_this_process_into_the_same_store(tmp_path):
+    """``--workers 0``: no cluster and no dask; the points one after another in this process,
+    written as a cluster's would be (several points per chunk), each bitwise equal to its scene
+    run alone, resumable the same way."""
+    from rollqp.sweep import sweep
+    vary = ["contact.friction=0.1,0.2,0.3", "load.tangential=0.2,0.6"]
+    base = _small().replace(**{"discretization.distance": 1.0})
+    store = tmp_path / "p.zarr"
+    summary = sweep(base, vary, store, workers=0)
+    assert summary.done == 6 and summary.workers == 0 and summary.per_chunk == 2 and "none, this process" in summary.table()
+    xr = pytest.importorskip("xarray")
+    ds = xr.open_zarr(store, chunks=None).load()
+    sw = build_sweep(base, vary)
+    for i in range(6):
+        alone = rollqp.run(sw.scenes[i]).arrays()
+        point = ds.sel(dict(zip(sw.keys, (ds[k].values[j] for k, j in zip(sw.keys, sw.index(i))))))
+        for name in ("pn", "pt", "creepage", "Q", "iterations"):
+            got = point[name].values[tuple(slice(0, n) for n in np.shape(alone[name]))]
+            np.testing.assert_array_equal(got, alone[name])  # bitwise: the same code, one BLAS thread
+    again = sweep(base, vary, store, workers=0)
+    assert again.kept == 6 and again.done == 0
+
+
+def test_workers_0_imports_no_dask(tmp_path):
+    import subprocess
+    import sys
+    code = ("import sys; from rollqp import cli; "
+            "rc = cli.main(['sweep', 'cattaneo-carter', '--vary', 'contact.friction=0.1,0.2', '--vary', "
+            "'discretization.distance=0.5', '--out', 's.zarr', '--workers', '0', '--quiet']); "
+            "print(rc, 'distributed' in sys.modules, 'dask' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert out.stdout.split() == ["0", "False", "False"], out.stderr[-2000:]

@@ -40,7 +40,7 @@ from .cattaneo import cattaneo_stick_half_width, cattaneo_traction
 from .hertz import hertz_half_width, hertz_peak_pressure, hertz_pressure
 from .lame import lame_ring_displacement
 from .mcewen import HERTZ_MAX_SHEAR, hertz_subsurface_stresses, mcewen_stresses
-from .mindlin import mindlin_dissipation, mindlin_traction, mindlin_turning_points
+from .mindlin import mindlin_displacement, mindlin_dissipation, mindlin_traction, mindlin_turning_points
 from .rounded_punch import rounded_punch_half_width, rounded_punch_load, rounded_punch_pressure
 
 __all__ = [
@@ -61,6 +61,7 @@ __all__ = [
     "mindlin_turning_points",
     "mindlin_traction",
     "mindlin_dissipation",
+    "mindlin_displacement",
     "rounded_punch_load",
     "rounded_punch_half_width",
     "rounded_punch_pressure",
@@ -77,7 +78,8 @@ SOURCES: dict[str, str] = {
     "creep_force_ratio": carter.SOURCE + "; " + carter.KALKER,
     "bentall_johnson_creepage": bentall_johnson.SOURCE,
     "lame_ring_displacement": lame.SOURCE,
-    **dict.fromkeys(("mindlin_turning_points", "mindlin_traction", "mindlin_dissipation"), mindlin.SOURCE),
+    **dict.fromkeys(("mindlin_turning_points", "mindlin_traction", "mindlin_dissipation", "mindlin_displacement"),
+                    mindlin.SOURCE),
     **dict.fromkeys(("rounded_punch_load", "rounded_punch_half_width", "rounded_punch_pressure"), rounded_punch.SOURCE),
     **dict.fromkeys(("hertz_subsurface_stresses", "mcewen_stresses"), mcewen.SOURCE),
 }

@@ -137,6 +137,13 @@ def carter_creepage(a, R, mu, ratio):
     ``∂w/∂x = −(2/(πE*))·PV∫ t(s)/(x − s) ds = −(μ/R)·x_c = d·μ(a − c)/R``, so ``s = 0`` gives
     ``ξ = −μ(a − c)/R`` for ``ratio > 0``. Source: Carter (1926); Johnson (1985) Ch. 8, see
     ``SOURCES["carter_creepage"]``.
+
+    Examples
+    --------
+    >>> from rollqp.closedforms import carter_creepage, creep_force_ratio
+    >>> xi = carter_creepage(1.0, 100.0, 0.1, 0.75)
+    >>> round(xi * 1e4, 6), round(float(creep_force_ratio(xi, 1.0, 100.0, 0.1)), 12)
+    (-5.0, 0.75)
     """
     a = _positive("a", a)
     R = _positive("R", R)

@@ -39,6 +39,15 @@ def hertz_half_width(P, R, Estar):
     Sign convention: docs/formulation.md §1 (``p ≥ 0`` compression). Equivalently
     ``p0 = 2P/(πa) = aE*/(2R)``. Source: Hertz (1882); Johnson (1985) Ch. 4, see
     ``SOURCES["hertz_half_width"]``.
+
+    Examples
+    --------
+    The paper's steel rollers (R = 100 mm, E* = 230769 MPa) under 1000 N/mm:
+
+    >>> from rollqp.closedforms import hertz_half_width, hertz_peak_pressure
+    >>> a = hertz_half_width(1000.0, 100.0, 230769.23)
+    >>> round(a, 4), round(hertz_peak_pressure(1000.0, a), 1)
+    (0.7428, 857.1)
     """
     P = _nonnegative("P", P)
     R = _positive("R", R)

@@ -53,7 +53,7 @@ def mcewen_stresses(x, z, a, p0, mu=0.0):
     -------
     (sxx, szz, txz) : floats or ndarrays
         Plane stresses, tension positive, in the body's frame (x along the strip, z into the
-        body), the sign convention of :mod:`rollqp.stresses` (Flamant kernels, Johnson eq. 2.23,
+        body), the sign convention of :mod:`rollqp.subsurface` (Flamant kernels, Johnson eq. 2.23,
         2.25), so ``szz = −p`` and ``txz = −t`` at the surface.
 
     Notes

@@ -1,4 +1,4 @@
-"""Mindlin–Deresiewicz: tangential load paths at constant normal load — turning points, traction and the
+"""Mindlin–Deresiewicz: tangential load paths at constant normal load — turning points, traction, the rigid displacement and the
 energy dissipated per cycle (2D, similar bodies).
 
 Symbols: ``a`` Hertz half-width, ``p0`` peak pressure, ``μ`` Coulomb coefficient, ``ratios`` a path of
@@ -133,3 +133,49 @@ def mindlin_dissipation(ratio, mu, P, Estar):
     mu, P, Estar = _nonnegative("mu", mu), _positive("P", P), _positive("Estar", Estar)
     g = (1.0 - r) * math.log1p(-r) + r - 0.5 * r * r
     return 4.0 * (mu * P) ** 2 / (math.pi * Estar) * g
+
+
+def mindlin_displacement(ratios, mu, P, Estar):
+    """The part of the rigid tangential displacement not linear in Q along a path of ``Q/(μP)`` (2D, Masing).
+
+    On the virgin branch ``u_v(r) = (μP/(πE*))·sgn(r)(1 − |r|)ln(1 − |r|)`` (the 2D Cattaneo
+    compliance of the stick zone, the same expression :func:`mindlin_dissipation` integrates);
+    after turning points the superposition of :func:`mindlin_traction`:
+    ``u = u_v(r_1) + Σ_{i≥2} 2·u_v((r_i − r_{i−1})/2) + 2·u_v((r − r_m)/2)`` over the remembered
+    turning points (:func:`mindlin_turning_points`). The 2D half-space adds to it a part linear in
+    Q and a constant, both set by its reference distance, that do no work over a closed cycle:
+    compare loops with their secant compliance removed (``rollqp run fretting --plot``). Source:
+    ``SOURCES["mindlin_displacement"]``.
+
+    Parameters
+    ----------
+    ratios : sequence of float
+        The path of ``Q/(μP)`` from 0 (each ``|r| < 1``), one value per state.
+    mu, P, Estar : float
+        Friction coefficient (>= 0), normal load per unit length (> 0), contact modulus (> 0).
+
+    Returns
+    -------
+    ndarray
+        ``u`` after each prefix of the path (length units), same length as ``ratios``.
+
+    Examples
+    --------
+    >>> u = mindlin_displacement([0.3, 0.6, 0.0, -0.6, 0.0, 0.6], 0.1, 1000.0, 1.15e5)
+    >>> bool(abs(u[-1] - u[1]) < 1e-15)       # the loop closes at the turning point it left
+    True
+    """
+    vals = [float(v) for v in _ratio_array(ratios).ravel()]
+    mu, P, Estar = _nonnegative("mu", mu), _positive("P", P), _positive("Estar", Estar)
+    c = mu * P / (math.pi * Estar)
+
+    def virgin(r):
+        return c * math.copysign(1.0, r) * (1.0 - abs(r)) * math.log1p(-abs(r))  # odd: u_v(−r) = −u_v(r)
+
+    out = np.empty(len(vals))
+    for j in range(len(vals)):
+        stack, cur = mindlin_turning_points(vals[:j + 1])
+        nodes = stack + [cur]
+        out[j] = sum((1.0 if i == 1 else 2.0) * virgin((nodes[i] - nodes[i - 1]) / (1.0 if i == 1 else 2.0))
+                     for i in range(1, len(nodes)))
+    return out

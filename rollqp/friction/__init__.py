@@ -125,7 +125,7 @@ def parse_friction(value) -> FrictionLaw:
         return Coulomb(number(KEY, value, f">= 0 (and <= {MAX_FRICTION:g}), or a table [contact.friction] with law = "
                                           f"{', '.join(map(repr, LAWS))}", lambda x: 0 <= x <= MAX_FRICTION))
     name = value.get("law")
-    if name not in LAWS:
+    if not isinstance(name, str) or name not in LAWS:  # a list or table is no name (and not hashable)
         raise InputError(f"{KEY}.law", f"must be one of {', '.join(map(repr, LAWS))}, got {name!r}"
                                        + suggestion(name, LAWS))
     cls = LAWS[name]

@@ -54,7 +54,7 @@ class Model:
     profiles : bool
         It takes body profiles (:mod:`rollqp.profiles`: any undeformed gap); False: the round rollers only.
     halfspace_field : bool
-        Its tractions act on a half-space, so the subsurface stresses of :mod:`rollqp.stresses` are its
+        Its tractions act on a half-space, so the subsurface stresses of :mod:`rollqp.subsurface` are its
         own; False: the stresses are a half-space field below its tractions (an approximation, noted).
     report : callable or None
         ``report(meta) -> [(label, text), …]``: rows of a run's summary from the result's ``meta["model"]``.

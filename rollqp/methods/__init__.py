@@ -191,6 +191,9 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
     scene up front, naming the alternatives.
     """
     caps = method.capabilities
+    if caps.dimension != 2:
+        raise InputError("solver.method", f"method {method.name!r} solves {caps.dimension}D steps (its capabilities); "
+                                          "a scene is a two-dimensional rolling contact")
     if coupled and "coupled" in caps.solves and friction not in caps.coupled_friction:
         raise InputError("solver.method", f"method {method.name!r} solves coupled steps with "
                                           f"{' or '.join(sorted(caps.coupled_friction))} friction only; with a "

@@ -155,8 +155,8 @@ class Alternation:
         sol.method, sol.status, sol.iterations = self.name, "solved", outer
         sol.time = time.perf_counter() - t_start
         sol.solver_time = nsol.solver_time + tsol.solver_time
-        sol.info.update(outer=outer, inner_normal=it_n, inner_tangential=it_t, history=history,
-                        limit=self.limit,
+        sol.outer, sol.inner_normal, sol.inner_tangential = outer, it_n, it_t
+        sol.extras.update(history=history, limit=self.limit,
                         # inner counts are meaningful only if the halves' solver reports them
                         iterations_reported=nsol.info.get("iterations_reported", True)
                         and tsol.info.get("iterations_reported", True))

@@ -15,8 +15,8 @@ turn on. rollqp reads the record; it never probes a method for attributes. The k
 ``"normal"``, ``"tangential"``, ``"coupled"``
     the step problems of :mod:`rollqp.problem` (their ``kind``);
 ``"steady"``
-    the non-symmetric steady-rolling tangential/coupled problem (slip ``s = ξ e + d·D_up w``,
-    docs/formulation.md §9), posed directly for a rolling start.
+    the non-symmetric steady-rolling tangential/coupled problem (slip ``s = ξ e + T w``, ``T`` the
+    transient step's fixed point, docs/formulation.md §9), posed directly for a rolling start.
 
 The registry (:mod:`rollqp.methods`) composes methods from these declarations only — a QP
 backend on a coupled scene runs inside the N–T alternation (:class:`~rollqp.methods.alternation.Alternation`);

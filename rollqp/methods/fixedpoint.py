@@ -22,7 +22,8 @@ transient then carried on.
 
 **Polishing.** ``polish(solution)`` (optional) is tried on every iterate whose residual fell: a
 method that converges fast from near a solution (Newton on the slip-dependent step) returns the
-solution, else ``None`` and the fixed point goes on.
+solution, else ``None`` and the fixed point goes on. ``stall_window`` (default ``STALL_WINDOW``) sets
+the window of the cycling test: a caller with other ways to go on (Newton) gives up sooner.
 
 **Failure.** The map contracts only where ``|∂b/∂s|`` is small against the elastic stiffness
 (the falling branch near saturation is where it does not; docs/stability.md): a
@@ -56,7 +57,8 @@ class BoundFixedPoint:
     ``info`` of a solution: ``bound_iterations``, ``bound_history`` (residual per iteration).
     """
 
-    def __init__(self, inner, max_iterations: int = 200, relaxation: float = 1.0, polish=None):
+    def __init__(self, inner, max_iterations: int = 200, relaxation: float = 1.0, polish=None,
+                 stall_window: int = STALL_WINDOW):
         if int(max_iterations) != max_iterations or max_iterations < 1:
             raise InputError("max_iterations", f"must be an integer >= 1, got {max_iterations!r}")
         if not (0.0 < relaxation <= 1.0):
@@ -65,6 +67,7 @@ class BoundFixedPoint:
         self.max_iterations = int(max_iterations)
         self.relaxation = float(relaxation)
         self.polish = polish
+        self.stall_window = int(stall_window)
         self.name = inner.name
         #: the inner method's, with slip-dependent bounds (posed by this fixed point), without the switches of
         #: a march to the steady state (the prediction, the accelerated start: fixed-bound QPs only)
@@ -85,7 +88,7 @@ class BoundFixedPoint:
         mu = law.mu(s)
         history, its, sol = [], 0, warm
         for k in range(1, self.max_iterations + 1):
-            sol = self.inner.solve(problem.replace(mu=mu, law=None), warm=sol)
+            sol = self.inner.solve(self._frozen(problem, mu, history), warm=sol)
             its += sol.iterations
             true = problem.evaluate(sol)
             history.append(true.residual)
@@ -104,10 +107,24 @@ class BoundFixedPoint:
                               f"{history[-1]:.3e} > {self.limit:.1e} after {self.max_iterations} QPs",
                               method=self.name, status="bound iteration limit", residual=history[-1], iterations=its)
         true.method, true.status, true.iterations = self.name, "solved", its
-        true.info.update(sol.info)
-        true.info.update(bound_iterations=len(history), bound_history=history)
+        true.extras.update(sol.extras)  # the last inner solve's statistics and data
+        true.backtracks, true.At = sol.backtracks, sol.At
+        true.extras.update(bound_iterations=len(history), bound_history=history)
         true.time = time.perf_counter() - t0
         return true
+
+    def _frozen(self, problem, mu, history):
+        """The step with the bound frozen at ``mu``; a frozen bound whose sliding limit ``μ fᵀp`` is below ``|Q|``
+        poses no step with stick (an InputError of the step problem): the iteration cannot go on (SolverError)."""
+        try:
+            return problem.replace(mu=mu, law=None)
+        except InputError as err:
+            if err.key != "Q":
+                raise
+            last = history[-1] if history else float("nan")
+            raise SolverError(f"the fixed point on the friction bound reached a bound below the load ({err}); "
+                              "try method newton", method=self.name, status="bound below the load",
+                              residual=last, iterations=len(history)) from None
 
     def _check(self, h, k):
         last = h[-1]
@@ -115,7 +132,7 @@ class BoundFixedPoint:
             raise SolverError(f"the fixed point on the friction bound diverges: residual {last:.3e} after {k} QPs "
                               f"(first {h[0]:.3e}); try method newton", method=self.name, status="diverged",
                               residual=float(last), iterations=k)
-        W = STALL_WINDOW
+        W = self.stall_window
         if len(h) >= 2 * W and min(h[-W:]) > STALL_FACTOR * min(h[:-W]):
             raise SolverError(f"the fixed point on the friction bound cycles: best residual {min(h[-W:]):.3e} over "
                               f"the last {W} QPs, {min(h[:-W]):.3e} before them; try method newton or a smaller "

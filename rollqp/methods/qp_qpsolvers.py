@@ -135,7 +135,7 @@ class QpsolversQP(QPMethod):
         import qpsolvers
         self._qpsolvers = qpsolvers
         if self.solver == "highs":
-            _highs_banner_to_stderr()
+            _discard_highs_banner()
 
     def _problem(self, form):
         n, up, lo, fx = constraint_rows(form)
@@ -179,21 +179,23 @@ class QpsolversQP(QPMethod):
 
 
 @functools.lru_cache(maxsize=None)
-def _highs_banner_to_stderr() -> None:
-    """Build the process's first HiGHS object with the C-level stdout pointed at stderr.
+def _discard_highs_banner() -> None:
+    """Build the process's first HiGHS object with the C-level stdout pointed at the null device.
 
     HiGHS prints its banner (version and licence) on stdout when the first ``Highs`` object of
-    a process is built, before any option can silence it; it would land in rollqp's summary
-    and in anything piped from it. The banner goes to stderr instead, once per process; later
-    objects print nothing (their log is off by ``output_flag``).
+    a process is built, before any option can silence it; it would land in rollqp's summary,
+    in anything piped from it, and on the terminal of ``rollqp crossval`` and ``rollqp bench``.
+    The banner is discarded, once per process (``highspy.__version__`` names the version);
+    later objects print nothing (their log is off by ``output_flag``).
     """
     import ctypes
     import sys
     import highspy
     sys.stdout.flush()
     saved = os.dup(1)
+    null = os.open(os.devnull, os.O_WRONLY)
     try:
-        os.dup2(2, 1)
+        os.dup2(null, 1)
         highspy.Highs()
         try:
             ctypes.CDLL(None).fflush(None)  # the banner sits in C's stdout buffer until flushed
@@ -202,6 +204,7 @@ def _highs_banner_to_stderr() -> None:
     finally:
         os.dup2(saved, 1)
         os.close(saved)
+        os.close(null)
 
 
 def _available(solver: str, package: str) -> bool:

@@ -1,6 +1,6 @@
-r"""The QP methods' rolling start: the march toward steady rolling, accelerated (issue 18).
+r"""The QP methods' rolling start: the march toward steady rolling, accelerated.
 
-A QP method cannot pose the steady rolling problem (its slip operator ``d·D_up·A`` has an
+A QP method cannot pose the steady rolling problem (its slip operator ``T·A``, docs/formulation.md §9, has an
 indefinite weighted symmetric part: no convex QP has it as Hessian), so :func:`rollqp.march`
 reaches the steady state by rolling at constant loads until the tractions stop changing. One
 marching step, as a function of the shear it starts from, is a map ``t ↦ G(t)``: the normal half
@@ -173,7 +173,7 @@ class Anderson:
 def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=None, tol=1e-8,
                       max_evaluations=1000):
     """The state to continue rollqp.march's rolling start from: ``state`` itself unless :func:`applies`,
-    else the best map output (smallest ``max|G(t) − t|``) of the accelerated iteration from the braked
+    else the best map output (smallest ``max|G(t) − t|``) of the accelerated iteration from the
     starting ``state`` (module docstring), as a march ``State``.
 
     ``tol``: the march's tolerance on the change of ``t`` per step, in μp0; the iteration stops at

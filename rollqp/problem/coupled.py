@@ -50,8 +50,9 @@ class CoupledStep:
     Notes
     -----
     ``Atn`` and ``Att`` are the *slip* operators: for transient steps the influence matrices
-    themselves; for steady rolling (``s = ξ e + d·D_up w``) rollqp.march passes
-    ``Δ·d·D_up·A_tn`` and ``Δ·d·D_up·A_tt`` with ``dq = Δ`` and ``c = 0``.
+    themselves; for steady rolling (``s = ξ e + T w``, :meth:`SceneOperators.steady
+    <rollqp.operators.SceneOperators.steady>`) rollqp.march passes ``Δ·T·A_tn`` and ``Δ·T·A_tt`` with
+    ``dq = Δ`` and ``c = 0``.
     """
 
     Ann: np.ndarray               # eq. 25–26

@@ -56,8 +56,24 @@ class StepSolution:
     """The unknowns of one step, how they were obtained, and rollqp's residuals.
 
     Absent parts are ``None`` (``g``/``delta`` for a tangential step, ``t``/``s``/``xi`` for
-    a normal one). ``iterations`` counts the method's own iterations; ``time`` is the wall
-    time of the solve in rollqp (``solver_time`` the external solver's own, if any).
+    a normal one). The statistics every method may report are typed fields (qpsolvers'
+    ``Solution`` style): ``iterations`` counts the method's own iterations; ``time`` is the wall
+    time of the solve in rollqp (``solver_time`` the external solver's own, if any);
+    ``backtracks`` the Armijo step reductions (Newton); ``outer``, ``inner_normal`` and
+    ``inner_tangential`` the outer iterations of the N–T alternation and the iterations of its
+    halves; ``mu`` the friction coefficient at the nodes of a step with a friction law (the next
+    step's memory); ``At`` the pair ``(t, A t)`` when the method computed the product (the march
+    then needs no new one). What is particular to one method or solver (a residual history, the
+    solver's status text, a QP multiplier) is in ``extras`` (``info`` is the same dict).
+
+    Examples
+    --------
+    >>> from rollqp import StepSolution
+    >>> sol = StepSolution(iterations=3, backtracks=1)
+    >>> sol.iterations, sol.backtracks, sol.extras
+    (3, 1, {})
+    >>> sol.info is sol.extras
+    True
     """
 
     p: np.ndarray | None = None
@@ -72,7 +88,18 @@ class StepSolution:
     iterations: int = 0
     time: float = 0.0
     solver_time: float = 0.0
-    info: dict = field(default_factory=dict)
+    extras: dict = field(default_factory=dict)
+    backtracks: int = 0
+    outer: int = 0
+    inner_normal: int = 0
+    inner_tangential: int = 0
+    mu: np.ndarray | None = field(default=None, repr=False)
+    At: tuple | None = field(default=None, repr=False)
+
+    @property
+    def info(self) -> dict:
+        """The method's own data (:attr:`extras`)."""
+        return self.extras
 
     @property
     def residual(self) -> float:

@@ -35,6 +35,15 @@ NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
 
 
 # =========================================================================== names
+def check_units(key: str, v: Any) -> str:
+    """The declared unit system (:data:`rollqp.units.UNIT_SYSTEMS`), or ``""`` for none."""
+    from ..units import UNIT_SYSTEMS
+    if v == "" or v in UNIT_SYSTEMS:
+        return v
+    raise InputError(key, f"must be one of {', '.join(map(repr, UNIT_SYSTEMS))} (the units the scene's numbers "
+                          f"are in; leave it out if none fits), got {v!r}")
+
+
 def check_scene_name(key: str, v: Any) -> str:
     """A scene's name (:data:`NAME_PATTERN`)."""
     v = string(key, v)
@@ -344,7 +353,10 @@ def check_work(scene) -> None:
     matrices, or the matrix-free work space) within the memory this process may use (:func:`memory_limits`) —
     refused before any work, with what they would need. A run's states go to its result file as they come
     (:mod:`rollqp.journal`); a run that keeps them in memory is checked by :func:`check_result_memory`."""
+    from ..advice import fast_path
     from ..matrixfree import check_scene, memory_estimate
+    if fast_path(scene).note is not None:
+        return  # it runs matrix-free (rollqp.advice): the scene it runs as is checked when it is built
     n, K = scene.n_nodes, scene.n_steps
     dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
     need = (scene.memory_estimate() if dense else memory_estimate(scene)) - _result_bytes(n, K + 1)

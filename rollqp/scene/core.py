@@ -41,6 +41,9 @@ class Scene(Derived):
     load : Load
     discretization : Discretization
     solver : SolverSettings
+    units : str
+        The units the numbers are in, for the summary and figures only (:data:`rollqp.units.UNIT_SYSTEMS`:
+        ``"N-mm"``, ``"N-m"``, ``"lbf-in"``; ``""``: not declared). Nothing is converted.
     source : str
         Where the scene came from (a path, ``builtin:<name>`` or ``<dict>``); not compared.
 
@@ -58,6 +61,7 @@ class Scene(Derived):
     load: Load
     discretization: Discretization = field(default_factory=Discretization)
     solver: SolverSettings = field(default_factory=SolverSettings)
+    units: str = ""
     source: str = field(default="<dict>", compare=False)
 
     def __post_init__(self):
@@ -70,6 +74,7 @@ class Scene(Derived):
         put("load", checks.check_load(self.load))
         put("discretization", checks.check_discretization(self.discretization))
         put("solver", checks.check_solver(self.solver))
+        put("units", checks.check_units("units", self.units))
         put("source", str(self.source))
         checks.check_whole(self)
 
@@ -126,7 +131,7 @@ class Scene(Derived):
 
 
 # =========================================================================== from a dict
-_TOP_KEYS = ("name", "description", "bodies", "contact", "load", "discretization", "solver")
+_TOP_KEYS = ("name", "description", "units", "bodies", "contact", "load", "discretization", "solver")
 _SECTIONS: dict[str, type] = {"contact": Contact, "load": Load,
                               "discretization": Discretization, "solver": SolverSettings}
 
@@ -219,7 +224,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     for k in ("tangential", "creepage", "approach", "rolled"):
         if k in ld:
             ld[k] = parse_history(ld[k], f"load.{k}")
-    return Scene(name=d.get("name", default_name), description=d.get("description", ""),
+    return Scene(name=d.get("name", default_name), description=d.get("description", ""), units=d.get("units", ""),
                  A=A, B=B, contact=Contact(**parts["contact"]), load=Load(**ld),
                  discretization=Discretization(**parts["discretization"]),
                  solver=SolverSettings(**parts["solver"]), source=source)

@@ -5,7 +5,7 @@ structure — unknown and missing keys, named with their dotted path and the clo
 and hands the values to :class:`~rollqp.scene.Scene`, which checks them. Nothing read is ever
 executed or used as a path (a scene's name is restricted, docs/scenes.md). Writing
 (:func:`scene_to_dict`, :func:`scene_to_toml`) gives the full scene with its defaults; the TOML
-goes through the ``tomli-w`` library (optional extra ``toml``), floats with ``repr`` precision so
+goes through the ``tomli-w`` library (a core dependency), floats with ``repr`` precision so
 that reading the text back gives an equal scene.
 """
 from __future__ import annotations
@@ -111,6 +111,19 @@ def load_scene(source: Any, overrides: dict | None = None) -> Scene:
     InputError
         ``SCENE`` if no such file or built-in scene exists; the file's path on a TOML syntax
         error; the dotted key on invalid input.
+
+    Examples
+    --------
+    >>> from rollqp import load_scene
+    >>> scene = load_scene("cattaneo-carter")
+    >>> scene.n_nodes, scene.solver.method, scene.contact.friction
+    (81, 'newton', 0.1)
+    >>> scene.replace(**{"discretization.elements": 20}).n_nodes
+    41
+    >>> load_scene("catano-carter")
+    Traceback (most recent call last):
+    ...
+    rollqp.errors.InputError: SCENE: no such file or built-in scene 'catano-carter'; did you mean 'cattaneo-carter'?...
     """
     if isinstance(source, Scene):
         return source.replace(**overrides) if overrides else source

@@ -43,7 +43,7 @@ def scene_to_dict(scene) -> dict:
     ``reference_distance``, the unused one of ``tangential``/``creepage``) are left out,
     since TOML has no null. JSON-serializable; :func:`scene_from_dict` reads it back.
     """
-    return {"name": scene.name, "description": scene.description,
+    return {"name": scene.name, "description": scene.description, **({"units": scene.units} if scene.units else {}),
             "bodies": {"A": part_dict(scene.A), "B": part_dict(scene.B)},
             "contact": part_dict(scene.contact), "load": part_dict(scene.load),
             "discretization": part_dict(scene.discretization), "solver": part_dict(scene.solver)}

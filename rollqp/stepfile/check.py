@@ -37,25 +37,22 @@ def solve_stored(step: StepFile, method: str, tolerance: float = 1e-10) -> StepS
 
     Uncoupled steps: the normal half, then the tangential half at its pressure (as the march
     does). Coupled steps: Newton on the coupled problem; ``nt-newton`` and the QP backends by
-    the N–T alternation (paper §6.3). ``info`` holds ``iterations_normal`` and
-    ``iterations_tangential`` (inner iterations) besides the method's own.
+    the N–T alternation (paper §6.3). ``inner_normal`` and ``inner_tangential`` count the iterations of
+    the halves.
     """
     from ..methods import compose, get_method
     pb = step.problem()
     meth = compose(get_method(method, tolerance=tolerance), pb.Ant is not None)
     warm = step.previous() if np.any(step.prev_p) else None  # none before the first load increment
     if pb.Ant is not None:
-        sol = meth.solve(pb, warm=warm)
-        sol.info.setdefault("inner_normal", 0)
-        sol.info.setdefault("inner_tangential", 0)
-        return sol
+        return meth.solve(pb, warm=warm)
     nsol = meth.solve(pb.normal_half(np.zeros(pb.n)), warm=warm)
     tsol = meth.solve(pb.tangential_half(nsol.p), warm=warm)
     sol = pb.solution(nsol.p, tsol.t, nsol.delta, tsol.xi, method=method, iterations=nsol.iterations + tsol.iterations,
-                      time=nsol.time + tsol.time, solver_time=nsol.solver_time + tsol.solver_time)
-    sol.info.update(inner_normal=nsol.iterations, inner_tangential=tsol.iterations,
-                    iterations_reported=nsol.info.get("iterations_reported", True)
-                    and tsol.info.get("iterations_reported", True))
+                      time=nsol.time + tsol.time, solver_time=nsol.solver_time + tsol.solver_time,
+                      inner_normal=nsol.iterations, inner_tangential=tsol.iterations)
+    sol.extras.update(iterations_reported=nsol.extras.get("iterations_reported", True)
+                      and tsol.extras.get("iterations_reported", True))
     return sol
 
 

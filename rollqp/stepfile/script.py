@@ -33,6 +33,7 @@ step) and the friction bound mu·max(p, 0). Each sweep is one QP per half, from 
 """
 import os
 import sys
+import warnings
 
 import cvxpy as cp
 import numpy as np
@@ -41,6 +42,7 @@ here = os.path.dirname(os.path.abspath(__file__))
 path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(here, @STEPFILE_LITERAL@)
 z = dict(np.load(path, allow_pickle=False))
 TOL = 1e-11  # change of x (p/p0, t/p0) per sweep at which the iteration stops
+INACCURATE = [0]  # QPs cvxpy reported "optimal_inaccurate" (Clarabel close to, not at, its 1e-12 tolerances)
 
 
 def half(name):
@@ -60,12 +62,16 @@ def build(d):
         q.value, lb.value, ub.value = q_value, lo, np.minimum(up, big)
         for tol in (1e-12, 1e-10, 1e-8):  # tight first (never the defaults); looser if Clarabel stalls
             try:
-                prob.solve(solver=cp.CLARABEL, tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, tol_ktratio=1e-6)
+                with warnings.catch_warnings():  # "optimal_inaccurate" is counted below, not warned per QP
+                    warnings.simplefilter("ignore", UserWarning)
+                    prob.solve(solver=cp.CLARABEL, tol_gap_abs=tol, tol_gap_rel=tol, tol_feas=tol, tol_ktratio=1e-6)
                 break
             except cp.error.SolverError:
                 continue
         if prob.status not in ("optimal", "optimal_inaccurate"):
             raise SystemExit(f"cvxpy: {prob.status}")
+        # Clarabel stopped short of 1e-12 but close ("almost solved"): kept, and rollqp check-step judges the result
+        INACCURATE[0] += prob.status == "optimal_inaccurate"
         return x.value.copy(), (float(eq[0].dual_value[0]) if eq else 0.0)
 
     return solve
@@ -86,7 +92,8 @@ for it in range(500):
     p, t = p_new, t_new
     if change < TOL:
         break
-print(f"{it + 1} sweeps, last change {change:.1e}")
+print(f"{it + 1} sweeps, last change {change:.1e}"
+      + (f"; {INACCURATE[0]} of {2 * (it + 1)} QPs near, not at, Clarabel's 1e-12 tolerances" if INACCURATE[0] else ""))
 out = {"p": p * N["x_scale"], "t": t * T["x_scale"]}
 if N["A"].shape[0]:
     out["delta"] = yn * float(N["y_scale"])

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 
 from ..errors import InputError
 
-__all__ = ["connect", "check_scheduler", "close_client", "compute_point", "compute_points", "run_sweep", "iter_jobs",
+__all__ = ["connect", "check_scheduler", "close_client", "InProcess", "compute_point", "compute_points", "run_sweep", "iter_jobs",
            "map_jobs", "Summary", "Progress", "CONNECT_TIMEOUT", "HANDSHAKE_BYTES"]
 
 #: Seconds to reach a scheduler given by ``--scheduler`` (and read its handshake) before giving up.
@@ -52,6 +52,17 @@ SCATTER_BYTES = 64 * 1024
 #: BLAS/OpenMP thread variables set to 1 in the local workers' environment.
 _THREAD_ENV = {k: "1" for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
 _SCHEMES = ("tcp", "tls", "inproc")
+#: dask settings of the local cluster (its processes read them when they start). The workers'
+#: statistical profiler samples the task thread's stack every 10 ms: time taken from the points
+#: (the GIL), for a profile nobody reads here. dask's own monitors (the event loops' tick every
+#: 20 ms, the system monitor every 0.5 s, the memory monitor every 0.1 s) cost an idle 2-worker
+#: cluster 7.4 % of a core (3.7 % in the workers, 3.7 % in the client; psutil's CPU times over
+#: 10 s), 2.2 % at the intervals below: CPU that a machine shared by session (Linux's
+#: autogroup) takes from the points.
+_LOCAL_CONFIG = {"distributed.worker.profile.enabled": False,
+                 "distributed.admin.tick.interval": "200ms",
+                 "distributed.admin.system-monitor.interval": "2s",
+                 "distributed.worker.memory.monitor-interval": "1s"}
 
 
 def _dask():
@@ -173,10 +184,48 @@ def check_scheduler(address, timeout: float = CONNECT_TIMEOUT) -> str:
     return address
 
 
+class InProcess:
+    """What :func:`run_sweep` and :func:`iter_jobs` ask of a dask ``Client``, done in this process
+    (``--workers 0``): each task runs when its result is asked for, one after another. No
+    cluster to start and no dask imported: a sweep of a few seconds of points, or one on a
+    machine whose cores are busy, is done sooner so (docs/sweeps.md)."""
+
+    def scheduler_info(self) -> dict:
+        return {"workers": {}}
+
+    def submit(self, fn, *args, key=None, pure=None):
+        return _Deferred(fn, args)
+
+    def scatter(self, data, **kwargs):
+        return data
+
+    def cancel(self, futures) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+
+class _Deferred:
+    """A task of :class:`InProcess`: run once, when its result is first asked for."""
+
+    def __init__(self, fn, args):
+        self.fn, self.args, self.out = fn, args, None
+
+    def result(self):
+        if self.fn is not None:
+            self.out, self.fn, self.args = self.fn(*self.args), None, None
+        return self.out
+
+    def done(self) -> bool:
+        return self.fn is None
+
+
 def connect(scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT):
     """A ``distributed.Client``: to ``scheduler`` (an address such as ``tcp://host:8786``, checked by
     :func:`check_scheduler`), or to a new ``LocalCluster`` of ``workers`` single-threaded
-    worker processes (default: one per core).
+    worker processes (default: one per core); ``workers = 0``: an :class:`InProcess` client
+    (the points run in this process, no cluster).
 
     Raises
     ------
@@ -185,6 +234,8 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
         seconds; ``--workers``: not in [1, :data:`MAX_WORKERS_PER_CORE` × cores], or given
         with ``--scheduler``.
     """
+    if scheduler is None and workers == 0 and not isinstance(workers, bool):
+        return InProcess()
     distributed = _dask()
     if scheduler is not None:
         if workers is not None:
@@ -199,18 +250,17 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
     cores = os.cpu_count() or 1
     n = cores if workers is None else workers
     if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_WORKERS_PER_CORE * cores:
-        raise InputError("--workers", f"must be an integer in [1, {MAX_WORKERS_PER_CORE * cores}] "
-                                      f"({MAX_WORKERS_PER_CORE} per core of this machine), got {_short(workers)}")
+        raise InputError("--workers", f"must be an integer in [0, {MAX_WORKERS_PER_CORE * cores}] "
+                                      f"(0: in this process, no cluster; at most {MAX_WORKERS_PER_CORE} per core of "
+                                      f"this machine), got {_short(workers)}")
     import dask
-    # the workers' statistical profiler samples the task thread's stack every 10 ms: time
-    # taken from the points (the GIL), for a profile nobody reads here
-    with dask.config.set({"distributed.worker.profile.enabled": False}):
+    with dask.config.set(_LOCAL_CONFIG):
         # no dashboard; the scheduler's HTTP server (which it always starts) on a port the
         # system picks, so that another cluster on 8787 makes no warning
         cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                            dashboard_address="127.0.0.1:0", scheduler_kwargs={"dashboard": False},
                                            env=dict(_THREAD_ENV), silence_logs=50)
-    return distributed.Client(cluster)
+        return distributed.Client(cluster)
 
 
 def _short(value, n: int = 80) -> str:
@@ -220,22 +270,23 @@ def _short(value, n: int = 80) -> str:
 
 def compute_point(scene) -> dict:
     """Run one scene (a :class:`~rollqp.scene.Scene` or its dict) on a worker: ``{"arrays", "time",
-    "worker"}``, or ``{"error", "time", "worker"}`` with its one-line error."""
+    "cpu", "worker"}`` (wall and CPU seconds of the worker's process), or ``{"error", "time", "cpu",
+    "worker"}`` with its one-line error."""
     from threadpoolctl import threadpool_limits
 
     from ..march import run
     from ..scene import scene_from_dict
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     worker = f"{socket.gethostname()}:{os.getpid()}"
     with threadpool_limits(limits=1):
         try:
             result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene)
         except Exception as err:  # an input the method cannot run, or a bug: one line, the sweep goes on
             return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0,
-                    "worker": worker}
+                    "cpu": time.process_time() - c0, "worker": worker}
     arrays = result.arrays()
     arrays.pop("meta")
-    return {"arrays": arrays, "time": time.perf_counter() - t0, "worker": worker}
+    return {"arrays": arrays, "time": time.perf_counter() - t0, "cpu": time.process_time() - c0, "worker": worker}
 
 
 def compute_points(base, points) -> list:
@@ -278,6 +329,7 @@ class Summary:
     failed: list = field(default_factory=list)
     wall: float = 0.0
     point_times: list = field(default_factory=list)
+    point_cpu: list = field(default_factory=list)
     interrupted: bool = False
     startup: float = 0.0
     prepare: float = 0.0
@@ -294,7 +346,8 @@ class Summary:
         rows = [("points", str(self.total)), ("kept from the store", str(self.kept)),
                 ("computed now", str(self.done)), ("failed", str(len(self.failed))),
                 ("missing", str(self.total - self.kept - self.done - len(self.failed))),
-                ("workers", f"{self.workers} ({self.per_chunk} point{'s' if self.per_chunk > 1 else ''} per task)"),
+                ("workers", f"{self.workers or 'none, this process'} ({self.per_chunk} point{'s' if self.per_chunk > 1 else ''} "
+                            "per task)"),
                 ("validation and store", f"{self.prepare:.2f} s"),
                 ("cluster start", f"{self.startup:.2f} s"),
                 ("wall time of the points", f"{self.wall:.2f} s"),
@@ -375,7 +428,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     the rest.
     """
     from .dataset import StoreWriter
-    distributed = _dask()
+    as_completed = iter if isinstance(client, InProcess) else _dask().as_completed
     writer = StoreWriter(group, sweep)
     tasks = writer.tasks(status)
     todo = sum(len(t) for t in tasks)
@@ -386,7 +439,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     futures, n = {}, 0
     try:
         futures = _submit(client, sweep, tasks)
-        for fut in distributed.as_completed(futures):
+        for fut in as_completed(list(futures)):
             points = futures.pop(fut)
             outs = fut.result()
             writer.write(points, outs)
@@ -396,6 +449,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
                 else:
                     summary.failed.append((sweep.label(i), out["error"]))
                 summary.point_times.append(out["time"])
+                summary.point_cpu.append(out.get("cpu", float("nan")))
                 if on_point is not None:
                     on_point(i, out)
             n += len(points)

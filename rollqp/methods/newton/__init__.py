@@ -314,7 +314,8 @@ class NewtonMethod:
     def finish(self, sol, it, info, t0):
         """Label a solution with the method, its iterations, ``info`` and the wall time since ``t0``."""
         sol.method, sol.status, sol.iterations = self.name, "solved", it
-        sol.info.update(info)
+        sol.backtracks = int(info.pop("backtracks", 0))
+        sol.extras.update(info)
         sol.time = time.perf_counter() - t0
         return sol
 

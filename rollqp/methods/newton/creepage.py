@@ -16,7 +16,7 @@ from .uncoupled import solve_tangential, solve_uncoupled
 __all__ = ["tangential_by_creepage"]
 
 
-def tangential_by_creepage(meth, pb, warm, t0, err):
+def tangential_by_creepage(meth, pb, warm, t0, err, slip_solve=None):
     r"""Fallback when GNMls fails on a tangential step with ``Q`` prescribed: solve for ``ξ``.
 
     The failure this repairs: with a single stick node (free rolling at μ ≲ 3e-4) the load
@@ -30,8 +30,10 @@ def tangential_by_creepage(meth, pb, warm, t0, err):
     iterations on the right active set); if that fails too, the ξ-prescribed solution at the
     root is kept when rollqp's residual of the original problem is within tolerance.
     Counted in ``info["creepage_search"]`` (evaluations). Otherwise ``err`` is raised.
+    ``slip_solve(meth, problem, warm, t0)``: the ξ-prescribed solve of a slip-dependent bound (default
+    :func:`~.slip.solve_slip`; the safeguarded step passes itself, :mod:`.slip_step`).
     """
-    search = _CreepageSearch(meth, pb, warm, t0, int(err.iterations or 0))
+    search = _CreepageSearch(meth, pb, warm, t0, int(err.iterations or 0), slip_solve)
     try:
         at_root = search.root()
     except (SolverError, ValueError, RuntimeError):  # a ξ-prescribed solve failed, or Brent did not converge
@@ -47,7 +49,7 @@ def tangential_by_creepage(meth, pb, warm, t0, err):
         sol = pb.solution(at_root.t, at_root.xi)
         if not sol.residual <= meth.tolerance:
             raise err from None
-        sol = meth.finish(sol, at_root.iterations, dict(at_root.info), t0)
+        sol = meth.finish(sol, at_root.iterations, dict(at_root.extras, backtracks=at_root.backtracks), t0)
     sol.info["creepage_search"] = search.evals + 1
     sol.iterations += search.its + at_root.iterations  # all Newton iterations of the step
     return sol
@@ -56,8 +58,10 @@ def tangential_by_creepage(meth, pb, warm, t0, err):
 class _CreepageSearch:
     """The root search of :func:`tangential_by_creepage` on ``F(ξ̂) = f̂ᵀt̂(ξ̂) − Q̂``."""
 
-    def __init__(self, meth, pb, warm, t0, its):
+    def __init__(self, meth, pb, warm, t0, its, slip_solve=None):
         self.meth, self.pb, self.t0 = meth, pb, t0
+        #: the ξ-prescribed slip-dependent solve (the safeguarded step, :mod:`.slip_step`; default plain Newton)
+        self.slip_solve = slip_solve or (lambda meth, sub, warm, t0: meth.checked(solve_slip(meth, sub, warm, t0)))
         self.sol, self.evals, self.its = warm, 0, its
         sc = pb.scales
         self.Qhat = pb.Q / sc.force
@@ -66,8 +70,8 @@ class _CreepageSearch:
     def solve_at(self, xh):
         sc = self.pb.scales
         sub = self.pb.replace(Q=None, xi=xh * sc.slip)
-        if sub.law is not None:  # a slip-dependent bound (rollqp.methods.newton.slip)
-            return self.meth.checked(solve_slip(self.meth, sub, self.sol, self.t0))
+        if sub.law is not None:  # a slip-dependent bound: safeguarded like the step itself (rollqp.methods.newton.slip)
+            return self.slip_solve(self.meth, sub, self.sol, self.t0)
         return solve_uncoupled(self.meth, sub, self.sol, self.t0)
 
     def F(self, xh):

@@ -42,8 +42,18 @@ its inner method, trying this iteration from each fixed-point iterate that impro
 iterations from near a solution, quadratic), then a cold start, then the creepage search. A step
 none of them solves is a :class:`~rollqp.errors.SolverError` naming the residual.
 
-Falling friction can make the step non-unique (docs/theory.md): the iteration finds the solution
-its start leads to — the previous step's, and then the fixed point's from the previous slip.
+**Which solution.** Falling friction can make the step non-unique (docs/theory.md). A solution is
+taken as it is found only if the falling law makes none of its modes unstable
+(:func:`unstable_modes`: no real eigenvalue ``<= 0`` of ``J_f⁻¹ J``, ``J_f`` the pseudo-Jacobian with the
+bound frozen) — the solution lies on the branch that grows continuously from the frozen bound as the
+law's slope is switched on, the only kind the fixed point on the bound can converge to (it contracts
+only where the spectral radius of its map is below 1, and ``J_f⁻¹ J = I − (that map's derivative)`` on
+the slipping nodes). Measured on a ramped transient (exponential law, ``v_h = 10`` mm/s, ``V = 10``
+m/s, step 43): the warm Newton iteration converged to a solution with one unstable mode, 0.19 μ_s p0
+from the previous state; the fixed point's, 0.15 away, has none, and is the one now returned. A
+solution with unstable modes is returned only when no attempt finds another (``info["unstable"]``).
+Steeper laws can have several stable solutions of one step; then the first attempt that finds one
+decides (docs/friction.md, "Newton against the QP fixed point over the velocity scale").
 """
 from __future__ import annotations
 
@@ -53,11 +63,19 @@ from ...errors import SolverError
 from ...problem import friction_residual
 from .common import ALPHA_MIN, not_converged
 
-__all__ = ["solve_slip", "POLISH_ITERATIONS"]
+__all__ = ["solve_slip", "unstable_modes", "POLISH_ITERATIONS", "FIXED_POINT_WINDOW"]
 
 #: Newton iterations allowed when polishing a fixed-point iterate (quadratic convergence from near a
 #: solution takes a handful; more means the iterate is not near enough yet).
 POLISH_ITERATIONS = 25
+#: An iteration whose merit fell by less than 10 % over its last ``STALL_ITERATIONS`` iterations stalls (short
+#: steps on a kink of a non-monotone law, measured on CONTACT's problem at 45 m/s: θ 4.8e-4 → 4.3e-4 over
+#: 150 iterations, 2.3 s, where the fixed point then solved the step in 0.02 s): the next attempt is taken.
+STALL_ITERATIONS = 10
+STALL_DECREASE = 0.9
+#: The fixed point inside the step is given up when its best residual over this many iterations is not 10 %
+#: below the best before them (the map does not contract there; a cold start and the creepage search remain).
+FIXED_POINT_WINDOW = 20
 
 
 class _SlipRows:
@@ -126,10 +144,11 @@ class _SlipRows:
         return z, j
 
 
-def solve_slip(meth, pb, warm, t0, max_iterations=None):
+def solve_slip(meth, pb, warm, t0, max_iterations=None, stall=True):
     """GNMls on the slip-dependent tangential step (module docstring) from ``warm`` (else zero shear).
 
-    ``meth`` is the Newton method; ``max_iterations`` (default the method's) bounds the iterations.
+    ``meth`` is the Newton method; ``max_iterations`` (default the method's) bounds the iterations; ``stall``:
+    give up an iteration that stalls (:data:`STALL_ITERATIONS`; the last attempt of a step runs to the limit).
     Raises :class:`~rollqp.errors.SolverError` on a singular matrix, a failed search or the limit."""
     sc = pb.scales
     dqh = pb.dq / sc.length
@@ -144,14 +163,14 @@ def solve_slip(meth, pb, warm, t0, max_iterations=None):
         t, start = np.asarray(warm.t, dtype=float) / sc.stress, "warm"
         xi0 = warm.xi / sc.slip if warm.xi is not None else 0.0
     z = np.append(t, xi0) if with_load else t.copy()
-    z, it, info = _iterate(meth, pb, rows, z, meth.max_iterations if max_iterations is None else max_iterations)
+    z, it, info = _iterate(meth, pb, rows, z, meth.max_iterations if max_iterations is None else max_iterations, stall)
     info["start"] = start
     tt = z[:n] * sc.stress
     xi = z[n] * sc.slip if with_load else pb.xi
     return meth.finish(pb.solution(tt, xi), it, info, t0)
 
 
-def _iterate(meth, pb, rows, z, max_iterations):
+def _iterate(meth, pb, rows, z, max_iterations, stall=True):
     """Newton directions on the dense pseudo-Jacobian with the Armijo search (eq. 74–79)."""
     stop = meth.tolerance * min(1.0, rows.r)
     x, y, s, b, phi = rows.at(z)
@@ -165,6 +184,10 @@ def _iterate(meth, pb, rows, z, max_iterations):
             break
         if it >= max_iterations:
             raise not_converged(meth, "slip-dependent tangential", merits, it, nrm, stop)
+        if stall and it >= STALL_ITERATIONS and merits[-1] > STALL_DECREASE * merits[-1 - STALL_ITERATIONS]:
+            raise SolverError(f"the slip-dependent tangential Newton iteration stalls: merit θ = {merits[-1]:.3e}, "
+                              f"{merits[-1 - STALL_ITERATIONS]:.3e} {STALL_ITERATIONS} iterations before",
+                              method=meth.name, status="stalled", iterations=it, residual=nrm)
         it += 1
         stick = rows.stick(x, y, b)
         if rows.with_load and not stick.any():  # the degenerate iterate (module docstring)
@@ -205,3 +228,56 @@ def _direction(J, phi):
     except np.linalg.LinAlgError:
         return None
     return d if np.isfinite(d).all() else None
+
+
+def _rows(meth, pb):
+    """:class:`_SlipRows` of ``pb`` and the unknowns ``z`` of a solution of it (``z(sol)``)."""
+    sc = pb.scales
+    dqh = pb.dq / sc.length
+    sys_ = meth.system(pb, dqh)
+    with_load = pb.Q is not None
+    xi_fixed = None if with_load else pb.xi / sc.slip
+    k0 = sys_.r * (pb.c / sc.displacement / dqh + (xi_fixed if xi_fixed is not None else 0.0))
+    rows = _SlipRows(pb, sys_, with_load, pb.Q / sc.force if with_load else None, k0)
+
+    def z(sol):
+        t = np.asarray(sol.t, dtype=float) / sc.stress
+        return np.append(t, sol.xi / sc.slip) if with_load else t
+    return rows, z
+
+
+def unstable_modes(meth, pb, sol) -> int:
+    r"""How many modes of the solution ``sol`` the falling law makes unstable: the real eigenvalues ``<= 0`` of
+    ``J_f⁻¹ J`` (module docstring, "Which solution").
+
+    ``J`` is the pseudo-Jacobian at ``sol`` (eq. 88s) and ``J_f`` the same with the bound frozen (``μ' = 0``:
+    the slip rows identity rows). Along the homotopy ``J(λ) = J_f + λ (J − J_f)`` from the frozen bound
+    (``λ = 0``) to the law (``λ = 1``), ``det J(λ) = det J_f ∏ (1 + λ(e_i − 1))`` vanishes for some
+    ``λ ∈ (0, 1]`` exactly when an eigenvalue ``e_i`` of ``J_f⁻¹ J`` is real and ``<= 0``: the solution then
+    lies past a fold of the branch that grows from the frozen bound as the law's slope is switched on.
+    ``J − J_f`` is nonzero on the slipping rows only, so the nontrivial ``e_i`` are ``1 + eig(C J_f⁻¹ E)``
+    (``C`` those rows of ``J − J_f``, ``E`` their unit columns): an ``m × m`` eigenproblem, ``m`` the
+    slipping nodes. 0 when no node slips, the law is flat there, or ``J_f`` is singular (no node sticks with
+    the load row: the frozen step is degenerate and tells nothing)."""
+    rows, z = _rows(meth, pb)
+    x, y, s, b, _ = rows.at(z(sol))
+    stick = rows.stick(x, y, b)
+    isl = np.flatnonzero(~stick & (b > 0.0))
+    if isl.size == 0 or (rows.with_load and not stick.any()):
+        return 0
+    J = rows.jacobian(x, y, s, b, stick)
+    N = J.shape[1]
+    C = J[isl] - np.eye(rows.n, N)[isl]
+    if not np.any(C):
+        return 0
+    Jf = J.copy()
+    Jf[isl] = np.eye(rows.n, N)[isl]
+    E = np.zeros((N, isl.size))
+    E[isl, np.arange(isl.size)] = 1.0
+    try:
+        X = np.linalg.solve(Jf, E)
+    except np.linalg.LinAlgError:
+        return 0
+    e = 1.0 + np.linalg.eigvals(C @ X)
+    real = np.abs(e.imag) <= 1e-12 * np.maximum(1.0, np.abs(e.real))
+    return int(np.count_nonzero(real & (e.real <= 0.0)))

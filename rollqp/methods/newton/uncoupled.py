@@ -115,7 +115,7 @@ def solve_tangential(meth, pb, warm, t0):
     info["start"] = start
     sol = pb.solution(tt, xi, At=At)
     sys_.last = (sol.t, At)
-    info["At"] = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
+    sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
 
 

@@ -18,16 +18,14 @@ arctangent and logarithm differences as one ``atan2`` and one ``log``). Out of p
 ``σyy = ν(σxx + σzz)`` (plane strain) with the body's own ν; the equivalents (principal stresses,
 the in-plane maximum shear τ1, von Mises and Tresca) follow (:func:`invariants`).
 
-``rollqp.stresses(result, step, grid)`` is the post-processing step of docs/architecture.md: it
-rebuilds the strip from the scene stored in the result file. The module itself is callable (calling
-it calls :func:`stresses`), so that ``rollqp.stresses(...)`` and ``rollqp.stresses.stress_history``
-(or ``import rollqp.stresses as S``) both work. BEM scenes use the same half-space
+``rollqp.stresses(result, step, grid)`` (:func:`stresses`, exported by the package) is the
+post-processing step of docs/architecture.md: it rebuilds the strip from the scene stored in the
+result file; the rest of this module (``rollqp.subsurface``) is the fields, their history over a run
+and the figures. BEM scenes use the same half-space
 field from their BEM tractions; the approximation and its size are in docs/stresses.md §4.
 """
 from __future__ import annotations
 
-import sys
-import types
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -452,13 +450,3 @@ def summary_rows(sf: StressField, p0: float, a: float) -> list[tuple[str, str]]:
              "s3": "peak compression s3"}
     return [(label, f"{sf.maxima[k][0] / p0:.4f} p0 at x = {sf.maxima[k][1] / a:.4f} a_H, "
                     f"z = {sf.maxima[k][2] / a:.4f} a_H") for k, label in names.items()]
-
-
-class _CallableModule(types.ModuleType):
-    """This module's type: calling ``rollqp.stresses(...)`` calls :func:`stresses` (module docstring)."""
-
-    def __call__(self, result, step: int, grid=None, body: str = "A") -> StressField:
-        return stresses(result, step, grid, body)
-
-
-sys.modules[__name__].__class__ = _CallableModule
