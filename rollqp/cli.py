@@ -253,7 +253,7 @@ def cmd_run(args) -> int:
     cb, close = _progress(args.quiet)
     if not args.quiet:
         _advise(scene)
-        cb = estimate_progress(cb, scene.n_steps - (0 if resume is None else len(resume["q"]) - 1))
+        cb = estimate_progress(cb, scene.n_steps - (0 if source is None else max(source.last, 0)))
     keep, observe = _spot_steps(args, scene)
     t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
@@ -262,6 +262,9 @@ def cmd_run(args) -> int:
             try:
                 result = run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
             except KeyboardInterrupt as err:
+                # the run is over and its states are written: a later Ctrl-C or SIGTERM must not cut the exit short
+                signal.signal(signal.SIGINT, signal.SIG_IGN)
+                previous = signal.SIG_IGN  # (SIGTERM's, set below)
                 close()
                 print(f"rollqp: {_saved(err, out, 'interrupted')}", file=sys.stderr)
                 return EXIT_TERMINATED if isinstance(err, Terminated) else EXIT_INTERRUPTED

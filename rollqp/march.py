@@ -590,7 +590,7 @@ def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1) -> St
     tsol = StepSolution(t=t, s=np.array(arrays["slip"][row], dtype=float), xi=float(arrays["creepage"][row]),
                         method="resumed", status="resumed")
     if "friction_coefficient" in arrays:  # a friction law's memory: the next step's μ starts from it
-        tsol.info["mu"] = np.array(arrays["friction_coefficient"][row], dtype=float)
+        tsol.mu = np.array(arrays["friction_coefficient"][row], dtype=float)
     return State(p, t, ops.w(p, t), nsol, tsol, None)
 
 

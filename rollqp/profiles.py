@@ -145,7 +145,9 @@ class Flat(Feature):
     def height(self, s):
         u = np.asarray(s, dtype=float) - self.position
         half = 0.5 * self.length
-        return np.where(np.abs(u) < half, (half * half - u * u) / (2.0 * self.radius), 0.0)
+        inside = np.abs(u) < half
+        u = np.where(inside, u, 0.0)  # far from the flat (a position of 1e308): no u² to overflow
+        return np.where(inside, (half * half - u * u) / (2.0 * self.radius), 0.0)
 
     def extent(self):
         return self.position - 0.5 * self.length, self.position + 0.5 * self.length
@@ -169,7 +171,8 @@ class Defect(Feature):
     kind: ClassVar[str] = "defect"
 
     def height(self, s):
-        u = 2.0 * (np.asarray(s, dtype=float) - self.position) / self.width
+        with np.errstate(over="ignore"):  # far from the defect u overflows to ±inf: outside, as it should be
+            u = 2.0 * (np.asarray(s, dtype=float) - self.position) / self.width
         inside = np.abs(u) < 1.0
         return np.where(inside, self.depth * DEFECT_SHAPES[self.shape](np.where(inside, u, 0.0)), 0.0)
 
@@ -293,7 +296,7 @@ def parse_profile(obj: Any, key: str, radius: float, folder: str | os.PathLike |
 
 def _parse_one(item: dict, key: str, radius: float, folder):
     kind = item.get("kind")
-    if kind not in FEATURE_KINDS:
+    if not isinstance(kind, str) or kind not in FEATURE_KINDS:  # a list or a table is no kind (nor hashable)
         raise InputError(f"{key}.kind", f"must be one of {', '.join(map(repr, FEATURE_KINDS))}, got {kind!r}"
                          + suggestion(kind, FEATURE_KINDS))
     for k in item:

@@ -53,11 +53,9 @@ MAP_ABOVE = 1 << 20
 BLOCK_BYTES = 2 << 20
 
 
-def _meta_limit() -> int:
-    """Longest ``meta`` text read: a valid scene file (16 MiB of TOML, its tables stored as arrays)
-    and 1 MiB for the model's data, versions and notes."""
-    from .scene.io import MAX_FILE_BYTES
-    return MAX_FILE_BYTES + (1 << 20)
+#: Longest ``meta`` text read: a valid scene file (16 MiB of TOML: ``rollqp.scene.io.MAX_FILE_BYTES``, its long
+#: lists stored as arrays) and 1 MiB for the model's data, versions and notes (a test holds them equal).
+META_LIMIT = (16 << 20) + (1 << 20)
 
 
 #: Longest array referenced from ``meta`` (a profile table of a million points, a list of a million steps).
@@ -792,7 +790,7 @@ def load_result(path, arg: str = "RESULT.npz", map_above: int | None = MAP_ABOVE
         if st.dtype.kind not in "iu" or (K1 and st[0] < 0) or np.any(np.diff(st) <= 0):
             raise InputError(arg, "key 'step' must hold increasing whole numbers >= 0 (the stored states' indices)")
     try:
-        meta = json.loads(text_value(z, "meta", arg, limit=_meta_limit()))
+        meta = json.loads(text_value(z, "meta", arg, limit=META_LIMIT))
     except (json.JSONDecodeError, RecursionError) as exc:
         raise InputError(arg, f"key 'meta' must be a JSON string ({type(exc).__name__})") from exc
     if not isinstance(meta, dict):
@@ -853,7 +851,7 @@ class ResumeSource:
         if journal is not None:
             head = journal.header["arrays"]
             from .npzfile import text_value
-            meta = decode_meta(json.loads(text_value(head, "meta", arg, limit=_meta_limit())), head, arg)
+            meta = decode_meta(json.loads(text_value(head, "meta", arg, limit=META_LIMIT)), head, arg)
             for k, notes in journal.notes:
                 _apply_notes(meta, k, notes)
             self.meta, self.keep_every = meta, int(journal.header["info"].get("keep_every", 1))
