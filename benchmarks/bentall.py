@@ -276,7 +276,7 @@ class AndersonOnly(Alternation):
 
 
 class FullAlternation(PlainMarch):
-    """The plain march with the alternation converged at every step (the march before the accelerated start)."""
+    """The plain march with the alternation converged at every step."""
 
     def __init__(self, *args, **kw):
         super().__init__(*args, **kw)  # rollqp.march then never switches to one sweep per step
@@ -320,14 +320,15 @@ def section_start():
     print("#### The coupled rolling start with the QP methods (CONTACT's grid, 216 constant elements, μ = 0.05, "
           "full coupling)\n")
     print("`newton` solves the steady problem directly; the QP methods reach it by marching (rollqp.march's "
-          "rolling start): the march map (one N–T sweep of a step of Δq = Le as a function of the shear) iterated "
-          "plainly to a residual of 0.1 μp0, then by Newton's method with the map's Jacobian from the QPs' active sets "
-          "(Anderson acceleration if that stops short; rollqp.methods.steady_start), each QP of the map solved first "
-          "on the active set of the previous evaluation (QPMethod.predicting; the backend when that is not within the "
-          "tolerance), then marching steps with the alternation converged, solved by the backend, until max|Δt| per "
-          "step < 1e-8 μp0. `without the Newton phase`: plain steps, then Anderson; `without the active-set "
-          "prediction`: every QP by the backend; `plain march`: neither Newton nor Anderson (one sweep per step, then "
-          "converged steps); `full alternation`: the alternation converged at every step (the march before the accelerated start). "
+          "rolling start), both from the normal half at zero shear: the march map (one N–T sweep of a step of "
+          "Δq = Le as a function of the shear) solved by Newton's method with the map's Jacobian from the QPs' "
+          "active sets, full steps with a Jacobian at every iterate (damped steps, then Anderson acceleration, if "
+          "those cycle; rollqp.methods.steady_start), each QP of the map solved first on the active set of its warm "
+          "start (QPMethod.predicting; the backend when that is not within the tolerance), then marching steps "
+          "with the alternation converged, solved by the backend, until max|Δt| per step < 1e-8 μp0. `without the "
+          "Newton phase`: plain steps, then Anderson; `without the active-set prediction`: every QP by the backend; "
+          "`plain march`: neither Newton nor Anderson (one sweep per step, then converged steps); `full "
+          "alternation`: the alternation converged at every step. "
           "Distance: max of |Δp|/p0 and |Δt|/(μp0) from `newton`'s steady state (the same discrete state: constant "
           "elements, Δq = Le). N–T sweeps: `iterations` of state 0 (two QPs each). CPU seconds, one process.\n")
     ref, cpu_ref, wall_ref = timed_cpu_run(s, "newton")
@@ -352,14 +353,14 @@ def section_start():
     jac = MapJacobian(ops, P=float(s.normal_load(0.0)), Q=0.0, xi=None, dq=s.dq, M=ops.history(), delta=None)
     rows = []
     for newton, memory, start in ((None, 0, None), (None, 10, 0.1), (None, 60, 1.0), (None, 150, 1.0),
-                                  (None, 150, 0.1), (None, 150, 0.01), (None, 300, 0.1), (0.3, 150, 0.1),
-                                  (0.1, 150, 0.1), (0.05, 150, 0.1)):
+                                  (None, 150, 0.1), (None, 150, 0.01), (None, 300, 0.1), (np.inf, 150, 0.1),
+                                  (0.3, 150, 0.1), (0.1, 150, 0.1), (0.05, 150, 0.1)):
         count[0] = 0
         _, evals, best = fixed_point(G, t0.copy(), s.contact.friction * s.p0, target=1e-10, memory=memory,
                                      anderson_from=start if start is not None else 1.0, patience=800,
                                      max_evaluations=800, jacobian=None if newton is None else jac,
                                      newton_from=newton or 0.0)
-        rows.append(["–" if newton is None else f"{newton:g}", memory or "0 (plain)",
+        rows.append(["–" if newton is None else ("at once" if newton == np.inf else f"{newton:g}"), memory or "0 (plain)",
                      "–" if start is None else f"{start:g}", evals, count[0], f"{best:.1e}"])
     print("The march map, `qp-osqp` (with the active-set prediction), from the braked state: residual max|G(t) − t|/"
           "(μp0) below which the Newton phase starts (– : none), Anderson's memory (differences kept) and the "

@@ -273,8 +273,8 @@ class _March:
 
     # ------------------------------------------------------------ the phases
     def start(self) -> StepRecord:
-        """State 0: the braked start, or the rolling start from its guess (``load.start``)."""
-        return self.rolling_start(self.guess()) if self.scene.load.start == "rolling" else self.braked_start()
+        """State 0: the braked start, or the rolling start (``load.start``)."""
+        return self.rolling_start() if self.scene.load.start == "rolling" else self.braked_start()
 
     def braked_start(self):
         """Step 0 of a braked start (§2.2, §4.4; docs/formulation.md §9), by static shift.
@@ -345,11 +345,19 @@ class _March:
             return self.braked_start().state
         return self.pressed()
 
-    def rolling_start(self, start: State) -> StepRecord:
-        """Rolling start from the guess ``start`` (:meth:`guess`): the direct steady solve for a method
-        that declares ``"steady"``, else, or if that solve fails, the march to the steady state (its
-        record then says why in ``note``: the march reaches the same discrete state, to
-        :data:`STEADY_TOL`)."""
+    def rolling_start(self) -> StepRecord:
+        """Rolling start from the guess (:meth:`guess`): the direct steady solve for a method that declares
+        ``"steady"``, else, or if that solve fails, the march to the steady state (its record then says why
+        in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`). A QP method solves
+        the guess's QPs with the active-set prediction on (:meth:`QPMethod.predicting
+        <rollqp.methods._qp.QPMethod.predicting>`: a guess, not a state that is kept)."""
+        from .methods.steady_start import predicting
+        was = predicting(self.method, True)
+        try:
+            start = self.guess()
+        finally:
+            if was is not None:
+                predicting(self.method, was)
         if "steady" not in self.method.capabilities.solves:
             return self.steady_by_marching(start)
         try:

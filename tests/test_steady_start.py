@@ -2,7 +2,7 @@
 
 * The march map's Jacobian from the QPs' active sets (MapJacobian) is the map's derivative:
   against finite differences of the map itself, coupled and uncoupled.
-* The Newton phase (chord_newton inside fixed_point) on an affine map lands on its fixed point at
+* The Newton phase (active_set_newton inside fixed_point) on an affine map lands on its fixed point at
   once; with a wrong Jacobian the iteration still converges (Anderson takes over).
 * A coupled rolling start with qp-osqp is newton's direct steady state (constant elements, Δq = Le:
   the same discrete problem, tests/test_steady.py), uses the Newton phase (fewer sweeps than without
@@ -45,7 +45,7 @@ def _steady_map(scene, method="qp-osqp"):
     return G, best[1], MapJacobian(ops, delta=None, **data), scale
 
 
-@pytest.mark.parametrize("case", ["coupled", "uncoupled"])
+@pytest.mark.parametrize("case", ["coupled", "uncoupled", "coupled-quadratic"])
 def test_map_jacobian_is_the_maps_derivative(case):
     """K v against G(t + v) − G(t) near the steady state, where the active sets hold for a small v.
 
@@ -53,10 +53,15 @@ def test_map_jacobian_is_the_maps_derivative(case):
     the difference quotient is good to ~1e-6 of |Kv|; bound 1e-4. A Jacobian that missed the
     coupling (A_nt, A_tn), the history or the moving bounds μp is off by far more (the coupling
     alone is ~10 % of K on this scene). Coupled: Bentall–Johnson, free rolling; uncoupled: §6.1.1's
-    similar rollers at Q = 0.75 μP; both 40 constant elements (an exact Jacobian: F·A symmetric)."""
-    scene = bentall_scene(0.05, elements=40, coupling="full") if case == "coupled" else \
-        rollqp.load_scene("cattaneo-carter").replace(**{"discretization.element": "constant",
-                                                         "discretization.elements": 40})
+    similar rollers at Q = 0.75 μP; both 40 constant elements (F·A symmetric). Coupled-quadratic: 20 QCE,
+    F·A asymmetric, where K is exact only with the collocation operator (measured 1e-8 of |K v|; with the
+    QP Hessian alone 1.4e-2)."""
+    if case == "uncoupled":
+        scene = rollqp.load_scene("cattaneo-carter").replace(**{"discretization.element": "constant",
+                                                                 "discretization.elements": 40})
+    else:
+        scene = bentall_scene(0.05, elements=40 if case == "coupled" else 20, coupling="full",
+                              element="constant" if case == "coupled" else "quadratic")
     G, t, jac, scale = _steady_map(scene)
     out = G(t)
     K = jac(t, *out[1:])
@@ -160,11 +165,67 @@ def test_march_to_steady_predicts_its_qps_and_keeps_the_backends_step():
 def test_newton_phase_without_a_jacobian_hands_back_its_start():
     """Where no Jacobian can be formed (MapJacobian gives None: a QP's reduced KKT system singular) the
     Newton phase stops at once, without an evaluation, and the fixed-point iteration goes on from its start."""
-    from rollqp.methods.steady_start import chord_newton
+    from rollqp.methods.steady_start import active_set_newton
     B = 0.5 * np.eye(3)
     G = lambda x: (B @ x + 1.0,)  # noqa: E731 - fixed point x = 2
     x = np.zeros(3)
-    best, k, r = chord_newton(G, lambda *a: None, (x, *G(x)), 1.0, target=1e-12, max_evaluations=10)
+    best, k, r = active_set_newton(G, lambda *a: None, (x, *G(x)), 1.0, target=1e-12, max_evaluations=10)
     assert k == 0 and best[0] is x and r == 1.0
     best, k, r = fixed_point(G, x, 1.0, target=1e-12, jacobian=lambda *a: None, newton_from=10.0)
     assert r <= 1e-12 and np.abs(best[1] - 2.0).max() <= 1e-11  # Anderson: an affine map in a few steps
+
+
+def test_active_set_newton_on_a_piecewise_affine_map():
+    """``G(x) = clip(A x + b, −1, 1)``, a contraction with a slow mode, piecewise affine like the march map:
+    full Newton steps with the Jacobian of each iterate (``diag(free)·A``) land on the fixed point once
+    they are on its piece — in far fewer evaluations than the plain iteration needs to 1e-12."""
+    from rollqp.methods.steady_start import active_set_newton
+    n = 20
+    rng = np.random.default_rng(1)
+    A = 0.98 * np.eye(n, k=-1) + 0.01 * rng.standard_normal((n, n))
+    b = 0.3 * rng.standard_normal(n) + 0.1
+    G = lambda x: (np.clip(A @ x + b, -1.0, 1.0),)  # noqa: E731
+    jac = lambda x, *_: (np.abs(A @ x + b) < 1.0)[:, None] * A  # noqa: E731
+    x0 = np.zeros(n)
+    best, k, r = active_set_newton(G, jac, (x0, *G(x0)), 1.0, target=1e-12, max_evaluations=50)
+    plain, kp, rp = fixed_point(G, x0, 1.0, target=1e-12, memory=0, max_evaluations=5000)
+    assert r <= 1e-12 and np.abs(best[1] - plain[1]).max() <= 1e-10
+    assert k <= 10 < kp, f"Newton {k} evaluations, plain iteration {kp}"
+
+
+def test_active_set_newton_refuses_a_cycling_step_and_marches():
+    """A piecewise-linear ``F = x − G(x)`` on which full Newton steps cycle (1 → −1 → 1: slope 1/3 outside
+    |x| ≤ 1/2, 1 inside): the step to −1 does not shrink the Newton correction (|d| = 2 at both ends), so
+    it is refused and a plain step ``x ← G(x)`` taken instead (to 1/3, inside), from which Newton lands on
+    the root: three evaluations."""
+    from rollqp.methods.steady_start import active_set_newton
+
+    def F(x):
+        return np.where(np.abs(x) <= 0.5, x, np.sign(x) * ((np.abs(x) - 0.5) / 3 + 0.5))
+
+    G = lambda x: (x - F(x),)  # noqa: E731
+    jac = lambda x, *_: np.diag(np.where(np.abs(x) <= 0.5, 0.0, 2 / 3))  # noqa: E731 - G' = 1 − F'
+    x0 = np.array([1.0])
+    best, k, r = active_set_newton(G, jac, (x0, *G(x0)), 1.0, target=1e-12, max_evaluations=50)
+    assert r <= 1e-12 and abs(float(best[1][0])) <= 1e-12 and k == 3, f"{k} evaluations, residual {r:.1e}"
+
+
+def test_predicted_quadratic_step_is_the_splittings_answer():
+    """A rolling step of §6.1.1 (40 QCE: F·A asymmetric, solved by the symmetric–skew splitting) with the
+    active-set prediction on, warm-started from the previous step: one solve of the collocation operator on
+    the predicted active set (``qp_solves`` 1, ``predicted``) and the backend's splitting answer to its
+    residual limit (measured 2.5e-13 μp0 apart; the splitting takes 6 QPs)."""
+    scene = rollqp.load_scene("cattaneo-carter").replace(**{"discretization.distance": 0.2})
+    meth = rollqp.get_method("qp-osqp", tolerance=scene.solver.tolerance)
+    recs = list(rollqp.march(scene, meth))
+    prev, rec = recs[-2], recs[-1]
+    backend = meth.solve(rec.problem, warm=prev.solution)
+    meth.predicting(True)
+    try:
+        predicted = meth.solve(rec.problem, warm=prev.solution)
+    finally:
+        meth.predicting(False)
+    assert predicted.info["predicted"] == 1 and predicted.info["qp_solves"] == 1 < backend.info["qp_solves"]
+    assert predicted.residual <= meth.tolerance
+    mu_p0 = scene.contact.friction * scene.p0
+    assert np.abs(predicted.t - backend.t).max() <= 2 * meth.residual_limit * mu_p0

@@ -114,6 +114,11 @@ class Alternation:
         <rollqp.methods.base.Capabilities.predicting>` of the inner method); whether it was on."""
         return self.inner.predicting(on)
 
+    def kkt_caches(self) -> tuple:
+        """The inner QP method's factor caches (:meth:`QPMethod.kkt_caches <rollqp.methods._qp.QPMethod.kkt_caches>`),
+        for a method that declares :attr:`~rollqp.methods.base.Capabilities.predicting`."""
+        return self.inner.kkt_caches()
+
     def setup(self, operators) -> None:
         """A new scene: the inner method's set-up (and the one-sweep mode off)."""
         self._single = False

@@ -10,26 +10,30 @@ fixed point, and the plain march ``t ← G(t)`` converges to it only linearly an
 disturbance is carried through the stick zone by the rolling and decays by about 10× per 100
 steps of ``Δq = Le`` on the Bentall–Johnson coupled start (216 constant elements; 750 steps).
 
-:func:`accelerated_start` iterates the same map in three phases. Plain steps while the residual
-``max|G(t) − t|/(μp0)`` is above :data:`NEWTON_FROM` (far from steady the stick and slip zones
-still move and the map is far from affine). Then Newton's method on ``G(t) − t = 0``
-(:func:`chord_newton`: damped, the Jacobian kept while it serves), with the map's Jacobian from the
-QPs' own active sets (:class:`MapJacobian`, the QP answers' sensitivity to their data): on fixed
-active sets the map is affine, and Newton lands on its fixed point in a step or two, where
-Anderson needs about as many evaluations as there are nodes (the slow modes, transport through the
-stick zone, span the space). If the Newton phase stops short (the active sets still change under
-its steps), Anderson acceleration continues from its best state (type II; Walker & Ni, SIAM J.
-Numer. Anal. 49 (2011): the extrapolation of the last ``m`` differences that minimizes the
-linearized residual) with :data:`MEMORY` differences.
+:func:`accelerated_start` solves ``G(t) − t = 0`` by Newton's method with the map's Jacobian from the
+QPs' own active sets (:class:`MapJacobian`, the QP answers' sensitivity to their data, with the
+collocation operator of each half: exact for every element type). ``G`` is piecewise affine (affine
+while its QPs keep their active sets), so a full Newton step with the Jacobian of its iterate
+(:func:`active_set_newton`) is the active-set Newton step of the steady problem seen through the
+march; it is kept where it shrinks the Newton correction, and plain marching steps ``t ← G(t)`` are
+taken where it does not (far from steady). From the start's guess (the normal half at zero shear)
+this reaches the fixed point in 4–40 map evaluations on the built-in coupled scenes and CONTACT's
+Bentall grids, where the plain march needs hundreds (a disturbance is carried through the stick zone
+by the rolling and decays by about 10× per 100 steps of ``Δq = Le`` on those grids). If it stops
+short (a singular QP sensitivity, Newton steps refused again and again), Anderson acceleration (type II; Walker & Ni, SIAM J. Numer. Anal.
+49 (2011): the extrapolation of the last ``m`` differences that minimizes the linearized residual)
+continues from its best state with :data:`MEMORY` differences.
 
-Every QP of the map is first solved on the active set of the previous evaluation
-(:meth:`QPMethod.predicting <rollqp.methods._qp.QPMethod.predicting>`: an exact KKT solve on cached
-factors, accepted at the backend's tolerance; the backend when it is not): near steady state the
-active sets no longer change, and the map costs two such solves instead of two QP solver runs.
-Every iterate the start returns is a map's *output*, i.e. QP answers within the tolerance; the
-march then continues with its own steps, solved by the backend (N–T alternation converged), until
-a step changes ``t`` by less than its tolerance, so the state it keeps is a marching step like any
-other. Measured with ``python benchmarks/bentall.py --only start``.
+Every QP of the map is first solved on the active set of its warm start (:meth:`QPMethod.predicting
+<rollqp.methods._qp.QPMethod.predicting>`: the splitting's fixed point by one solve of the
+collocation operator's reduced KKT system on cached LU factors, repeated from each candidate's own
+active set, accepted at the backend's tolerance; the backend when it is not): the map then costs a
+few such solves instead of two QP solver runs of ~5 splitting QPs each. Every iterate the start
+returns is a map's *output*, i.e. QP answers within the tolerance; the march then continues with its
+own steps, solved by the backend (N–T alternation converged), until a step changes ``t`` by less than
+its tolerance, so the state it keeps is a marching step like any other. Measured with ``python
+benchmarks/bentall.py --only start`` and ``python benchmarks/speed.py`` (the rolling starts of the
+built-in coupled scenes).
 """
 from __future__ import annotations
 
@@ -37,7 +41,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from ..problem import State
-from ._qp import _chol_solve, _kkt_factor
+from ._qp import _chol_solve, _kkt_factor, _kkt_lu, _lu_solve, collocation
 
 #: Anderson extrapolation starts once ``max|G(t) − t|/(μp0)`` is below this (without the Newton phase,
 #: or after it stopped short). Measured on the
@@ -51,23 +55,26 @@ ANDERSON_FROM = 0.1
 #: 300 from 1e-1: 333.
 MEMORY = 150
 #: The fixed-point iteration stops at this fraction of the march's own tolerance (its verification
-#: steps then change ``t`` by far less than that tolerance), …
-TARGET = 1e-2
+#: steps then change ``t`` by far less than that tolerance; at 1e-4, 1e-12 μp0, the first of them, the
+#: backend's N–T alternation, converges in one sweep, where at 1e-2 its coupled residual ``A_nt (t' − t)``
+#: was at the alternation's limit and it took two: two QP solver runs saved for one more Newton step), …
+TARGET = 1e-4
 #: … or when its best residual has not improved by 10 % over this many evaluations (the QP
 #: solvers' own accuracy, or a map Anderson does not help): the march takes over from the best state.
 PATIENCE = 200
 
 
-#: The quasi-Newton phase (:func:`chord_newton`) starts once the plain iteration's residual is below this
-#: (in μp0). Measured on the Bentall–Johnson coupled start (``python benchmarks/bentall.py --only start``):
-#: from the braked state (residual 0.6) the Newton steps overshoot to where the stick and slip zones are
-#: elsewhere and the iteration diverges; from 0.3 and 0.1 it converges (see :data:`REFRESH`).
-NEWTON_FROM = 0.1
-#: The Jacobian is computed anew when an accepted step reduces the Newton correction by less than this
-#: factor, or when the damping factor falls below MIN_STEP …
-REFRESH, MIN_STEP = 0.2, 1 / 16
-#: … at most this many times: then Anderson continues from the best state.
-MAX_JACOBIANS = 10
+#: The Newton phase (:func:`active_set_newton`) starts once the plain iteration's residual is below this
+#: (in μp0): at once (it takes plain steps itself where its Newton steps do not serve) …
+NEWTON_FROM = np.inf
+#: … and hands over to Anderson after this many Newton steps refused in a row (with 1 + 2 + … + 32 = 63
+#: plain steps between them: a Jacobian that does not serve). Measured on the scenes of
+#: :func:`active_set_newton`: at most 5 in a row (goodman-bentall from the braked state).
+REFUSALS = 6
+#: It also hands over when its accepted steps do not halve the Newton correction within this many (a
+#: Jacobian that only damps the march). Measured on the same scenes: at most 7 (CONTACT's 216-element grid,
+#: where the steps slide down at ~0.88 a step from a correction of 1.3 μp0 before the active sets settle).
+HALVING = 20
 
 
 def applies(method, ops) -> bool:
@@ -97,11 +104,11 @@ def sweep_map(method, ops, state, counters=None, *, P, Q, xi, dq, M, delta=None)
     one N–T outer iteration, as in the alternation)."""
     inner = method  # its halves' solver (the N–T alternation hands the halves to its inner method as they are)
     warm = {"n": state.nsol, "t": state.tsol}
-    zero = np.zeros(ops.n)
+    pressing = ops.coupled_step(P, np.zeros(ops.n), dq, Q=Q, xi=xi, delta=delta) if ops.coupled else None  # once
 
     def G(t):
         if ops.coupled:
-            nsol = inner.solve(ops.coupled_step(P, zero, dq, Q=Q, xi=xi, delta=delta).normal_half(t), warm=warm["n"])
+            nsol = inner.solve(pressing.normal_half(t), warm=warm["n"])
         else:  # the normal half does not see the shear: solved once, before the start
             nsol = state.nsol
         c = -(M @ ops.w(nsol.p, t))
@@ -188,7 +195,9 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
     try:
         best, _, _ = fixed_point(G, state.t, ops.mu * ops.scales.stress, target=TARGET * tol,
                                  max_evaluations=max_evaluations,
-                                 jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta)
+                                 jacobian=MapJacobian(ops, P=P, Q=Q, xi=xi, dq=dq, M=M, delta=delta,
+                                                      caches=method.kkt_caches() if method.capabilities.predicting
+                                                      else (None, None))
                                  if method.capabilities.quasi_newton else None)
     finally:
         method.predicting(was)
@@ -198,8 +207,8 @@ def accelerated_start(method, ops, state, counters, *, P, Q, xi, dq, M, delta=No
 def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FROM, patience=PATIENCE,
                 max_evaluations=1000, jacobian=None, newton_from=NEWTON_FROM):
     """Iterate ``x ← G(x)`` with Anderson acceleration below ``anderson_from`` (module docstring); with
-    ``jacobian`` (``K(x, *extra)``, :class:`MapJacobian`), the quasi-Newton phase (:func:`chord_newton`)
-    once the residual is below ``newton_from``, and Anderson from its best state if it stops short.
+    ``jacobian`` (``K(x, *extra)``, :class:`MapJacobian`), the Newton phase (:func:`active_set_newton`) once
+    the residual is below ``newton_from``, and Anderson from its best state if it stops short.
 
     ``G(x)`` returns ``(G(x), *extra)``; the residual is ``max|G(x) − x|/scale``. Returns ``(best,
     evaluations, best residual)`` with ``best = (x, G(x), *extra)`` of the smallest residual (None if
@@ -220,8 +229,8 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
         if r <= target or since >= patience:
             break
         if jacobian is not None and r <= newton_from:
-            nb, nk, nr = chord_newton(G, jacobian, (x, gx, *extra), scale, target=target,
-                                      max_evaluations=max_evaluations - k)
+            nb, nk, nr = active_set_newton(G, jacobian, (x, gx, *extra), scale, target=target,
+                                           max_evaluations=max_evaluations - k)
             jacobian, k = None, k + nk  # once: Anderson (below) from the best state if it stopped short
             if nr < best_r:
                 best, best_r, since = nb, nr, 0
@@ -240,51 +249,88 @@ def fixed_point(G, x, scale, *, target, memory=MEMORY, anderson_from=ANDERSON_FR
     return best, k, best_r
 
 
-def chord_newton(G, jacobian, start, scale, *, target, max_evaluations, refresh=REFRESH,
-                 max_jacobians=MAX_JACOBIANS, min_step=MIN_STEP):
-    """Newton's method on ``G(x) − x = 0``, damped, with the Jacobian kept while it serves: the
-    correction ``d = (I − K)⁻¹ (G(x) − x)``, ``K = jacobian(x, *extra)``, and the step ``x + α d``.
+def active_set_newton(G, jacobian, start, scale, *, target, max_evaluations):
+    """Newton's method on ``G(x) − x = 0`` with the Jacobian of every iterate, plain steps where it does not
+    serve: ``d = (I − K)⁻¹ (G(x) − x)``, ``K = jacobian(x, *extra)`` on the active sets of the map's QP
+    answers at ``x``.
 
-    A step is accepted when the next correction with the same ``K`` is smaller, ``|d̄| ≤ (1 − α/4)|d|``
-    (the natural monotonicity test of affine-invariant Newton methods, Deuflhard, *Newton Methods for
-    Nonlinear Problems* §3.1: the residual ``max|G(x) − x|`` is no measure of the distance to the fixed
-    point here, the march contracting by ~2.5 % a step), else ``α`` is halved; ``α`` doubles again
-    after an accepted step. ``K`` is computed at the start, where an accepted step reduced the
-    correction by less than ``refresh``, and where ``α`` fell below ``min_step``. Stops at the residual
-    ``target``, on a failed evaluation (a QP not solved at an iterate far off), after ``max_jacobians``
-    or ``max_evaluations``, and where ``jacobian`` gives None (a singular QP sensitivity). Returns ``(best, evaluations, best residual)`` as :func:`fixed_point`.
+    ``G`` is piecewise affine (affine while its QPs keep their active sets), so the full step ``x + d`` is
+    the active-set (semismooth) Newton step of the steady problem seen through the march: it lands on the
+    fixed point of the affine piece it starts on, and once the active sets are the fixed point's, on the
+    fixed point itself. Far from it the step can wander between pieces; the step is kept only if the
+    correction at its end is smaller, ``|d̄| < |d|`` (the natural monotonicity test of affine-invariant
+    Newton methods, Deuflhard, *Newton Methods for Nonlinear Problems* §3.1, with the Jacobian of each
+    iterate: the residual ``max|G(x) − x|`` is no measure of the distance here, the march contracting by
+    only a few per cent a step). Else the iteration takes plain marching steps ``x ← G(x)`` from ``x`` —
+    1, 2, 4, … in a row between two refused Newton steps, so that far from steady it is the march itself,
+    with few Jacobians — and tries Newton again. Measured (the march maps of CONTACT's Bentall grid at 216
+    and 432 elements, goodman-bentall at μ = 0.3 and 0.05 with full and Goodman coupling, harmonic and
+    §6.1.1's rollers, from the rolling start's guess and from the braked state): 4–63 map evaluations,
+    where the plain march needs hundreds and full Newton steps alone wandered on the finer grid.
+
+    Stops at the residual ``target``, where ``jacobian`` gives None (a singular QP sensitivity), after
+    :data:`REFUSALS` refused Newton steps in a row, after :data:`HALVING` accepted ones that did not halve
+    the correction, and after ``max_evaluations``. Returns ``(best,
+    evaluations, best residual)`` as :func:`fixed_point`.
     """
-    from scipy.linalg import lu_factor, lu_solve
     x, gx, *extra = start
-    best, best_r, lu, jacobians, k, alpha = start, float(np.abs(gx - x).max()) / scale, None, 0, 0, 1.0
-    while k < max_evaluations:
-        if lu is None:
-            K = jacobian(x, *extra) if jacobians < max_jacobians else None
-            if K is None:  # enough Jacobians, or none to be had here (a singular QP sensitivity)
-                break
-            lu, jacobians = lu_factor(np.eye(x.size) - K, check_finite=False), jacobians + 1
-            d = lu_solve(lu, gx - x, check_finite=False)
-        xt = x + alpha * d
-        k += 1
+    best, best_r, k, plain = start, _residual(x, gx, scale), 0, 1
+    refused, since, level = 0, 0, np.inf
+
+    def correction(x, gx, extra):
+        K = jacobian(x, *extra)
+        if K is None:
+            return None
         try:
-            gt, *et = G(xt)
-        except (SolverError, InputError):  # an iterate far off
-            gt = None
-        rt = np.inf if gt is None else float(np.abs(gt - xt).max()) / scale
-        if rt < best_r:
-            best, best_r = (xt, gt, *et), rt
-        if rt <= target:
+            return np.linalg.solve(np.eye(x.size) - K, gx - x)
+        except np.linalg.LinAlgError:
+            return None
+
+    d = correction(x, gx, extra)
+    while d is not None and k < max_evaluations and best_r > target:
+        k += 1
+        out, dt = _evaluate(G, x + d), None
+        if out is not None:
+            rt = _residual(out[0], out[1], scale)
+            if rt < best_r:
+                best, best_r = out, rt
+            if rt <= target:
+                break
+            dt = correction(*out[:2], out[2:])
+        if dt is not None and np.abs(dt).max() < np.abs(d).max():
+            (x, gx, *extra), d, plain, refused = out, dt, 1, 0
+            size = float(np.abs(d).max())
+            since, level = (0, size) if size <= 0.5 * level else (since + 1, level)
+            if since >= HALVING:
+                break
+            continue
+        refused, level = refused + 1, np.inf
+        if refused >= REFUSALS:
             break
-        dt = lu_solve(lu, gt - xt, check_finite=False) if np.isfinite(rt) else None
-        if dt is not None and np.abs(dt).max() <= (1 - alpha / 4) * np.abs(d).max():
-            if np.abs(dt).max() > (1 - alpha * (1 - refresh)) * np.abs(d).max():  # slower than refresh a full step
-                lu = None  # slow: a new Jacobian at the accepted point
-            x, gx, extra, d, alpha = xt, gt, et, dt, min(1.0, 2 * alpha)
-        else:
-            alpha /= 2
-            if alpha < min_step:
-                lu, alpha = None, 1.0  # a new Jacobian where we are
+        for _ in range(min(plain, max_evaluations - k)):  # Newton refused: plain steps of the march
+            k += 1
+            x, (gx, *extra) = gx, G(gx)
+            r = _residual(x, gx, scale)
+            if r < best_r:
+                best, best_r = (x, gx, *extra), r
+            if r <= target:
+                break
+        plain *= 2
+        d = correction(x, gx, extra)
     return best, k, best_r
+
+
+def _evaluate(G, x):
+    """``(x, G(x), *extra)``, or None where the map fails (a QP not solved at an iterate far off)."""
+    try:
+        return (x, *G(x))
+    except (SolverError, InputError):
+        return None
+
+
+def _residual(x, gx, scale) -> float:
+    r = float(np.abs(gx - x).max()) / scale
+    return r if np.isfinite(r) else np.inf
 
 
 class MapJacobian:
@@ -297,12 +343,17 @@ class MapJacobian:
     map's data depend on ``t`` through the normal half's gap offset ``A_nt t`` (``dq = ∂q/∂e · A_nt dt``,
     :attr:`QPForm.shift_scale`), the history ``c = −M w(p, t)`` of the tangential half, whose own
     history is ``c + A_tn p`` (so ``dc = (I − M) A_tn dp − M A_tt dt``), and its bounds ``±μ p⁺``.
-    The Hessians are the QPs' own (the symmetric part ``sym(F·A)`` for an asymmetric ``F·A``: an
-    approximate Jacobian there, exact for constant elements). Dense ``n × n`` products, ``O(n³)`` a call.
+    The operator of each half is the collocation operator of its QP form
+    (:func:`~rollqp.methods._qp.collocation_operator`: the Hessian ``sym(F·A)`` with the skew part put
+    back, what the splitting's answer solves), so ``K`` is the map's Jacobian for every element type (with
+    the Hessian alone it was an approximation for an asymmetric ``F·A``, and the Newton phase converged
+    only linearly on QCE: 32 map evaluations on goodman-bentall's rolling start, 9 with the exact ``K``).
+    Dense ``n × n`` products, ``O(n³)`` a call.
     """
 
-    def __init__(self, ops, *, P, Q, xi, dq, M, delta):
+    def __init__(self, ops, *, P, Q, xi, dq, M, delta, caches=(None, None)):
         self.ops, self.M, self.data = ops, M, dict(P=P, Q=Q, xi=xi, dq=dq, delta=delta)
+        self.caches = caches  # (Cholesky, LU) KKTCaches of the map's QP method: the same free sets, factored once
         self.MAtt = np.asarray(M @ ops.Att.dense())  # fixed for the start: once (M has ≤ 3 entries a row)
         if ops.coupled:
             Atn = ops.Atn.dense()
@@ -314,30 +365,41 @@ class MapJacobian:
         c = -(self.M @ ops.w(nsol.p, t))
         if ops.coupled:
             step = ops.coupled_step(d["P"], np.zeros(ops.n), d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"])
-            fn = step.normal_half(t).qp_form()
-            Jn = qp_response(fn, nsol.p / stress, nsol.info["qp_multiplier"], fn.shift_scale[:, None] * self.Ant)
+            half = step.normal_half(t)
+            fn = half.qp_form()
+            Jn = qp_response(fn, nsol.p / stress, nsol.info["qp_multiplier"], fn.shift_scale[:, None] * self.Ant,
+                             E=_collocation(half, fn), caches=self.caches)
             if Jn is None:
                 return None
             Jn *= stress  # dp/dt
             dc = self.ImMAtn @ Jn - self.MAtt
             dbound = (ops.mu / stress) * (nsol.p > 0)[:, None] * Jn
-            ft = ops.coupled_step(d["P"], c, d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"]).tangential_half(nsol.p)
+            half = ops.coupled_step(d["P"], c, d["dq"], Q=d["Q"], xi=d["xi"], delta=d["delta"]).tangential_half(nsol.p)
         else:
             dc, dbound = -self.MAtt, None
-            ft = ops.tangential_step(nsol.p, c, d["dq"], Q=d["Q"], xi=d["xi"])
-        ft = ft.qp_form()
-        Jt = qp_response(ft, tsol.t / stress, tsol.info["qp_multiplier"], ft.shift_scale[:, None] * dc, dbound)
+            half = ops.tangential_step(nsol.p, c, d["dq"], Q=d["Q"], xi=d["xi"])
+        ft = half.qp_form()
+        Jt = qp_response(ft, tsol.t / stress, tsol.info["qp_multiplier"], ft.shift_scale[:, None] * dc, dbound,
+                         E=_collocation(half, ft), caches=self.caches)
         return None if Jt is None else stress * Jt
 
 
-def qp_response(form, x, y, dq, dbound=None):
+def _collocation(problem, form):
+    """The collocation operator of ``problem``'s QP ``form`` (:func:`~rollqp.methods._qp.collocation`), or None
+    where ``F·A`` is symmetric (the Hessian is the operator)."""
+    return collocation(problem, form) if problem.A.split(problem.f).asymmetry > 0 else None
+
+
+def qp_response(form, x, y, dq, dbound=None, E=None, caches=(None, None)):
     """``dx``: the change of the QP answer ``x`` (multiplier ``y``) with ``q`` changed by ``dq`` and the
     bounds' magnitude (``upper = −lower``) by ``dbound`` (columns: directions), on the active set of
     ``(x, y)`` read as :func:`~rollqp.methods._qp.active_set_refine` reads it, and with the nodes on a
     bound counted at it (:class:`MapJacobian`). Solved with :func:`~rollqp.methods._qp.active_set_refine`'s
-    factors (the Cholesky factor of ``H_FF`` and the load row's Schur complement); None if singular."""
-    H, a = form.H, form.a
-    lam = form.multipliers(x, y)
+    factors (the Cholesky factor of ``H_FF`` and the load row's Schur complement); None if singular.
+    ``E``: the collocation operator in place of the Hessian (:class:`MapJacobian`; LU factors); ``caches``:
+    ``(Cholesky, LU)`` :class:`~rollqp.methods._qp.KKTCache` objects to take the factors from (the QP method's)."""
+    H, a = (form.H if E is None else E), form.a
+    lam = H @ x + form.q + (0.0 if a is None else float(y) * a)
     width = form.upper - form.lower  # a bound pair closer than rounding (μp of ~1e-21 p0 at the contact's
     fixed = form.fixed | (width <= 1e-12 * np.max(width, initial=0.0, where=np.isfinite(width)))  # edge): fixed
     # at a bound also where x is on it with a zero multiplier (a node at the edge of a zone): its
@@ -351,11 +413,12 @@ def qp_response(form, x, y, dq, dbound=None):
     F = np.flatnonzero(free)
     if F.size == 0:
         return dx
-    fac = _kkt_factor(H, free, a)
+    cache = caches[0 if E is None else 1]
+    fac = cache.get(H, free, a) if cache is not None else (_kkt_factor if E is None else _kkt_lu)(H, free, a)
     if fac is None:
         return None
     chol, z2, schur = fac
-    z = _chol_solve(chol, -dq[F] - H[F] @ dx)  # dx is zero on F: H[F] dx = H_FA dx_A
+    z = (_chol_solve if E is None else _lu_solve)(chol, -dq[F] - H[F] @ dx)  # dx is zero on F: H[F] dx = H_FA dx_A
     if a is not None:
         z -= np.outer(z2, (a[F] @ z + a @ dx) / schur)  # a_Fᵀ dx_F = −a_Aᵀ dx_A
     dx[F] = z
