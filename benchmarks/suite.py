@@ -516,7 +516,7 @@ PARTS = ("tolerance", "discretization", "scaling")
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="rollqp bench", description=__doc__.splitlines()[0])
-    ap.add_argument("--quick", action="store_true", help="a smoke test under a minute (fewer cases, one repeat)")
+    ap.add_argument("--quick", action="store_true", help="a smoke test: fewer cases, one repeat (about 30 s of CPU; 1-1.5 min on 2 cores)")
     ap.add_argument("--parts", default=",".join(PARTS), help=f"comma-separated parts (default {','.join(PARTS)})")
     ap.add_argument("--methods", default=",".join(METHOD_NAMES),
                     help=f"comma-separated methods (default {','.join(METHOD_NAMES)})")

@@ -63,7 +63,7 @@ def test_resumed_run_compares_wall_time_with_its_own_steps(tmp_path):
     assert float(row.split()[2]) >= own - 1e-3
 
 
-@pytest.mark.parametrize("key, value", [("units", "furlongs"), ("units", 3)])
+@pytest.mark.parametrize("key, value", [("units", "furlongs"), ("units", 3), ("units", ["N-mm"]), ("units", {"a": 1})])
 def test_bad_units_is_one_line(key, value):
     with pytest.raises(rollqp.InputError, match="units: must be one of 'N-mm'"):
         rollqp.load_scene("cattaneo-carter").replace(**{key: value})

@@ -38,7 +38,7 @@ NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
 def check_units(key: str, v: Any) -> str:
     """The declared unit system (:data:`rollqp.units.UNIT_SYSTEMS`), or ``""`` for none."""
     from ..units import UNIT_SYSTEMS
-    if v == "" or v in UNIT_SYSTEMS:
+    if isinstance(v, str) and (v == "" or v in UNIT_SYSTEMS):  # a list or table is no name (and not hashable)
         return v
     raise InputError(key, f"must be one of {', '.join(map(repr, UNIT_SYSTEMS))} (the units the scene's numbers "
                           f"are in; leave it out if none fits), got {v!r}")
