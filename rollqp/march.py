@@ -675,16 +675,17 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     asked = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(method, str) and method != asked.solver.method:
         asked = asked.replace(**{"solver.method": method})
-    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
+    if out is None:  # before any work: the states it would hold, on the operators it would build
+        from .advice import fast_path
+        from .scene.checks import check_result_memory
+        check_result_memory(fast_path(asked).scene if method is None or isinstance(method, str) else asked, keep)
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
     tail = None
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
         check_resumed(scene, prepared, tail)
-    if out is None:
-        from .scene.checks import check_result_memory
-        check_result_memory(scene, keep)
     result = new_result(asked, ops, meth.name, keep_every=keep, out=out)  # meta: the scene as given, the method that ran it
     if scene.solver.method != asked.solver.method:
         from .advice import fast_path
