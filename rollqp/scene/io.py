@@ -96,8 +96,8 @@ def _other_dimension_key(key, dimension: int):
     return other
 
 
-def scene_from_toml(text: str, source: str = "<string>", default_name: str = "scene") -> Scene:
-    """Build and validate a scene from TOML text.
+def scene_from_toml(text: str, source: str = "<string>", default_name: str = "scene", overrides=None) -> Scene:
+    """Build and validate a scene from TOML text (``overrides``: dotted keys set before it is validated).
 
     Raises
     ------
@@ -112,7 +112,19 @@ def scene_from_toml(text: str, source: str = "<string>", default_name: str = "sc
         raise InputError(source, f"invalid TOML: {exc}") from exc
     except RecursionError:
         raise InputError(source, "invalid TOML: nested too deeply") from None
-    return scene_from_dict(data, source=source, default_name=default_name)
+    return scene_from_dict(_overridden(data, overrides), source=source, default_name=default_name)
+
+
+def _overridden(data, overrides):
+    """``data`` with the dotted ``overrides`` set (a command line's ``--method``: the scene is validated with it)."""
+    for key, value in (overrides or {}).items():
+        *tables, last = key.split(".")
+        d = data
+        for t in tables:
+            d = d.setdefault(t, {}) if isinstance(d, dict) else d
+        if isinstance(d, dict):
+            d[last] = value
+    return data
 
 
 def _builtin_dir():
@@ -139,7 +151,7 @@ def builtin_scenes() -> dict[str, str]:
     return out
 
 
-def load_scene(source: Any) -> Scene:
+def load_scene(source: Any, overrides: dict | None = None) -> Scene:
     """Read and validate a scene.
 
     Parameters
@@ -148,6 +160,10 @@ def load_scene(source: Any) -> Scene:
         A path to a TOML file; the name of a built-in scene (:func:`builtin_scenes`; a file
         of that name takes precedence); a nested dict as :meth:`Scene.to_dict` gives; or a
         scene, returned as is.
+    overrides : dict, optional
+        Dotted keys (``{"solver.method": "mf-newton"}``) set in a file's or built-in scene's table
+        before it is validated, so that the scene is checked as it will run (a command line's
+        ``--method``).
 
     Returns
     -------
@@ -174,9 +190,10 @@ def load_scene(source: Any) -> Scene:
     rollqp.errors.InputError: SCENE: no such file or built-in scene 'catano-carter'; did you mean 'cattaneo-carter'?...
     """
     if isinstance(source, SceneBase):
-        return source
+        return source.replace(**overrides) if overrides else source
     if isinstance(source, dict):
-        return scene_from_dict(source)
+        import copy
+        return scene_from_dict(_overridden(copy.deepcopy(source), overrides) if overrides else source)
     if not isinstance(source, (str, os.PathLike)):
         raise InputError("SCENE", "must be a path to a TOML file, the name of a built-in scene "
                                   f"or a dict, got {type(source).__name__}")
@@ -188,12 +205,12 @@ def load_scene(source: Any) -> Scene:
             text = path.read_bytes().decode("utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise InputError(str(path), f"cannot read the scene file: {exc}") from exc
-        return scene_from_toml(text, source=str(path), default_name=safe_name(path.stem))
+        return scene_from_toml(text, source=str(path), default_name=safe_name(path.stem), overrides=overrides)
     builtins = _builtin_files()
     name = os.fspath(source)
     if isinstance(source, str) and name in builtins:
         text = builtins[name].read_text(encoding="utf-8")
-        return scene_from_toml(text, source=f"builtin:{name}", default_name=name)
+        return scene_from_toml(text, source=f"builtin:{name}", default_name=name, overrides=overrides)
     raise InputError("SCENE", f"no such file or built-in scene {name!r}"
                               f"{suggestion(name, builtins)}; built-in scenes: "
                               f"{', '.join(builtins)}")

@@ -29,7 +29,7 @@ from .contact import Contact
 from .march import StepRecord, static_shift, steady, transient
 from .result import Result3D
 
-__all__ = ["prepare", "march", "run", "new_result", "resumed_record"]
+__all__ = ["prepare", "march", "run", "new_result", "resumed_record", "resume_arrays"]
 
 
 def prepare(scene, method=None):
@@ -149,41 +149,74 @@ def _raw_distance(meta: dict, rec: StepRecord, contact) -> None:
     row["steps"] += 1
 
 
-def run(scene, method=None, progress=None, resume=None, observe=None) -> Result3D:
+def resume_arrays(resume):
+    """The arrays to continue from: ``resume`` is the arrays of a result file (a dict,
+    :func:`rollqp.load_result`) or what ``rollqp run --resume`` read (:func:`rollqp.result.resume_source`:
+    a 3D run writes its result file, no journal), or None."""
+    if resume is None or isinstance(resume, dict):
+        return resume
+    if resume.journal is not None:
+        raise InputError(resume.arg, "a journal beside a 3D result file: 3D runs write no journal; resume from the "
+                                     "result file itself (remove the .journal file)")
+    return resume.arrays
+
+
+def _started(result, resume) -> None:
+    """A resumed run's result: the earlier states, and what state 0 and the earlier steps noted."""
+    result.extend(resume)
+    result.meta["resumed_from"] = len(result) - 1
+    earlier = resume.get("meta", {})
+    earlier = earlier if isinstance(earlier, dict) else json.loads(str(earlier))
+    for key in ("static_shift", "rolling_start", "raw_distance"):
+        if key in earlier:
+            result.meta[key] = earlier[key]
+
+
+def _noted(result, rec, contact) -> None:
+    """What a record adds to the result's notes (``meta``)."""
+    if rec.k == 0 and "marched" in rec.info:
+        result.meta["rolling_start"] = f"marched to the steady state in {rec.info['marched']} steps"
+    if rec.k == 0 and "shift" in rec.info:
+        result.meta["static_shift"] = [float(v) for v in rec.info["shift"]]
+    _raw_distance(result.meta, rec, contact)
+
+
+def run(scene, method=None, progress=None, resume=None, observe=None, out=None, keep_every=None) -> Result3D:
     """Run a 3D scene and return its :class:`~rollqp.three.result.Result3D` (arguments as
     :func:`rollqp.march.run`: ``progress(k, K)`` after each rolling step, ``observe(record, contact)``
-    with every record, ``resume`` the arrays of an earlier result file of this scene).
+    with every record, ``resume`` an earlier result file's arrays or :func:`resume_arrays`' source,
+    ``out`` the result file written at the end — and, with the completed states and the reason in
+    ``meta["failed"]`` or ``meta["interrupted"]``, when the run fails or is interrupted).
+    ``keep_every``: a 3D run keeps every state (None or 1).
 
     Raises
     ------
     SolverError, InputError, KeyboardInterrupt
         ``err.partial`` holds the result of the completed states.
     """
+    if keep_every not in (None, 1):
+        raise InputError("--keep-every", f"a 3D run keeps every state (1), got {keep_every!r}")
+    resume = resume_arrays(resume)
     asked = scene if isinstance(scene, SceneBase) else load_scene(scene)
     scene, meth, contact = prepared = prepare(asked, method)
     result = new_result(scene, contact, meth.name)
     if resume is not None:
-        result.extend(resume)
-        result.meta["resumed_from"] = len(result) - 1
-        earlier = resume.get("meta", {})
-        earlier = earlier if isinstance(earlier, dict) else json.loads(str(earlier))
-        for key in ("static_shift", "rolling_start", "raw_distance"):   # what state 0 and the earlier steps said
-            if key in earlier:
-                result.meta[key] = earlier[key]
+        _started(result, resume)
     K = scene.n_steps
     try:
         for rec in march(scene, prepared=prepared, resume=resume):
             result.add(rec)
-            if rec.k == 0 and "marched" in rec.info:
-                result.meta["rolling_start"] = f"marched to the steady state in {rec.info['marched']} steps"
-            if rec.k == 0 and "shift" in rec.info:
-                result.meta["static_shift"] = [float(v) for v in rec.info["shift"]]
-            _raw_distance(result.meta, rec, contact)
+            _noted(result, rec, contact)
             if observe is not None:
                 observe(rec, contact)
             if progress is not None and rec.k > 0:
                 progress(rec.k, K)
     except (SolverError, InputError, KeyboardInterrupt) as err:
         err.partial = result
+        if out is not None and len(result):
+            result.meta["interrupted" if isinstance(err, KeyboardInterrupt) else "failed"] = str(err) or "interrupted"
+            result.save(out)
         raise
+    if out is not None:
+        result.save(out)
     return result
