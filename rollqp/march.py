@@ -472,6 +472,14 @@ class _March:
         return rec
 
 
+def _two_d(scene) -> Scene:
+    """``scene`` if it is a 2D scene, else a one-line :class:`InputError` naming the 3D entry points."""
+    if not isinstance(scene, Scene):   # another dimension's scene (docs/architecture.md, three dimensions)
+        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.three.run.run and "
+                                  "rollqp.three.run.march run it (on the command line: rollqp run)")
+    return scene
+
+
 def prepare(scene, method=None):
     """``(scene, method, operators)``: the scene validated, its method composed and set up on its operators.
 
@@ -485,10 +493,7 @@ def prepare(scene, method=None):
     """
     from .advice import fast_path
     from .methods import compose, scene_method
-    scene = scene if isinstance(scene, Scene) else load_scene(scene)
-    if not isinstance(scene, Scene):   # another dimension's scene (docs/architecture.md, three dimensions)
-        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.three.run.run and "
-                                  "rollqp.three.run.march run it (on the command line: rollqp run)")
+    scene = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     if method is None or isinstance(method, str):
@@ -675,7 +680,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
     from .result import ResumeSource, resume_source
-    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    asked = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != asked.solver.method:
         asked = asked.replace(**{"solver.method": method})
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume

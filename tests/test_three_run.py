@@ -260,3 +260,21 @@ def test_docs_results_table_is_the_registry_s():
     text = (Path(__file__).resolve().parents[1] / "docs" / "results.md").read_text(encoding="utf-8")
     table = text.split("<!-- fields3d table: begin -->\n", 1)[1].split("<!-- fields3d table: end -->", 1)[0]
     assert table.strip() == markdown_table().strip()
+
+
+def test_an_interrupted_run_writes_its_completed_states(tmp_path):
+    import rollqp
+    scene = coarse("cattaneo-3d", **{"discretization.distance": 1.5})
+    out = tmp_path / "cut.npz"
+
+    def stop(rec, contact):
+        if rec.k == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt) as err:
+        run(scene, observe=stop, out=str(out))
+    assert len(err.value.partial) == 3
+    back = rollqp.load_result(out)
+    assert back["q"].shape == (3,) and "interrupted" in back["meta"]
+    with pytest.raises(InputError, match="^--keep-every"):
+        run(scene, keep_every=2)
