@@ -87,6 +87,12 @@ class SlipContinuation:
         self.name, self.capabilities, self.tolerance = inner.name, inner.capabilities, inner.tolerance
         self.threshold = float(threshold)
 
+    def __getattr__(self, name):
+        """The inner method's settings (``max_iterations``, …): this wrapper only selects solutions."""
+        if name == "inner":
+            raise AttributeError(name)
+        return getattr(self.inner, name)
+
     def setup(self, operators) -> None:
         self.inner.setup(operators)
 
