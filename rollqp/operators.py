@@ -187,7 +187,7 @@ class SceneOperators:
 
     def step_friction(self, q=0.0, dq=None, previous=None, steady=False):
         """``(mu, law)`` of a step at the rolled distance ``q`` (:func:`rollqp.friction.bound.step_coefficient`):
-        the number ``μ`` and ``None`` for Coulomb — the step problems' old path, bitwise."""
+        the number ``μ`` and ``None`` for Coulomb (the constant bound's path)."""
         from .friction.bound import step_coefficient
         sc, a = self.scene, self.scales.length
         return step_coefficient(self.friction, self.strip.x / a, q / a, sc.load.direction,
@@ -310,7 +310,7 @@ def _finite(name, v) -> None:
     """The one check a march-built step keeps on the arrays it takes from the last step's solution:
     finite (one sum: a NaN or an infinity makes it non-finite), else the InputError a validated step
     would raise."""
-    if not math.isfinite(float(np.add.reduce(v))):  # (the ufunc: np.sum costs three times as much)
+    if not math.isfinite(float(np.add.reduce(v))):  # (the ufunc: np.sum's dispatch costs more)
         raise InputError(name, "must be finite (the last step's solution was not)")
 
 

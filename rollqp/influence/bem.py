@@ -79,8 +79,7 @@ and (``J`` reverses the node order)
 load case ``N_j`` in component ``b`` of body α). Local components make a rigid rotation of a
 rim (the wind-up of a roller on a thin shaft) a constant ``u_t`` and no ``u_n``: it neither
 slips nor opens the gap, as it must. (Cartesian components would turn it into a spurious
-tangential strain ``∝ x/R``: +52 % on Carter's creepage at ``a/R = 0.3`` on the paper's 15 mm
-shaft; measured before this choice.) Nodes of A and B are paired by arc length (material is
+tangential strain ``∝ x/R``; its size on Carter's creepage is in docs/bem.md.) Nodes of A and B are paired by arc length (material is
 convected along each surface by arc length), and the undeformed gap is the separation of
 the paired points along the line of centres,
 ``h(s) = R_A(1 - cos(s/R_A)) + R_B(1 - cos(s/R_B))`` (``= s²/2R`` to leading order).

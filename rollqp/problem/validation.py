@@ -38,7 +38,7 @@ def _real(name, v) -> np.ndarray:
             raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
         a = a.astype(float)
     if a.size:
-        big = np.abs(a).max()  # (the method, not np.max: a third of the time on step-sized vectors)
+        big = np.abs(a).max()  # (the method: np.max's dispatch costs more on step-sized vectors)
         if not big <= MAX_MAGNITUDE:  # NaN compares false: one test for both
             if not np.all(np.isfinite(a)):
                 raise InputError(name, "must be finite")
