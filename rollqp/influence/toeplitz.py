@@ -132,9 +132,7 @@ class ToeplitzOperator(Operator):
             raise InputError(name, "must be finite")
         P.flags.writeable = False
         self._P, self._r, self._n, self._ne = P, int(r), int(n), int(ne)
-        import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
-        self._L = scipy.fft.next_fast_len(P.shape[1], real=True)
-        self._Phat = scipy.fft.rfft(P, n=self._L, axis=1)
+        self._spectra()
         self.name = name
         self._memo = {}
         self._m = None
@@ -156,38 +154,76 @@ class ToeplitzOperator(Operator):
         """``c`` times this operator (a new operator)."""
         return ToeplitzOperator(c * self._P, self._r, self._n, self._ne, name or self.name)
 
-    def _gather(self, x):
-        """``u_a[r e] = x[conn[e, a]]`` for every local node ``a``: shape ``(nen, -k_min + 1)``."""
-        nen, r, ne = self._P.shape[0], self._r, self._ne
-        u = np.zeros((nen, r * (ne - 1) + 1) + x.shape[1:])
-        for a in range(nen):
-            u[a, ::r] = x[a:a + r * (ne - 1) + 1:r]
-        return u
+    def _spectra(self):
+        r"""The transforms of one product (:meth:`matvec`): one forward and one inverse FFT of length ``L``.
+
+        With ``j = r e + a`` the product is ``y[i] = Σ_a Σ_{j ∈ J_a} P_a[i − k_min − j + a] x[j]``,
+        ``J_a = {a, a + r, …, a + r(n_e − 1)}``. Extended to every node ``j ≡ a`` (mod ``r``) it is, per
+        residue ``ρ``, a convolution of ``x`` restricted to the nodes ``j ≡ ρ`` with the kernel ``K_ρ[m] =
+        Σ_{a ≡ ρ} P_a[m + a]``, ``K̂_ρ(ω) = Σ_{a ≡ ρ} e^{iωa} P̂_a(ω)``; the nodes the extension adds (the
+        one or two end nodes that an element's local node ``a`` never reaches) are subtracted again,
+        ``O(n)`` each (:attr:`_ends`). For ``r = 2`` the two residues come from one transform of ``x``:
+        ``X_ρ(ω) = (X(ω) ± X(ω + π))/2`` and ``X(ω + π)`` is the half-spectrum reversed and conjugated (``L``
+        even), so ``Ŷ = A X + B conj(X reversed)`` with ``A = (K̂_0 + K̂_1)/2``, ``B = (K̂_0 − K̂_1)/2``. ``L``
+        is a fast length (``scipy.fft.next_fast_len``) of at least ``2n − 1`` and ``n − k_min + r``: the
+        circular wrap-around of the shifted kernels then falls on indices that are not kept, and the
+        product is the exact linear convolution (before: one transform per local node, three for
+        quadratic elements, and one inverse).
+        """
+        import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
+        P, r, n, ne = self._P, self._r, self._n, self._ne
+        nen, lp = P.shape
+        L = scipy.fft.next_fast_len(max(2 * n - 1, lp + r), real=True)
+        while L % 2:
+            L = scipy.fft.next_fast_len(L + 1, real=True)
+        self._L = L
+        Phat = scipy.fft.rfft(P, n=L, axis=1)
+        w = np.exp(2j * np.pi * np.arange(L // 2 + 1) / L)
+        K = [sum(Phat[a] * w ** a for a in range(nen) if a % r == rho) for rho in range(r)]
+        if r == 1:
+            self._AB = (K[0], None)
+        else:
+            self._AB = (0.5 * (K[0] + K[1]), 0.5 * (K[0] - K[1]))
+        kept = np.arange(n) - self.kmin                           # the kept indices of the convolution
+        ends = []
+        for a in range(nen):                                      # nodes j ≡ a (mod r) that J_a misses
+            every = np.arange(a % r, n, r)
+            for j in np.setdiff1d(every, a + r * np.arange(ne)):
+                k = (kept - j) % L                                # the circular kernel index of Q_a = P_a[· + a]
+                k = np.where(k > lp - 1 - a, k - L, k) + a
+                ends.append((int(j), np.where((k >= 0) & (k < lp), P[a, np.clip(k, 0, lp - 1)], 0.0)))
+        self._ends = ends
 
     def matvec(self, x):
-        """``M x`` (eq. 25, 28) by zero-padded FFT: exact linear convolution, ``O(n log n)``."""
+        """``M x`` (eq. 25, 28) by one zero-padded forward FFT and one inverse (:meth:`_spectra`): exact linear
+        convolution, ``O(n log n)``."""
         x = np.asarray(x, dtype=float)
-        u = self._gather(x)
         import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
-        uh = scipy.fft.rfft(u, n=self._L, axis=1)
-        Phat = self._Phat if x.ndim == 1 else self._Phat[:, :, None]
-        y = scipy.fft.irfft((Phat * uh).sum(axis=0), n=self._L, axis=0)
-        return y[-self.kmin:-self.kmin + self._n]
+        L, (A, B) = self._L, self._AB
+        X = scipy.fft.rfft(x, n=L, axis=0)
+        if x.ndim > 1:
+            A, B = A[:, None], (None if B is None else B[:, None])
+        Y = A * X if B is None else A * X + B * np.conj(X[::-1])
+        y = scipy.fft.irfft(Y, n=L, axis=0)[-self.kmin:-self.kmin + self._n]
+        for j, v in self._ends:
+            y -= v * x[j] if x.ndim == 1 else np.outer(v, x[j])
+        return y
 
     def rmatvec(self, y):
-        """``yᵀ M`` (``Mᵀ y``): the correlation of ``y`` with each ``P_a``, gathered at the element nodes."""
+        """``yᵀ M`` (``Mᵀ y``): the correlation of ``y`` with the kernels of :meth:`_spectra`, by one forward and
+        one inverse FFT (the residues of ``r = 2`` recombined as in :meth:`matvec`), less the end nodes."""
         y = np.asarray(y, dtype=float)
-        nen, r, ne, L = self._P.shape[0], self._r, self._ne, self._L
-        # c_a[m] = Σ_i P_a[i - m - k_min] y_i for m = r e: correlation via conj in Fourier space
         import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
-        yh = scipy.fft.rfft(y, n=L, axis=0)
-        Phat = self._Phat if y.ndim == 1 else self._Phat[:, :, None]
-        c = scipy.fft.irfft(np.conj(Phat) * yh[None], n=L, axis=1)
-        out = np.zeros(y.shape)
-        for a in range(nen):
-            # lag m + k_min of the circular correlation (m = r e; wrap-around hits y's zero padding)
-            idx = (r * np.arange(ne) + self.kmin) % L
-            out[a:a + r * (ne - 1) + 1:r] += c[a, idx]
+        L, (A, B), off = self._L, self._AB, -self.kmin
+        pad = np.zeros((L,) + y.shape[1:])
+        pad[off:off + self._n] = y
+        Yh = scipy.fft.rfft(pad, axis=0)
+        if y.ndim > 1:
+            A, B = A[:, None], (None if B is None else B[:, None])
+        W = np.conj(A) * Yh if B is None else np.conj(A) * Yh + (B * np.conj(Yh))[::-1]
+        out = scipy.fft.irfft(W, n=L, axis=0)[:self._n]
+        for j, v in self._ends:
+            out[j] -= v @ y
         return out
 
     def dense(self) -> np.ndarray:
@@ -234,7 +270,8 @@ class ToeplitzOperator(Operator):
     @property
     def nbytes(self) -> int:
         """Bytes held (generators and their transforms; the dense matrix if it was asked for)."""
-        return int(self._P.nbytes + self._Phat.nbytes + (0 if self._m is None else self._m.nbytes))
+        spectra = sum(0 if v is None else v.nbytes for v in self._AB) + sum(v.nbytes for _, v in self._ends)
+        return int(self._P.nbytes + spectra + (0 if self._m is None else self._m.nbytes))
 
 
 def log_operator(strip, d_ref: float, scale: float = 1.0, name: str = "influence") -> ToeplitzOperator:
