@@ -1,9 +1,8 @@
 r"""Which solution of a slip-dependent step every method returns: the end of the path from the frozen bound.
 
 A falling friction law can give one step several solutions (docs/friction.md, "Which solution of a step").
-Which one a method finds would then depend on the method — measured: Newton and the fixed point around
-``qp-clarabel`` returned solutions 0.38 μ_s p0 apart, both with rollqp's residual below 1e-12, on ramped
-transients at ``v_h = 1`` and 10 mm/s. :class:`SlipContinuation` makes the choice once, for every method
+Which one a method finds would then depend on the method (docs/friction.md shows two methods' solutions of
+the same step far apart, both to round-off). :class:`SlipContinuation` makes the choice once, for every method
 that the registry composes with it (:func:`rollqp.methods.compose`): the solution returned is the end at
 ``λ = 1`` of the curve of solutions of the steps with the bound
 
@@ -28,11 +27,10 @@ with rollqp's residual, and all of them are the same solution.
 told from its data at a cost below the path's. A second solution needs the bound map (the fixed point on the
 bound, :mod:`.fixedpoint`) to expand somewhere, i.e. ``|∂μ/∂s|`` times the slip's response to a change of the
 traction over the slip zone above one (docs/theory.md); the per-node estimate :func:`steepness`,
-``κ = max_i |∂μ/∂s|_max p_i⁺ A_ii/Δq``, misses the response of the zone as a whole — measured on the ramped
-transient of docs/friction.md: steps with several solutions from κ = 0.55 on 80 elements and from κ = 0.35 on
-160 (none at 0.33 on 80), so no threshold on it holds on every mesh. On a mild law the path is short (one to a
-few points: docs/friction.md's sweep table, column "path points"). A law that does not fall (``μ_s = μ_k``: a constant coefficient through the law's path) and every other
-step take the method's own path unchanged. ``threshold`` sets another limit on κ (``inf``: never select, the
+``κ = max_i |∂μ/∂s|_max p_i⁺ A_ii/Δq``, misses the response of the zone as a whole, so a threshold on it
+that holds on one mesh need not hold on a finer one. On a mild law the path is short (docs/friction.md's
+sweep table, column "path points"). A law that does not fall (``μ_s = μ_k``: a constant coefficient through
+the law's path) and every other step take the method's own path unchanged. ``threshold`` sets another limit on κ (``inf``: never select, the
 methods' own choice).
 
 **Steady solves** are not selected: their operator is far from symmetric, the step at ``λ = 0`` is no convex
@@ -108,8 +106,7 @@ class SlipContinuation:
         law = problem.law
         if problem.kind != "tangential" or law is None or law.on_path or law.steady:
             # a steady solve's operator T·A is far from symmetric: its step at λ = 0 is no convex QP and need
-            # not have one solution (measured: from Coulomb's steady state at Q = 0.746 μ_s P on CONTACT's
-            # veldep_fric problem the curve turned back below λ = 0); its branch is chosen by the braked start
+            # not have one solution (module docstring, "Steady solves"; docs/friction.md)
             return self.inner.solve(problem, warm=warm)
         kappa = steepness(problem)
         if not (kappa > 0.0 and kappa >= self.threshold):

@@ -23,7 +23,7 @@ on the piece's smooth equations in the hyperplane normal to it, and where a marg
 negative, the point where it is zero (regula falsi on the step length); there the node changes piece and the
 curve goes on along the new piece's tangent in the direction that enters it (the node's new margin grows).
 A fold inside a piece is passed by the arclength parametrization; a fold at a change of piece by the direction
-rule (measured: a falling law's steps at ``v_h = 1`` mm/s turn back in ``λ`` at tens of such points).
+rule (a falling law's steepest steps turn back in ``λ`` at many such points).
 
 Unknowns ``u = (t̂, ξ̂, λ)`` (``ξ̂`` when ``Q`` is prescribed) in the units of docs/formulation.md §5
 (``t̂ = t/p0``, ``ŝ = s E*/p0``); the matrices are dense ``(N + 1)²`` with ``N = n + 1`` (the slip-dependent
@@ -46,12 +46,11 @@ CORRECTOR_ITERATIONS, CORRECTOR_TOLERANCE = 8, 1e-13
 #: Step control (in the ``u`` norm, ``t̂`` ~ μ, ``λ`` in [0, 1]): first and largest step, the corrector's
 #: largest distance from the predictor and the smallest cosine between successive tangents (a smaller angle
 #: keeps the corrector on the branch it follows: with 0.5 and 0.9 the path jumped onto another branch of the
-#: same step, measured on a ramped transient at v_h = 1 mm/s), and the step below which the path stops.
+#: same step on docs/friction.md's ramped transient at v_h = 1 mm/s), and the step below which the path stops.
 FIRST_STEP, LARGEST_STEP, DISTANCE, COSINE, SMALLEST_STEP = 0.1, 0.2, 0.2, 0.95, 1e-10
-#: Points (predictor–corrector steps and changes of piece) before the path is given up: the steepest steps
-#: measured took 654 (exponential law, v_h = 1 mm/s, V = 10 m/s, 80 elements; docs/friction.md's sweep), about a
-#: fifth of this; a step with no solution (a force above the creep curve's peak) crawls at a small λ instead
-#: (measured: λ = 0.046 after 20000 points, 27 s, on CONTACT's problem at 0.95 μ_s P, 46 elements).
+#: Points (predictor–corrector steps and changes of piece) before the path is given up: about five times the
+#: steepest steps of docs/friction.md's sweep (column "path points"); a step with no solution (a force above
+#: the creep curve's peak) crawls at a small λ instead of ending, and is given up here.
 MAX_POINTS = 3000
 #: ``|ξ̂|`` beyond which the path runs into gross sliding (a creepage of 1e6 p0/E*: no stick zone is near).
 XI_LIMIT = 1e6
