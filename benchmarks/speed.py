@@ -280,13 +280,14 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     pin_threads()
     command = "python benchmarks/speed.py" + (" --full" if args.full else "") + (" --docs" if args.docs else "")
-    print(machine_table(command) + "\n", flush=True)
+    machine = machine_table(command)  # the load average at the start, as its row says
+    print(machine + "\n", flush=True)
     res = rows(args.full, lambda m: print(f"  {m}", file=sys.stderr, flush=True))
     body = table(["target", "required", "measured", ""], res)
     print(body)
     if args.docs:
         doc = ROOT / "docs" / "performance.md"
-        write_sections(doc, {"speed": machine_table(command) + "\n\n" + body})
+        write_sections(doc, {"speed": machine + "\n\n" + body})
     return 0
 
 
