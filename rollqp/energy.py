@@ -32,34 +32,41 @@ import numpy as np
 
 from .fields import FORCE, STRESS, Field, register
 
-__all__ = ["friction_power", "dissipation", "elastic_energy", "load_work", "balance", "steady_identity", "power"]
+__all__ = ["friction_power", "dissipation", "friction_work", "step_length", "elastic_energy", "load_work", "balance",
+           "steady_identity", "power"]
 
 
-def friction_power(rec, ops) -> np.ndarray:
-    """``−t·s`` at the nodes: dissipation per unit area and unit rolled distance (≥ 0 up to the
-    solver tolerance; the starting state of a braked start: per a_H of static shift)."""
-    return -rec.state.t * rec.state.tsol.s
+def friction_power(rows) -> np.ndarray:
+    """``−t·s`` at the nodes of a block of states (:class:`rollqp.fields.Rows`): dissipation per unit area
+    and unit rolled distance (≥ 0 up to the solver tolerance; the starting state of a braked start: per
+    a_H of static shift)."""
+    return -rows["pt"] * rows["slip"]
 
 
-def dissipation(rec, ops) -> float:
-    """``D = −fᵀ(t∘s)``: frictional dissipation per unit rolled distance (and axial length)."""
-    return float(ops.f @ friction_power(rec, ops))
+def dissipation(rows) -> np.ndarray:
+    """``D = −fᵀ(t∘s)`` of each state of a block: frictional dissipation per unit rolled distance (and
+    axial length); one dot product a state (the same sums as state by state, to the last bit)."""
+    f, power = rows.constants["f"], rows["friction_power"]
+    return np.array([float(f @ row) for row in power])
 
 
-def _dq(rec) -> float:
-    """The length the step's slip is per: ``|Δq_k|`` of a rolling step (its own under ``load.rolled``), ``Δ = a_H``
-    of a static-shift step at rest (a stop of ``load.rolled``: the slip ``s = (w^k − w^{k−1})/Δ + ξ`` is per
-    ``a_H`` of shift, §4.4, so ``s Δ`` is the slip displacement and ``ξ Δ`` the rigid shift); 0 for the
-    starting state (``k = 0``: the braked start's increments are not recorded one by one)."""
+def friction_work(rows) -> np.ndarray:
+    """The step's frictional work ``D Δq`` (``D Δ`` at rest; 0 for the starting state): ``Δq`` is the
+    length the step's slip is per, kept for each state by the run (:func:`step_length`)."""
+    dq = rows["_dq"]
+    D = rows["dissipation"]
+    return np.where(dq != 0.0, D * dq, 0.0)
+
+
+def step_length(rec) -> float:
+    """The length the step's slip is per: ``|Δq_k|`` of a rolling step (its own under ``load.rolled``),
+    ``Δ = a_H`` of a static-shift step at rest (a stop of ``load.rolled``: the slip ``s = (w^k − w^{k−1})/Δ
+    + ξ`` is per ``a_H`` of shift, §4.4, so ``s Δ`` is the slip displacement and ``ξ Δ`` the rigid shift);
+    0 for the starting state (``k = 0``: the braked start's increments are not recorded one by one).
+    :class:`~rollqp.result.Result` keeps it with each state (``_dq``) for the derived works."""
     if rec.k == 0 or rec.problem is None or rec.phase not in ("rolling", "static-shift"):
         return 0.0
     return float(rec.problem.dq)
-
-
-def friction_work(rec, ops) -> float:
-    """The step's frictional work ``D Δq`` (``D Δ`` at rest, :func:`_dq`; 0 for the starting state)."""
-    dq = _dq(rec)
-    return dissipation(rec, ops) * dq if dq else 0.0
 
 
 def elastic_energy(rec, ops) -> float:
@@ -104,24 +111,23 @@ def _normal_displacement(rec):
     return None, False
 
 
-def load_work(rec, ops) -> float:
-    """``−½(Q_k + Q_{k−1}) ξ Δq + ½(P_k + P_{k−1})(δ_k − δ_{k−1})`` of a rolling step or a step at rest (``Δ``
-    for ``Δq``, :func:`_dq`; 0 for the starting state).
+def load_work(rows) -> np.ndarray:
+    """``−½(Q_k + Q_{k−1}) ξ Δq + ½(P_k + P_{k−1})(δ_k − δ_{k−1})`` of each rolling step or step at rest of a
+    block (``Δ`` for ``Δq``, :func:`step_length`; 0 for the starting state), ``P_{k−1} = fᵀp^{k−1}``.
 
     Both loads by the trapezoidal rule over the step: the elastic energy is a function of the state, and
     the work of a force that changes through the step is its mean times the displacement (with ``Q_k``
     alone a fretting cycle at rest, ``|ΔQ| = 0.0375 μ P̄`` a step, left 2e-4 N per step unbalanced, the
     size of the step's frictional work)."""
-    dq = _dq(rec)
-    if dq == 0.0:
-        return 0.0
-    st, pr = rec.state, rec.previous
-    Q0 = rec.Q if pr is None or pr.t is None else float(ops.f @ pr.t)
-    W = -0.5 * (rec.Q + Q0) * float(st.tsol.xi) * dq
-    if pr is not None and pr.nsol is not None and st.nsol is not None and pr.p is not None:
-        P0 = float(ops.f @ pr.p)
-        W += 0.5 * (rec.P + P0) * (float(st.nsol.delta) - float(pr.nsol.delta))
-    return W
+    f, dq = rows.constants["f"], rows["_dq"]
+    Q, Q0, xi = rows["Q"], rows.before("Q"), rows["creepage"]
+    P, pn0 = rows["P"], rows.before("pn")
+    delta, delta0 = rows["approach"], rows.before("approach")
+    out = np.zeros(rows.m)
+    for i in np.flatnonzero(dq != 0.0).tolist():  # the starting state (dq = 0) has no predecessor
+        W = -0.5 * (float(Q[i]) + float(Q0[i])) * float(xi[i]) * float(dq[i])
+        out[i] = W + 0.5 * (float(P[i]) + float(f @ pn0[i])) * (float(delta[i]) - float(delta0[i]))
+    return out
 
 
 def _mu(scene) -> bool:
@@ -132,15 +138,15 @@ def _mu(scene) -> bool:
 
 for _f in (
     Field("friction_power", "state", STRESS, "frictional dissipation density -t s >= 0 per unit rolled distance "
-          "(times |V|: power per unit area); written when mu > 0", compute=friction_power, needed=_mu),
+          "(times |V|: power per unit area); written when mu > 0", derive=friction_power, needed=_mu),
     Field("dissipation", "step", FORCE, "frictional dissipation D = -integral(t s dx) per unit rolled distance "
-          "(and axial length); written when mu > 0", compute=dissipation, needed=_mu),
+          "(and axial length); written when mu > 0", derive=dissipation, needed=_mu),
     Field("friction_work", "step", "force", "frictional work of the step per unit axial length, D dq (0 for the starting "
-          "state); its cumulative sum is the accumulated work", compute=friction_work, needed=_mu),
+          "state); its cumulative sum is the accumulated work", derive=friction_work, needed=_mu, reduce="sum"),
     Field("elastic_energy", "step", "force", "elastic energy of the contact tractions per unit axial length, "
           "1/2 p.F.Ann.p + p.F.Ant.t + 1/2 t.F.Att.t (relative to d_ref)", compute=elastic_energy),
     Field("load_work", "step", "force", "work of the applied loads in the step, -mean(Q) xi dq + "
-          "mean(P) d(delta) (0 for the starting state)", compute=load_work),
+          "mean(P) d(delta) (0 for the starting state)", derive=load_work, reduce="sum"),
 ):
     register(_f)
 

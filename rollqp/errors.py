@@ -21,8 +21,14 @@ class InputError(RollqpError, ValueError):
         What is wrong and what is allowed.
     """
 
+    #: Longest message kept: a message that shows the input it refuses could be megabytes long (a table
+    #: of a million numbers); the rest is cut, with the length said.
+    MAX_MESSAGE = 2000
+
     def __init__(self, key: str, message: str):
         self.key = key
+        if len(message) > self.MAX_MESSAGE:
+            message = f"{message[:self.MAX_MESSAGE]}… ({len(message)} characters)"
         super().__init__(f"{key}: {message}")
 
 

@@ -4,9 +4,11 @@ Each :class:`Field` names an array of the result file (docs/results.md), its sha
 ``(K+1, n)``, one row per stored state; ``"step"``: ``(K+1,)``; ``"node"``: ``(n,)``; ``"scalar"``),
 its physical dimension and a one-line description, and how it is computed: from a
 :class:`~rollqp.march.StepRecord` and the scene's :class:`~rollqp.operators.SceneOperators`
-(``compute``), or from the scene alone (scalars). :class:`~rollqp.result.Result` fills the fields
-a scene needs (``needed(scene)``) as the records arrive; the dataset writers
-(xarray) read the units and descriptions from here.
+(``compute``, as each record arrives), from the stored fields of a block of states at once
+(``derive``, when the result's arrays are made: in bulk, not step by step), or from the scene alone
+(scalars). :class:`~rollqp.result.Result` fills the fields a scene needs (``needed(scene)``); the
+dataset writers (xarray) read the units and descriptions from here. ``reduce`` says how a result
+that keeps every k-th state combines the steps in between (docs/results.md).
 
 Adding a result field is adding one :class:`Field` to :data:`FIELDS` (or registering one with
 :func:`register` from the module that computes it): nothing else changes.
@@ -21,10 +23,13 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["Field", "FIELDS", "register", "fields_for"]
+__all__ = ["Field", "FIELDS", "register", "fields_for", "Rows"]
 
 #: Shapes a field may have: per stored state and node, per stored state, per node, scalar.
 SHAPES = ("state", "step", "node", "scalar")
+#: How a result that keeps every k-th state combines a field over the steps since the last stored
+#: state: the stored state's own value, the sum (works, times, iteration counts), the largest.
+REDUCTIONS = ("last", "sum", "max")
 
 
 @dataclass(frozen=True)
@@ -46,6 +51,13 @@ class Field:
     compute : callable or None
         ``compute(record, operators) -> value`` for a ``"state"``/``"step"`` field; ``None`` for
         the core fields that :class:`~rollqp.result.Result` reads off the record itself.
+    derive : callable or None
+        ``derive(rows) -> array``: the field of a block of consecutive states at once, from the
+        stored fields (:class:`Rows`: ``rows["pt"]``, ``rows.before("pn")``, ``rows.constants``);
+        computed when the arrays are made, not per step.
+    reduce : {"last", "sum", "max"}
+        How a result keeping every k-th state combines the steps between stored states
+        (:data:`REDUCTIONS`).
     needed : callable
         ``needed(scene) -> bool``: whether a scene's result holds the field (model only what a
         scene needs); the core fields are always there.
@@ -61,10 +73,46 @@ class Field:
     compute: Callable | None = None
     needed: Callable = staticmethod(lambda scene: True)
     contract: bool = False
+    derive: Callable | None = None
+    reduce: str = "last"
 
     def __post_init__(self):
         if self.shape not in SHAPES:
             raise ValueError(f"field {self.name!r}: shape must be one of {SHAPES}, got {self.shape!r}")
+        if self.reduce not in REDUCTIONS:
+            raise ValueError(f"field {self.name!r}: reduce must be one of {REDUCTIONS}, got {self.reduce!r}")
+        if self.compute is not None and self.derive is not None:
+            raise ValueError(f"field {self.name!r}: computed from the record or derived from stored fields, not both")
+
+
+class Rows:
+    """A block of consecutive states as :attr:`Field.derive` sees it.
+
+    ``rows[name]`` is a field of the block's states (``m`` rows: read from the store, or derived
+    first if it is a derived field), ``rows.before(name)`` the same field of each state's
+    predecessor (NaN rows for the starting state, which has none), ``rows.constants`` the run's
+    constants (``"f"``: the nodes' weights; ``"wear_A"``, ``"wear_B"``: Archard coefficients).
+    """
+
+    def __init__(self, read, m: int, constants: dict, read_before=None):
+        self._read, self._before, self.m, self.constants = read, read_before, m, constants
+        self._cache = {}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        got = self._cache.get(name)
+        if got is None:
+            f = FIELDS.get(name)
+            got = self._read(name)
+            if got is None and f is not None and f.derive is not None:
+                got = np.asarray(f.derive(self), dtype=dtype_of(name))
+            if got is None:
+                raise KeyError(name)
+            self._cache[name] = got
+        return got
+
+    def before(self, name: str) -> np.ndarray:
+        """``name`` of each state's predecessor (the state before the block for the first row)."""
+        return self._before(name)
 
 
 STRESS, LENGTH, FORCE = "force/length^2", "length", "force/length"
@@ -84,15 +132,17 @@ FIELDS: dict[str, Field] = {f.name: f for f in (
     Field("creepage", "step", "1", "creepage xi = (V_A - V_B)/|V|", contract=True),
     Field("approach", "step", LENGTH, "rigid approach delta", contract=True),
     Field("shift", "step", LENGTH, "rigid static shift of a braked start (0 for rolling states)"),
+    Field("step", "step", "1", "index k of each stored state in the run, 0..K (every k unless the run kept only "
+                               "every k-th state: keep_every in meta)", dtype="int64"),
     Field("iterations", "step", "1", "solver iterations of the step (outer iterations for N-T)", dtype="int64",
-          contract=True),
-    Field("step_time", "step", "s", "wall seconds of the step", contract=True),
+          contract=True, reduce="sum"),
+    Field("step_time", "step", "s", "wall seconds of the step", contract=True, reduce="sum"),
     Field("residual", "step", "1", "the step's complementarity residual (nondimensional max norm, "
-                                   "docs/formulation.md §5)", contract=True),
+                                   "docs/formulation.md §5)", contract=True, reduce="max"),
     Field("inner_normal", "step", "1", "iterations of the normal halves (N-T: summed over outer iterations)",
-          dtype="int64"),
-    Field("inner_tangential", "step", "1", "iterations of the tangential halves", dtype="int64"),
-    Field("backtracks", "step", "1", "Armijo step reductions of the Newton methods", dtype="int64"),
+          dtype="int64", reduce="sum"),
+    Field("inner_tangential", "step", "1", "iterations of the tangential halves", dtype="int64", reduce="sum"),
+    Field("backtracks", "step", "1", "Armijo step reductions of the Newton methods", dtype="int64", reduce="sum"),
     Field("a_H", "scalar", LENGTH, "Hertz half-width of the reference load", contract=True),
     Field("p0", "scalar", STRESS, "Hertz peak pressure of the reference load", contract=True),
     Field("R", "scalar", LENGTH, "relative radius, 1/R = 1/R_A + 1/R_B", contract=True),
@@ -112,8 +162,8 @@ def register(f: Field) -> Field:
 
 
 def fields_for(scene) -> list[Field]:
-    """The computed fields (``compute`` set) that ``scene``'s result holds."""
-    return [f for f in FIELDS.values() if f.compute is not None and f.needed(scene)]
+    """The computed and derived fields (``compute`` or ``derive`` set) that ``scene``'s result holds."""
+    return [f for f in FIELDS.values() if (f.compute is not None or f.derive is not None) and f.needed(scene)]
 
 
 def dtype_of(name: str):
@@ -129,11 +179,15 @@ def markdown_table() -> str:
     for f in FIELDS.values():
         units = "–" if f.units == "1" else f.units
         note = "" if f.contract else " *(beyond the contract)*"
+        if f.reduce != "last":
+            note = f" (keeping every k-th state: the {'sum' if f.reduce == 'sum' else 'largest'} over the steps since " \
+                   f"the previous stored state){note}"
         text = f.description.replace("|", "\\|")
         rows.append(f"| `{f.name}` | {shapes[f.shape]} | {units} | {text}{note} |")
     rows.append("| `meta` | () | – | JSON string: the full scene with defaults, the method, the model's data, "
-                "package versions, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
-                "`rolling_start`) |")
+                "package versions, `keep_every`, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
+                "`rolling_start`); a list of more than 64 numbers in it (a profile table) is stored as the array "
+                "`meta.<path>` and written `{\"$array\": \"meta.<path>\"}` in its place |")
     return "\n".join(rows)
 
 

@@ -42,6 +42,7 @@ coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
 from __future__ import annotations
 
 import functools
+import os
 import time
 from dataclasses import dataclass, field
 from typing import Iterator
@@ -271,6 +272,10 @@ class _March:
                           shift=shift, step_time=time.perf_counter() - t0, nodes=nodes, gross_sliding=gross)
 
     # ------------------------------------------------------------ the phases
+    def start(self) -> StepRecord:
+        """State 0: the braked start, or the rolling start (``load.start``)."""
+        return self.rolling_start() if self.scene.load.start == "rolling" else self.braked_start()
+
     def braked_start(self):
         """Step 0 of a braked start (§2.2, §4.4; docs/formulation.md §9), by static shift.
 
@@ -467,6 +472,14 @@ class _March:
         return rec
 
 
+def _two_d(scene) -> Scene:
+    """``scene`` if it is a 2D scene, else a one-line :class:`InputError` naming the 3D entry points."""
+    if not isinstance(scene, Scene):   # another dimension's scene (docs/architecture.md, three dimensions)
+        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.three.run.run and "
+                                  "rollqp.three.run.march run it (on the command line: rollqp run)")
+    return scene
+
+
 def prepare(scene, method=None):
     """``(scene, method, operators)``: the scene validated, its method composed and set up on its operators.
 
@@ -480,7 +493,7 @@ def prepare(scene, method=None):
     """
     from .advice import fast_path
     from .methods import compose, scene_method
-    scene = scene if isinstance(scene, Scene) else load_scene(scene)
+    scene = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     if method is None or isinstance(method, str):
@@ -497,7 +510,7 @@ def prepare(scene, method=None):
     return scene, meth, ops
 
 
-def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRecord]:
+def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Iterator[StepRecord]:
     """The transient of ``scene`` as a stream of :class:`StepRecord` (module docstring).
 
     Parameters
@@ -509,8 +522,12 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
     prepared : tuple, optional
         ``(scene, method, operators)`` from :func:`prepare` (to look at the operators first).
     resume : dict, optional
-        The arrays of a result file of this scene (:func:`~rollqp.result.load_result`): the march
-        continues after its last state (:func:`resumed_state`) and yields only the steps after it.
+        The arrays of a result file of this scene (:func:`~rollqp.result.load_result`, or
+        :meth:`ResumeSource.tail <rollqp.result.ResumeSource.tail>`): the march continues after its
+        last state (:func:`resumed_state`) and yields only the steps after it.
+    verify : bool
+        With ``resume``: check first that the last stored state solves its own step
+        (:func:`check_resumed`).
 
     Yields
     ------
@@ -522,15 +539,18 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
     SolverError
         A step failed; ``err.step`` names it (0: the start).
     InputError
-        The scene cannot be run with this method, or the contact leaves the zone.
+        The scene cannot be run with this method, or the contact leaves the zone; ``--resume``: the
+        stored states are another scene's, or the last one does not solve its step.
     """
     scene, meth, ops = prepared if prepared is not None else prepare(scene, method)
     m = _March(scene, ops, meth)
     if resume is not None:
-        state, first = resumed_state(scene, ops, resume), len(resume["q"])
+        if verify:
+            check_resumed(scene, (scene, meth, ops), resume, march=m)
+        state, first = resumed_state(scene, ops, resume), _last_index(resume) + 1
     else:
         try:
-            start = m.rolling_start() if scene.load.start == "rolling" else m.braked_start()
+            start = m.start()
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
@@ -546,13 +566,25 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
         yield rec
 
 
-def resumed_state(scene, ops: SceneOperators, arrays: dict) -> State:
-    """The last state of a result file of ``scene``, as the march continues from it.
+def _last_index(arrays) -> int:
+    """The index k of the last stored state (``step`` if the file keeps only some states)."""
+    return int(arrays["step"][-1]) if "step" in arrays else len(arrays["q"]) - 1
 
-    Tractions, approach and creepage are the stored ones (float64, as the march keeps them);
-    ``w`` is recomputed from the tractions (eq. 28). The continuation equals an uninterrupted
-    run to round-off: the warm starts are the same numbers, but what a method built during the
-    first part (Newton's reused factorizations, a QP solver's internal state) is built anew.
+
+#: A resumed state must equal its step solved again from the state before it to this fraction of p0
+#: (pressures) and μp0 (tractions): ten thousand times the methods' tolerance (1e-10: two solutions
+#: of a step from different warm starts agree to ~1e-10), far below any change to a state that matters.
+RESUME_TOL = 1e-6
+
+
+def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1) -> State:
+    """A stored state of a result file of ``scene`` (the last one, ``row = -1``), as the march continues from it.
+
+    Tractions, approach and creepage are the stored ones (float64, as the march keeps them), and a
+    friction law's memory (the stored ``friction_coefficient``); ``w`` is recomputed from the
+    tractions (eq. 28). The continuation equals an uninterrupted run to round-off: the warm starts
+    are the same numbers, but what a method built during the first part (Newton's reused
+    factorizations, a QP solver's internal state) is built anew.
 
     Raises
     ------
@@ -560,21 +592,54 @@ def resumed_state(scene, ops: SceneOperators, arrays: dict) -> State:
         ``--resume``: the file belongs to another scene (other nodes or rolled distances).
     """
     x, q = np.asarray(arrays["x"]), np.asarray(arrays["q"])
+    steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(q.size)
     qs = scene.q_steps
     if x.shape != (ops.n,) or not np.allclose(x, ops.strip.x, rtol=0, atol=1e-12 * scene.half_width):
         raise InputError("--resume", f"the result file's {x.size} nodes are not this scene's {ops.n}: another scene")
-    if q.size > qs.size or not np.allclose(q, qs[:q.size], rtol=1e-12, atol=1e-15 * scene.a_H):
+    if (steps.shape != q.shape or q.size == 0 or steps[-1] >= qs.size
+            or not np.allclose(q, qs[steps], rtol=1e-12, atol=1e-15 * scene.a_H)):
         raise InputError("--resume", f"the result file's rolled distances are not this scene's "
                                      f"(it has {q.size} states, the scene {qs.size}): another scene")
-    p, t = np.array(arrays["pn"][-1], dtype=float), np.array(arrays["pt"][-1], dtype=float)
-    nsol = StepSolution(p=p, g=np.array(arrays["gap"][-1], dtype=float), delta=float(arrays["approach"][-1]),
+    p, t = np.array(arrays["pn"][row], dtype=float), np.array(arrays["pt"][row], dtype=float)
+    nsol = StepSolution(p=p, g=np.array(arrays["gap"][row], dtype=float), delta=float(arrays["approach"][row]),
                         method="resumed", status="resumed")
-    tsol = StepSolution(t=t, s=np.array(arrays["slip"][-1], dtype=float), xi=float(arrays["creepage"][-1]),
+    tsol = StepSolution(t=t, s=np.array(arrays["slip"][row], dtype=float), xi=float(arrays["creepage"][row]),
                         method="resumed", status="resumed")
+    if "friction_coefficient" in arrays:  # a friction law's memory: the next step's μ starts from it
+        tsol.mu = np.array(arrays["friction_coefficient"][row], dtype=float)
     return State(p, t, ops.w(p, t), nsol, tsol, None)
 
 
-def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
+def check_resumed(scene, prepared, arrays: dict, march=None) -> None:
+    """The last stored state of ``arrays`` solves its own step: that step is solved again from the state
+    before it (from the start for state 0) and must agree to :data:`RESUME_TOL`, else the file was
+    changed or is corrupt (an :class:`InputError` on ``--resume``, one line, nothing run)."""
+    scene, meth, ops = prepared
+    m = march if march is not None else _March(scene, ops, meth)
+    k = _last_index(arrays)
+    steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(len(arrays["q"]))
+    stored = resumed_state(scene, ops, arrays, -1)
+    try:
+        if k == 0:
+            again = m.start().state
+        elif steps.size >= 2 and int(steps[-2]) == k - 1:
+            again = m.rolling(k, float(m.plan.q[k]), resumed_state(scene, ops, arrays, -2), ops.history()).state
+        else:
+            raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
+                                         "which it needs to be continued")
+    except SolverError as err:
+        raise InputError("--resume", f"the last state ({k}) cannot be checked: its step, solved again, failed "
+                                     f"({str(err)[:120]})") from None
+    p0, mu = ops.scales.stress, max(float(getattr(ops, "mu", 0.0) or 0.0), 1e-300)
+    dp = float(np.max(np.abs(again.p - stored.p))) / p0
+    dt = float(np.max(np.abs(again.t - stored.t))) / (min(mu, 1.0) * p0) if mu > 1e-300 else 0.0
+    if not (dp <= RESUME_TOL and dt <= RESUME_TOL):
+        raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
+                                     f"state before it, its pressure differs by {dp:.3g} p0 and its traction by "
+                                     f"{dt:.3g} mu p0 (more than {RESUME_TOL:g}): the file was changed or is corrupt")
+
+
+def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -585,13 +650,23 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
         Overrides ``[solver].method`` (:func:`prepare`).
     progress : callable, optional
         Called as ``progress(k, K)`` after each rolling step.
-    resume : dict, optional
-        The arrays of an earlier, incomplete result file of this scene
-        (:func:`~rollqp.result.load_result`): its states are kept and the run continues after
-        the last one (:func:`resumed_state`); ``meta["resumed_from"]`` records where.
+    resume : dict, path or ResumeSource, optional
+        An earlier, incomplete part of this run: the arrays of its result file
+        (:func:`~rollqp.result.load_result`), the path of its result file or journal, or a
+        :class:`~rollqp.result.ResumeSource`. Its states are kept and the run continues after the last
+        one (:func:`resumed_state`, once :func:`check_resumed` has passed); ``meta["resumed_from"]``
+        records where.
     observe : callable, optional
         Called as ``observe(record, operators)`` with every :class:`StepRecord` (to keep some
         steps' problems, e.g. for a cross-check: :func:`rollqp.crossval.spot_check`).
+    out : path, optional
+        The result file: every state is appended to its journal as it is completed (nothing kept in
+        memory), and the file is written at the end, or when the run fails or is interrupted, with
+        ``meta["failed"]`` or ``meta["interrupted"]`` (docs/results.md). Without it, the states stay in
+        memory and nothing is written.
+    keep_every : int, optional
+        Keep every k-th state (and the last two); the steps in between are combined into the kept
+        ones (``Field.reduce``). Default 1, or the resumed file's.
 
     Raises
     ------
@@ -604,35 +679,76 @@ def run(scene, method=None, progress=None, resume=None, observe=None) -> Result:
     KeyboardInterrupt
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
-    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    from .result import ResumeSource, resume_source
+    asked = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != asked.solver.method:
         asked = asked.replace(**{"solver.method": method})
+    source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
+    keep = _keep_every(keep_every, source)
+    if out is None:  # before any work: the states it would hold, on the operators it would build
+        from .advice import fast_path
+        from .scene.checks import check_result_memory
+        check_result_memory(fast_path(asked).scene if method is None or isinstance(method, str) else asked, keep)
     scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
-    result = new_result(asked, ops, meth.name)  # meta: the scene as given, the method that ran it
+    tail = None
+    if source is not None:
+        tail = source.tail() if isinstance(source, ResumeSource) else source
+        check_resumed(scene, prepared, tail)
+    result = new_result(asked, ops, meth.name, keep_every=keep, out=out)  # meta: the scene as given, the method that ran it
     if scene.solver.method != asked.solver.method:
         from .advice import fast_path
         result.meta["method_note"] = fast_path(asked).note
-    if resume is not None:
-        result.extend(resume)
-        result.meta["resumed_from"] = len(result) - 1
-    K = scene.n_steps
+    from .atomic import stop_once
+    with stop_once():  # a second Ctrl-C never interrupts the writing of what the first one saves
+        return _run(scene, prepared, result, source, tail, observe, progress)
+
+
+def _run(scene, prepared, result, source, tail, observe, progress) -> Result:
+    """:func:`run`'s loop: the records into ``result``; on a failure or a signal, the result finished with a note."""
+    ops, K = prepared[2], scene.n_steps
     try:
-        for rec in march(scene, prepared=prepared, resume=resume):
+        if source is not None:
+            result.resume(source)
+            result.meta["resumed_from"] = _last_index(tail)
+        for rec in march(scene, prepared=prepared, resume=tail, verify=False):
             result.add(rec, ops)
-            if rec.note is not None:
-                result.meta["start_note"] = rec.note
             if observe is not None:
                 observe(rec, ops)
             if progress is not None and rec.k > 0:
                 progress(rec.k, K)
-    except (SolverError, InputError, KeyboardInterrupt) as err:
+    except (SolverError, InputError, KeyboardInterrupt, MemoryError) as err:
+        note = {"interrupted": "interrupted"} if isinstance(err, KeyboardInterrupt) else \
+            {"failed": str(err) or type(err).__name__}
+        try:
+            result.finish(note)
+        except KeyboardInterrupt:  # a signal held during the write: the file is written, the first one goes on
+            pass
         err.partial = result
         raise
-    return result
+    try:
+        return result.finish()
+    except KeyboardInterrupt as err:  # a signal while the file was written: it is complete
+        err.partial = result
+        raise
 
 
-def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
-    """An empty :class:`Result` with the scene's scalars, metadata and the computed fields it needs."""
+def _keep_every(keep_every, source) -> int:
+    """``keep_every`` of a run: the resumed file's, which an explicit value must not contradict."""
+    from .result import ResumeSource
+    had = source.keep_every if isinstance(source, ResumeSource) else \
+        int(source["meta"].get("keep_every", 1)) if isinstance(source, dict) and isinstance(source.get("meta"), dict) \
+        else None
+    if keep_every is None:
+        return had or 1
+    if had is not None and keep_every != had:
+        raise InputError("--keep-every", f"the resumed run keeps every {had}-th state; resume it with that "
+                                         f"(or without --keep-every), got {keep_every!r}")
+    return keep_every
+
+
+def new_result(scene, ops: SceneOperators, method_name: str, keep_every: int = 1, out=None) -> Result:
+    """An empty :class:`Result` with the scene's scalars, metadata and the computed fields it needs
+    (``out``: written to that file through its journal, :func:`run`)."""
     from .version import __version__
     from .fields import fields_for
     meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info),
@@ -645,7 +761,9 @@ def new_result(scene, ops: SceneOperators, method_name: str) -> Result:
                             else "")}
     scalars = {"a_H": scene.a_H, "p0": scene.p0, "R": scene.R, "Estar": scene.Estar, "beta": scene.beta,
                "leading_edge": scene.leading_edge}
-    return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta, extra=fields_for(scene))
+    constants = {"f": ops.f, "wear_A": scene.A.wear or 0.0, "wear_B": scene.B.wear or 0.0}
+    return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta, extra=fields_for(scene), constants=constants,
+                  keep_every=keep_every, out=out, operators=ops)
 
 
 def _versions() -> dict:

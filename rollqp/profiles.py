@@ -145,7 +145,9 @@ class Flat(Feature):
     def height(self, s):
         u = np.asarray(s, dtype=float) - self.position
         half = 0.5 * self.length
-        return np.where(np.abs(u) < half, (half * half - u * u) / (2.0 * self.radius), 0.0)
+        inside = np.abs(u) < half
+        u = np.where(inside, u, 0.0)  # far from the flat (a position of 1e308): no u² to overflow
+        return np.where(inside, (half * half - u * u) / (2.0 * self.radius), 0.0)
 
     def extent(self):
         return self.position - 0.5 * self.length, self.position + 0.5 * self.length
@@ -169,7 +171,8 @@ class Defect(Feature):
     kind: ClassVar[str] = "defect"
 
     def height(self, s):
-        u = 2.0 * (np.asarray(s, dtype=float) - self.position) / self.width
+        with np.errstate(over="ignore"):  # far from the defect u overflows to ±inf: outside, as it should be
+            u = 2.0 * (np.asarray(s, dtype=float) - self.position) / self.width
         inside = np.abs(u) < 1.0
         return np.where(inside, self.depth * DEFECT_SHAPES[self.shape](np.where(inside, u, 0.0)), 0.0)
 
@@ -293,7 +296,7 @@ def parse_profile(obj: Any, key: str, radius: float, folder: str | os.PathLike |
 
 def _parse_one(item: dict, key: str, radius: float, folder):
     kind = item.get("kind")
-    if kind not in FEATURE_KINDS:
+    if not isinstance(kind, str) or kind not in FEATURE_KINDS:  # a list or a table is no kind (nor hashable)
         raise InputError(f"{key}.kind", f"must be one of {', '.join(map(repr, FEATURE_KINDS))}, got {kind!r}"
                          + suggestion(kind, FEATURE_KINDS))
     for k in item:
@@ -320,15 +323,21 @@ def _parse_table(key, values, radius, folder):
         _need(key, values, ("x", "h"), "table")
         x = np.asarray(real_sequence(f"{key}.x", values["x"], MAX_POINTS))
         h = np.asarray(real_sequence(f"{key}.h", values["h"], MAX_POINTS))
-    if x.size < 2:
-        raise InputError(f"{key}.x", f"needs at least 2 points, got {x.size}")
+    xkey, hkey = (f"{key}.file", f"{key}.file") if "file" in values else (f"{key}.x", f"{key}.h")
+    if not 2 <= x.size <= MAX_POINTS:
+        raise InputError(xkey, f"needs 2 to {MAX_POINTS} points, got {x.size}")
     if h.size != x.size:
-        raise InputError(f"{key}.h", f"must have as many entries as {key}.x ({x.size}), got {h.size}")
-    bad = np.flatnonzero(~(np.diff(x) > 0))
+        raise InputError(hkey, f"must have as many entries as {key}.x ({x.size}), got {h.size}")
+    bad = np.flatnonzero(~(x[1:] > x[:-1]))  # compared, not subtracted: no overflow at ±1e308
     if bad.size:
         i = int(bad[0]) + 1
-        raise InputError(f"{key}.x", f"must be strictly increasing, but x[{i}] = {x[i]!r} follows "
-                                     f"x[{i - 1}] = {x[i - 1]!r}")
+        raise InputError(xkey, f"x must be strictly increasing, but x[{i}] = {float(x[i])!r} follows "
+                               f"x[{i - 1}] = {float(x[i - 1])!r}")
+    big = np.flatnonzero(~(np.abs(h) <= radius))
+    if big.size:  # a height beyond the radius is no roller's surface (and 1e308 overflows the gap)
+        i = int(big[0])
+        raise InputError(hkey, f"heights must be within ±radius = ±{radius:.6g} (length units), but h[{i}] = "
+                               f"{float(h[i])!r}")
     return Table(tuple(map(float, x)), tuple(map(float, h)), frame)
 
 
@@ -358,29 +367,52 @@ def read_profile_file(name: Any, key: str, folder=None) -> tuple[np.ndarray, np.
     must stay inside it and inside the working folder: no absolute paths, no ``..`` out of it, no
     links leading out.
     """
-    if not isinstance(name, str) or not name:
-        raise InputError(key, f"must be a file name (a .csv or .npz file beside the scene file), got {name!r}")
-    base = Path(folder if folder is not None else os.getcwd()).resolve()
-    cwd = Path(os.getcwd()).resolve()
-    path = (base / name).resolve()
+    if not isinstance(name, str) or not name or len(name) > 4096 or "\0" in name:
+        shown = repr(name)[:80] if isinstance(name, str) else type(name).__name__
+        raise InputError(key, f"must be a file name (a .csv or .npz file beside the scene file, no NUL character), "
+                              f"got {shown}")
+    try:
+        base = Path(folder if folder is not None else os.getcwd()).resolve()
+        cwd = Path(os.getcwd()).resolve()
+        path = (base / name).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:  # a symbolic link loop (RuntimeError before 3.13)
+        raise InputError(key, f"{name[:80]!r} cannot be resolved to a file ({type(exc).__name__}: "
+                              f"{str(exc)[:80]})") from None
     if Path(name).is_absolute() or not (path.is_relative_to(base) and path.is_relative_to(cwd)):
         raise InputError(key, f"{name!r} must be a file inside the scene file's folder ({base}) and the working "
                               f"folder ({cwd})")
     if path.suffix.lower() not in (".csv", ".npz"):
         raise InputError(key, f"{name!r} must be a .csv or .npz file")
-    if not path.is_file():
-        raise InputError(key, f"no such file: {name!r} (looked in {base})")
-    if path.stat().st_size > MAX_FILE_BYTES:
+    try:
+        if not path.is_file():
+            raise InputError(key, f"no such file: {name!r} (looked in {base})")
+        size = path.stat().st_size
+    except OSError as exc:
+        raise InputError(key, f"cannot read {name!r} ({exc.strerror or exc})") from None
+    if size > MAX_FILE_BYTES:
         raise InputError(key, f"{name!r} is larger than {MAX_FILE_BYTES >> 20} MiB")
     if path.suffix.lower() == ".npz":
         from .npzfile import read_npz, real_array
         z = read_npz(path, key)
         n = np.asarray(z.get("x", np.zeros(0))).size
         return real_array(z, "x", (n,), key), real_array(z, "h", (n,), key)
+    return _read_csv(path, name, key)
+
+
+def _read_csv(path, name, key) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, h)`` of a CSV of two numeric columns (``#`` comments); an empty file or one without a row of
+    numbers is an error, not numpy's warning."""
+    import warnings
     try:
-        data = np.loadtxt(path, delimiter=",", comments="#", dtype=float, ndmin=2)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # numpy warns on a file without data rows: an error here
+            data = np.loadtxt(path, delimiter=",", comments="#", dtype=float, ndmin=2)
+    except UserWarning:
+        raise InputError(key, f"{name!r} holds no rows of numbers x, h (an empty CSV file)") from None
     except (ValueError, OSError, UnicodeDecodeError) as exc:
         raise InputError(key, f"{name!r} is not a CSV of two numeric columns x, h ({str(exc)[:100]})") from None
+    if data.shape[0] == 0:
+        raise InputError(key, f"{name!r} holds no rows of numbers x, h (an empty CSV file)")
     if data.shape[1] != 2 or not np.all(np.isfinite(data)):
         raise InputError(key, f"{name!r} must have exactly two finite numeric columns x, h (got {data.shape[1]})")
     return data[:, 0].copy(), data[:, 1].copy()

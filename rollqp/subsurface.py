@@ -40,6 +40,11 @@ COMPONENTS = ("sxx", "szz", "txz")
 #: Every quantity of a :class:`StressField` (σyy, principal stresses s1 ≥ s2 ≥ s3 of the 3D tensor,
 #: τ1 the in-plane maximum shear, von Mises and Tresca equivalents).
 QUANTITIES = COMPONENTS + ("syy", "s1", "s2", "s3", "tau1", "von_mises", "tresca")
+#: Smallest half-width and depth of :func:`default_grid` (units of a_H): the field is computed to
+#: round-off down to depths of 1e-5 a_H per grid point; far below, its kernels (1/r⁴) lose all digits.
+MIN_EXTENT = 1e-3
+#: Traction values (states × nodes) of a block of states in :func:`stress_history`.
+STATES_PER_BLOCK = 1 << 20
 #: Points per block of the element integrals: about 30 arrays of block × elements doubles that stay
 #: in the processor's cache (measured: 512 points run a 200 × 200 grid in 0.13 s of CPU, 10 000 in 0.31 s).
 BLOCK = 512
@@ -224,7 +229,7 @@ def _source(result) -> tuple[dict, object]:
     from .result import Result, load_result
     from .scene import load_scene
     if isinstance(result, Result):
-        arrays = result.arrays()
+        arrays = dict(result.arrays())
         arrays["meta"] = result.meta
     elif isinstance(result, dict):
         arrays = result
@@ -243,7 +248,14 @@ def _source(result) -> tuple[dict, object]:
             meta = None
     if not isinstance(meta, dict) or not isinstance(meta.get("scene"), dict):
         raise InputError("result", "the result holds no scene (meta['scene']): the strip cannot be rebuilt")
-    return arrays, load_scene(meta["scene"])
+    scene = load_scene(meta["scene"])
+    for key, value in (("a_H", scene.a_H), ("p0", scene.p0)):  # what the grid and the summary divide by
+        got = float(np.asarray(arrays.get(key, np.nan), dtype=float).reshape(-1)[0]) if np.size(arrays.get(key, [])) == 1 \
+            else float("nan")
+        if not abs(got - value) <= 1e-9 * value:
+            raise InputError("result", f"key {key!r} = {got!r} is not the {key} of the scene stored in the file "
+                                       f"({value:.6g}): a corrupt or edited file")
+    return arrays, scene
 
 
 def _strip(arrays, scene) -> Strip:
@@ -280,8 +292,9 @@ def default_grid(scene, nx: int = 200, nz: int = 200, width: float = 1.5, depth:
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= 4000:
             raise InputError(key, f"must be an integer in [1, 4000], got {v!r}")
     for key, v in (("width", width), ("depth", depth)):
-        if not (isinstance(v, (int, float, np.floating)) and np.isfinite(v) and 0 < v <= 100):
-            raise InputError(key, f"must be a number in (0, 100] (units of a_H), got {v!r}")
+        if isinstance(v, bool) or not (isinstance(v, (int, float, np.integer, np.floating)) and np.isfinite(v)
+                                       and MIN_EXTENT <= v <= 100):
+            raise InputError(key, f"must be a number in [{MIN_EXTENT:g}, 100] (units of a_H), got {v!r}")
     a = scene.a_H
     return np.linspace(-width * a, width * a, nx), np.linspace(depth * a / nz, depth * a, nz)
 
@@ -326,8 +339,21 @@ def stresses(result, step: int, grid=None, body: str = "A") -> StressField:
     mat, sign = _body(body, scene)
     gx, gz = check_grid(default_grid(scene) if grid is None else grid)
     X, Z = np.meshgrid(gx, gz)
-    values = _field(strip, X, Z, arrays["pn"][k], sign * arrays["pt"][k], mat.nu)
+    with np.errstate(all="ignore"):  # a grid too close to the surface: not finite, said below
+        values = _field(strip, X, Z, np.asarray(arrays["pn"][k], dtype=float), sign * np.asarray(arrays["pt"][k], dtype=float),
+                        mat.nu)
+    _finite(values.values())
     return StressField(gx, gz, values, body, k, float(arrays["q"][k]), _maxima(values, X, Z))
+
+
+def _finite(arrays) -> None:
+    """The stresses are finite (a point too close to the surface, or too far in scene units, overflows the
+    kernels 1/r⁴): otherwise an :class:`InputError` on the grid, never NaN peaks."""
+    for v in arrays:
+        if not np.all(np.isfinite(v)):
+            raise InputError("grid", "the stresses are not finite on this grid: its points are too close to the "
+                                     "surface or too far from the contact for the kernels (use depths of at least "
+                                     "1e-5 a_H and points within 1e6 a_H)")
 
 
 def stress_history(result, grid=None, body: str = "A", steps=None) -> StressHistory:
@@ -344,23 +370,34 @@ def stress_history(result, grid=None, body: str = "A", steps=None) -> StressHist
     gx, gz = check_grid(default_grid(scene, 100, 60) if grid is None else grid)
     X, Z = np.meshgrid(gx, gz)
     x, z = X.ravel(), Z.ravel()
-    P, T = np.asarray(arrays["pn"])[ks], sign * np.asarray(arrays["pt"])[ks]
     best = {name: np.full((ks.size, 3), -np.inf) for name in PEAKS + ("s3",)}
-    for i in range(0, x.size, BLOCK):
-        s = _contract(strip, x[i:i + BLOCK], z[i:i + BLOCK], P, T)
-        inv = invariants(s[:, 0], s[:, 1], s[:, 2], mat.nu)
-        inv["s3"] = -inv["s3"]
-        for name, rows in best.items():
-            j = np.argmax(inv[name], axis=1)
-            v = inv[name][np.arange(ks.size), j]
-            better = v > rows[:, 0]
-            rows[better] = np.stack([v, x[i:i + BLOCK][j], z[i:i + BLOCK][j]], axis=1)[better]
+    per = max(1, STATES_PER_BLOCK // max(1, np.shape(arrays["pn"])[1]))
+    for j in range(0, ks.size, per):  # a block of states at a time: a long run's states need not fit in memory
+        sel = ks[j:j + per]
+        P, T = np.asarray(arrays["pn"][sel], dtype=float), sign * np.asarray(arrays["pt"][sel], dtype=float)
+        _block_peaks(strip, x, z, P, T, mat.nu, {k: v[j:j + per] for k, v in best.items()})
     best["s3"][:, 0] *= -1
     overall = {}
     for name, rows in best.items():
         j = int(np.argmin(rows[:, 0]) if name == "s3" else np.argmax(rows[:, 0]))
         overall[name] = (float(rows[j, 0]), float(rows[j, 1]), float(rows[j, 2]), int(ks[j]))
     return StressHistory(gx, gz, ks, best, overall, body)
+
+
+def _block_peaks(strip, x, z, P, T, nu, best) -> None:
+    """The peaks of the states ``P``, ``T`` over the points ``x``, ``z`` into ``best`` (rows value, x, z)."""
+    S = P.shape[0]
+    for i in range(0, x.size, BLOCK):
+        with np.errstate(all="ignore"):
+            s = _contract(strip, x[i:i + BLOCK], z[i:i + BLOCK], P, T)
+            inv = invariants(s[:, 0], s[:, 1], s[:, 2], nu)
+        _finite(inv.values())
+        inv["s3"] = -inv["s3"]
+        for name, rows in best.items():
+            j = np.argmax(inv[name], axis=1)
+            v = inv[name][np.arange(S), j]
+            better = v > rows[:, 0]
+            rows[better] = np.stack([v, x[i:i + BLOCK][j], z[i:i + BLOCK][j]], axis=1)[better]
 
 
 def save_field(sf: StressField, path) -> str:

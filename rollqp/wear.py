@@ -25,19 +25,20 @@ __all__ = ["wear_rate", "profile"]
 
 
 def wear_rate(body: str):
-    """``compute(record, operators)`` of the field ``wear_rate_<body>``: ``(k/H)·p·|s|``."""
-    def compute(rec, ops):
-        k = getattr(ops.scene, body).wear
-        if not rec.phase == "rolling" or rec.state.p is None:
-            return np.zeros(ops.n)
-        return k * rec.state.p * np.abs(rec.state.tsol.s)
-    return compute
+    """``derive(rows)`` of the field ``wear_rate_<body>``: ``(k/H)·p·|s|`` of the rolling states of a block
+    (:class:`rollqp.fields.Rows`; 0 for a static-shift or steady state), ``k/H`` the run's constant
+    ``wear_<body>``."""
+    def derive(rows):
+        k = float(rows.constants[f"wear_{body}"])
+        rolling = rows["_rolling"].astype(bool)[:, None]
+        return np.where(rolling, k * rows["pn"] * np.abs(rows["slip"]), 0.0)
+    return derive
 
 
 for _b in ("A", "B"):
     register(Field(f"wear_rate_{_b}", "state", "1", f"Archard worn-depth rate (k/H) p |s| of body {_b} per unit "
                    f"rolled distance (written when bodies.{_b}.wear is set; 0 for a braked starting state)",
-                   compute=wear_rate(_b), needed=(lambda b: lambda scene: getattr(scene, b).wear is not None)(_b)))
+                   derive=wear_rate(_b), needed=(lambda b: lambda scene: getattr(scene, b).wear is not None)(_b)))
 
 
 def profile(result, body: str = "A", coefficient=None, resolution: int = 4):
@@ -63,12 +64,17 @@ def profile(result, body: str = "A", coefficient=None, resolution: int = 4):
     arrays, scene = _source(result)
     if body not in ("A", "B"):
         raise InputError("body", f"must be 'A' or 'B', got {body!r}")
+    if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)) or not 1 <= resolution <= 100:
+        raise InputError("resolution", f"must be a whole number in [1, 100] (surface points per node spacing), "
+                                       f"got {resolution!r}")
     mat = getattr(scene, body)
     key = f"wear_rate_{body}"
     if coefficient is None and key not in arrays:
         raise InputError("coefficient", f"give k/H: the scene has no bodies.{body}.wear and the result no {key!r}")
-    if coefficient is not None and not (np.isfinite(coefficient) and coefficient >= 0):
-        raise InputError("coefficient", f"must be a finite number >= 0 (k/H), got {coefficient!r}")
+    if coefficient is not None and (isinstance(coefficient, bool) or not isinstance(coefficient, (int, float, np.integer, np.floating))
+                                    or not 0 <= coefficient <= 1.0 / scene.p0):
+        raise InputError("coefficient", f"must be a number in [0, 1/p0 = {1.0 / scene.p0:.6g}] (k/H in 1/stress: "
+                                        f"Archard's k·p0/H is at most 1), got {coefficient!r}")
     d = scene.discretization
     strip = Strip(scene.half_width, d.elements, d.element)
     q = np.asarray(arrays["q"], dtype=float)

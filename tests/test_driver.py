@@ -280,11 +280,11 @@ def test_result_save_failure_keeps_old_file(short, tmp_path, monkeypatch):
     path = tmp_path / "out.npz"
     path.write_bytes(b"previous result")
 
-    def broken(fh, **kw):
-        fh.write(b"half a file")
+    def broken(fh, array, **kw):  # the disk fills while an array is written
+        fh.write(b"half an array")
         raise OSError("disk full")
     result = Result(x=arrays["x"], scalars={}, meta={})
-    monkeypatch.setattr(np, "savez", broken)
+    monkeypatch.setattr(np.lib.format, "write_array", broken)
     with pytest.raises(OSError):
         result.save(path)
     assert path.read_bytes() == b"previous result", "a failed save leaves the old file intact"

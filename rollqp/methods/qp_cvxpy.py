@@ -12,12 +12,24 @@ re-solves otherwise) and ``status_polish`` checked; ``solver="CLARABEL"`` is acc
 """
 from __future__ import annotations
 
-import cvxpy as cp
+import importlib.util
+
 import numpy as np
 
 from ._qp import QPMethod, constraint_rows
 from .qp_clarabel import ClarabelQP, clarabel_settings
 from .qp_osqp import OsqpQP
+
+if importlib.util.find_spec("cvxpy") is None:  # not installed: the registry names the extra to install
+    raise ModuleNotFoundError("No module named 'cvxpy'", name="cvxpy")
+
+
+def _cvxpy():
+    """cvxpy, imported when a problem is first built: reading the method's capabilities (the registry, the
+    advice before a run) does not import it (90 MB of memory)."""
+    import cvxpy
+    return cvxpy
+
 
 try:
     import osqp as _osqp
@@ -46,6 +58,7 @@ class CvxpyQP(QPMethod):
         self.solver = solver
 
     def _build(self, form):
+        cp = _cvxpy()
         n, up, lo, fx = constraint_rows(form)
         x = cp.Variable(n, name="x")
         q = cp.Parameter(n, name="q")
@@ -86,6 +99,7 @@ class CvxpyQP(QPMethod):
         return kw
 
     def _solve_form(self, form, x0, source=None):
+        cp = _cvxpy()
         (prob, x, params, cons), fresh = self._solver_for(form, source, self._build)
         params["q"].value = form.q
         if "b" in params:

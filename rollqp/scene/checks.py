@@ -139,7 +139,7 @@ def check_solver(s: Any) -> SolverSettings:
     if not isinstance(s, SolverSettings):
         raise InputError("solver", f"must be a SolverSettings, got {s!r}")
     return SolverSettings(
-        method=check_method(s.method, "solver.method"),
+        method=check_method(s.method, "solver.method", dimension=2),
         tolerance=number("solver.tolerance", s.tolerance, "in [1e-15, 1e-2]",
                           lambda x: 1e-15 <= x <= 1e-2),
         max_iterations=None if s.max_iterations is None else integer(
@@ -209,11 +209,22 @@ def check_derived(scene) -> None:
             raise InputError(keys.split(",")[0], f"the derived {what} = {v!r} is out of range: "
                                                  f"{keys} are too extreme to compute with")
     check_strip_fits(scene)
+    check_wear(scene)
     ratio = scene.discretization.distance * scene.a_H / scene.dq
     if not math.isfinite(ratio) or ratio > MAX_STEPS:
         raise InputError("discretization.distance",
                          f"asks for {ratio:.3g} steps of {scene.discretization.step:g} Le; at most {MAX_STEPS} "
                          f"are run (distance <= {MAX_STEPS * scene.dq / scene.a_H:.6g} a_H at this step)")
+
+
+def check_wear(scene) -> None:
+    """An Archard coefficient ``k/H`` (``bodies.X.wear``, 1/stress) gives ``k·p0/H`` <= 1: the worn depth per unit
+    slip under the peak pressure is at most the slip itself (measured ones are 1e-9 to 1e-2); beyond, the wear
+    rate ``(k/H)·p·|s|`` is no wear at all, and at 1e305 it is not even a number."""
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):
+        if body.wear is not None and not body.wear * scene.p0 <= 1.0:
+            raise InputError(f"{key}.wear", f"must be a number in [0, 1/p0 = {1.0 / scene.p0:.6g}] (k/H in 1/stress: "
+                                            f"Archard's k·p0/H is at most 1), got {body.wear!r}")
 
 
 def check_strip_fits(scene) -> None:
@@ -235,30 +246,150 @@ def check_strip_fits(scene) -> None:
                                                   f"(over a zone of {L:.6g})") from None
 
 
-def available_memory() -> float:
-    """Physical memory of this machine in bytes (``inf`` if it cannot be read)."""
+def memory_limits(proc: str = "/proc") -> dict:
+    """What limits the memory of this process, in bytes (a limit that is not set is absent):
+
+    * ``"physical"``: the machine's memory;
+    * ``"cgroup"``: the smallest ``memory.max`` (cgroup v2) or ``memory.limit_in_bytes`` (v1) of this
+      process's cgroup and its parents (a container's or a batch job's limit);
+    * ``"address space"``: ``RLIMIT_AS`` (``ulimit -v``) less the address space already mapped.
+
+    ``proc``: where ``/proc`` is (a test gives a folder with ``self/cgroup``, ``self/mountinfo`` and the
+    cgroup files under the mount points it names).
+    """
+    out = {}
     try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+        out["physical"] = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
     except (ValueError, OSError, AttributeError):
-        return float("inf")
+        pass
+    cg = _cgroup_limit(proc)
+    if cg is not None:
+        out["cgroup"] = cg
+    try:
+        import resource
+        soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    except (ImportError, OSError, ValueError):
+        soft = -1
+    if soft not in (-1, getattr(__import__("resource"), "RLIM_INFINITY", -1)) and soft > 0:
+        out["address space"] = float(max(soft - _mapped(proc), 0))
+    return out
+
+
+def _mapped(proc: str) -> int:
+    """The address space this process has mapped (``VmSize``), bytes."""
+    try:
+        with open(os.path.join(proc, "self", "status"), encoding="ascii", errors="replace") as fh:
+            for line in fh:
+                if line.startswith("VmSize:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0
+
+
+#: A cgroup limit at or above this is no limit (cgroup v1 writes 2^63 rounded down to a page).
+_NO_LIMIT = float(1 << 60)
+
+
+def _cgroup_limit(proc: str) -> float | None:
+    """The smallest memory limit of this process's cgroup and its parents (module docs: memory_limits)."""
+    try:
+        with open(os.path.join(proc, "self", "cgroup"), encoding="utf-8", errors="replace") as fh:
+            groups = [line.rstrip("\n").split(":", 2) for line in fh if line.count(":") >= 2]
+        with open(os.path.join(proc, "self", "mountinfo"), encoding="utf-8", errors="replace") as fh:
+            mounts = [line.split() for line in fh]
+    except OSError:
+        return None
+    best = None
+    for hid, controllers, path in groups:
+        v2 = hid == "0" and controllers == ""
+        if not v2 and "memory" not in controllers.split(","):
+            continue
+        name = "memory.max" if v2 else "memory.limit_in_bytes"
+        for root, point in _cgroup_mounts(mounts, v2):
+            rel = path[len(root):] if root != "/" and path.startswith(root) else path
+            for folder in _parents(rel):
+                value = _read_limit(os.path.join(point, folder.lstrip("/"), name))
+                if value is not None and value < _NO_LIMIT:
+                    best = value if best is None else min(best, value)
+    return best
+
+
+def _cgroup_mounts(mounts, v2: bool):
+    """``(root, mount point)`` of the cgroup2 mounts, or of the v1 mounts with the memory controller."""
+    for m in mounts:
+        if "-" not in m:
+            continue
+        dash = m.index("-")
+        fstype = m[dash + 1] if len(m) > dash + 1 else ""
+        opts = m[dash + 3].split(",") if len(m) > dash + 3 else []
+        if (v2 and fstype == "cgroup2") or (not v2 and fstype == "cgroup" and "memory" in opts):
+            yield m[3], m[4]
+
+
+def _parents(path: str):
+    """``/a/b/c``, ``/a/b``, ``/a``, ``/``."""
+    parts = [p for p in path.split("/") if p]
+    for i in range(len(parts), -1, -1):
+        yield "/" + "/".join(parts[:i])
+
+
+def _read_limit(path: str) -> float | None:
+    try:
+        with open(path, encoding="ascii", errors="replace") as fh:
+            text = fh.read(64).strip()
+    except OSError:
+        return None
+    return float(text) if text.isdigit() else None  # "max": no limit
+
+
+def available_memory() -> float:
+    """The memory this process may use, bytes: the least of :func:`memory_limits` (``inf`` if none is known)."""
+    return min(memory_limits().values(), default=float("inf"))
 
 
 def check_work(scene) -> None:
-    """The work a scene asks for fits: nodes within :data:`MAX_NODES`, and the dense influence
-    matrices and the result arrays within this machine's memory — refused before any work, with
-    what they would need."""
+    """The work a scene asks for fits: nodes within :data:`MAX_NODES`, and the operators (the dense influence
+    matrices, or the matrix-free work space) within the memory this process may use (:func:`memory_limits`) —
+    refused before any work, with what they would need. A run's states go to its result file as they come
+    (:mod:`rollqp.journal`); a run that keeps them in memory is checked by :func:`check_result_memory`."""
     from ..advice import fast_path
     from ..matrixfree import check_scene, memory_estimate
     if fast_path(scene).note is not None:
         return  # it runs matrix-free (rollqp.advice): the scene it runs as is checked when it is built
     n, K = scene.n_nodes, scene.n_steps
     dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
-    need, memory = (scene.memory_estimate() if dense else memory_estimate(scene)), available_memory()
+    need = (scene.memory_estimate() if dense else memory_estimate(scene)) - _result_bytes(n, K + 1)
+    _refuse_beyond(need, "discretization.elements", f"its operators ({n} nodes)", "use fewer elements")
+
+
+def _result_bytes(n: int, states: int) -> float:
+    """The result's per-state arrays in memory, as the scene's memory estimates count them."""
+    return 8.0 * 6 * states * n
+
+
+def check_result_memory(scene, keep_every: int = 1) -> None:
+    """A run that keeps its states in memory (:func:`rollqp.run` without ``out``) can hold them: the kept states
+    (every ``keep_every``-th) and the operators within the memory this process may use."""
+    from ..matrixfree import check_scene, memory_estimate
+    n, K = scene.n_nodes, scene.n_steps
+    dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
+    kept = -(-(K + 1) // keep_every) + 1
+    need = (scene.memory_estimate() if dense else memory_estimate(scene)) - _result_bytes(n, K + 1) + \
+        _result_bytes(n, kept)
+    _refuse_beyond(need, "discretization.distance", f"{kept} states of {n} nodes in memory",
+                   "give the run a result file (rollqp run; run(..., out=PATH)), whose states are written as they "
+                   "come, or keep every k-th state")
+
+
+def _refuse_beyond(need: float, key: str, what: str, remedy: str) -> None:
+    limits = memory_limits()
+    which, memory = min(limits.items(), key=lambda kv: kv[1], default=("physical", float("inf")))
     if need > 0.8 * memory:
-        per_node = n * n * 8 * 6 if dense else n * 8.0 * 200    # the operators' share of the need
-        raise InputError("discretization.elements" if per_node > 0.5 * need else "discretization.distance",
-                         f"this scene needs about {need / 2**30:.3g} GiB ({n} nodes, {K + 1} states), more than "
-                         f"80 % of this machine's {memory / 2**30:.3g} GiB: use fewer elements or a shorter distance")
+        source = {"physical": "this machine's memory", "cgroup": "the memory limit of this process's cgroup",
+                  "address space": "the address space left under ulimit -v (RLIMIT_AS)"}[which]
+        raise InputError(key, f"{what} need about {need / 2**30:.3g} GiB, more than 80 % of {source}, "
+                              f"{memory / 2**30:.3g} GiB: {remedy}")
 
 
 def check_loads(scene) -> None:

@@ -198,10 +198,12 @@ class StepFile:
             kw[k] = int(kw[k])
         kind = text_value(z, "kind", arg, ("coupled", "uncoupled"))
         step_type = text_value(z, "step_type", arg, STEP_TYPES)
-        try:
-            scene = json.loads(text_value(z, "scene", arg))
+        from ..result import META_LIMIT
+        try:  # a scene file's size (its profile tables inline): the limit of a result file's meta
+            scene = json.loads(text_value(z, "scene", arg, limit=META_LIMIT))
         except (json.JSONDecodeError, RecursionError) as exc:
             raise InputError(arg, f"key 'scene' must be a JSON string ({type(exc).__name__})") from exc
+        _check_scales(kw, scene, arg)
         step = cls(kind=kind, step_type=step_type, ref_method=text_value(z, "ref_method", arg)[:100], scene=scene, **kw)
         step.problem()  # validates the data (weights > 0, loads, friction, …)
         step.check_forms(z, arg)
@@ -253,3 +255,22 @@ def clarabel_json(arrays: dict, half: str) -> dict:
     settings.pop("iterative_refinement_max_iter")
     return {"P": csc(sp.triu(form.H)), "q": form.q.tolist(), "A": csc(A), "b": b.tolist(),
             "cones": [{name: int(m)} for name, m in cones], "settings": settings}
+
+
+def _check_scales(kw: dict, scene, arg: str) -> None:
+    """A step file's scales (``a_H``, ``p0``, ``Estar``) are its scene's, and its previous state's approach and
+    creepage (a warm start) are within reach of them: every form, residual and solve divides by them, so an
+    edited one is an error naming the key, not an overflow or a NaN."""
+    from ..errors import RollqpError
+    from ..scene import load_scene
+    try:
+        sc = load_scene(scene)
+    except RollqpError as err:
+        raise InputError(arg, f"key 'scene' is not a valid scene ({str(err)[:200]})") from None
+    for key, value in (("a_H", sc.a_H), ("p0", sc.p0), ("Estar", sc.Estar)):
+        if not abs(kw[key] - value) <= 1e-9 * value:
+            raise InputError(arg, f"key {key!r} = {kw[key]!r} is not the {key} of the file's scene ({value:.6g}): "
+                                  "a corrupt or edited file")
+    for key, limit in (("prev_delta", 1e6 * sc.a_H), ("prev_xi", 1e3)):  # (NaN: not known, allowed)
+        if abs(kw[key]) > limit:
+            raise InputError(arg, f"key {key!r} = {kw[key]!r} is beyond any previous state (|{key}| <= {limit:.3g})")

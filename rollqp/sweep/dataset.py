@@ -96,7 +96,7 @@ def open_result(path):
 
 def result_fields(sweep) -> list:
     """The fields a sweep's points hold: the core fields and every computed field any point needs."""
-    names = {f.name for f in FIELDS.values() if f.compute is None} | set(sweep.facts.fields)
+    names = {f.name for f in FIELDS.values() if f.compute is None and f.derive is None} | set(sweep.facts.fields)
     return [FIELDS[n] for n in FIELDS if n in names and n not in ("q", "x")]
 
 

@@ -160,6 +160,7 @@ class NewtonMethod:
         self._systems = {}
         self._coupled = {}
         self._last = None  # (A, f, kind, Δq̂, scales, system) of the last uncoupled step
+        self._large, self._dropped = 1, set()  # large systems kept at once; keys of those dropped
 
     @classmethod
     def from_settings(cls, settings, **options) -> "NewtonMethod":
@@ -175,6 +176,7 @@ class NewtonMethod:
         self._coupled = {}
         self._cache = {}
         self._last = None
+        self._large, self._dropped = 1, set()
 
 
     # ------------------------------------------------------------------ public
@@ -214,6 +216,13 @@ class NewtonMethod:
     #: Scaled systems kept per method (with their LU factors) before the oldest is dropped: a
     #: scene has a few (normal, tangential at Δq and at the braked start's Δ, steady).
     MAX_SYSTEMS = 16
+    #: Large systems (``K`` of :data:`LARGE_BYTES` or more: at 2,561 nodes 50 MB, with its factors up to 100 MB)
+    #: kept at once: one to begin with, so that the start's systems (a normal half that stays fixed, the
+    #: braked start's Δ) make way for the rolling steps' instead of staying beside them; one more each time
+    #: a dropped system is asked for again (a scene whose steps alternate between two: one rebuild, n²
+    #: operations and a factorization), up to :data:`MAX_LARGE_SYSTEMS`.
+    MAX_LARGE_SYSTEMS = 3
+    LARGE_BYTES = 8 << 20
 
     def system(self, pb, dqh) -> ReducedSystem:
         """The :class:`~.linear.ReducedSystem` of an uncoupled step, built once per operator, weights,
@@ -232,9 +241,13 @@ class NewtonMethod:
         key = (pb.kind, pb.A, pb.f.tobytes(), sc, dqh, self.r)
         hit = self._systems.get(key)
         if hit is not None:
+            self._systems[key] = self._systems.pop(key)  # most recently used last
             self._last = (pb.A, pb.f, pb.kind, dqh, sc, hit)
             return hit
-        Ahat = pb.A.dense() * (sc.modulus / sc.length)
+        n = pb.n
+        self._make_room(key, 8 * n * (n + 1))
+        K = np.empty((n, n + 1))  # Â in its first n columns, scaled into K in place (ReducedSystem)
+        Ahat = np.multiply(pb.A.dense(), sc.modulus / sc.length, out=K[:, :n])
         fhat = pb.f / sc.length
         scale = float(np.mean(np.diag(Ahat)))
         if not scale > 0:
@@ -245,7 +258,8 @@ class NewtonMethod:
         else:
             r = self.r if self.r is not None else dqh / scale
             last, t_scale = np.ones(pb.n), dqh  # ∂(r ŝ)/∂ξ̂ = r, ∂(r ŝ)/∂t̂ = r Â/Δq̂
-        sys_ = ReducedSystem(pb.A, pb.f, Ahat, fhat, r, last, t_scale, unit=sc.modulus / sc.length / sc.stress)
+        sys_ = ReducedSystem(pb.A, pb.f, Ahat, fhat, r, last, t_scale, unit=sc.modulus / sc.length / sc.stress,
+                             workspace=K, a_scale=sc.modulus / sc.length)
         self._keep(self._systems, key, sys_)
         self._last = (pb.A, pb.f, pb.kind, dqh, sc, sys_)
         return sys_
@@ -261,6 +275,20 @@ class NewtonMethod:
             hit = (S, CoupledFactors(S))
             self._keep(self._coupled, key, hit)
         return hit
+
+    def _make_room(self, key, nbytes: int) -> None:
+        """Before the large system ``key`` is built: drop the least recently used large ones beyond the
+        number kept (:data:`MAX_LARGE_SYSTEMS` says how it grows)."""
+        if nbytes < self.LARGE_BYTES:
+            return
+        if key in self._dropped:  # asked for again: the scene alternates between more systems
+            self._large = min(self._large + 1, self.MAX_LARGE_SYSTEMS)
+        large = [k for k, v in self._systems.items() if v.K.nbytes >= self.LARGE_BYTES]
+        for k in large[:max(0, len(large) - self._large + 1)]:
+            if self._last is not None and self._last[5] is self._systems[k]:
+                self._last = None
+            del self._systems[k]
+            self._dropped.add(k)
 
     def _keep(self, store, key, value):
         if len(store) >= self.MAX_SYSTEMS:

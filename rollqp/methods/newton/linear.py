@@ -31,6 +31,8 @@ PARTIAL_MIN = 320
 RUN_GAP = 32
 #: More blocks than this: one dense product instead.
 MAX_BLOCKS = 12
+#: Columns of the reduced matrix gathered at a time into its factorization's array.
+FACTOR_COLUMNS = 256
 _NONE = np.empty(0, dtype=np.intp)  # no nodes (read-only)
 _NONE.flags.writeable = False
 
@@ -80,7 +82,7 @@ class ReducedSystem:
     few active sets.
     """
 
-    __slots__ = ("A", "f", "Ahat", "fhat", "r", "K", "_K_nl", "load_column", "unit", "partial", "last", "settled", "_base",
+    __slots__ = ("A", "f", "a_scale", "fhat", "r", "K", "_K_nl", "load_column", "unit", "partial", "last", "settled", "_base",
                  "factorizations", "updates", "_factors", "_masks", "ncp")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
@@ -92,11 +94,17 @@ class ReducedSystem:
     #: Factorizations kept per system (the oldest dropped first; together at most the size of ``K``).
     MAX_FACTORS = 4
 
-    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale, unit=1.0):
+    def __init__(self, A, f, Ahat, fhat, r, last_column, t_scale, unit=1.0, workspace=None, a_scale=None):
         n = fhat.size
-        self.A, self.f, self.Ahat, self.fhat, self.r = A, f, Ahat, fhat, r
-        K = np.empty((n, n + 1))
-        K[:, :n] = (r / t_scale) * Ahat
+        self.A, self.f, self.fhat, self.r = A, f, fhat, r
+        #: ``Â = a_scale · A`` (:meth:`ahat_product`); ``Â`` itself is not kept (n² doubles less per system)
+        self.a_scale = a_scale
+        if workspace is not None:  # ``Ahat`` is ``workspace[:, :n]``: scaled in place into K (no second n × n array)
+            K = workspace
+            K[:, :n] *= r / t_scale
+        else:
+            K = np.empty((n, n + 1))
+            K[:, :n] = (r / t_scale) * Ahat
         K[:, n] = r * last_column
         self.K = K
         col = K[:, n].copy()  # contiguous: y's load term (a strided column costs twice as much)
@@ -120,6 +128,15 @@ class ReducedSystem:
         self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
         self.updates = 0  # directions solved by a Schur complement on an older factorization
 
+    def ahat_product(self, x) -> np.ndarray:
+        """``Â x``, ``Â = A·E*/L`` the nondimensional influence matrix (the normal step's starting guesses)."""
+        return (self.A @ x) * self.a_scale
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of the system's arrays: ``K`` (``K_nl`` is a view of it) and the kept factorizations."""
+        return self.K.nbytes + sum(b[3].nbytes for b in self._factors.values())
+
     def mask(self, with_load):
         """The row-choice mask of an iteration (``n`` nodes, and the load row last, always true), one
         array per system reused by every iteration (:func:`~.uncoupled.iterate` sets the node rows)."""
@@ -134,9 +151,11 @@ class ReducedSystem:
 
     @property
     def K_nl(self) -> np.ndarray:
-        """``K`` without the load column (contiguous: the products of a prescribed δ/ξ)."""
+        """``K`` without the load column: a view (its rows are ``K``'s with a stride of n + 1, which BLAS
+        takes as it is: the products of a prescribed δ/ξ cost the same as on a contiguous copy, measured,
+        and give the same numbers, without a second n × n array)."""
         if self._K_nl is None:
-            self._K_nl = np.ascontiguousarray(self.K[:, :-1])
+            self._K_nl = self.K[:, :-1]
         return self._K_nl
 
     def jacobian(self, mask, with_load):
@@ -158,8 +177,13 @@ class ReducedSystem:
         nf = free.size
         M = np.empty((nf + with_load, nf + with_load), order="F")
         # small n: two takes (np.ix_ costs 2.4× as much at 81 nodes); large n: np.ix_, without the
-        # intermediate nf × n rows of the takes
-        M[:nf, :nf] = K[np.ix_(free, free)] if self.partial else K.take(free, 0).take(free, 1)
+        # intermediate nf × n rows of the takes, a block of columns at a time (no second nf × nf array)
+        if self.partial:
+            for j in range(0, nf, FACTOR_COLUMNS):
+                cols = free[j:j + FACTOR_COLUMNS]
+                M[:nf, j:j + cols.size] = K[np.ix_(free, cols)]
+        else:
+            M[:nf, :nf] = K.take(free, 0).take(free, 1)
         if with_load:
             M[:nf, nf] = K[free, n]
             M[nf, :nf] = self.fhat[free]

@@ -60,10 +60,10 @@ def _normal_start(pb, sys_, warm):
         if start == "warm" and warm.delta is not None:
             d0 = warm.delta / u0
         else:  # the approach that closes the gap on average over the guessed contact
-            d0 = float(np.mean((hhat + sys_.Ahat @ p0)[guess]))
+            d0 = float(np.mean((hhat + sys_.ahat_product(p0))[guess]))
         return np.append(p0, d0), start
     if start == "cold":  # scale the profile to close the gap on average over it
-        Ap = (sys_.Ahat @ p0)[guess].mean()
+        Ap = sys_.ahat_product(p0)[guess].mean()
         c = (dhat_fixed - hhat[guess].mean()) / Ap if Ap > 0 else 0.0
         p0 = p0 * max(c, 0.0)
     return p0.copy(), start

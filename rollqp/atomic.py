@@ -1,0 +1,227 @@
+"""Writing output files safely: atomic replacement, the temporaries of killed writers, one writer per
+file, and signals held back while a file is being written (docs/results.md, "Writing").
+
+* A file is written to a temporary file in its own folder (``.rollqp-<pid>.<start>-<random>``),
+  then renamed over the target: a reader sees the old file or the new one, never half of one.
+  Temporaries left by a writer that was killed (SIGKILL during the write) are removed by the next
+  write into the same folder (:func:`remove_stale_temporaries`); a process is recognized by its
+  id *and* its start time, so a temporary whose id now belongs to another process is still stale.
+* :class:`OutputLock` gives one process the right to write a result file for the length of a
+  run: an advisory ``flock`` on ``PATH.lock``, which the kernel releases when its holder dies,
+  however it dies (a lock file left behind, or whose process id now belongs to another process,
+  is taken over at once).
+* :func:`held_signals`: SIGINT and SIGTERM are held back while a file is written, so that a second
+  Ctrl-C 0–40 ms after the first never interrupts the write of what the first one saves.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import signal
+import tempfile
+import threading
+
+from .errors import InputError
+
+__all__ = ["TEMP_PREFIX", "process_start", "alive", "remove_stale_temporaries", "temporary", "replace",
+           "OutputLock", "held_signals", "stop_once"]
+
+#: Temporary files of an atomic write start with this (module docstring).
+TEMP_PREFIX = ".rollqp-"
+
+
+def process_start(pid: int) -> str | None:
+    """The start time of process ``pid`` (clock ticks after boot, ``/proc/PID/stat`` field 22), or None."""
+    try:
+        with open(f"/proc/{int(pid)}/stat", "rb") as fh:
+            text = fh.read(4096).decode("ascii", "replace")
+    except (OSError, ValueError):
+        return None
+    fields = text[text.rfind(")") + 2:].split()  # after the command name, which may hold spaces
+    return fields[19] if len(fields) > 19 else None
+
+
+def alive(pid: int, start: str | None = None) -> bool:
+    """Whether process ``pid`` exists on this machine (and, if ``start`` is given and readable, started then)."""
+    if pid <= 0:
+        return False
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else
+        pass
+    except OverflowError:
+        return False
+    if start is None:
+        return True
+    now = process_start(pid)
+    return now is None or now == start
+
+
+def _own_tag() -> str:
+    start = process_start(os.getpid())
+    return f"{os.getpid()}" + (f".{start}" if start else "")
+
+
+def remove_stale_temporaries(folder) -> list[str]:
+    """Delete the temporary files of writes whose process no longer runs; return their names."""
+    removed = []
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return removed
+    for name in names:
+        if not name.startswith(TEMP_PREFIX):
+            continue
+        tag = name[len(TEMP_PREFIX):].split("-", 1)[0]
+        pid, _, start = tag.partition(".")
+        if pid.isdigit() and not alive(int(pid), start or None):
+            try:
+                os.unlink(os.path.join(folder, name))
+                removed.append(name)
+            except OSError:
+                pass
+    return removed
+
+
+def temporary(path, suffix: str = ".npz") -> tuple[int, str]:
+    """``(fd, name)`` of a new temporary file beside ``path`` (stale ones of killed writers removed first)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    remove_stale_temporaries(folder)
+    return tempfile.mkstemp(suffix=suffix, dir=folder, prefix=f"{TEMP_PREFIX}{_own_tag()}-")
+
+
+def replace(tmp: str, path) -> None:
+    """Give the temporary ``tmp`` the usual file mode and rename it over ``path``."""
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp creates 0600
+    os.replace(tmp, path)
+
+
+class OutputLock:
+    """Exclusive right to write one output for the length of a run (``with OutputLock(path):``).
+
+    An advisory lock (``flock``) on ``PATH.lock``, which holds the writer's process id for the
+    message. A second run writing the same ``--out`` while the first is alive is refused at once,
+    before any work (:class:`InputError` naming ``--out`` and the other process), instead of racing
+    it. The kernel drops the lock with its process, so a lock file left by a killed run, or one whose
+    process id now belongs to another process, is taken over. On a file system without ``flock``, the
+    process id and start time written in the file decide whether its writer still runs.
+    """
+
+    def __init__(self, path, key: str = "--out"):
+        self.lock = os.fspath(path) + ".lock"
+        self.key = key
+        self.fd = -1
+
+    def __enter__(self) -> "OutputLock":
+        import fcntl
+        for _ in range(5):
+            fd = os.open(self.lock, os.O_CREAT | os.O_RDWR, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                owner = self._owner(fd)
+                os.close(fd)
+                raise InputError(self.key, f"another rollqp process{f' (pid {owner})' if owner else ''} is writing "
+                                           f"{self.lock[:-5]!r}; wait for it or choose another --out") from None
+            except OSError:  # no flock here: the id and start time in the file
+                os.close(fd)
+                return self._without_flock()
+            try:
+                same = os.path.samestat(os.fstat(fd), os.stat(self.lock))
+            except FileNotFoundError:
+                same = False
+            if not same:  # its holder removed it as we opened it: lock the new one
+                os.close(fd)
+                continue
+            os.ftruncate(fd, 0)
+            os.write(fd, _own_tag().replace(".", " ").encode())
+            self.fd = fd
+            return self
+        raise InputError(self.key, f"cannot lock {self.lock!r}")
+
+    def _without_flock(self) -> "OutputLock":
+        for _ in range(2):
+            try:
+                fd = os.open(self.lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            except FileExistsError:
+                with open(self.lock, "rb") as fh:
+                    parts = fh.read(64).decode("ascii", "replace").split()
+                if parts and parts[0].isdigit() and alive(int(parts[0]), parts[1] if len(parts) > 1 else None):
+                    raise InputError(self.key, f"another rollqp process (pid {parts[0]}) is writing "
+                                               f"{self.lock[:-5]!r}; wait for it or choose another --out") from None
+                with contextlib.suppress(FileNotFoundError):
+                    os.unlink(self.lock)  # stale: its process is gone
+                continue
+            os.write(fd, _own_tag().replace(".", " ").encode())
+            self.fd = fd
+            return self
+        raise InputError(self.key, f"cannot lock {self.lock!r}")
+
+    @staticmethod
+    def _owner(fd) -> int | None:
+        try:
+            text = os.pread(fd, 64, 0).decode("ascii", "replace").split()
+        except OSError:
+            return None
+        return int(text[0]) if text and text[0].isdigit() else None
+
+    def __exit__(self, *exc) -> None:
+        if self.fd >= 0:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(self.lock)  # first, while it is held (a waiter then finds a new file)
+            os.close(self.fd)
+            self.fd = -1
+
+
+@contextlib.contextmanager
+def held_signals():
+    """SIGINT and SIGTERM held back for the block (the main thread only; elsewhere nothing changes).
+
+    Yields the list of the signals that arrived; the caller decides what they mean once the file is
+    written (:meth:`rollqp.result.Result.finish` raises the first one again).
+    """
+    got: list[int] = []
+    if threading.current_thread() is not threading.main_thread():
+        yield got
+        return
+    old = {}
+    try:
+        for s in (signal.SIGINT, signal.SIGTERM):
+            old[s] = signal.signal(s, lambda signum, frame: got.append(signum))
+        yield got
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
+
+
+@contextlib.contextmanager
+def stop_once():
+    """For the block (a run): the first SIGINT (and SIGTERM, where a handler is set, as the command line does) acts
+    as before — Python's KeyboardInterrupt, the command line's ``Terminated`` — and every later one is held back:
+    a second Ctrl-C 0–40 ms after the first, while the first one's states are being written, changes nothing.
+    The main thread only; elsewhere nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    stopping, old = [], {}
+
+    def handler(signum, frame):
+        if stopping:
+            return
+        stopping.append(signum)
+        old[signum](signum, frame)
+
+    try:
+        for s in (signal.SIGINT, signal.SIGTERM):
+            prev = signal.getsignal(s)
+            if callable(prev):
+                old[s] = prev
+                signal.signal(s, handler)
+        yield
+    finally:
+        for s, h in old.items():
+            signal.signal(s, h)
