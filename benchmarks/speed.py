@@ -187,7 +187,7 @@ def coupled_rolling_scenes() -> list:
     out = []
     for name in sorted(rollqp.builtin_scenes()):
         sc = rollqp.load_scene(name)
-        if sc.coupling_level == "full":
+        if getattr(sc, "coupling_level", None) == "full":   # (3D scenes have none)
             out.append(sc.replace(**{"load.start": "rolling"}))
     return out
 

@@ -32,8 +32,9 @@ from rollqp.strip import Strip
 #: ≤ 1.3e-13 μp0 for the QP starts (stopped at 1e-12), 4.9e-10 μp0 for nt-newton's alternation
 #: (goodman-bentall; harmonic 6.5e-11); bound 1e-8 μp0, the agreement the rolling start promises.
 AGREE = 1e-8
-#: Every built-in scene with full coupling (dissimilar bodies): each is checked with a rolling start.
-COUPLED = sorted(n for n in rollqp.builtin_scenes() if rollqp.load_scene(n).coupling_level == "full")
+#: Every built-in 2D scene with full coupling (dissimilar bodies): each is checked with a rolling start
+#: (the 3D scenes have no rolling start and no coupling level).
+COUPLED = sorted(n for n in rollqp.builtin_scenes() if getattr(rollqp.load_scene(n), "coupling_level", None) == "full")
 
 
 def rolling(name, **changes):
