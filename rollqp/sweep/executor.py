@@ -54,11 +54,9 @@ _THREAD_ENV = {k: "1" for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_
 _SCHEMES = ("tcp", "tls", "inproc")
 #: dask settings of the local cluster (its processes read them when they start). The workers'
 #: statistical profiler samples the task thread's stack every 10 ms: time taken from the points
-#: (the GIL), for a profile nobody reads here. dask's own monitors (the event loops' tick every
-#: 20 ms, the system monitor every 0.5 s, the memory monitor every 0.1 s) cost an idle 2-worker
-#: cluster 7.4 % of a core (3.7 % in the workers, 3.7 % in the client; psutil's CPU times over
-#: 10 s), 2.2 % at the intervals below: CPU that a machine shared by session (Linux's
-#: autogroup) takes from the points.
+#: (the GIL), for a profile nobody reads here. dask's own monitors (the event loops' tick, the
+#: system monitor, the memory monitor) run less often than dask's defaults: an idle cluster's CPU
+#: (docs/sweeps.md), which a machine shared by session (Linux's autogroup) takes from the points.
 _LOCAL_CONFIG = {"distributed.worker.profile.enabled": False,
                  "distributed.admin.tick.interval": "200ms",
                  "distributed.admin.system-monitor.interval": "2s",
