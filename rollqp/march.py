@@ -480,7 +480,7 @@ def _two_d(scene) -> Scene:
     return scene
 
 
-def prepare(scene, method=None):
+def prepare(scene, method=None, *, geometry=None):
     """``(scene, method, operators)``: the scene validated, its method composed and set up on its operators.
 
     Parameters
@@ -490,6 +490,9 @@ def prepare(scene, method=None):
     method : str or Method, optional
         A method name (overrides ``[solver].method``) or a method object (used as it is, composed
         with the N–T alternation if the scene is coupled and it does not solve coupled steps).
+    geometry : Memo, optional
+        Where the influence model keeps what depends on the bodies alone, shared by the scenes it is
+        handed to (:meth:`SceneOperators.build <rollqp.operators.SceneOperators.build>`).
     """
     from .advice import fast_path
     from .methods import compose, scene_method
@@ -505,7 +508,7 @@ def prepare(scene, method=None):
     else:
         meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
     caps = meth.capabilities
-    ops = SceneOperators.build(scene, symmetrized=caps.operator == "symmetrized", capabilities=caps)
+    ops = SceneOperators.build(scene, symmetrized=caps.operator == "symmetrized", capabilities=caps, geometry=geometry)
     meth.setup(ops)
     return scene, meth, ops
 
@@ -639,7 +642,8 @@ def check_resumed(scene, prepared, arrays: dict, march=None) -> None:
                                      f"{dt:.3g} mu p0 (more than {RESUME_TOL:g}): the file was changed or is corrupt")
 
 
-def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None) -> Result:
+def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None,
+        geometry=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -667,6 +671,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     keep_every : int, optional
         Keep every k-th state (and the last two); the steps in between are combined into the kept
         ones (``Field.reduce``). Default 1, or the resumed file's.
+    geometry : Memo, optional
+        Shared by the runs it is handed to: what the influence model keeps of the bodies (:func:`prepare`).
 
     Raises
     ------
@@ -689,7 +695,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         from .advice import fast_path
         from .scene.checks import check_result_memory
         check_result_memory(fast_path(asked).scene if method is None or isinstance(method, str) else asked, keep)
-    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method, geometry=geometry)
     tail = None
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source

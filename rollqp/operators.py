@@ -73,15 +73,18 @@ class SceneOperators:
         self._last_bound: tuple | None = None
 
     @classmethod
-    def build(cls, scene, symmetrized: bool = False, capabilities=None, memo: Memo | None = None) -> "SceneOperators":
+    def build(cls, scene, symmetrized: bool = False, capabilities=None, memo: Memo | None = None,
+              geometry: Memo | None = None) -> "SceneOperators":
         """Discretize ``scene``; ``symmetrized`` selects the QP operator ``F⁻¹ sym(F A)``.
 
         ``capabilities``: the :class:`~rollqp.methods.base.Capabilities` of the method object that runs the
         scene (:func:`rollqp.march.prepare` passes them; default: those the scene's ``solver.method``
         declares): dense matrices, or FFT operators for a method that works with products only on a
         large half-space strip (:func:`rollqp.matrixfree.mode`). ``memo``: the scene's :attr:`memo` (default
-        a new one); a caller that builds several scenes on the same bodies may hand them one, so that what
-        the influence model keeps of the geometry is built once (the BEM's rollers)."""
+        a new one; it keeps this scene's history and steady operators, so it is never shared between
+        scenes). ``geometry``: where the influence model keeps what depends on the bodies alone (the
+        BEM's rollers; default ``memo``); a caller that builds several scenes on the same bodies (a
+        sweep's worker) may hand them one, so that it is built once."""
         d = scene.discretization
         memo = Memo() if memo is None else memo
         strip = Strip(scene.half_width, d.elements, d.element)
@@ -89,7 +92,7 @@ class SceneOperators:
             return cls._build_matrix_free(scene, strip, memo).with_profiles()
         t0 = time.perf_counter()
         model = get_model(scene.contact.model)  # (rollqp.influence.Model)
-        infl = model.build(scene, strip, memo=memo) if model.memo else model.build(scene, strip)
+        infl = model.build(scene, strip, memo=memo if geometry is None else geometry) if model.memo else model.build(scene, strip)
         f = strip.weights
         info = dict(infl.info)
         info["asymmetry_Ann"] = asymmetry(infl.Ann, f)

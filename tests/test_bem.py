@@ -316,6 +316,24 @@ def test_cache_and_summary(tmp_path):
     assert "BEM" in text and "MiB" in text and "dropped" in text and "asymmetry" in text
 
 
+def test_geometry_memo_shared_by_runs():
+    """``run(..., geometry=memo)`` (what a sweep's worker hands each point): the second run takes both
+    rollers from the memo, and a run of another step length on the same rollers equals its own run
+    bitwise (the memo holds the bodies only, never a scene's history or steady operators)."""
+    sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "solver.method": "newton",
+                                                        "discretization.distance": 0.5,
+                                                        "bodies.A.shaft_radius": 20.0})
+    other = sc.replace(**{"discretization.step": 2.0 * sc.discretization.step})
+    memo = Memo(size=8)
+    r1 = rollqp.run(sc, geometry=memo)
+    r2 = rollqp.run(other, geometry=memo)
+    assert r1.meta["model"]["bem_assembled"] == 2 and len(memo) == 2
+    assert r2.meta["model"]["bem_assembled"] == 0 and r2.meta["model"]["bem_cached"]
+    alone = rollqp.run(other)
+    for key in ("pn", "pt"):
+        np.testing.assert_array_equal(np.asarray(r2.rows[key]), np.asarray(alone.rows[key]))
+
+
 def test_symmetric_pair_assembles_one_roller():
     """Two equal rollers (the same radius, shaft and material): the second is the first's compliance."""
     strip = rollqp.Strip(1.3131, 40, "quadratic")

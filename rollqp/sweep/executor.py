@@ -266,6 +266,19 @@ def _short(value, n: int = 80) -> str:
     return describe(value, n)
 
 
+#: What a worker process keeps of the bodies between the points it runs (the BEM's rollers: seconds
+#: each, the same for every point that does not vary them), handed to each run; at most 8 kept.
+_GEOMETRY = None
+
+
+def _geometry():
+    global _GEOMETRY
+    if _GEOMETRY is None:
+        from ..influence import Memo
+        _GEOMETRY = Memo(size=8)
+    return _GEOMETRY
+
+
 def compute_point(scene) -> dict:
     """Run one scene (a :class:`~rollqp.scene.Scene` or its dict) on a worker: ``{"arrays", "time",
     "cpu", "worker"}`` (wall and CPU seconds of the worker's process), or ``{"error", "time", "cpu",
@@ -278,7 +291,7 @@ def compute_point(scene) -> dict:
     worker = f"{socket.gethostname()}:{os.getpid()}"
     with threadpool_limits(limits=1):
         try:
-            result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene)
+            result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene, geometry=_geometry())
         except Exception as err:  # an input the method cannot run, or a bug: one line, the sweep goes on
             return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0,
                     "cpu": time.process_time() - c0, "worker": worker}
