@@ -84,7 +84,7 @@ def edited(scene, edit):
     if (base.name, edit) not in _EDITED:
         name = f"{base.name}-edited-{len(_EDITED)}"
         register_model(dataclasses.replace(base, name=name, operators=None,
-                                           build=lambda sc, strip: edit(base.build(sc, strip), strip, sc)))
+                                           build=lambda sc, strip, **kw: edit(base.build(sc, strip, **kw), strip, sc)))
         _EDITED[base.name, edit] = name
     return scene.replace(**{"contact.model": _EDITED[base.name, edit]})
 

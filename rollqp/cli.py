@@ -24,6 +24,8 @@ import argparse
 import os
 import sys
 import time
+from dataclasses import dataclass
+from typing import Callable
 
 EXIT_INPUT, EXIT_SOLVER = 2, 3
 #: Interrupted by Ctrl-C (SIGINT) or SIGTERM: the shell's 128 + signal number.
@@ -60,8 +62,9 @@ class _Version(argparse.Action):
 
 
 def _parser():
-    from .methods import METHOD_NAMES
-    p = _Parser(prog="rollqp", description="2D transient rolling contact: convex QP steps and generalized Newton.")
+    from .methods import SCENE_METHOD_NAMES as METHOD_NAMES  # either dimension's (docs/scenes.md)
+    p = _Parser(prog="rollqp", description="Transient rolling contact in 2D and 3D: convex QP/SOCP steps and "
+                                           "generalized Newton.")
     p.add_argument("--version", action=_Version)
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
     r = sub.add_parser("run", help="run a scene and write its result file")
@@ -80,8 +83,9 @@ def _parser():
     r.add_argument("--stresses", action="store_true", help="report the peak subsurface von Mises and tau1 over "
                    "the run, with place and state (docs/stresses.md)")
     r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
-                   help="solve three steps again with qp-clarabel and qp-osqp and show the differences "
-                        "(default: on for strips of at most 400 nodes run by a method other than those)")
+                   help="solve three steps again with qp-clarabel and qp-osqp (3D: qp-clarabel, or newton for a "
+                        "conic run) and show the differences (default: on for strips of at most 400 nodes run by "
+                        "a method other than those; 3D: the steps that fit about 12 s)")
     sub.add_parser("scenes", help="list the built-in scenes")
     s = sub.add_parser("show", help="print a scene's TOML with defaults filled in")
     s.add_argument("scene")
@@ -98,7 +102,7 @@ def _parser():
                    "(default 1e-6: see docs/stepfiles.md)")
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
     x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
-    x.add_argument("--step", type=int, default=None, help="step K (default 1)")
+    x.add_argument("--step", type=int, default=None, help="step K (default 1; a 3D scene: every step of its run)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
     _stresses_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
@@ -210,7 +214,7 @@ def _run_scene(args):
     else:  # --method is the scene's method before it is validated (solver.operator = "matrix-free" with mf-newton)
         scene = load_scene(args.scene, {"solver.method": args.method} if args.method else None)
     from .methods import method_class
-    method_class(scene.solver.method)  # installed? (a missing backend names its pip extra)
+    method_class(scene.solver.method, scene.dimension)  # installed? (a missing backend names its pip extra)
     out = check_output(args.out or (source.path if source is not None else None) or default_output(scene.name))
     _check_plot(args.plot)
     return scene, source, out
@@ -237,14 +241,81 @@ def _give_back_freed_memory() -> None:
         pass
 
 
-def cmd_run(args) -> int:
-    import signal
+@dataclass(frozen=True)
+class Family:
+    """What the command line does with the scenes of one dimension (``scene.dimension``): one record per
+    dimension, so that the commands dispatch through it and never test the dimension themselves.
 
+    ``run(scene, progress=, resume=, observe=)`` the run (a result with ``arrays()``, ``save()``);
+    ``summary(arrays, scene, method, wall, stresses)``; ``plot(arrays, scene, path)``; ``advise(scene)``
+    the notes before a run; ``spot(args, scene)`` → ``(kept, observe)`` of the cross-check and ``check(kept,
+    scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
+    ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
+    ``rollqp crossval``'s report and returns the exit code.
+    """
+
+    run: Callable
+    summary: Callable
+    plot: Callable
+    advise: Callable
+    spot: Callable
+    check: Callable
+    stresses: Callable | None
+    commands: frozenset
+    crossval: Callable
+
+
+def _family_2d() -> Family:
     from .march import run
     from .plot import plot_result
     from .report import summary
+    from .subsurface import stress_history
+    return Family(run, summary, plot_result, _advise, _spot_steps, _spot_lines, stress_history,
+                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d)
+
+
+def _family_3d() -> Family:
+    from .plot.three import three_figure
+    from .three.advice import notes
+    from .three.report import summary
+    from .three.run import run
+
+    def advise(scene):
+        for note in notes(scene):
+            print(f"rollqp: {note}", file=sys.stderr, flush=True)
+
+    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
+                  _crossval_3d)
+
+
+#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
+FAMILIES = {2: _family_2d, 3: _family_3d}
+
+
+def family(scene) -> Family:
+    """The :class:`Family` of ``scene``'s dimension."""
+    return FAMILIES[scene.dimension]()
+
+
+def _takes(scene, command: str) -> None:
+    """Refuse a scene whose dimension's record does not list ``command``."""
+    if command not in family(scene).commands:
+        from .errors import InputError
+        dims = " and ".join(f"{d}D" for d, f in FAMILIES.items() if command in f().commands)
+        raise InputError("SCENE", f"{scene.name!r} is a {scene.dimension}D scene; rollqp {command} works on {dims} "
+                                  "scenes (rollqp run, show and scenes take every dimension)")
+
+
+def cmd_run(args) -> int:
+    import signal
+
     from .result import OutputLock
     scene, source, out = _run_scene(args)
+    fam = family(scene)
+    if getattr(args, "stresses", False) and fam.stresses is None:
+        from .errors import InputError
+        raise InputError("--stresses", f"the subsurface stresses are computed for 2D scenes only; {scene.name!r} is "
+                                       f"{scene.dimension}D")
     _give_back_freed_memory()
     if source is not None and source.journal is None and source.last == scene.n_steps:
         print(f"rollqp: {args.resume} is complete ({scene.n_steps} rolling steps): nothing to resume",
@@ -252,15 +323,15 @@ def cmd_run(args) -> int:
         return 0
     cb, close = _progress(args.quiet)
     if not args.quiet:
-        _advise(scene)
+        fam.advise(scene)
         cb = estimate_progress(cb, scene.n_steps - (0 if source is None else max(source.last, 0)))
-    keep, observe = _spot_steps(args, scene)
+    keep, observe = fam.spot(args, scene)
     t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
     try:
         with OutputLock(out):
             try:
-                result = run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
+                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
             except KeyboardInterrupt as err:
                 # the run is over and its states are written: a later Ctrl-C or SIGTERM must not cut the exit short
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -281,22 +352,60 @@ def cmd_run(args) -> int:
         signal.signal(signal.SIGTERM, previous)
     res = result.arrays()
     if args.plot:
-        plot_result(res, scene, args.plot)
+        fam.plot(res, scene, args.plot)
     if not args.quiet:
-        peaks = None
-        if getattr(args, "stresses", False):
-            from .subsurface import stress_history
-            peaks = stress_history(result)
-        print(summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
+        peaks = fam.stresses(result) if getattr(args, "stresses", False) else None
+        print(fam.summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
         if keep:
-            from .crossval import spot_check
             t1 = time.perf_counter()
-            head, *failures = str(spot_check(list(keep.values()))).splitlines()
+            head, *failures = fam.check(keep, scene).splitlines()
             print(f"  cross-check   {head} ({time.perf_counter() - t1:.2f} s)")
             for line in failures:  # each in full, on a line of its own
                 print(f"                {line}")
         print(f"  result        {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
     return 0
+
+
+def _spot_lines(keep, scene) -> str:
+    """The 2D cross-check (:func:`rollqp.crossval.spot_check` of the kept step files)."""
+    from .crossval import spot_check
+    return str(spot_check(list(keep.values())))
+
+
+def _spot_3d(args, scene):
+    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check — by
+    default as many as fit :data:`~rollqp.three.crosscheck.SPOT_BUDGET` (the last first), all three with
+    ``--cross-check``."""
+    from .three.crosscheck import SpotObserver, spot_steps
+    if args.quiet or args.cross_check is False:
+        return {}, None
+    steps = spot_steps(scene.n_steps, None if args.cross_check else scene.contact_elements())
+    if not steps:
+        return {}, None
+    observer = SpotObserver(steps)
+    return observer, observer
+
+
+def _crossval_2d(scene, step, methods) -> int:
+    """``rollqp crossval`` of a 2D scene: every method on one step (:func:`rollqp.crossval.report`)."""
+    from .crossval import report
+    print(report(scene, step=step, methods=methods))
+    return 0
+
+
+def _crossval_3d(scene, step, methods) -> int:
+    """``rollqp crossval`` of a 3D scene: every step (or ``--step K``) of its run solved again by the SOCP
+    backends and Newton (:func:`rollqp.three.crosscheck.crossval`); exit 1 if they disagree."""
+    from .three.crosscheck import crossval
+    check = crossval(scene, step, methods, tolerance=scene.solver.tolerance)
+    print(check.table())
+    print(str(check))
+    return 0 if check.agrees() else 1
+
+
+def _check_3d(observer, scene) -> str:
+    from .three.crosscheck import cross_check
+    return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance))
 
 
 #: A run's remaining time above which ``rollqp run`` prints its estimate after the first steps (seconds).
@@ -383,6 +492,7 @@ def cmd_export_step(args) -> int:
     from .stepfile import export_step
     from .result import check_output
     scene = load_scene(args.scene)
+    _takes(scene, "export-step")
     out = check_output(args.out or default_output(scene.name, f"-step{args.step}.npz"), "step file")
     step = export_step(scene, args.step, method=args.method)
     for path in step.save(out):
@@ -405,7 +515,7 @@ def cmd_check_step(args) -> int:
 
 def cmd_crossval(args) -> int:
     from .crossval import report
-    from .methods import METHOD_NAMES
+    from .methods import SCENE_METHOD_NAMES as METHOD_NAMES
     methods = None
     if args.methods:
         methods = [m.strip() for m in args.methods.split(",") if m.strip()]
@@ -417,9 +527,11 @@ def cmd_crossval(args) -> int:
     if args.scene.endswith(".npz"):
         from .stepfile import StepFile
         print(report(StepFile.load(args.scene, arg="SCENE"), methods=methods))
-    else:
-        print(report(args.scene, step=args.step, methods=methods))
-    return 0
+        return 0
+    from .scene import load_scene
+    scene = load_scene(args.scene)
+    _takes(scene, "crossval")
+    return family(scene).crossval(scene, args.step, methods)
 
 
 def benchmarks_folder():
@@ -511,6 +623,7 @@ def cmd_sweep(args) -> int:
     from .scene import load_scene
     from .sweep import sweep
     scene = load_scene(args.scene)
+    _takes(scene, "sweep")
     out = args.out or default_output(scene.name, "-sweep.zarr")
     summary = _sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
                                            quiet=args.quiet))
@@ -524,6 +637,7 @@ def cmd_creep_curve(args) -> int:
     from .scene import load_scene
     from .sweep.creep import creep_curve
     scene = load_scene(args.scene)
+    _takes(scene, "creep-curve")
     out = args.out or default_output(scene.name, "-creep.zarr")
     _check_plot(args.plot)
     curve = _sweep_signals(lambda: creep_curve(scene, args.ratios, args.friction, out, scheduler=args.scheduler,

@@ -472,7 +472,15 @@ class _March:
         return rec
 
 
-def prepare(scene, method=None):
+def _two_d(scene) -> Scene:
+    """``scene`` if it is a 2D scene, else a one-line :class:`InputError` naming the 3D entry points."""
+    if not isinstance(scene, Scene):   # another dimension's scene (docs/architecture.md, three dimensions)
+        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.three.run.run and "
+                                  "rollqp.three.run.march run it (on the command line: rollqp run)")
+    return scene
+
+
+def prepare(scene, method=None, *, geometry=None):
     """``(scene, method, operators)``: the scene validated, its method composed and set up on its operators.
 
     Parameters
@@ -482,10 +490,13 @@ def prepare(scene, method=None):
     method : str or Method, optional
         A method name (overrides ``[solver].method``) or a method object (used as it is, composed
         with the N–T alternation if the scene is coupled and it does not solve coupled steps).
+    geometry : Memo, optional
+        Where the influence model keeps what depends on the bodies alone, shared by the scenes it is
+        handed to (:meth:`SceneOperators.build <rollqp.operators.SceneOperators.build>`).
     """
     from .advice import fast_path
     from .methods import compose, scene_method
-    scene = scene if isinstance(scene, Scene) else load_scene(scene)
+    scene = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     if method is None or isinstance(method, str):
@@ -497,7 +508,7 @@ def prepare(scene, method=None):
     else:
         meth = compose(method, coupled, max_outer=scene.solver.max_iterations, friction=kind)
     caps = meth.capabilities
-    ops = SceneOperators.build(scene, symmetrized=caps.operator == "symmetrized", capabilities=caps)
+    ops = SceneOperators.build(scene, symmetrized=caps.operator == "symmetrized", capabilities=caps, geometry=geometry)
     meth.setup(ops)
     return scene, meth, ops
 
@@ -631,7 +642,8 @@ def check_resumed(scene, prepared, arrays: dict, march=None) -> None:
                                      f"{dt:.3g} mu p0 (more than {RESUME_TOL:g}): the file was changed or is corrupt")
 
 
-def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None) -> Result:
+def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None,
+        geometry=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -659,6 +671,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     keep_every : int, optional
         Keep every k-th state (and the last two); the steps in between are combined into the kept
         ones (``Field.reduce``). Default 1, or the resumed file's.
+    geometry : Memo, optional
+        Shared by the runs it is handed to: what the influence model keeps of the bodies (:func:`prepare`).
 
     Raises
     ------
@@ -672,7 +686,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
     from .result import ResumeSource, resume_source
-    asked = scene if isinstance(scene, Scene) else load_scene(scene)
+    asked = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != asked.solver.method:
         asked = asked.replace(**{"solver.method": method})
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
@@ -681,7 +695,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         from .advice import fast_path
         from .scene.checks import check_result_memory
         check_result_memory(fast_path(asked).scene if method is None or isinstance(method, str) else asked, keep)
-    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method)
+    scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method, geometry=geometry)
     tail = None
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source

@@ -20,9 +20,9 @@ import numpy as np
 
 from . import matrixfree
 from .errors import InputError
-from .influence import get_model
+from .influence import Memo, get_model
 from .influence.operator import Operator, asymmetry
-from .problem import CoupledStep, NormalStep, Scales, TangentialStep, _check_sliding_limit, _trusted
+from .problem import CoupledStep, FrictionBound, NormalStep, Scales, TangentialStep, _check_sliding_limit
 from .strip import RowSparse, Strip
 
 __all__ = ["SceneOperators"]
@@ -51,6 +51,9 @@ class SceneOperators:
     info : dict
         The influence model's data and diagnostics, the measured asymmetries of ``F·A``,
         ``influence_seconds``, ``operator``.
+    memo : Memo
+        What is built once and kept for the scene (:class:`~rollqp.influence.memo.Memo`): the history and
+        steady operators, and what the influence model keeps of the geometry (the BEM's roller compliances).
     """
 
     scene: object
@@ -63,22 +66,33 @@ class SceneOperators:
     scales: Scales
     symmetrized: bool = False
     info: dict = field(default_factory=dict)
-    _memo: dict = field(default_factory=dict, repr=False)
+    memo: Memo = field(default_factory=Memo, repr=False)
+
+    def __post_init__(self):
+        # the bound of the last step the march made, with the pressure and μ objects it is of (tangential_step)
+        self._last_bound: tuple | None = None
 
     @classmethod
-    def build(cls, scene, symmetrized: bool = False, capabilities=None) -> "SceneOperators":
+    def build(cls, scene, symmetrized: bool = False, capabilities=None, memo: Memo | None = None,
+              geometry: Memo | None = None) -> "SceneOperators":
         """Discretize ``scene``; ``symmetrized`` selects the QP operator ``F⁻¹ sym(F A)``.
 
         ``capabilities``: the :class:`~rollqp.methods.base.Capabilities` of the method object that runs the
         scene (:func:`rollqp.march.prepare` passes them; default: those the scene's ``solver.method``
         declares): dense matrices, or FFT operators for a method that works with products only on a
-        large half-space strip (:func:`rollqp.matrixfree.mode`)."""
+        large half-space strip (:func:`rollqp.matrixfree.mode`). ``memo``: the scene's :attr:`memo` (default
+        a new one; it keeps this scene's history and steady operators, so it is never shared between
+        scenes). ``geometry``: where the influence model keeps what depends on the bodies alone (the
+        BEM's rollers; default ``memo``); a caller that builds several scenes on the same bodies (a
+        sweep's worker) may hand them one, so that it is built once."""
         d = scene.discretization
+        memo = Memo() if memo is None else memo
         strip = Strip(scene.half_width, d.elements, d.element)
         if matrixfree.mode(scene, capabilities) == "matrix-free":
-            return cls._build_matrix_free(scene, strip).with_profiles()
+            return cls._build_matrix_free(scene, strip, memo).with_profiles()
         t0 = time.perf_counter()
-        infl = get_model(scene.contact.model).build(scene, strip)  # (rollqp.influence.Model)
+        model = get_model(scene.contact.model)  # (rollqp.influence.Model)
+        infl = model.build(scene, strip, memo=memo if geometry is None else geometry) if model.memo else model.build(scene, strip)
         f = strip.weights
         info = dict(infl.info)
         info["asymmetry_Ann"] = asymmetry(infl.Ann, f)
@@ -93,7 +107,7 @@ class SceneOperators:
         info["operator"] = "symmetrized" if symmetrized else "collocation"
         Atn, Ant = (None if M is None else Operator(M, "influence") for M in (infl.Atn, infl.Ant))
         ops = cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=infl.h,
-                  scales=Scales(scene.a_H, scene.p0, scene.Estar), symmetrized=symmetrized, info=info)
+                  scales=Scales(scene.a_H, scene.p0, scene.Estar), symmetrized=symmetrized, info=info, memo=memo)
         return ops.with_profiles()
 
     def with_profiles(self) -> "SceneOperators":
@@ -128,14 +142,14 @@ class SceneOperators:
         return h
 
     @classmethod
-    def _build_matrix_free(cls, scene, strip) -> "SceneOperators":
+    def _build_matrix_free(cls, scene, strip, memo) -> "SceneOperators":
         """FFT operators on the uniform strip (:mod:`rollqp.matrixfree`; docs/matrix-free.md)."""
         t0 = time.perf_counter()
         Ann, Att, Atn, Ant, h, info = matrixfree.build(scene, strip)
         info["influence_seconds"] = time.perf_counter() - t0
         info["operator"] = "collocation"
         return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=h,
-                   scales=Scales(scene.a_H, scene.p0, scene.Estar), info=info)
+                   scales=Scales(scene.a_H, scene.p0, scene.Estar), info=info, memo=memo)
 
     @property
     def matrix_free(self) -> bool:
@@ -176,7 +190,7 @@ class SceneOperators:
 
     def step_friction(self, q=0.0, dq=None, previous=None, steady=False):
         """``(mu, law)`` of a step at the rolled distance ``q`` (:func:`rollqp.friction.bound.step_coefficient`):
-        the number ``μ`` and ``None`` for Coulomb — the step problems' old path, bitwise."""
+        the number ``μ`` and ``None`` for Coulomb (the constant bound's path)."""
         from .friction.bound import step_coefficient
         sc, a = self.scene, self.scales.length
         return step_coefficient(self.friction, self.strip.x / a, q / a, sc.load.direction,
@@ -197,9 +211,7 @@ class SceneOperators:
         dq = sc.dq if dq is None else dq
         direction = sc.load.direction if direction is None else direction
         key = ("history", formulation, float(dq), int(direction))
-        if key not in self._memo:
-            self._memo[key] = self.build_history(formulation, dq, direction)
-        return self._memo[key]
+        return self.memo.get(key, lambda: self.build_history(formulation, dq, direction))
 
     def build_history(self, formulation: str, dq: float, direction: int):
         """A new history operator ``M`` (eq. 37, 48), not kept: sparse rows on either path (scipy.sparse,
@@ -220,15 +232,15 @@ class SceneOperators:
         t)/dq`` is then the steady slip ``ξ e + T w`` (docs/formulation.md §4, §9), and a march from the
         steady state stays there.
         """
-        if "steady" not in self._memo and self.matrix_free:   # products, no matrix (rollqp.matrixfree)
-            self._memo["steady"] = matrixfree.steady_operators(self)
-        if "steady" not in self._memo:
-            sc = self.scene
-            T = self.scales.length * self.strip.steady_operator(sc.load.direction, sc.discretization.formulation,
-                                                                sc.dq)
-            Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")
-            self._memo["steady"] = (Atn, Operator(T @ self.Att.dense(), "steady A_tt"))
-        return self._memo["steady"]
+        return self.memo.get("steady", self._build_steady)
+
+    def _build_steady(self) -> tuple[Operator | None, Operator]:
+        if self.matrix_free:   # products, no matrix (rollqp.matrixfree)
+            return matrixfree.steady_operators(self)
+        sc = self.scene
+        T = self.scales.length * self.strip.steady_operator(sc.load.direction, sc.discretization.formulation, sc.dq)
+        Atn = None if self.Atn is None else Operator(T @ self.Atn.dense(), "steady A_tn")
+        return Atn, Operator(T @ self.Att.dense(), "steady A_tt")
 
     # ------------------------------------------------------------ step problems
     def normal_step(self, P, t=None, delta=None, h=None, validate=True) -> NormalStep:
@@ -236,14 +248,14 @@ class SceneOperators:
         undeformed gap of the step (default :attr:`h`; a moving profile's :meth:`gap`).
 
         ``validate=False`` (rollqp.march): the values are the scene's validated data and the method's
-        checked solutions, and the step is built without re-validating them (:func:`~rollqp.problem._trusted`)."""
+        checked solutions, and the step is made with ``trusted=True`` (not checked again)."""
         offset = None if (self.Ant is None or t is None) else self.Ant @ t
         h = self.h if h is None else h
         if not validate:
             if offset is not None:
                 _finite("t", offset)
-            return _trusted(NormalStep, A=self.Ann, f=self.f, h=h, P=_float(P), delta=_float(delta), offset=offset,
-                            scales=self.scales)
+            return NormalStep(A=self.Ann, f=self.f, h=h, P=_float(P), delta=_float(delta), offset=offset,
+                              scales=self.scales, trusted=True)
         return NormalStep(A=self.Ann, f=self.f, h=h, P=P, delta=delta, offset=offset, scales=self.scales)
 
     def tangential_step(self, p, c, dq, Q=None, xi=None, steady=False, friction=None, validate=True) -> TangentialStep:
@@ -258,17 +270,17 @@ class SceneOperators:
         if validate:
             return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
         _finite("c", c)
-        pb = _trusted(TangentialStep, A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
-                      scales=self.scales, law=law)
-        last = self._memo.get("bound")  # (p, μ, bound, sliding limit, bound_hat) of the last march-built step
-        if last is not None and last[0] is p and last[1] is mu and law is None:
-            # the same pressure (a fixed normal half) and μ: the same bound (TangentialStep's cached properties)
-            pb.__dict__["bound"], pb.__dict__["bound_hat"] = last[2], last[4]
+        last = self._last_bound  # (p, μ, FrictionBound, sliding limit) of the last march-built step
+        known = last is not None and last[0] is p and last[1] is mu and law is None
+        # the same pressure (a fixed normal half) and μ: the same bound, handed to the step
+        pb = TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
+                            scales=self.scales, law=law, trusted=True, known_bound=last[2] if known else None)
+        if known:
             _check_sliding_limit(pb, last[3])
         else:
             _finite("p", pb.bound)
             if law is None:
-                self._memo["bound"] = (p, mu, pb.bound, _check_sliding_limit(pb), pb.bound_hat)
+                self._last_bound = (p, mu, FrictionBound(pb.bound, pb.bound_hat), _check_sliding_limit(pb))
             else:
                 _check_sliding_limit(pb)
         return pb
@@ -301,7 +313,7 @@ def _finite(name, v) -> None:
     """The one check a march-built step keeps on the arrays it takes from the last step's solution:
     finite (one sum: a NaN or an infinity makes it non-finite), else the InputError a validated step
     would raise."""
-    if not math.isfinite(float(np.add.reduce(v))):  # (the ufunc: np.sum costs three times as much)
+    if not math.isfinite(float(np.add.reduce(v))):  # (the ufunc: np.sum's dispatch costs more)
         raise InputError(name, "must be finite (the last step's solution was not)")
 
 

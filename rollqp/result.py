@@ -771,6 +771,9 @@ def load_result(path, arg: str = "RESULT.npz", map_above: int | None = MAP_ABOVE
     for key in ("x", "q", "meta"):
         if key not in z:
             raise InputError(arg, f"{os.fspath(path)!r} is not a rollqp result file (no key {key!r})")
+    if "y" in z:  # a grid of elements: a 3D scene's result file (docs/results.md, "Three dimensions")
+        from .three.fields import read_checked
+        return read_checked(z, arg)
     n, K1 = np.shape(z["x"])[0] if np.ndim(z["x"]) == 1 else -1, np.shape(z["q"])[0] if np.ndim(z["q"]) == 1 else -1
     if n < 1 or K1 < 1:
         raise InputError(arg, f"keys 'x' and 'q' must be non-empty 1-D arrays, got shapes {np.shape(z['x'])}, "

@@ -246,7 +246,8 @@ class RowSparse:
     ``O(n k)`` instead of a dense ``O(n²)`` one, with the same non-zero values (a padded entry
     has the value 0 and adds nothing). Only ``@`` (with a vector or an ``n × m`` matrix),
     ``shape``, :meth:`dense` and ``np.asarray`` are provided. Up to :data:`DENSE_MAX` entries the
-    product with a vector is the dense one (one BLAS call: 1.2 µs against 2.8 µs at 81 nodes).
+    product with a vector is the dense one (one BLAS call; both products' costs by size:
+    docs/performance.md, ``python benchmarks/row_sparse.py``).
     """
 
     __slots__ = ("cols", "vals", "shape", "_small")

@@ -7,6 +7,9 @@
   scenes never compare them; no method name, influence model name or ``isinstance(…, float)``
   friction test appears as code outside the registry or record that owns it.
 * No cache in ``rollqp/`` is keyed on ``id()`` (set-up happens once per scene instead).
+* No object is made or changed by writing its internals: no ``object.__new__``, no writes into an
+  instance's ``__dict__`` (a step problem made without its checks is made by its constructor with
+  ``trusted=True``; what is computed once is kept in a memo its owner holds).
 """
 from __future__ import annotations
 
@@ -134,6 +137,19 @@ def test_no_id_keyed_caches():
             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
             if re.search(r"\bid\(", line) and not line.lstrip().startswith("#")]
     assert not hits, f"id()-keyed lookups in rollqp/: {hits}"
+
+
+INTERNALS = re.compile(r"object\.__new__\(|__dict__\s*\[[^\]]*\]\s*=|__dict__\.(?:update|pop|setdefault|clear)\(")
+
+
+def test_no_writes_into_object_internals():
+    hits = [f"{p.relative_to(ROOT)}:{i}: {line.strip()}" for p in _sources("rollqp")
+            for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+            if INTERNALS.search(line) and not line.lstrip().startswith("#")]
+    assert not hits, f"objects made or changed through their internals in rollqp/: {hits}"
+    for line in ("obj = object.__new__(cls)", "pb.__dict__[\"bound\"] = b", "new.__dict__.update(old.__dict__)"):
+        assert INTERNALS.search(line), line  # the check is not blind
+    assert not INTERNALS.search("values = {**ref.__dict__}")  # reading is not writing
 
 
 @pytest.mark.integration

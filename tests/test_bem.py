@@ -16,7 +16,7 @@ import pytest
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.errors import InputError
-from rollqp.influence import bem
+from rollqp.influence import Memo, bem
 from rollqp.influence.bem import annulus_mesh, bem_influence, contact_compliance, lame_ring
 from rollqp.influence.halfspace import halfspace_influence
 from rollqp.methods import get_method
@@ -296,16 +296,50 @@ def test_geometric_coupling_levels():
 
 
 def test_cache_and_summary(tmp_path):
-    """The same geometry is assembled once; the run summary reports cost and coupling."""
+    """A roller is assembled once per memo: the scene's own (two runs assemble twice), or one handed to
+    several scenes (the second takes both rollers from it, the same arrays); the summary reports cost and
+    coupling."""
     sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "solver.method": "newton",
                                                         "discretization.distance": 0.5,
                                                         "bodies.A.shaft_radius": 20.0})
     r1 = rollqp.run(sc)
     r2 = rollqp.run(sc)
-    assert not r1.meta["model"]["bem_cached"] and r2.meta["model"]["bem_cached"]
+    assert not r1.meta["model"]["bem_cached"] and not r2.meta["model"]["bem_cached"]
+    assert r1.meta["model"]["bem_assembled"] == 2
     np.testing.assert_array_equal(np.asarray(r1.rows["pn"]), np.asarray(r2.rows["pn"]))
+    memo = Memo()
+    o1, o2 = (rollqp.SceneOperators.build(sc, memo=memo) for _ in range(2))
+    assert (o1.info["bem_assembled"], o2.info["bem_assembled"], o2.info["bem_cached"]) == (2, 0, True)
+    assert o1.memo is memo and len(memo) == 2
+    np.testing.assert_array_equal(o1.Ann.dense(), o2.Ann.dense())
     text = summary(r1.arrays(), sc, "newton", 1.0)
     assert "BEM" in text and "MiB" in text and "dropped" in text and "asymmetry" in text
+
+
+def test_geometry_memo_shared_by_runs():
+    """``run(..., geometry=memo)`` (what a sweep's worker hands each point): the second run takes both
+    rollers from the memo, and a run of another step length on the same rollers equals its own run
+    bitwise (the memo holds the bodies only, never a scene's history or steady operators)."""
+    sc = rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "bem", "solver.method": "newton",
+                                                        "discretization.distance": 0.5,
+                                                        "bodies.A.shaft_radius": 20.0})
+    other = sc.replace(**{"discretization.step": 2.0 * sc.discretization.step})
+    memo = Memo(size=8)
+    r1 = rollqp.run(sc, geometry=memo)
+    r2 = rollqp.run(other, geometry=memo)
+    assert r1.meta["model"]["bem_assembled"] == 2 and len(memo) == 2
+    assert r2.meta["model"]["bem_assembled"] == 0 and r2.meta["model"]["bem_cached"]
+    alone = rollqp.run(other)
+    for key in ("pn", "pt"):
+        np.testing.assert_array_equal(np.asarray(r2.rows[key]), np.asarray(alone.rows[key]))
+
+
+def test_symmetric_pair_assembles_one_roller():
+    """Two equal rollers (the same radius, shaft and material): the second is the first's compliance."""
+    strip = rollqp.Strip(1.3131, 40, "quadratic")
+    Es = _estar(STEEL_A, STEEL_A)
+    infl = bem_influence(strip, A=STEEL_A, B=STEEL_A, Estar=Es, beta=0.0)
+    assert infl.info["bem_assembled"] == 1 and not infl.info["bem_cached"]
 
 
 # ------------------------------------------------------------------------------ bad input

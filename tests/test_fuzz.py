@@ -105,7 +105,8 @@ def _short(name: str) -> dict:
 
 @pytest.fixture(scope="module")
 def bases():
-    out = {name: _short(name) for name in sorted(rollqp.builtin_scenes())}
+    out = {name: _short(name) for name in sorted(rollqp.builtin_scenes())
+           if rollqp.load_scene(name).dimension == 2}    # 3D scenes: tests/test_three_scene.py
     bem = json.loads(json.dumps(out["cattaneo-carter"]))
     bem["contact"]["model"] = "bem"
     bem["discretization"]["elements"] = 12

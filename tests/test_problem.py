@@ -412,3 +412,35 @@ def test_scene_matrices_are_checked_once_and_read_only():
     prob = rollqp.NormalStep(A=mine, f=model.f, h=model.h, P=1000.0, scales=model.scales)
     mine[0, 0] = 1e9                   # the user's array changes; the problem does not
     assert np.asarray(prob.A)[0, 0] == model.Ann.dense()[0, 0]
+
+
+# ------------------------------------------------------------------ trusted construction
+def _tangential_toy(**kw):
+    return TangentialStep(A=A_TOY, f=F_TOY, p=PT_TOY, mu=MU_TOY, c=np.zeros(N_TOY), dq=1.0, Q=0.5, **kw)
+
+
+def test_trusted_construction_skips_the_checks_and_keeps_the_values():
+    """``trusted=True`` is the same constructor without the checks: the values are kept as given (a list stays a
+    list, a load out of range is not refused); without it they are checked and converted."""
+    checked = NormalStep(A=A_TOY, f=list(F_TOY), h=np.zeros(N_TOY), P=1)
+    assert isinstance(checked.f, np.ndarray) and isinstance(checked.P, float)
+    trusted = NormalStep(A=A_TOY, f=list(F_TOY), h=np.zeros(N_TOY), P=-1.0, trusted=True)
+    assert isinstance(trusted.f, list) and trusted.P == -1.0
+    with pytest.raises(InputError, match="normal load"):
+        NormalStep(A=A_TOY, f=F_TOY, h=np.zeros(N_TOY), P=-1.0)
+    with pytest.raises(InputError, match="normal load"):
+        checked.replace(P=-1.0)          # replace checks
+    assert checked.derived(P=-1.0).P == -1.0  # derived is trusted
+
+
+def test_a_known_bound_is_used_by_a_trusted_step_only_and_never_carried():
+    """``known_bound`` (the bound of the very same pressure and μ, computed before) is what a trusted step
+    returns as its bound; a checked step computes its own, and a copy never carries it."""
+    ref = _tangential_toy()
+    fake = rollqp.problem.FrictionBound(np.full(N_TOY, 7.0), (np.full(N_TOY, 7.0), np.full(N_TOY, -7.0)))
+    trusted = _tangential_toy(trusted=True, known_bound=fake)
+    assert trusted.bound is fake.values and trusted.bound_hat is fake.hat
+    assert np.array_equal(_tangential_toy(known_bound=fake).bound, ref.bound)
+    np.testing.assert_array_equal(ref.bound, MU_TOY * PT_TOY)
+    for copy in (trusted.derived(Q=0.25), trusted.replace(Q=0.25), trusted.shifted(np.zeros(N_TOY))):
+        np.testing.assert_array_equal(copy.bound, ref.bound)

@@ -13,6 +13,7 @@ from __future__ import annotations
 from ..errors import InputError
 from . import builtin
 from .halfspace import Influence, halfspace_influence, min_eigenvalue
+from .memo import Memo
 from .model import DEFAULT as DEFAULT_MODEL
 from .model import Model
 from .model import get as get_model
@@ -28,7 +29,7 @@ def bem_influence(strip, **kw) -> Influence:
     return build(strip, **kw)
 
 __all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence", "Model",
-           "register_model", "get_model", "model_names", "DEFAULT_MODEL"]
+           "register_model", "get_model", "model_names", "DEFAULT_MODEL", "Memo"]
 
 #: Available influence models (``contact.model``).
 MODELS = {"halfspace": halfspace_influence, "bem": bem_influence}

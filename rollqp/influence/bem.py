@@ -79,8 +79,7 @@ and (``J`` reverses the node order)
 load case ``N_j`` in component ``b`` of body α). Local components make a rigid rotation of a
 rim (the wind-up of a roller on a thin shaft) a constant ``u_t`` and no ``u_n``: it neither
 slips nor opens the gap, as it must. (Cartesian components would turn it into a spurious
-tangential strain ``∝ x/R``: +52 % on Carter's creepage at ``a/R = 0.3`` on the paper's 15 mm
-shaft; measured before this choice.) Nodes of A and B are paired by arc length (material is
+tangential strain ``∝ x/R``; its size on Carter's creepage is in docs/bem.md.) Nodes of A and B are paired by arc length (material is
 convected along each surface by arc length), and the undeformed gap is the separation of
 the paired points along the line of centres,
 ``h(s) = R_A(1 - cos(s/R_A)) + R_B(1 - cos(s/R_B))`` (``= s²/2R`` to leading order).
@@ -105,6 +104,7 @@ import scipy.linalg
 from ..errors import InputError
 from .halfspace import COUPLINGS, Influence, min_eigenvalue
 from .kernels import log_moments as _log_moments
+from .memo import Memo
 from .operator import asymmetry
 
 __all__ = ["AnnulusMesh", "annulus_mesh", "BEMBody", "body_matrices", "contact_compliance",
@@ -514,29 +514,37 @@ def lame_ring(mesh: AnnulusMesh, nu: float, pressure: float = 1.0, E: float = 1.
 
 
 # ---------------------------------------------------------------------------------- the influence
-#: The contact compliances of the last :data:`GEOMETRY_MEMO_SIZE` roller geometries, keyed by the
-#: geometry itself (strip half-width, elements and element type; radius, shaft radius, E, ν; the
-#: outer and inner element counts): the roller's BEM assembly and condensation (``O(N³)``, seconds)
-#: depend on nothing else, so two scenes on the same rollers — a study over loads, friction or the
-#: method, the two bodies of a symmetric pair — assemble each roller once per process. Read-only
-#: arrays; ``info["cached"]`` says whether a scene's bodies came from here.
-GEOMETRY_MEMO: dict = {}
+#: How many roller compliances a :class:`~rollqp.influence.memo.Memo` made by :func:`geometry_memo` keeps.
 GEOMETRY_MEMO_SIZE = 8
 
 
-def body_compliance(strip, radius, shaft, E, nu, n_outer, n_inner):
-    """``(S, info)`` of one roller (:func:`contact_compliance`), through the geometry memo :data:`GEOMETRY_MEMO`."""
-    key = (float(strip.half_width), int(strip.n_elements), strip.element, float(radius), float(shaft),
+def geometry_memo() -> Memo:
+    """A memo for :func:`body_compliance` (at most :data:`GEOMETRY_MEMO_SIZE` rollers): what a caller that builds
+    several scenes on the same rollers hands to each (:class:`~rollqp.influence.memo.Memo`)."""
+    return Memo(size=GEOMETRY_MEMO_SIZE)
+
+
+def body_compliance(strip, radius, shaft, E, nu, n_outer, n_inner, memo: Memo | None = None):
+    """``(S, info)`` of one roller (:func:`contact_compliance`), kept in ``memo``.
+
+    The key is the geometry itself (strip half-width, elements and element type; radius, shaft radius,
+    E, ν; the outer and inner element counts): the roller's BEM assembly and condensation (``O(N³)``,
+    seconds) depend on nothing else, so the two bodies of a symmetric pair, or two scenes given the same
+    memo, assemble each roller once. ``S`` is read-only; ``info["cached"]`` says whether it came from
+    ``memo`` (None: a memo of this call only).
+    """
+    memo = Memo() if memo is None else memo
+    key = ("bem-body", float(strip.half_width), int(strip.n_elements), strip.element, float(radius), float(shaft),
            float(E), float(nu), int(n_outer), int(n_inner))
-    if key in GEOMETRY_MEMO:
-        C, info = GEOMETRY_MEMO[key]
-        return C, dict(info, cached=True)
-    C, info = contact_compliance(strip, radius, shaft, E, nu, n_outer, n_inner)
-    C.setflags(write=False)
-    if len(GEOMETRY_MEMO) >= GEOMETRY_MEMO_SIZE:
-        GEOMETRY_MEMO.pop(next(iter(GEOMETRY_MEMO)))
-    GEOMETRY_MEMO[key] = (C, info)
-    return C, dict(info, cached=False)
+    cached = key in memo
+
+    def build():
+        C, info = contact_compliance(strip, radius, shaft, E, nu, n_outer, n_inner)
+        C.setflags(write=False)
+        return C, info
+
+    C, info = memo.get(key, build)
+    return C, dict(info, cached=cached)
 
 
 def contact_gap(s, R_A, R_B):
@@ -549,7 +557,8 @@ def contact_gap(s, R_A, R_B):
 
 
 def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.0, coupling: str = "off",
-                  n_outer: int = DEFAULT_OUTER, n_inner: int = DEFAULT_INNER, **_ignored) -> Influence:
+                  n_outer: int = DEFAULT_OUTER, n_inner: int = DEFAULT_INNER, memo: Memo | None = None,
+                  **_ignored) -> Influence:
     """True-geometry influence of two rollers on rigid shafts (eq. 23–30; module docstring).
 
     Parameters
@@ -566,6 +575,9 @@ def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.
         ``"full"``, dropped with ``"off"``; its size is ``info["coupling_size"]``.
     n_outer, n_inner : int
         Elements outside the strip and on each shaft (defaults: the paper's 19 and 16).
+    memo : Memo, optional
+        Where the rollers' compliances are kept (:func:`body_compliance`; the scene's operators hand
+        theirs). Default: a memo of this call, so a symmetric pair assembles one roller.
     **_ignored
         The half-space builder's ``R_A``, ``R_B`` and ``d_ref`` (``build_influence`` passes the
         same keywords to every model): the radii come from ``A`` and ``B``, and with rigid
@@ -587,8 +599,9 @@ def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.
             raise InputError(f"{key}.shaft_radius", "is required when contact.model = 'bem' "
                                                     "(the inner radius of the roller, in (0, radius))")
     t0 = time.perf_counter()
-    CA, infoA = body_compliance(strip, A.radius, A.shaft_radius, A.E, A.nu, n_outer, n_inner)
-    CB, infoB = body_compliance(strip, B.radius, B.shaft_radius, B.E, B.nu, n_outer, n_inner)
+    memo = Memo() if memo is None else memo
+    CA, infoA = body_compliance(strip, A.radius, A.shaft_radius, A.E, A.nu, n_outer, n_inner, memo)
+    CB, infoB = body_compliance(strip, B.radius, B.shaft_radius, B.E, B.nu, n_outer, n_inner, memo)
     J = np.arange(strip.n)[::-1]
     comb = lambda a, b: CA[a, b] + CB[a, b][np.ix_(J, J)]  # noqa: E731
     Ann, Att, Ant, Atn = comb(1, 1), comb(0, 0), comb(1, 0), comb(0, 1)
@@ -602,6 +615,7 @@ def bem_influence(strip, *, A=None, B=None, Estar: float = 1.0, beta: float = 0.
             "bem_assembly_seconds": infoA["assembly_seconds"] * (not infoA["cached"])
             + infoB["assembly_seconds"] * (not infoB["cached"]),
             "bem_cached": bool(infoA["cached"] and infoB["cached"]),
+            "bem_assembled": int(not infoA["cached"]) + int(not infoB["cached"]),
             "bem_memory_bytes": max(infoA["memory_bytes"], infoB["memory_bytes"]),
             "bem_grading_ratio": [infoA["grading_ratio"], infoB["grading_ratio"]],
             "asymmetry_FA": asymmetry(Ann, f), "asymmetry_FAtt": asymmetry(Att, f),

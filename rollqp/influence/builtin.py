@@ -51,12 +51,13 @@ def halfspace_operators_of(scene, strip):
     return Ann, Att, Atn, Ant, h, info
 
 
-def bem_of(scene, strip):
-    """The true-geometry influence of ``scene``'s rollers on rigid shafts (:func:`rollqp.influence.bem.bem_influence`)."""
+def bem_of(scene, strip, memo=None):
+    """The true-geometry influence of ``scene``'s rollers on rigid shafts (:func:`rollqp.influence.bem.bem_influence`;
+    ``memo``: where the rollers' compliances are kept, the scene operators' :class:`~rollqp.influence.memo.Memo`)."""
     from .bem import bem_influence
     return bem_influence(strip, Estar=scene.Estar, beta=scene.beta, R_A=scene.A.radius, R_B=scene.B.radius,
                          coupling=scene.coupling_level, d_ref=scene.reference_distance_value, A=scene.A, B=scene.B,
-                         n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1])
+                         n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1], memo=memo)
 
 
 #: Smallest strip element length over the smaller radius for ``model = "bem"``: the BEM nodes are
@@ -90,7 +91,7 @@ def check_bem_scene(scene) -> None:
 def bem_rows(m: dict) -> list[tuple[str, str]]:
     """A BEM run's summary rows from its ``meta["model"]``: assembly cost, geometric coupling, asymmetry of F·A
     (docs/bem.md)."""
-    cost = ("cached (same geometry built before)" if m.get("bem_cached") else
+    cost = ("cached (the same rollers built before with this memo)" if m.get("bem_cached") else
             f"{m.get('bem_seconds', float('nan')):.3f} s assembly + condensation")
     return [("BEM", f"{cost}, {m.get('bem_memory_bytes', 0) / 2 ** 20:.1f} MiB per body system; "
                     f"{m.get('bem_outer_elements')} outer + {m.get('bem_inner_elements')} shaft elements"),
@@ -105,4 +106,4 @@ HALFSPACE = Model("halfspace", halfspace_of, "elastic half-spaces (docs/formulat
 BEM = Model("bem", bem_of, "true roller geometry on rigid shafts by BEM (docs/bem.md)",
             keys=("contact.bem_outer_elements", "contact.bem_inner_elements", "contact.coupling",
                   "bodies.A.shaft_radius", "bodies.B.shaft_radius"),
-            check=check_bem_scene, profiles=False, halfspace_field=False, report=bem_rows)
+            check=check_bem_scene, profiles=False, halfspace_field=False, report=bem_rows, memo=True)

@@ -381,7 +381,7 @@ def _lanczos_rel(Lf) -> float:
 
 
 #: Nodes above which a uniform strip's definiteness is decided matrix-free (:func:`_check_by_threshold`)
-#: instead of by an attempted Cholesky factorization (``O(n³/3)``: 2.7 s at 5,121 nodes here).
+#: instead of by an attempted Cholesky factorization (``O(n³/3)``; the costs by size: docs/matrix-free.md).
 CHOLESKY_MAX = 4096
 
 
@@ -480,8 +480,8 @@ def halfspace_influence(strip, *, Estar: float, beta: float, R_A: float, R_B: fl
     On a uniform strip the matrices are filled from their ``O(n)`` Toeplitz generators. The
     positive-definiteness check is an attempted Cholesky factorization (``O(n³/3)``) up to
     :data:`CHOLESKY_MAX` nodes and, above it on a uniform strip, the rank-one threshold by FFT
-    products (:func:`_check_by_threshold`): 5,121 quadratic nodes assemble in about 0.6 s
-    (``python benchmarks/assembly.py --nodes 2561 5121``).
+    products (:func:`_check_by_threshold`); the assembly's time and memory by size are in
+    docs/matrix-free.md.
     """
     Estar = positive_real("Estar", float(Estar))
     beta = float(beta)

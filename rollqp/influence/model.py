@@ -58,6 +58,9 @@ class Model:
         own; False: the stresses are a half-space field below its tractions (an approximation, noted).
     report : callable or None
         ``report(meta) -> [(label, text), …]``: rows of a run's summary from the result's ``meta["model"]``.
+    memo : bool
+        ``build`` takes the keyword ``memo``: the :class:`~rollqp.influence.memo.Memo` of the scene's
+        operators, where it keeps what depends on the geometry alone (the BEM's roller compliances).
     """
 
     name: str
@@ -69,6 +72,7 @@ class Model:
     profiles: bool = True
     halfspace_field: bool = True
     report: Callable | None = None
+    memo: bool = False
 
     @property
     def matrix_free(self) -> bool:

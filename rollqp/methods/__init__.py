@@ -11,6 +11,25 @@
                           DAQP, quadprog, ProxQP, PIQP, HiGHS; :mod:`.qp_qpsolvers`)
 ========================  ==========================================================
 
+**Three dimensions** (a scene with ``[contact] dimension = 3``, :mod:`rollqp.three`). A name keeps
+its meaning across dimensions — ``newton`` is rollqp's generalized Newton method, a ``qp-*`` name the
+convex programs on that external solver — and each dimension has its own table of classes:
+
+========================  ==========================================================
+``newton``                generalized Newton on the disc projection (:mod:`rollqp.three.gnm`)
+``qp-clarabel``           Clarabel: the normal QP and the tangential SOCP (one cone per element)
+``socp-clarabel``         the same (the name says the cone)
+``qp-cvxpy``              cvxpy's statement of the QP and the SOCP, solved by Clarabel
+``socp-cvxpy``            the same
+``socp-scs``              cvxpy's statement solved by SCS (first order, extra ``cvxpy``)
+``qp-osqp``               OSQP: the normal QP only; no cones, so a 3D scene (tangential SOCPs)
+                          refuses it up front, naming the methods that can
+========================  ==========================================================
+
+A name registered for one dimension only (``nt-newton``, ``mf-newton``, ``qps-*``; the ``socp-*``
+names) resolves in the other to its own class, whose record (``Capabilities.dimension``) refuses
+the scene up front (:func:`compose`, :func:`compose_3d`).
+
 Optional backends are always registered by name; one whose package is not installed
 raises :class:`~rollqp.errors.MissingBackendError` naming the pip extra, and
 :func:`available_methods` leaves it out. Modules are imported on first use. :func:`register` adds a
@@ -52,7 +71,24 @@ _REGISTRY = {
        for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
 }
 
+# name -> (module, class, extra) of the methods of three-dimensional scenes (rollqp.three)
+_REGISTRY_3D = {
+    "newton": ("rollqp.three.gnm", "NewtonMethod", None),
+    "qp-clarabel": ("rollqp.three.socp", "ClarabelMethod", None),
+    "socp-clarabel": ("rollqp.three.socp", "ClarabelMethod", None),
+    "qp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
+    "socp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
+    "socp-scs": ("rollqp.three.socp", "ScsMethod", "cvxpy"),
+    "qp-osqp": ("rollqp.three.socp", "OsqpMethod", None),
+}
+_TABLES = {2: _REGISTRY, 3: _REGISTRY_3D}
+
+#: The methods of two-dimensional scenes.
 METHOD_NAMES = tuple(_REGISTRY)
+#: The methods of three-dimensional scenes (``[contact] dimension = 3``).
+METHOD_NAMES_3D = tuple(_REGISTRY_3D)
+#: Every name a scene's ``solver.method`` (or ``--method``) may hold, of either dimension.
+SCENE_METHOD_NAMES = METHOD_NAMES + tuple(k for k in _REGISTRY_3D if k not in _REGISTRY)
 #: The methods that pose convex QPs (each half of a step one QP; coupled steps by the N–T
 #: alternation): for listings and benchmarks. What a method can do is its ``capabilities``.
 QP_METHODS = tuple(k for k in _REGISTRY if k.startswith(("qp-", "qps-")))
@@ -67,32 +103,50 @@ COMPARE_METHODS = ("newton", "qp-clarabel")
 CROSS_CHECK_METHODS = ("qp-clarabel", "qp-osqp")
 #: The method :func:`rollqp.solve_step` poses one step with by default (a convex QP, interior point).
 STEP_METHOD = "qp-clarabel"
+#: The methods a 3D run is cross-checked with (:func:`rollqp.three.crosscheck.cross_check`): the conic
+#: route (Clarabel, core dependency) and Newton; the one that ran the scene is left out.
+CROSS_CHECK_METHODS_3D = ("qp-clarabel", "newton")
+#: The methods ``rollqp crossval`` solves every step of a 3D scene with (those installed): rollqp's Newton
+#: method and the SOCP backends (Clarabel natively, cvxpy's statement solved by Clarabel).
+CROSSVAL_METHODS_3D = ("newton", "socp-clarabel", "socp-cvxpy")
 
 
 def register(name: str, cls: type, extra: str | None = None) -> None:
     """Register a method class under ``name`` (a scene's ``solver.method``, :func:`get_method`).
 
     ``cls`` follows the protocol of :mod:`rollqp.methods.base`: ``name``, a class attribute
-    ``capabilities`` (:class:`Capabilities`), ``from_settings``, ``setup`` and ``solve``. ``extra``: the
-    pip extra that installs what it needs, named when its import fails.
+    ``capabilities`` (:class:`Capabilities`), ``from_settings``, ``setup`` and ``solve``. It goes into
+    the table of the dimension its record declares (``capabilities.dimension``). ``extra``: the pip
+    extra that installs what it needs, named when its import fails.
 
     Raises
     ------
     InputError
-        ``name`` is already registered, or ``cls`` declares no :class:`Capabilities`.
+        ``name`` is already registered for that dimension, or ``cls`` declares no :class:`Capabilities`.
     """
-    if not isinstance(name, str) or not name or name in _REGISTRY:
-        raise InputError("name", f"must be a new method name (registered: {', '.join(_REGISTRY)}), got {name!r}")
     declared = next((vars(k)["capabilities"] for k in cls.__mro__ if "capabilities" in vars(k)), None)
     if not isinstance(declared, Capabilities):
         raise InputError("cls", f"a method class declares its Capabilities as the class attribute "
                                 f"'capabilities' ({cls!r} does not)")
-    _REGISTRY[name] = (cls, None, extra)
+    table = _TABLES.get(declared.dimension)
+    if table is None:
+        raise InputError("cls", f"capabilities.dimension must be one of {sorted(_TABLES)}, got {declared.dimension!r}")
+    if not isinstance(name, str) or not name or name in table:
+        raise InputError("name", f"must be a new method name (registered: {', '.join(table)}), got {name!r}")
+    table[name] = (cls, None, extra)
+    _refresh_names()
 
 
-def capabilities(name: str) -> Capabilities:
-    """What the method ``name`` declares (its class's ``capabilities``), without making it; the
-    declaration of a method that needs the matrix and solves nothing if its package is not installed.
+def _refresh_names() -> None:
+    global METHOD_NAMES, METHOD_NAMES_3D, SCENE_METHOD_NAMES
+    METHOD_NAMES, METHOD_NAMES_3D = tuple(_REGISTRY), tuple(_REGISTRY_3D)
+    SCENE_METHOD_NAMES = METHOD_NAMES + tuple(k for k in _REGISTRY_3D if k not in _REGISTRY)
+
+
+def capabilities(name: str, dimension: int = 2) -> Capabilities:
+    """What the method ``name`` declares for scenes of ``dimension`` (its class's ``capabilities``),
+    without making it; the declaration of a method that needs the matrix and solves nothing if its
+    package is not installed.
 
     Raises
     ------
@@ -100,35 +154,53 @@ def capabilities(name: str) -> Capabilities:
         ``solver.method`` for an unknown name.
     """
     try:
-        return method_class(name).capabilities
+        return method_class(name, dimension).capabilities
     except MissingBackendError:
-        return Capabilities()
+        return Capabilities(dimension=dimension)
 
 
-def available_methods() -> list[str]:
-    """Names of the methods whose modules import on this installation."""
+def available_methods(dimension: int = 2) -> list[str]:
+    """Names of the methods of ``dimension`` whose modules import on this installation."""
     out = []
-    for name in _REGISTRY:
+    for name in _TABLES[dimension]:
         try:
-            method_class(name)
+            method_class(name, dimension)
         except (MissingBackendError, InputError):
             continue
         out.append(name)
     return out
 
 
-def check_name(name, key: str = "solver.method") -> str:
-    """``name`` if it is a registered method, else an :class:`InputError` on ``key`` listing them."""
-    if not isinstance(name, str) or name not in _REGISTRY:
+def check_name(name, key: str = "solver.method", dimension: int | None = None) -> str:
+    """``name`` if it is a registered method, else an :class:`InputError` on ``key`` listing them.
+
+    With ``dimension``, the method's record must declare that dimension (a 2D-only method on a 3D
+    scene and the reverse are refused here, through :class:`Capabilities`, naming the methods of
+    that dimension); a method whose package is missing passes (running it names the pip extra).
+    """
+    names = SCENE_METHOD_NAMES
+    if not isinstance(name, str) or name not in names:
         import difflib
-        close = difflib.get_close_matches(name, list(_REGISTRY), n=1) if isinstance(name, str) else []
+        close = difflib.get_close_matches(name, list(names), n=1) if isinstance(name, str) else []
         hint = f"; did you mean {close[0]!r}?" if close else ""
-        raise InputError(key, f"must be one of {', '.join(map(repr, _REGISTRY))}, got {name!r}{hint}")
+        raise InputError(key, f"must be one of {', '.join(map(repr, names))}, got {name!r}{hint}")
+    if dimension is not None:
+        try:
+            declared = method_class(name, dimension).capabilities.dimension
+        except MissingBackendError:
+            return name
+        if declared != dimension:
+            own = ", ".join(_RUNNABLE[dimension]())
+            raise InputError(key, f"method {name!r} solves {declared}D steps (its capabilities); a {dimension}D "
+                                  f"scene needs one of {own}")
     return name
 
 
-def method_class(name: str) -> type:
-    """The class of method ``name``, importing its module on first use.
+def method_class(name: str, dimension: int = 2) -> type:
+    """The class of method ``name`` for scenes of ``dimension``, importing its module on first use.
+
+    A name registered for the other dimension only resolves to that class: its
+    :class:`Capabilities` then refuse the scene (:func:`compose`, :func:`compose_3d`).
 
     Raises
     ------
@@ -138,7 +210,12 @@ def method_class(name: str) -> type:
         The method's package is not installed (the message names the pip extra).
     """
     check_name(name)
-    module, cls, extra = _REGISTRY[name]
+    if dimension not in _TABLES:
+        raise InputError("contact.dimension", f"must be one of {sorted(_TABLES)}, got {dimension!r}")
+    table = _TABLES[dimension]
+    if name not in table:
+        table = next(t for t in _TABLES.values() if name in t)
+    module, cls, extra = table[name]
     if isinstance(module, type):  # registered as a class (register)
         return module
     try:
@@ -149,16 +226,20 @@ def method_class(name: str) -> type:
     return getattr(mod, cls)
 
 
-def get_method(name: str, **settings) -> Method:
-    """A fresh instance of method ``name`` with ``settings`` (tolerance, max_iterations, …).
+def get_method(name: str, dimension: int = 2, **settings) -> Method:
+    """A fresh instance of method ``name`` (for scenes of ``dimension``) with ``settings`` (tolerance,
+    max_iterations, …); its ``name`` is the registry's.
 
     An unknown setting is an :class:`InputError` naming it.
     """
-    cls = method_class(name)
+    cls = method_class(name, dimension)
     try:
-        return cls(**settings)
+        method = cls(**settings)
     except TypeError as exc:  # a keyword the constructor does not take
         raise InputError(name, f"invalid settings {sorted(settings)}: {exc}") from None
+    if method.name != name:
+        method.name = name
+    return method
 
 
 def scene_method(settings, coupled: bool = False, friction: str = "constant", **options) -> Method:
@@ -209,6 +290,66 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
         from .alternation import Alternation
         return Alternation(method, max_outer=max_outer, limit=caps.coupled_limit)
     return method
+
+
+def scene_method_3d(settings, **options) -> Method:
+    """The method a three-dimensional scene runs with: ``settings.method`` from the 3D table, built from
+    the scene's solver settings and checked by :func:`compose_3d`."""
+    method = method_class(settings.method, 3).from_settings(settings, **options)
+    if method.name != settings.method:
+        method.name = settings.method
+    return compose_3d(method)
+
+
+def compose_3d(method: Method) -> Method:
+    """``method`` if its record can run a 3D scene: dimension 3, and tangential steps on the friction
+    disc (a second-order cone per element); else an :class:`InputError` naming the methods that can.
+
+    (Dissimilar bodies run the normal–tangential alternation of :mod:`rollqp.three.march` with the
+    method's own halves: every 3D method is composed so.)
+    """
+    caps = method.capabilities
+    if caps.dimension != 3:
+        raise InputError("solver.method", f"method {method.name!r} solves {caps.dimension}D steps (its capabilities); "
+                                          f"a 3D scene needs one of {', '.join(cone_methods())}")
+    _require_cones(method.name, caps)
+    return method
+
+
+def _require_cones(name: str, caps: Capabilities, key: str = "solver.method") -> None:
+    if not {"normal", "tangential"} <= caps.solves or caps.friction_set != "disc" or caps.traction_components != 2:
+        raise InputError(key, f"method {name!r} cannot solve a 3D tangential step (the friction disc |t| <= mu p "
+                              f"of each element is a second-order cone, which it cannot pose); methods that can: "
+                              f"{', '.join(cone_methods())}")
+
+
+def require_3d(name, key: str = "solver.method") -> str:
+    """Check, through its record, that method ``name`` runs a 3D scene (the scene's check, before any work):
+    :func:`check_name` for dimension 3, then the cones of :func:`compose_3d`."""
+    check_name(name, key, dimension=3)
+    try:
+        caps = method_class(name, 3).capabilities
+    except MissingBackendError:
+        return name
+    _require_cones(name, caps, key)
+    return name
+
+
+def cone_methods() -> tuple:
+    """The installed 3D methods that solve tangential steps on the friction disc (their records say so)."""
+    out = []
+    for name in _REGISTRY_3D:
+        try:
+            caps = method_class(name, 3).capabilities
+        except MissingBackendError:
+            continue
+        if {"normal", "tangential"} <= caps.solves and caps.friction_set == "disc":
+            out.append(name)
+    return tuple(out)
+
+
+#: The methods that run a scene of each dimension (named in the refusals).
+_RUNNABLE = {2: lambda: tuple(_REGISTRY), 3: cone_methods}
 
 
 def matrix_free(name: str) -> bool:

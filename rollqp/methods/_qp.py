@@ -52,11 +52,10 @@ class QPMethod:
     previous iterate, ``q_k = q + S x_{k−1}``. Its fixed point satisfies the KKT
     conditions of the collocation problem exactly. The solution map of a strongly
     monotone variational inequality is 1-Lipschitz from ``H⁻¹``-norm data to ``H``-norm
-    solutions, so the error contracts by ``ρ = ‖H^{-1/2} S H^{-1/2}‖₂`` per QP; measured
-    ρ ≈ 0.05 for quadratic and 0.065 for linear elements, independent of the mesh
-    (``docs/validation.md``). The single symmetrized QP is *not* a small perturbation:
-    on 40 quadratic elements it puts a vertex/midnode checkerboard of 13 % of p0 on the
-    Hertz pressure, because ``S`` feeds the log kernel's weakest mode.
+    solutions, so the error contracts by ``ρ = ‖H^{-1/2} S H^{-1/2}‖₂`` per QP, independent
+    of the mesh (its values: docs/validation.md). The single symmetrized QP is *not* a small
+    perturbation: it puts a vertex/midnode checkerboard on the Hertz pressure, because ``S``
+    feeds the log kernel's weakest mode (docs/formulation.md §8).
 
     ``info`` of a solution: ``qp_solves`` (QPs of the splitting), ``backend_time`` (wall time of
     the backend's calls: data update, solve, retries), ``setups`` (solver objects built),
@@ -246,9 +245,9 @@ class QPMethod:
                                   residual=problem.solution_from_qp(form, x, y).residual)
 
     # --------------------------------------------------------------- helpers
-    #: Candidates of the active-set prediction (:meth:`predicting`) before the backend is called. Measured on
-    #: the Bentall–Johnson coupled start (``python benchmarks/bentall.py --only start``): with 3, OSQP still
-    #: solved 83 of the start's ~600 QPs (0.85 s); with 6, 10 or 20 none (0.43 s).
+    #: Candidates of the active-set prediction (:meth:`predicting`) before the backend is called: enough
+    #: that the backend solves none of the coupled rolling start's QPs (docs/performance.md, "Measured
+    #: settings of the methods").
     PREDICT_STEPS = 10
 
     def _answer(self, form, x0, y0, source, scratch=False):

@@ -101,10 +101,9 @@ class Alternation:
         iterating to the limit. For a march toward a steady rolling state (``rollqp.march``'s
         rolling start), where only the fixed point counts: the march's own steps continue the
         alternation, whose fixed point with the history of the previous step is the coupled steady
-        state. Measured on the Bentall–Johnson coupled start (216 constant elements,
-        ``benchmarks/bentall.py --only start``): the march takes about as many steps with one sweep as
-        with the full alternation (3 sweeps a step on average), a third of the QPs. The march ends
-        with full steps (mode off), so the state it keeps is a converged coupled step.
+        state, in about as many steps as with the full alternation and fewer QPs (docs/performance.md,
+        "Measured settings of the methods"). The march ends with full steps (mode off), so the state it
+        keeps is a converged coupled step.
         """
         was, self._single = self._single, bool(on)
         return was
@@ -172,9 +171,8 @@ class Alternation:
 
         * **stall**: after ``2·STALL_WINDOW`` outer iterations, the best residual of the last
           ``STALL_WINDOW`` is not below ``STALL_FACTOR`` times the best one before them. A linear
-          contraction passes even at rate 0.99 (0.99^20 = 0.82 < 0.9); measured on §6.2.1 with
-          μ = 5 (2β = 1): a period-2 cycle between 1.5e-3 and 1.9e-3 from the 5th outer
-          iteration on, which used to run to ``max_outer``;
+          contraction passes even at rate 0.99 (0.99^20 = 0.82 < 0.9); a cycle does not (§6.2.1 with
+          μ = 5, 2β = 1: docs/stability.md, "Strong coupling");
         * **divergence**: a non-finite residual, or one above ``DIVERGE_FACTOR`` times the first.
         """
         h = history

@@ -15,10 +15,9 @@ bound). Its fixed points are exactly the solutions of the slip-dependent step.
 iterate's own slip) below the inner method's tolerance, or below its ``residual_limit`` (what its
 QP solutions are trusted to) once it has stopped falling (less than a factor :data:`STALL_RATE` over
 the last iteration): after a fixed-bound solve only the bound's change ``|μ(s^{(k+1)}) − μ^{(k)}| p``
-at slipping nodes remains in it. A map that still contracts, however slowly, is iterated on: the
-falling law's map contracts by 0.54 per iteration on a ramped transient (measured), and stopping
-it at the QPs' limit of 1e-8 left the traction 2e-7 μ p0 from the step's solution, an error the
-transient then carried on.
+at slipping nodes remains in it. A map that still contracts, however slowly, is iterated on: a
+falling law's map contracts slowly on a ramped transient, and stopping it at the QPs' limit left an
+error in the traction that the transient then carried on (docs/friction.md).
 
 **Polishing.** ``polish(solution)`` (optional) is tried on every iterate whose residual fell: a
 method that converges fast from near a solution (Newton on the slip-dependent step) returns the

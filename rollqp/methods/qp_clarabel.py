@@ -27,10 +27,9 @@ def clarabel_tolerances(tolerance: float) -> tuple[float, float]:
     The duality-gap test bounds the sum of the products of each bound's slack and
     multiplier (``p_i·ĝ_i f_i``, ``(μp_i − |t_i|)·|ŝ_i| f_i``), not each ``min(·,·)``. Where
     one factor is small but not zero — gap just outside the contact, slip at the edge of a
-    slip zone — the other is left at about gap/factor. Measured maximum residual over the
-    193 steps of ``rollqp run cattaneo-carter --method qp-clarabel``: gap tolerance 1e-12
-    → 5.5e-8, 1e-13 → 3.1e-9, 1e-14 → 4.9e-10. Four decades below the requested
-    tolerance (floored at 1e-15) therefore reaches it; Clarabel then often reports
+    slip zone — the other is left at about gap/factor. Four decades below the requested
+    tolerance (floored at 1e-15) reaches it (the measured residuals by gap tolerance:
+    docs/performance.md, "Measured settings of the methods"); Clarabel then often reports
     ``AlmostSolved`` (its reduced tolerances met), and rollqp's own residual decides.
     """
     t = max(1e-4 * tolerance, 1e-15)

@@ -12,6 +12,7 @@ kind           the scene                                              figure
 ``path``       a stop or a reversal of the rolling (``load.rolled``)  :func:`path_figure`
 ``friction``   a friction law: μ that varies with x or slip velocity  :func:`friction_figure`
 ``transient``  similar bodies rolling (Cattaneo to Carter, a ramp)    :func:`transient_figure`
+``three``      a 3D scene (Kalker's problem: an ellipse, ξ, η, φ)      :func:`three_figure`
 =============  =====================================================  ==========================
 
 Every figure labels its axes in mathtext, gives each closed form a colour of its own
@@ -37,9 +38,10 @@ from .dissimilar import (FREE_ROLLING_RATIO, SETTLED_RATE, comparison_figure, co
 from .friction import friction_figure
 from .paths import path_figure, profile_figure, rest_figure
 from .style import LABELS, REFERENCES, STATE_COLORS, STATE_NAMES, arrays, pyplot, scene_of
+from .three import three_figure
 from .transient import snapshot_indices, transient_figure
 
-__all__ = ["pyplot", "plot_result", "figure_kind", "FIGURES", "transient_figure", "coupled_figure", "profile_figure",
+__all__ = ["pyplot", "plot_result", "figure_kind", "FIGURES", "transient_figure", "three_figure", "coupled_figure", "profile_figure",
            "rest_figure", "path_figure", "friction_figure", "snapshot_figure", "zone_map_figure", "dissimilar_figure",
            "comparison_figure", "draw_snapshots", "draw_zone_map", "draw_history", "draw_pressure", "draw_traction",
            "select_states", "settled_q", "snapshot_indices", "LABELS", "REFERENCES", "STATE_COLORS", "STATE_NAMES",
@@ -47,21 +49,26 @@ __all__ = ["pyplot", "plot_result", "figure_kind", "FIGURES", "transient_figure"
 
 #: The figure of each kind (:func:`figure_kind`).
 FIGURES = {"coupled": coupled_figure, "profile": profile_figure, "rest": rest_figure, "path": path_figure,
-           "friction": friction_figure, "transient": transient_figure}
+           "friction": friction_figure, "transient": transient_figure, "three": three_figure}
+#: The kind of every scene of a dimension that has one figure (the scene's ``dimension``).
+DIMENSION_KINDS = {3: "three"}
 
 
 def figure_kind(res, scene=None) -> str:
     """What a run is about, which decides its figure (module table).
 
-    In this order: normal–tangential coupling (β ≠ 0, coupling not "off"); a body profile with a
-    feature that rolls through the contact; tangential loads that change while the rollers stand
-    still (static steps with a varying Q); a stop or a reversal of the rolling; a friction law (μ
-    not one number); else a transient of similar bodies.
+    A 3D scene has its own kind (:data:`DIMENSION_KINDS`). Else, in this order: normal–tangential
+    coupling (β ≠ 0, coupling not "off"); a body profile with a feature that rolls through the
+    contact; tangential loads that change while the rollers stand still (static steps with a varying
+    Q); a stop or a reversal of the rolling; a friction law (μ not one number); else a transient of
+    similar bodies.
     """
     res = arrays(res)
     scene = scene_of(res, scene)
     if scene is None:
         return "transient"
+    if scene.dimension in DIMENSION_KINDS:
+        return DIMENSION_KINDS[scene.dimension]
     if scene.coupling_level != "off" and abs(scene.beta) > BETA_ZERO:
         return "coupled"
     if any(b.profile is not None and b.profile.moves for b in (scene.A, scene.B)):

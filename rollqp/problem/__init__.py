@@ -47,9 +47,9 @@ from .scales import Scales
 from .solution import (SEPARATION, SLIP, STICK, Residuals, StepSolution, classify, compare,
                        friction_residual)
 from .state import State
-from .tangential import TangentialStep
-from .validation import MAX_MAGNITUDE, _check_sliding_limit, _trusted  # noqa: F401 - used by rollqp.operators
+from .tangential import FrictionBound, TangentialStep
+from .validation import MAX_MAGNITUDE, _check_sliding_limit  # noqa: F401 - used by rollqp.operators
 
-__all__ = ["Scales", "State", "NormalStep", "TangentialStep", "CoupledStep", "QPForm", "StepSolution", "Residuals",
+__all__ = ["Scales", "State", "NormalStep", "TangentialStep", "FrictionBound", "CoupledStep", "QPForm", "StepSolution", "Residuals",
            "classify", "compare", "friction_residual", "qp_hessian", "symmetrized", "SEPARATION", "STICK", "SLIP",
            "MAX_MAGNITUDE"]

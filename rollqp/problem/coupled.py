@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 
 import numpy as np
 
 from ..errors import InputError
-from .validation import _check_arrays, _check_friction, _check_sliding_limit, _exactly_one, _per_node, _set_scalars, _trusted
+from .validation import _check_arrays, _check_friction, _check_sliding_limit, _exactly_one, _per_node, _set_scalars
 from .normal import NormalStep
 from .scales import Scales
 from .solution import Residuals, StepSolution, friction_residual
@@ -16,7 +16,7 @@ from .tangential import TangentialStep
 __all__ = ["CoupledStep"]
 
 
-@dataclass(frozen=True)
+@dataclass
 class CoupledStep:
     r"""The coupled step (paper eq. 63–64, 67; docs/formulation.md §4): all rows of ``Φ``.
 
@@ -46,6 +46,10 @@ class CoupledStep:
         Step length (for a static shift: its length unit; for steady rolling see below).
     P, delta : exactly one;  Q, xi : exactly one.
     scales : Scales
+    law : SlipBound, optional
+        A slip-dependent bound ``μ(s)`` (:mod:`rollqp.friction`); None: ``μ`` fixed.
+    trusted : bool, optional
+        The values are valid already: the checks are skipped (as for :class:`NormalStep`).
 
     Notes
     -----
@@ -70,9 +74,12 @@ class CoupledStep:
     xi: float | None = None       # … or the creepage prescribed
     scales: Scales = field(default_factory=Scales)
     law: object = None            # slip-dependent bound μ(s) (rollqp.friction.SlipBound); None: μ fixed
+    trusted: InitVar[bool] = False
     kind = "coupled"
 
-    def __post_init__(self):
+    def __post_init__(self, trusted):
+        if trusted:
+            return
         _check_arrays(self, ("Ann", "Att", "Ant", "Atn"), ("h", "c"))
         _set_scalars(self, ("dq", "P", "delta", "Q", "xi") + (() if _per_node(self.mu) else ("mu",)))
         _check_friction(self)
@@ -114,9 +121,9 @@ class CoupledStep:
         off = None if self.Ant is None else self.Ant @ np.asarray(t, dtype=float)
         if off is not None and not np.all(np.isfinite(off)):
             raise InputError("t", "the fixed shear must be finite")
-        # not re-validated: the coupled step's checked data (_trusted)
-        return _trusted(NormalStep, A=self.Ann, f=self.f, h=self.h, P=self.P, delta=self.delta, offset=off,
-                        scales=self.scales)
+        # not re-validated: the coupled step's checked data
+        return NormalStep(A=self.Ann, f=self.f, h=self.h, P=self.P, delta=self.delta, offset=off, scales=self.scales,
+                          trusted=True)
 
     def tangential_half(self, p) -> TangentialStep:
         """The tangential step with the pressure ``p`` fixed (eq. 61/62): bound ``μ p⁺``."""
@@ -124,9 +131,9 @@ class CoupledStep:
         if not np.all(np.isfinite(p)):
             raise InputError("p", "the fixed pressure must be finite")
         c = self.c if self.Atn is None else self.c + self.Atn @ p
-        # not re-validated (_trusted) but for the sliding limit, which depends on this pressure
-        half = _trusted(TangentialStep, A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q,
-                        xi=self.xi, scales=self.scales, law=self.law)
+        # not re-validated (trusted) but for the sliding limit, which depends on this pressure
+        half = TangentialStep(A=self.Att, f=self.f, p=p, mu=self.mu, c=c, dq=self.dq, Q=self.Q, xi=self.xi,
+                              scales=self.scales, law=self.law, trusted=True)
         _check_sliding_limit(half)
         return half
 

@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 
 import numpy as np
 
 from ..errors import InputError
-from .validation import _check_arrays, _derived, _exactly_one, _set_scalars
+from .validation import _check_arrays, _copy, _exactly_one, _set_scalars
 from .qp import QPForm, qp_hessian, symmetrized
 from .scales import Scales
 from .solution import Residuals, StepSolution
@@ -15,7 +15,7 @@ from .solution import Residuals, StepSolution
 __all__ = ["NormalStep"]
 
 
-@dataclass(frozen=True)
+@dataclass
 class NormalStep:
     """The normal (Signorini) step problem (paper eq. 53, 67; docs/formulation.md §4).
 
@@ -33,6 +33,22 @@ class NormalStep:
         Fixed gap change ``A_nt t̄`` from a known shear (zero if absent).
     scales : Scales
         Units of the nondimensional residuals.
+    trusted : bool, optional
+        The values are valid already (the scene's validated operators and a method's checked solutions, as
+        rollqp.march passes them): the checks below are skipped. Default False: every argument is checked
+        and stored as rollqp works with it (float arrays, an :class:`~rollqp.influence.operator.Operator`,
+        floats), an :class:`~rollqp.errors.InputError` naming the first that is not valid.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rollqp import NormalStep
+    >>> step = NormalStep(A=np.eye(3), f=np.ones(3), h=np.zeros(3), P=1.0)
+    >>> step.n, step.P
+    (3, 1.0)
+    >>> NormalStep(A=np.eye(3), f=np.ones(3), h=np.zeros(3), P=-1.0)
+    Traceback (most recent call last):
+    rollqp.errors.InputError: P: the normal load must be a finite number > 0, got -1.0
     """
 
     A: np.ndarray
@@ -42,10 +58,13 @@ class NormalStep:
     delta: float | None = None
     offset: np.ndarray | None = None
     scales: Scales = field(default_factory=Scales)
+    trusted: InitVar[bool] = False
     kind = "normal"
     law = None  # no friction bound (the tangential and coupled steps' slip-dependent ``law``)
 
-    def __post_init__(self):
+    def __post_init__(self, trusted):
+        if trusted:
+            return
         _check_arrays(self, ("A",), ("h",), ("offset",))
         _set_scalars(self, ("P", "delta"))
         _exactly_one(("P", "delta"), (self.P, self.delta))
@@ -59,11 +78,12 @@ class NormalStep:
         return self.f.size
 
     def replace(self, **kw) -> "NormalStep":
+        """The same step with the values ``kw``, checked."""
         return dataclasses.replace(self, **kw)
 
     def derived(self, **kw) -> "NormalStep":
-        """:meth:`replace` without re-validation, for values the caller guarantees valid (:func:`_trusted`)."""
-        return _derived(self, **kw)
+        """:meth:`replace` made with ``trusted=True``, for values the caller guarantees valid."""
+        return _copy(self, **kw)
 
     @property
     def h_total(self) -> np.ndarray:
@@ -83,7 +103,7 @@ class NormalStep:
 
     def shifted(self, extra: np.ndarray) -> "NormalStep":
         """The same problem with ``extra`` (displacement units) added to the gap: ``o + extra``."""
-        return _derived(self, offset=extra if self.offset is None else self.offset + extra)
+        return _copy(self, offset=extra if self.offset is None else self.offset + extra)
 
     def evaluate(self, sol: "StepSolution") -> "StepSolution":
         """``sol``'s pressure and approach re-evaluated on this problem (rollqp's residuals)."""

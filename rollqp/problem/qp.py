@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import InitVar, dataclass
 
 import numpy as np
 
@@ -38,7 +38,7 @@ def symmetrized(A, f: np.ndarray) -> Operator:
     return as_operator(A).split(f).sym
 
 
-@dataclass(frozen=True)
+@dataclass
 class QPForm:
     r"""A convex QP in rollqp's scaled variables, shared by all QP backends.
 
@@ -51,7 +51,8 @@ class QPForm:
     are of order one (solver tolerances then mean what they say). The equality multiplier
     ``y`` is defined by the Lagrangian ``½xᵀHx + qᵀx + y(aᵀx − b) − …`` (so ``∇ = −y a``
     at an interior solution); :meth:`unscaled_multiplier` maps the solver's ``y`` back.
-    Infinite bounds are ``±inf``.
+    Infinite bounds are ``±inf``. ``known_structure``: the :attr:`structure` of a QP with the same
+    constraints (:meth:`with_q`), not computed again.
     """
 
     H: np.ndarray
@@ -69,13 +70,16 @@ class QPForm:
     #: ``∂q/∂e``: the change of ``q`` per unit (displacement) added to the gap offset (normal) or the
     #: history vector (tangential), the shift of the splitting's QPs (None: unknown).
     shift_scale: np.ndarray | None = None
+    known_structure: InitVar[tuple | None] = None
+
+    def __post_init__(self, known_structure):
+        self._known_structure = known_structure
 
     def with_q(self, q: np.ndarray) -> "QPForm":
-        """The same QP with the linear term ``q`` (the splitting's next QP); the cached :attr:`structure` kept."""
-        new = object.__new__(QPForm)  # frozen: the fields set through __dict__, as dataclasses.replace would
-        new.__dict__.update(self.__dict__)
-        new.__dict__["q"] = q
-        return new
+        """The same QP with the linear term ``q`` (the splitting's next QP); its :attr:`structure` kept."""
+        return QPForm(H=self.H, q=q, lower=self.lower, upper=self.upper, a=self.a, b=self.b, obj_scale=self.obj_scale,
+                      eq_scale=self.eq_scale, kind=self.kind, dual_scale=self.dual_scale, shift_scale=self.shift_scale,
+                      known_structure=self.structure)
 
     def traction(self, x) -> np.ndarray:
         """The nondimensional traction of a QP solution: ``x`` (normal) or ``x`` clipped to its bounds (tangential)."""
@@ -111,6 +115,8 @@ class QPForm:
     @functools.cached_property
     def structure(self) -> tuple:
         """What fixes the constraint matrix: the solver object can be reused while it holds."""
+        if self._known_structure is not None:
+            return self._known_structure
         return (self.kind, self.H.shape[0], self.a is not None,
                 np.isfinite(self.lower).tobytes(), np.isfinite(self.upper).tobytes(), self.fixed.tobytes())
 

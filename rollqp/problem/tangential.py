@@ -3,20 +3,30 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 
 import numpy as np
 
 from ..errors import InputError
-from .validation import _check_arrays, _check_friction, _check_sliding_limit, _derived, _exactly_one, _per_node, _set_scalars
+from .validation import _check_arrays, _check_friction, _check_sliding_limit, _copy, _exactly_one, _per_node, _set_scalars
 from .qp import QPForm, qp_hessian, symmetrized
 from .scales import Scales
 from .solution import Residuals, StepSolution, friction_residual
 
-__all__ = ["TangentialStep"]
+__all__ = ["TangentialStep", "FrictionBound"]
 
 
 @dataclass(frozen=True)
+class FrictionBound:
+    """A tangential step's friction bound ``μ·max(p̄, 0)`` (eq. 60) and its nondimensional ``(b̂, −b̂)``,
+    read-only arrays: :attr:`TangentialStep.bound` and :attr:`TangentialStep.bound_hat` of one pressure
+    ``p̄`` and one ``μ``, handed to the next step of the same two (:class:`TangentialStep`'s ``known_bound``)."""
+
+    values: np.ndarray
+    hat: tuple
+
+
+@dataclass
 class TangentialStep:
     """The tangential (friction) step problem (paper eq. 61/62, 67; docs/formulation.md §4).
 
@@ -37,6 +47,22 @@ class TangentialStep:
     Q, xi : float
         Tangential load ``Q = fᵀt`` or prescribed creepage ``ξ``: exactly one.
     scales : Scales
+    law : SlipBound, optional
+        A slip-dependent bound ``μ(s)`` (:mod:`rollqp.friction`); None: ``μ`` fixed.
+    trusted : bool, optional
+        The values are valid already: the checks are skipped (as for :class:`NormalStep`).
+    known_bound : FrictionBound, optional
+        With ``trusted``: the bound of this step's very ``p`` and ``mu`` objects, computed for an earlier
+        step (the march's fixed normal half), used instead of computing it again.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from rollqp import TangentialStep
+    >>> step = TangentialStep(A=np.eye(3), f=np.ones(3), p=np.array([0.0, 2.0, 1.0]), mu=0.5, c=np.zeros(3),
+    ...                       dq=1.0, Q=0.5)
+    >>> step.bound
+    array([0. , 1. , 0.5])
     """
 
     A: np.ndarray                 # A_tt (eq. 28, 29): an Operator once validated
@@ -49,9 +75,14 @@ class TangentialStep:
     xi: float | None = None       # … or the creepage prescribed
     scales: Scales = field(default_factory=Scales)
     law: object = None            # slip-dependent bound μ(s) (rollqp.friction.SlipBound); None: μ fixed
+    trusted: InitVar[bool] = False
+    known_bound: InitVar[FrictionBound | None] = None
     kind = "tangential"
 
-    def __post_init__(self):
+    def __post_init__(self, trusted, known_bound):
+        self._known_bound = known_bound if trusted else None
+        if trusted:
+            return
         _check_arrays(self, ("A",), ("p", "c"))
         _set_scalars(self, ("dq", "Q", "xi") + (() if _per_node(self.mu) else ("mu",)))  # μ per node: _check_friction
         _check_friction(self)
@@ -69,7 +100,10 @@ class TangentialStep:
     @functools.cached_property
     def bound(self) -> np.ndarray:
         """``μ·max(p̄, 0)`` (with a slip-dependent ``law``: at zero slip, the static bound); computed once
-        per step problem (read-only: the march, the solver and rollqp's residual each read it)."""
+        per step problem (read-only: the march, the solver and rollqp's residual each read it), or given
+        (``known_bound``)."""
+        if self._known_bound is not None:
+            return self._known_bound.values
         if self.law is not None:
             b = self.law.mu(np.zeros(self.n)) * np.maximum(self.p, 0.0)
         else:
@@ -81,6 +115,8 @@ class TangentialStep:
     def bound_hat(self) -> tuple:
         """``(b̂, −b̂)``, ``b̂ = μp̄⁺/p0`` of :attr:`bound` (read-only): rollqp's friction residual and
         Newton's friction rows read them."""
+        if self._known_bound is not None:
+            return self._known_bound.hat
         bh = self.bound / self.scales.stress
         nb = -bh
         bh.flags.writeable = nb.flags.writeable = False
@@ -102,11 +138,12 @@ class TangentialStep:
         return self.replace(mu=self.law.mu(s), law=None)
 
     def replace(self, **kw) -> "TangentialStep":
+        """The same step with the values ``kw``, checked."""
         return dataclasses.replace(self, **kw)
 
     def derived(self, **kw) -> "TangentialStep":
-        """:meth:`replace` without re-validation, for values the caller guarantees valid (:func:`_trusted`)."""
-        return _derived(self, **kw)
+        """:meth:`replace` made with ``trusted=True``, for values the caller guarantees valid."""
+        return _copy(self, **kw)
 
     def slip(self, t, xi, At=None) -> np.ndarray:
         """``s = ξ e + (c + A t)/Δq`` (eq. 36, 47); ``At``: the product ``A t`` if already computed."""
@@ -122,7 +159,7 @@ class TangentialStep:
 
     def shifted(self, extra: np.ndarray) -> "TangentialStep":
         """The same problem with ``extra`` (displacement units) added to the history: ``c + extra``."""
-        return _derived(self, c=self.c + extra)
+        return _copy(self, c=self.c + extra)
 
     def evaluate(self, sol: "StepSolution") -> "StepSolution":
         """``sol``'s traction and creepage re-evaluated on this problem (rollqp's residuals)."""

@@ -1,7 +1,8 @@
 """The checks of a step problem's inputs: real, finite, of the right shape, within range (one-line errors).
 
-Each step problem's ``__post_init__`` runs them on its fields; the march builds its steps from validated
-operators and checked solutions without them (:func:`_trusted`).
+Each step problem's ``__post_init__`` runs them on its fields, unless it is made with ``trusted=True``:
+the march builds its steps from the scene's validated operators and the methods' checked solutions so,
+and a checked step's halves and copies are made so (:func:`_copy`).
 """
 from __future__ import annotations
 
@@ -37,7 +38,7 @@ def _real(name, v) -> np.ndarray:
             raise InputError(name, f"must hold real numbers, got {type(v).__name__} of dtype {a.dtype}")
         a = a.astype(float)
     if a.size:
-        big = np.abs(a).max()  # (the method, not np.max: a third of the time on step-sized vectors)
+        big = np.abs(a).max()  # (the method: np.max's dispatch costs more on step-sized vectors)
         if not big <= MAX_MAGNITUDE:  # NaN compares false: one test for both
             if not np.all(np.isfinite(a)):
                 raise InputError(name, "must be finite")
@@ -62,7 +63,7 @@ def _scalar(name, v):
 
 def _set_scalars(step, names) -> None:
     for name in names:
-        object.__setattr__(step, name, _scalar(name, getattr(step, name)))
+        setattr(step, name, _scalar(name, getattr(step, name)))
 
 
 def _vec(name, v, n):
@@ -84,7 +85,7 @@ def _set_weights(step) -> int:
     f = _vec("f", f, n)
     if (f <= 0).any():
         raise InputError("f", "weights must all be > 0")
-    object.__setattr__(step, "f", f)
+    step.f = f
     return n
 
 
@@ -97,10 +98,10 @@ def _check_arrays(step, operators=(), vectors=(), optional=()) -> int:
         if value is not None or name in ("A", "Ann", "Att"):
             if not isinstance(value, Operator):
                 value = _real(name, value)
-            object.__setattr__(step, name, as_operator(value, name, n))
+            setattr(step, name, as_operator(value, name, n))
     for name in vectors + optional:
         if getattr(step, name) is not None or name in vectors:
-            object.__setattr__(step, name, _vec(name, getattr(step, name), n))
+            setattr(step, name, _vec(name, getattr(step, name), n))
     return n
 
 
@@ -118,7 +119,7 @@ def _check_friction(step) -> None:
         mu = _vec("mu", step.mu, step.f.size)
         if np.any(mu < 0):
             raise InputError("mu", f"the coefficients of friction must all be >= 0, got min {float(mu.min())!r}")
-        object.__setattr__(step, "mu", mu)
+        step.mu = mu
     law = getattr(step, "law", None)
     if law is not None and not (callable(getattr(law, "mu", None)) and callable(getattr(law, "dmu", None))):
         raise InputError("law", f"must be a slip-dependent bound with mu(s) and dmu(s) (rollqp.friction.SlipBound), "
@@ -144,50 +145,16 @@ def _check_sliding_limit(step, cap=None) -> float | None:
     return cap
 
 
-def _trusted(cls, **values):
-    """A step problem of class ``cls`` from values that are already valid, without re-validation.
-
-    For the halves of a checked :class:`CoupledStep`, the symmetrized or shifted copies of a
-    checked step (each QP of the symmetric–skew splitting), and the steps rollqp.march builds from
-    the scene's validated operators and the method's checked solutions
-    (:meth:`~rollqp.operators.SceneOperators.tangential_step` with ``validate=False``): their
-    operators are checked :class:`Operator`\\ s and their vectors are products of them with
-    checked or solver-computed arrays, so the ``O(n)``–``O(n²)`` checks of ``__post_init__`` would
-    only repeat (measured 3–14 % of a QP step on §6.1.1; a validated tangential step costs 16 µs
-    there against 2.4 µs, a fifth of a Newton rolling step). The caller vouches for the values.
-    """
-    obj = object.__new__(cls)
-    d = obj.__dict__
-    plain, factories = _defaults(cls)
-    d.update(plain)
-    d.update(values)
-    for name, make in factories:
-        if name not in values:
-            d[name] = make()
-    return obj
+def _copy(step, **changes):
+    """``step`` with ``changes``, made by its class with ``trusted=True``: the caller vouches that the values
+    are valid (a checked step's own, and products of them with checked or solver-computed arrays), so the
+    checks of ``__post_init__``, which would only repeat, are skipped."""
+    values = {name: getattr(step, name) for name in _field_names(type(step))}
+    values.update(changes)
+    return type(step)(**values, trusted=True)
 
 
 @functools.cache
-def _defaults(cls) -> tuple:
-    """``(defaults, factories)`` of ``cls``'s fields: the plain default values, and the
-    ``(name, default_factory)`` pairs (called for each object: a factory's value may be mutable)."""
-    fields = dataclasses.fields(cls)
-    return ({f.name: f.default for f in fields if f.default is not dataclasses.MISSING},
-            tuple((f.name, f.default_factory) for f in fields if f.default_factory is not dataclasses.MISSING))
-
-
-def _derived(step, **changes):
-    """``step`` with ``changes`` (already valid: :func:`_trusted`), not re-validated."""
-    obj = object.__new__(type(step))  # frozen: the fields set through __dict__, as dataclasses.replace would
-    obj.__dict__.update(step.__dict__)
-    obj.__dict__.update(changes)
-    for name in _cached(type(step)):  # cached properties of the old values (TangentialStep.bound, …)
-        obj.__dict__.pop(name, None)
-    return obj
-
-
-@functools.cache
-def _cached(cls) -> tuple:
-    """The names of ``cls``'s cached properties (computed from the fields, so not carried to a copy)."""
-    return tuple(name for klass in cls.__mro__ for name, v in vars(klass).items()
-                 if isinstance(v, functools.cached_property))
+def _field_names(cls) -> tuple:
+    """The names of ``cls``'s fields (a step problem's data, the constructor's arguments but ``trusted``)."""
+    return tuple(f.name for f in dataclasses.fields(cls))

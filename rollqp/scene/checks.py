@@ -139,7 +139,7 @@ def check_solver(s: Any) -> SolverSettings:
     if not isinstance(s, SolverSettings):
         raise InputError("solver", f"must be a SolverSettings, got {s!r}")
     return SolverSettings(
-        method=check_method(s.method, "solver.method"),
+        method=check_method(s.method, "solver.method", dimension=2),
         tolerance=number("solver.tolerance", s.tolerance, "in [1e-15, 1e-2]",
                           lambda x: 1e-15 <= x <= 1e-2),
         max_iterations=None if s.max_iterations is None else integer(

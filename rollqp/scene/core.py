@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from dataclasses import dataclass, field, fields
-from typing import Any
+from typing import Any, ClassVar
 
 from ..errors import InputError
 from ..histories import parse_history
@@ -19,11 +19,20 @@ from .derived import Derived
 from .plain import plain, scene_to_dict, scene_to_toml
 from .schema import Body, Contact, Discretization, Load, SolverSettings
 
-__all__ = ["Scene", "scene_from_dict"]
+__all__ = ["Scene", "SceneBase", "scene_from_dict"]
+
+
+class SceneBase:
+    """What every scene is, whatever its dimension: ``dimension`` (a scene file's ``[contact]
+    dimension``: 2, this package's :class:`Scene`; 3, :class:`rollqp.three.scene.Scene3D`), and the
+    interface the command line and a run read — ``name``, ``source``, ``solver``, ``n_steps``,
+    ``to_dict()``, ``to_toml()``, ``replace(**changes)``."""
+
+    dimension: ClassVar[int] = 2
 
 
 @dataclass(frozen=True)
-class Scene(Derived):
+class Scene(Derived, SceneBase):
     """A validated rolling-contact problem (docs/scenes.md).
 
     Construction validates every field and the scene as a whole and normalizes the values

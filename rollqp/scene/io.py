@@ -10,6 +10,7 @@ that reading the text back gives an equal scene.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 from importlib import resources
 from pathlib import Path
@@ -23,13 +24,76 @@ except ModuleNotFoundError:  # pragma: no cover - Python 3.10
 from ..errors import InputError
 from ..validate import suggestion
 from .checks import safe_name
-from .core import Scene, scene_from_dict
+from .core import Scene, SceneBase
+from .core import scene_from_dict as scene_from_dict_2d
 from .plain import part_dict, plain, scene_to_dict, scene_to_toml  # noqa: F401 - re-exported
 
 __all__ = ["load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes", "scene_to_dict", "scene_to_toml"]
 
 #: Largest scene file read (bytes): scenes are a few hundred bytes; tables of 10^5 points fit.
 MAX_FILE_BYTES = 16 << 20
+
+
+def _parse_3d(d: dict, source: str, default_name: str):
+    from ..three.scene import scene_from_dict as parse  # imported on first use: import rollqp stays light
+    return parse(d, source=source, default_name=default_name)
+
+
+#: The parser of each scene dimension (``[contact] dimension``).
+_PARSERS = {2: scene_from_dict_2d, 3: _parse_3d}
+
+
+def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene"):
+    """Build and validate a scene from its nested dict, of the dimension its ``[contact] dimension``
+    names (default 2: :class:`~rollqp.scene.Scene`; 3: :class:`~rollqp.three.scene.Scene3D`).
+
+    Raises
+    ------
+    InputError
+        ``contact.dimension`` if it is not 2 or 3; else as the scene of that dimension.
+    """
+    contact = d.get("contact") if isinstance(d, dict) else None
+    dimension = contact.get("dimension", 2) if isinstance(contact, dict) else 2
+    if isinstance(dimension, bool) or dimension not in _PARSERS:
+        raise InputError("contact.dimension", f"must be one of {', '.join(map(str, _PARSERS))} (default 2), got "
+                                              f"{dimension!r}")
+    if dimension == 2 and isinstance(contact, dict) and "dimension" in contact:  # the 2D schema has no such key: 2 is its default
+        d = {**d, "contact": {k: v for k, v in contact.items() if k != "dimension"}}
+    try:
+        return _PARSERS[dimension](d, source=source, default_name=default_name)
+    except InputError as err:
+        other = _other_dimension_key(err.key, dimension)
+        if other is None:
+            raise
+        raise InputError(err.key, f"{str(err).split(': ', 1)[-1]}; it is a key of {other}D scenes and this scene is "
+                                  f"{dimension}D ([contact] dimension = {dimension}{' by default' if dimension == 2 else ''}"
+                                  f"; docs/scenes.md)") from None
+
+
+def _table_keys(dimension: int) -> dict:
+    """``{table: key names}`` of the scene tables of ``dimension`` (their dataclass fields)."""
+    if dimension == 2:
+        from .schema import Body, Contact, Discretization, Load, SolverSettings
+        classes = {"bodies": Body, "contact": Contact, "load": Load, "discretization": Discretization,
+                   "solver": SolverSettings}
+    else:
+        from ..three.scene import Body3D, Contact3D, Discretization3D, Load3D, Solver3D
+        classes = {"bodies": Body3D, "contact": Contact3D, "load": Load3D, "discretization": Discretization3D,
+                   "solver": Solver3D}
+    return {t: {f.name for f in dataclasses.fields(c)} for t, c in classes.items()}
+
+
+def _other_dimension_key(key, dimension: int):
+    """The other dimension if ``key`` (``table.name`` or ``bodies.X.name``) is a key of its scenes
+    and not of ``dimension``'s, else None: the hint of an unknown key from the wrong dimension."""
+    parts = str(key).split(".")
+    if len(parts) not in (2, 3) or (len(parts) == 3 and parts[0] != "bodies"):
+        return None
+    table, name = parts[0], parts[-1]
+    other = 5 - dimension
+    if name in _table_keys(dimension).get(table, ()) or name not in _table_keys(other).get(table, ()):
+        return None
+    return other
 
 
 def scene_from_toml(text: str, source: str = "<string>", default_name: str = "scene", overrides=None) -> Scene:
@@ -125,7 +189,7 @@ def load_scene(source: Any, overrides: dict | None = None) -> Scene:
     ...
     rollqp.errors.InputError: SCENE: no such file or built-in scene 'catano-carter'; did you mean 'cattaneo-carter'?...
     """
-    if isinstance(source, Scene):
+    if isinstance(source, SceneBase):
         return source.replace(**overrides) if overrides else source
     if isinstance(source, dict):
         import copy

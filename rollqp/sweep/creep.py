@@ -199,7 +199,7 @@ def creep_curve(scene, ratios="0.05:0.95:19", friction=None, out="creep.zarr", *
     ``scheduler``, ``workers``, ``client``, ``quiet``) and read the curve back.
 
     The store is read with zarr (the four arrays the curve needs, state 0): xarray and pandas
-    are not imported by the command, ~1 s of CPU on this machine.
+    are not imported by the command.
     """
     import zarr
 

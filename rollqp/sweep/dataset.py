@@ -37,8 +37,8 @@ __all__ = ["open_result", "create_store", "open_store", "StoreWriter", "write_po
 STATUS = {"missing": 0, "done": 1, "failed": 2}
 #: The global attribute that holds the sweep's fingerprint (:meth:`rollqp.sweep.Sweep.fingerprint`).
 FINGERPRINT = "rollqp_sweep_fingerprint"
-#: Most points in one chunk (one task): past ~16 points the per-chunk cost of a write (~20 ms for
-#: ~30 variables, one file each) is already small beside the points' own.
+#: Most points in one chunk (one task): past ~16 points the per-chunk cost of a write (~30 variables,
+#: one file each; measured in docs/sweeps.md) is already small beside the points' own.
 MAX_POINTS_PER_CHUNK = 32
 #: Most bytes of one chunk of the largest (per-state float) variable: a bound on a task's memory.
 CHUNK_BYTES = 32 * 2**20
@@ -107,7 +107,7 @@ def points_per_chunk(sweep, workers: int = 1) -> int:
     points, and the last tasks leave workers idle while the others finish: for N points of
     cost c each, a per-task cost o and B points a task, the wall time is about
     ``(N·c + (N/B)·o)/workers + B·c/2``, least at ``B = √(2·N·o/(workers·c))`` — the formula
-    above for o/c ≈ 1/8 (a §6.1.1 point of ~0.1 s against ~10 ms a task on a loaded machine).
+    above for o/c ≈ 1/8 (a §6.1.1 point against a task's round trip and write: docs/sweeps.md).
     At most :data:`MAX_POINTS_PER_CHUNK`, and at most :data:`CHUNK_BYTES` of the largest field
     per chunk; at least one.
     """
@@ -329,8 +329,8 @@ class StoreWriter:
     chunk is filled in memory and written whole. In a zarr-2 store on disk (what
     :func:`create_store` makes) a block is encoded with the array's own compressor and written
     as its chunk file (zarr-2's key ``i.j.k``) through a temporary file renamed over it, so a
-    kill never leaves half a chunk; zarr's asynchronous path costs ~1 ms of thread hops per
-    array, ~30 arrays a chunk, and far more on a loaded machine. Otherwise zarr writes the
+    kill never leaves half a chunk; zarr's asynchronous path costs thread hops per array, ~30
+    arrays a chunk, more on a loaded machine. Otherwise zarr writes the
     blocks. Points of the chunk not in the write keep what the store holds (a re-run that
     computes only a chunk's failed points reads the chunk first).
     """

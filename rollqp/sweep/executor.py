@@ -54,11 +54,9 @@ _THREAD_ENV = {k: "1" for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_
 _SCHEMES = ("tcp", "tls", "inproc")
 #: dask settings of the local cluster (its processes read them when they start). The workers'
 #: statistical profiler samples the task thread's stack every 10 ms: time taken from the points
-#: (the GIL), for a profile nobody reads here. dask's own monitors (the event loops' tick every
-#: 20 ms, the system monitor every 0.5 s, the memory monitor every 0.1 s) cost an idle 2-worker
-#: cluster 7.4 % of a core (3.7 % in the workers, 3.7 % in the client; psutil's CPU times over
-#: 10 s), 2.2 % at the intervals below: CPU that a machine shared by session (Linux's
-#: autogroup) takes from the points.
+#: (the GIL), for a profile nobody reads here. dask's own monitors (the event loops' tick, the
+#: system monitor, the memory monitor) run less often than dask's defaults: an idle cluster's CPU
+#: (docs/sweeps.md), which a machine shared by session (Linux's autogroup) takes from the points.
 _LOCAL_CONFIG = {"distributed.worker.profile.enabled": False,
                  "distributed.admin.tick.interval": "200ms",
                  "distributed.admin.system-monitor.interval": "2s",
@@ -268,6 +266,19 @@ def _short(value, n: int = 80) -> str:
     return describe(value, n)
 
 
+#: What a worker process keeps of the bodies between the points it runs (the BEM's rollers: seconds
+#: each, the same for every point that does not vary them), handed to each run; at most 8 kept.
+_GEOMETRY = None
+
+
+def _geometry():
+    global _GEOMETRY
+    if _GEOMETRY is None:
+        from ..influence import Memo
+        _GEOMETRY = Memo(size=8)
+    return _GEOMETRY
+
+
 def compute_point(scene) -> dict:
     """Run one scene (a :class:`~rollqp.scene.Scene` or its dict) on a worker: ``{"arrays", "time",
     "cpu", "worker"}`` (wall and CPU seconds of the worker's process), or ``{"error", "time", "cpu",
@@ -280,7 +291,7 @@ def compute_point(scene) -> dict:
     worker = f"{socket.gethostname()}:{os.getpid()}"
     with threadpool_limits(limits=1):
         try:
-            result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene)
+            result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene, geometry=_geometry())
         except Exception as err:  # an input the method cannot run, or a bug: one line, the sweep goes on
             return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0,
                     "cpu": time.process_time() - c0, "worker": worker}

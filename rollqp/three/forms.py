@@ -85,21 +85,25 @@ def _split(FA):
     return H, K, obj
 
 
-def normal_form(problem) -> ConicForm:
-    """The QP of eq. 3D.20 for a :class:`~rollqp.three.problem.NormalStep` (dense ``Â``)."""
+def normal_form(problem, elements=None) -> ConicForm:
+    """The QP of eq. 3D.20 for a :class:`~rollqp.three.problem.NormalStep` (dense ``Â``), over
+    ``elements`` (default: every element of the grid; the others are held at ``p = 0``)."""
     sc = problem.scales
-    n = problem.n
+    V = np.arange(problem.n) if elements is None else np.asarray(elements)
     ah = problem.area / sc.length ** 2
     f = ah * sc.modulus / sc.length
-    H, skew, obj = problem.A.memo(("qp", f), lambda: _split(f * problem.A.dense()))
-    q = ah * problem.h_total / sc.displacement
-    rows, a, b = (), np.zeros((0, n)), np.zeros(0)
+    if elements is None:
+        H, skew, obj = problem.A.memo(("qp", f), lambda: _split(f * problem.A.dense()))
+    else:
+        H, skew, obj = problem.A.memo(("qp", V.tobytes(), f), lambda: _split(f * problem.A.dense(V, V)))
+    q = ah * problem.h_total[V] / sc.displacement
+    rows, a, b = (), np.zeros((0, V.size)), np.zeros(0)
     if problem.delta is not None:
         q = q - ah * problem.delta / sc.displacement
     else:
-        rows, a, b = ("FN",), np.full((1, n), ah), np.array([problem.FN / sc.force])
+        rows, a, b = ("FN",), np.full((1, V.size), ah), np.array([problem.FN / sc.force])
     eq = float(np.max(a)) if a.size else 1.0
-    return ConicForm("normal", H, q / obj, a / eq, b / eq, None, np.arange(n), obj, eq, rows,
+    return ConicForm("normal", H, q / obj, a / eq, b / eq, None, V, obj, eq, rows,
                      skew if np.any(skew != 0) else None)
 
 

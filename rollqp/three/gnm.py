@@ -43,6 +43,7 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from ..errors import InputError, SolverError
+from ..methods.base import Capabilities, check_options
 from .problem import disc_projection
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
@@ -96,13 +97,14 @@ class NewtonMethod:
     Examples
     --------
     >>> m = NewtonMethod(tolerance=1e-10)
-    >>> m.name, sorted(m.solves)
-    ('newton-3d', ['normal', 'steady', 'tangential'])
+    >>> m.name, sorted(m.capabilities.solves), m.capabilities.friction_set
+    ('newton-3d', ['normal', 'steady', 'tangential'], 'disc')
     """
 
-    #: The registry's names are its own (rollqp.methods): this is the class's default label.
+    #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "newton-3d"
-    solves = frozenset({"normal", "tangential", "steady"})
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
+                                dimension=3, traction_components=2, friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, r: float | None = None,
                  rho: float = 0.5, sigma: float = 1e-4, path: str = "auto"):
@@ -116,6 +118,14 @@ class NewtonMethod:
             raise InputError("path", f"must be 'auto', 'dense' or 'krylov', got {path!r}")
         self.tolerance, self.max_iterations, self.r = float(tolerance), int(max_iterations), r
         self.rho, self.sigma, self.path = float(rho), float(sigma), path
+
+    @classmethod
+    def from_settings(cls, settings, **options):
+        """From a scene's solver settings: ``tolerance``, ``max_iterations`` (default 100),
+        ``augmentation`` (``r``); options ``path``, ``rho``, ``sigma``."""
+        check_options(cls.name, options, ("path", "rho", "sigma"))
+        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations or 100,
+                   r=settings.augmentation, **options)
 
     def setup(self, operators=None) -> None:
         """Nothing to build: the dense blocks are memoized by the operators themselves."""

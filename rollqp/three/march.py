@@ -4,7 +4,7 @@ r"""The 3D problems as sequences of steps (docs/theory3d.md §4, §6, §8).
   tangential force ``(Fx, Fy)`` in ``steps`` increments (shift steps, eq. 3D.16 at ``Δq = c``);
 * :func:`steady` — steady rolling with prescribed creepages ``(ξ, η, φ)`` or forces
   ``(Fx, Fy)`` and ``φ``: solved directly by a method that solves the steady operator
-  (``"steady" in method.solves``: Newton), marched to the steady state otherwise (each step an
+  (``"steady" in method.capabilities.solves``: Newton), marched to the steady state otherwise (each step an
   SOCP with ``Δq = dx``; docs/theory3d.md §6);
 * :func:`transient` — rolling in x from a start (the braked state of :func:`static_shift`) with
   steps ``Δq``: a generator of :class:`StepRecord`\ s.
@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from .contact import Loads
-from .problem import element_states
+from .problem import disc_projection, element_states
 
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
@@ -35,6 +35,10 @@ MAX_SWEEPS = 100
 #: march converges in 3–6 contact lengths (docs/validation3d.md §9: 70–98 steps of dx on 20 elements
 #: across a circle ≈ 4 c); 60 c is ten times that.
 MAX_MARCH_DISTANCE = 60.0
+#: A Newton iterate on the march map is kept if its step changes the tractions by at most this fraction of
+#: the change at the point it came from (else the march's own step is taken): a superlinear iteration
+#: reduces it by orders of magnitude per step, a plain march by its contraction factor (about 0.9).
+NEWTON_DECREASE = 0.5
 #: Differences kept by the Anderson acceleration of the march to the steady state (the 2D
 #: project's rolling start keeps 5): measured in docs/validation3d.md against the plain march.
 ANDERSON_MEMORY = 6
@@ -118,7 +122,9 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
     """Cattaneo–Mindlin: ``FN``, then ``(Fx, Fy)`` in ``steps`` equal increments (shift steps).
 
     Returns the list of :class:`StepRecord` (phase ``"shift"``), the last one the braked state;
-    ``info["shift"]`` is the accumulated rigid shift ``(Σ ξ c, Σ η c)`` of A relative to B.
+    ``info["shift"]`` is the accumulated rigid shift ``(Σ ξ c, Σ η c)`` of A relative to B,
+    ``info["loads"]`` the step's :class:`Loads` and ``info["before"]`` the ``(p, t)`` it started from
+    (``None``: the unloaded surfaces), so that the step can be posed again.
     """
     if int(steps) != steps or steps < 1:
         raise InputError("load.start_steps", f"must be an integer >= 1, got {steps!r}")
@@ -131,28 +137,72 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
         shift = shift + contact.scales.length * np.array([ts.xi, ts.eta])
         rec = _record(contact, j - 1, "shift", 0.0, ns, ts, loads, sw, time.perf_counter() - t0,
                       _states(contact, ns.p, ts.t, ts.s))
-        rec.info["shift"] = tuple(shift)
+        rec.info.update(shift=tuple(shift), loads=loads, before=previous)
         out.append(rec)
         previous, warm = (ns.p, ts.t), (ns, ts)
     return out
 
 
 def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=None, memory: int = None,
-           pressure=None):
-    """Steady rolling (eq. 3D.17): directly if ``"steady" in method.solves``, else by marching
-    rolling steps of ``Δq = dx`` from ``start`` (a :class:`StepRecord`, or zero tractions) until the
-    tractions change by less than the method's tolerance (``info["marched"]`` steps), accelerated
-    by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`; 0: plain).
-    ``pressure``: the normal solution to use (similar bodies; solved here if ``None``)."""
+           pressure=None, accelerate: str = "chord"):
+    """Steady rolling (eq. 3D.17): directly if ``"steady" in method.capabilities.solves``, else as the fixed
+    point of rolling steps of ``Δq = dx`` from ``start`` (a :class:`StepRecord`, or zero tractions), reached
+    when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
+
+    ``accelerate``: ``"chord"`` (similar bodies; default) Newton's method on the march map
+    (:mod:`rollqp.three.chord`, eq. 3D.29), every iterate evaluated by the method; ``"anderson"`` the
+    march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
+    0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
+    bodies; solved here if ``None``)."""
     t0 = time.perf_counter()
-    if "steady" in method.solves:
+    if "steady" in method.capabilities.solves:
         warm = (start, start) if start is not None else None
         nsol, tsol, sw = coupled_step(contact, method, FN, "steady", loads, direction=direction, warm=warm,
                                       pressure=pressure)
         return _record(contact, 0, "steady", 0.0, nsol, tsol, loads, sw, time.perf_counter() - t0,
                        _states(contact, nsol.p, tsol.t, tsol.s))
+    if accelerate not in ("chord", "anderson"):
+        raise InputError("accelerate", f"must be 'chord' or 'anderson', got {accelerate!r}")
+    if accelerate == "chord" and not contact.ops.coupled:
+        return _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure)
     return _march_to_steady(contact, method, FN, loads, direction, start, t0,
                             ANDERSON_MEMORY if memory is None else int(memory), pressure)
+
+
+def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure=None):
+    """The fixed point of the march by Newton's method on the march map (:func:`rollqp.three.chord.chord_step`),
+    a march step wherever a Newton iterate does not reduce the change by :data:`NEWTON_DECREASE`."""
+    from .chord import chord_step
+    nsol = pressure or normal(contact, method, FN)
+    dx, n = contact.grid.dx, contact.grid.n
+    shifted = contact.ops.shifted("tt", -direction * dx)
+    unit = contact.mu * contact.scales.stress
+    base = np.zeros((2, n)) if start is None else np.asarray(start.t, dtype=float)
+    x, best, warm = base, None, None       # best: (change, x, G(x)) of the last accepted base point
+    limit = int(np.ceil(MAX_MARCH_DISTANCE * contact.scales.length / dx))
+    bound = contact.mu * np.maximum(nsol.p, 0.0)
+    for k in range(1, limit + 1):
+        prob = contact.tangential_step("rolling", nsol.p, loads, (nsol.p, x), dx, direction)
+        try:
+            ts = method.solve(prob, warm)
+        except SolverError:
+            if best is None:           # a march step itself failed: nothing to fall back on
+                raise
+            x, warm, best = best[2], None, None       # the Newton iterate's step failed: the march's instead
+            continue
+        change = float(np.max(np.abs(ts.t - x))) / unit
+        if change <= method.tolerance:
+            rec = _record(contact, 0, "steady", 0.0, nsol, ts, loads, 1, time.perf_counter() - t0,
+                          _states(contact, nsol.p, ts.t, ts.s))
+            rec.info.update({"marched": k, "change": change, "accelerate": "chord"})
+            return rec
+        if best is not None and not change <= NEWTON_DECREASE * best[0]:
+            x, warm, best = best[2], None, None        # the Newton iterate failed: the march's own step instead
+            continue
+        best, warm = (change, x, ts.t), ts
+        cand = chord_step(prob, ts, shifted, x)
+        x = ts.t if cand is None else disc_projection(cand, bound)   # the fixed point is inside the discs
+    raise SolverError(f"no steady state after {limit} steps (rolling {MAX_MARCH_DISTANCE:g} c)", method=method.name)
 
 
 def _pack(p, t):
@@ -203,10 +253,12 @@ def _anderson(X, Gs, scale):
     return Gs[-1] - dG @ gamma
 
 
-def transient(contact, method, FN: float, loads, dq: float, steps: int, direction: int = -1, start=None):
-    r"""Rolling steps ``k = 1 … steps`` of ``Δq`` from ``start`` (a :class:`StepRecord`; zero
-    tractions if ``None``, yielded first as ``k = 0``). ``loads``: a :class:`Loads` or a function
-    ``q ↦ Loads``. Yields :class:`StepRecord`\ s; a :class:`SolverError` carries the step."""
+def transient(contact, method, FN: float, loads, dq: float, steps: int, direction: int = -1, start=None,
+              first: int = 1):
+    r"""Rolling steps ``k = first … steps`` of ``Δq`` (at ``q = k Δq``) from ``start`` (a
+    :class:`StepRecord`, the state before step ``first``; zero tractions if ``None``), which is
+    yielded first. ``loads``: a :class:`Loads` or a function ``q ↦ Loads``. Yields
+    :class:`StepRecord`\ s; a :class:`SolverError` carries the step."""
     load_at = loads if callable(loads) else (lambda q: loads)
     if start is None:
         nsol = normal(contact, method, FN)
@@ -219,7 +271,7 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
     fixed = None
     if not contact.ops.coupled:
         fixed = normal(contact, method, FN, warm=None)
-    for k in range(1, int(steps) + 1):
+    for k in range(int(first), int(steps) + 1):
         t0 = time.perf_counter()
         q = k * dq
         ld = load_at(q)

@@ -17,7 +17,7 @@ import numpy as np
 from .contact import Loads
 from .march import normal, steady
 
-__all__ = ["semi_axes", "hertz_errors", "creep_matrix", "cattaneo_errors"]
+__all__ = ["semi_axes", "hertz_errors", "hertz_field_errors", "creep_matrix", "cattaneo_errors"]
 
 
 def semi_axes(contact, p) -> tuple[float, float]:
@@ -28,20 +28,27 @@ def semi_axes(contact, p) -> tuple[float, float]:
 
 
 def hertz_errors(contact, solution) -> dict:
-    """Errors of a normal solution against the Hertz ellipse of the contact (relative to ``a, b, p0,
-    δ``): ``a``, ``b`` (:func:`semi_axes`), ``p0`` (the pressure interpolated to the centre by the
-    ellipsoid through the four central elements' ``p²``), ``delta``, ``rms`` (``p − p_Hertz`` over
-    the grid, in ``p0``), ``max`` (in ``p0``)."""
-    e = contact.ellipse
-    p = np.asarray(solution.p, dtype=float)
-    ah, bh = semi_axes(contact, p)
-    ph = e.pressure(contact.x, contact.y)
+    """Errors of a normal solution against the Hertz ellipse of the contact (:func:`hertz_field_errors`)."""
+    return hertz_field_errors(contact.x, contact.y, solution.p, solution.delta, contact.ellipse)
+
+
+def hertz_field_errors(x, y, p, delta, ellipse) -> dict:
+    """Errors of a pressure field ``p`` at the element centres ``(x, y)`` (flattened) and its approach
+    against the Hertz ``ellipse`` (relative to ``a, b, p0, δ``): ``a``, ``b`` (the semi-axes of the
+    ellipsoidal pressure with ``p``'s second moments, exact for Hertz's: ``∫x²p/∫p = a²/5``), ``p0``
+    (the pressure interpolated to the centre by the quadric through the nine central elements'
+    ``p²``), ``delta``, ``rms`` (``p − p_Hertz`` over the grid, in ``p0``), ``max`` (in ``p0``)."""
+    e = ellipse
+    x, y, p = (np.asarray(v, dtype=float).ravel() for v in (x, y, p))
+    P = float(p.sum())
+    ah, bh = float(np.sqrt(5 * np.sum(x ** 2 * p) / P)), float(np.sqrt(5 * np.sum(y ** 2 * p) / P))
+    ph = e.pressure(x, y)
     # p² is the quadric p0²(1 − x²/a² − y²/b²) for Hertz: fit it on the elements nearest the centre
-    near = np.argsort(np.hypot(contact.x / e.a, contact.y / e.b))[:9]
-    M = np.column_stack([np.ones(near.size), contact.x[near] ** 2, contact.y[near] ** 2])
+    near = np.argsort(np.hypot(x / e.a, y / e.b))[:9]
+    M = np.column_stack([np.ones(near.size), x[near] ** 2, y[near] ** 2])
     coef = np.linalg.lstsq(M, p[near] ** 2, rcond=None)[0]
     return {"a": ah / e.a - 1, "b": bh / e.b - 1, "p0": float(np.sqrt(coef[0])) / e.p0 - 1,
-            "delta": solution.delta / e.delta - 1, "rms": float(np.sqrt(np.mean((p - ph) ** 2))) / e.p0,
+            "delta": delta / e.delta - 1, "rms": float(np.sqrt(np.mean((p - ph) ** 2))) / e.p0,
             "max": float(np.max(np.abs(p - ph))) / e.p0}
 
 

@@ -12,12 +12,13 @@ rollqp's own residuals on the step problem. On top of the solver:
   the skew part at the previous iterate (docs/formulation.md §8); a splitting that does not
   contract is a :class:`~rollqp.errors.SolverError` (the steady operator: its skew part dominates;
   the SOCP route reaches the steady state by marching, :mod:`rollqp.three.steady`);
-* **polish**: an interior point method ends with every complementary pair small but not zero, so
-  elements at the edge of the stick area are off by about ``√gap``. The answer is refined by a
-  few generalized Newton iterations on the same equations, started from it
-  (:class:`~rollqp.three.gnm.NewtonMethod`: on the solver's own stick/slip partition this is a
-  Newton solve of its KKT system, the cone analogue of OSQP's polish) and kept only if rollqp's
-  residual drops; ``info["unpolished"]`` keeps the solver's own residual;
+* **active-set refinement** (:mod:`rollqp.three.refine`): an interior point method ends with every
+  complementary pair small but not zero, so elements at the edge of the contact or of the stick area
+  are off by about ``√gap``. The answer is refined by the conic program's own KKT system on the
+  active set the solver identified (eq. 3D.28: Newton iterations on smooth equations, the active set
+  held fixed — OSQP's polish carried to the cone, as the 2D QPs' ``active_set_refine``) and kept only
+  if rollqp's residual drops; ``info["raw"]`` keeps the solver's own answer and ``info["raw_residual"]``
+  its residual, so that its distance from any other method stays visible;
 * one solver object per structure (variables, cones, Hessian), afterwards only ``q`` and ``b``
   are updated (Clarabel ``update``).
 
@@ -33,15 +34,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError, MissingBackendError, SolverError
+from ..methods.base import Capabilities, check_options
 from .forms import normal_form, tangential_form
-from .gnm import NewtonMethod
+from .refine import active_set_refine
 
-__all__ = ["ClarabelMethod", "OsqpMethod", "CvxpyMethod", "cone_methods"]
+__all__ = ["ConicMethod", "ClarabelMethod", "OsqpMethod", "CvxpyMethod", "ScsMethod", "raw_solution"]
+#: Clarabel's linear solver for the KKT systems of these dense programs (:func:`_clarabel_settings`).
+FACTORIZATION = "faer"
 #: Largest splitting sequence; the contraction is measured and a growing change stops it earlier.
 MAX_SPLITTING = 60
-#: Newton iterations of the polish: from an interior-point answer the partition is right and
-#: the Newton steps converge in 1–3 iterations; more means the partition was wrong.
-POLISH_ITERATIONS = 8
 
 
 class ConicMethod:
@@ -52,24 +53,36 @@ class ConicMethod:
     tolerance : float
         Requested rollqp residual; a solution above ``residual_limit`` (default
         ``max(100·tolerance, 1e-12)``) is a :class:`SolverError`.
-    polish : bool
-        Refine the solver's answer by Newton (module docstring).
+    refine : bool
+        Refine the solver's answer on its active set (module docstring); the raw answer stays in
+        ``info["raw"]``.
     max_iterations : int, optional
         The solver's own iteration limit.
+    residual_limit : float, optional
+        The largest rollqp residual accepted.
     """
 
+    #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "conic"
-    solves = frozenset({"normal", "tangential"})
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimension=3, traction_components=2,
+                                friction_set="disc")
 
-    def __init__(self, tolerance: float = 1e-10, polish: bool = True, max_iterations: int | None = None,
+    def __init__(self, tolerance: float = 1e-10, refine: bool = True, max_iterations: int | None = None,
                  residual_limit: float | None = None):
         if not (np.isfinite(tolerance) and 0 < tolerance < 1):
             raise InputError("solver.tolerance", f"must be in (0, 1), got {tolerance!r}")
         self.tolerance = float(tolerance)
-        self.polish = bool(polish)
+        self.refine = bool(refine)
         self.max_iterations = max_iterations
         self.residual_limit = residual_limit if residual_limit is not None else max(100 * tolerance, 1e-12)
         self._solvers = {}
+
+    @classmethod
+    def from_settings(cls, settings, **options):
+        """From a scene's solver settings: ``tolerance``, ``max_iterations`` (the solver's own limit);
+        options ``refine``, ``residual_limit``."""
+        check_options(cls.name, options, ("refine", "residual_limit"))
+        return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations, **options)
 
     def setup(self, operators=None) -> None:
         """A new contact: drop the solver objects of the previous one."""
@@ -77,20 +90,35 @@ class ConicMethod:
 
     def solve(self, problem, warm=None):
         """Solve a normal or tangential step (eq. 3D.20/3D.21); rollqp's residuals decide."""
-        if problem.kind not in self.solves:
+        if problem.kind not in self.capabilities.solves:
+            from ..methods import cone_methods
             raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step "
                                               f"(methods that can: {', '.join(cone_methods())})")
         t0 = time.perf_counter()
-        form = normal_form(problem) if problem.kind == "normal" else tangential_form(problem)
-        x, y, info = self._splitting(form)
-        sol = _solution(problem, form, x, y, self.name, info)
-        if self.polish:
-            sol = self._polished(problem, sol)
+        elements = predicted_contact(problem, warm) if problem.kind == "normal" else None
+        sol, info = self._solve_on(problem, elements)
+        if elements is not None and not sol.residual <= self.residual_limit:   # the prediction missed
+            sol, info = self._solve_on(problem, None)
+            sol.info["predicted"] = "missed: solved on every element"
         sol.info["time"] = time.perf_counter() - t0
         if not sol.residual <= self.residual_limit:
             raise SolverError(f"rollqp's residual above the limit {self.residual_limit:.1e}", method=self.name,
                               status=info.get("status"), residual=sol.residual)
         return sol
+
+    def _solve_on(self, problem, elements):
+        """The conic program over ``elements`` (normal step; None: all), refined; rollqp's residual is over
+        every element."""
+        form = normal_form(problem, elements) if problem.kind == "normal" else tangential_form(problem)
+        x, y, info = self._splitting(form)
+        sol = _solution(problem, form, x, y, self.name, info)
+        if self.refine:
+            sol = self._refined(problem, sol)
+        else:
+            sol.info.update(raw_residual=sol.residual, raw=_unknowns(sol), refined=False)
+        if elements is not None:
+            sol.info["predicted"] = int(elements.size)
+        return sol, info
 
     def _splitting(self, form):
         """Solve the form; with a skew part, the splitting's sequence (docs/formulation.md §8)."""
@@ -111,23 +139,67 @@ class ConicMethod:
         info["splitting_changes"] = changes
         return x, y, info
 
-    def _polished(self, problem, sol):
-        newton = NewtonMethod(tolerance=self.tolerance, max_iterations=POLISH_ITERATIONS)
-        sol.info["unpolished"] = sol.residual
-        try:
-            ref = newton.solve(problem, warm=sol)
-        except SolverError:
-            sol.info["polished"] = False
-            return sol
-        if ref.residual < sol.residual:
-            ref.info.update({k: v for k, v in sol.info.items() if k not in ref.info})
-            ref.info.update({"polished": True, "polish_iterations": ref.iterations})
-            return type(sol)(**{**ref.__dict__, "method": self.name, "iterations": sol.iterations})
-        sol.info["polished"] = False
+    def _refined(self, problem, sol):
+        """:func:`~rollqp.three.refine.active_set_refine` of the solver's answer, kept if rollqp's
+        residual drops; the raw answer and its residual in ``info``."""
+        raw = {"raw_residual": sol.residual, "raw": _unknowns(sol)}
+        ref = active_set_refine(problem, sol)
+        if ref is not None and ref.residual < sol.residual:
+            info = {**sol.info, **raw, "refined": True, "refine_iterations": ref.iterations}
+            return type(sol)(**{**ref.__dict__, "method": self.name, "iterations": sol.iterations, "info": info})
+        sol.info.update(raw, refined=False)
         return sol
 
     def _solve_form(self, form, q):   # pragma: no cover - abstract
         raise NotImplementedError
+
+
+#: Rows of elements added around a warm start's contact set for the normal QP's variables.
+CONTACT_MARGIN = 2
+
+
+def predicted_contact(problem, warm):
+    """The elements a normal step's QP is posed over: the warm start's contact set (``p > 0``) and
+    :data:`CONTACT_MARGIN` rows of elements around it, or None (every element) without a warm start.
+
+    The other elements are held at ``p = 0``; the answer is kept only if rollqp's residual over the whole
+    grid passes, and then it solves the full QP too (its KKT conditions hold: the left-out elements'
+    gaps are ``>= 0`` at zero pressure). A miss is solved again on every element. The QP shrinks from the
+    whole grid to about the contact (the 40 × 40 kalker-circular grid: 1600 to about 900 variables, a
+    dense factorization about 6 times cheaper).
+    """
+    if warm is None or warm.p is None or np.shape(warm.p) != (problem.n,):
+        return None
+    grid = problem.A.grid
+    mask = (np.asarray(warm.p) > 0).reshape(grid.shape)
+    if not mask.any():
+        return None
+    r = CONTACT_MARGIN
+    padded = np.pad(mask, r)
+    out = np.zeros_like(mask)
+    for di in range(2 * r + 1):
+        for dj in range(2 * r + 1):
+            out |= padded[di:di + grid.ny, dj:dj + grid.nx]
+    V = np.flatnonzero(out.ravel())
+    return None if V.size == problem.n else V
+
+
+def _unknowns(sol) -> dict:
+    """The unknowns of a solution (copies): ``p, delta`` or ``t, xi, eta``."""
+    if sol.p is not None:
+        return {"p": np.array(sol.p), "delta": sol.delta}
+    return {"t": np.array(sol.t), "xi": sol.xi, "eta": sol.eta}
+
+
+def raw_solution(problem, solution):
+    """The conic solver's own answer behind ``solution`` (``info["raw"]``, before the active-set
+    refinement), evaluated on ``problem`` with rollqp's residuals; ``solution`` itself if it has none."""
+    raw = solution.info.get("raw")
+    if raw is None:
+        return solution
+    if "p" in raw:
+        return problem.solution(raw["p"], raw["delta"], method=solution.method)
+    return problem.solution(raw["t"], raw["xi"], raw["eta"], method=solution.method)
 
 
 def _solution(problem, form, x, y, name, info):
@@ -135,7 +207,8 @@ def _solution(problem, form, x, y, name, info):
     sc = problem.scales
     unknowns = form.multipliers_to_unknowns(y)
     if form.kind == "normal":
-        p = np.maximum(np.asarray(x), 0.0) * sc.stress
+        p = np.zeros(problem.n)
+        p[form.elements] = np.maximum(np.asarray(x), 0.0) * sc.stress
         delta = problem.delta if problem.delta is not None else -float(unknowns[0]) * sc.displacement
         return problem.solution(p, delta, method=name, iterations=info.get("iterations", 0), info=info)
     nv = form.elements.size
@@ -151,7 +224,7 @@ def _clarabel_settings(tolerance, max_iterations):
     s = clarabel.DefaultSettings()
     # four decades below the residual asked for (2D: qp_clarabel), floored at 1e-13: at 1e-14 Clarabel
     # stops "AlmostSolved" at a residual of 3e-4 on a 30 × 30 rolling step (540 cones), at 1e-13 it
-    # reaches 9e-9 "Solved" (measured; the polish takes either to round-off)
+    # reaches 9e-9 "Solved" (measured; the active-set refinement takes either to round-off)
     gap = max(1e-4 * tolerance, 1e-13)
     values = dict(verbose=False, presolve_enable=False, tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=gap,
                   tol_ktratio=min(1e-6, gap), iterative_refinement_reltol=1e-14,
@@ -159,6 +232,10 @@ def _clarabel_settings(tolerance, max_iterations):
                   max_iter=int(max_iterations or 200))
     for k, v in values.items():
         setattr(s, k, v)
+    try:  # the supernodal factorization: the Hessian of the contact is dense (measured: 3x less CPU than QDLDL's
+        s.direct_solve_method = FACTORIZATION   # on the 40 x 40 grid, equal answers)
+    except (AttributeError, ValueError, TypeError):  # pragma: no cover - an older Clarabel: its default
+        pass
     return s
 
 
@@ -186,7 +263,7 @@ def _constraint_rows(form):
 class ClarabelMethod(ConicMethod):
     """Clarabel (interior point, native cones): the QP of eq. 3D.20 and the SOCP of eq. 3D.21."""
 
-    name = "socp-clarabel"
+    name = "clarabel"
 
     def _solve_form(self, form, q):
         import clarabel
@@ -211,8 +288,10 @@ class ClarabelMethod(ConicMethod):
 class OsqpMethod(ConicMethod):
     """OSQP (ADMM, polished) on the normal QP of eq. 3D.20; a tangential step is an InputError."""
 
-    name = "qp-osqp-3d"
-    solves = frozenset({"normal"})
+    name = "osqp"
+    #: No cones: the friction disc cannot be posed, so it solves the normal QP only.
+    capabilities = Capabilities(solves=frozenset({"normal"}), dimension=3, traction_components=2,
+                                friction_set="interval")
 
     def _solve_form(self, form, q):
         import osqp
@@ -246,15 +325,18 @@ class CvxpyMethod(ConicMethod):
     """cvxpy's textbook statement of eq. 3D.20/3D.21 (DPP parameters), on ``solver`` (``"CLARABEL"``
     or ``"SCS"``)."""
 
-    name = "socp-cvxpy"
+    name = "cvxpy"
+    #: The solver cvxpy hands the program to.
+    default_solver = "CLARABEL"
 
-    def __init__(self, tolerance: float = 1e-10, polish: bool = True, max_iterations=None, residual_limit=None,
-                 solver: str = "CLARABEL"):
-        super().__init__(tolerance, polish, max_iterations, residual_limit)
+    def __init__(self, tolerance: float = 1e-10, refine: bool = True, max_iterations=None, residual_limit=None,
+                 solver: str | None = None):
+        super().__init__(tolerance, refine, max_iterations, residual_limit)
         try:
             import cvxpy
         except ImportError:
-            raise MissingBackendError("socp-cvxpy needs cvxpy: pip install 'rollqp[cvxpy]'") from None
+            raise MissingBackendError("the cvxpy methods need cvxpy: pip install 'rollqp[cvxpy]'") from None
+        solver = self.default_solver if solver is None else solver
         if solver not in cvxpy.installed_solvers() or solver not in ("CLARABEL", "SCS"):
             raise InputError("solver", f"must be an installed one of CLARABEL, SCS, got {solver!r}")
         self.solver = solver
@@ -264,7 +346,7 @@ class CvxpyMethod(ConicMethod):
             return dict(eps_abs=1e-12, eps_rel=1e-12, max_iters=int(self.max_iterations or 200000))
         gap = max(1e-4 * self.tolerance, 1e-13)   # as _clarabel_settings
         return dict(tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=gap, tol_ktratio=min(1e-6, gap),
-                    max_iter=int(self.max_iterations or 200))
+                    max_iter=int(self.max_iterations or 200), direct_solve_method=FACTORIZATION)
 
     def _build(self, form):
         import cvxpy as cp
@@ -309,6 +391,9 @@ class CvxpyMethod(ConicMethod):
                                         "iterations": int(prob.solver_stats.num_iters or 0)}
 
 
-def cone_methods() -> tuple:
-    """The labels of the 3D methods that can solve a tangential (disc-constrained) step."""
-    return tuple(cls.name for cls in (NewtonMethod, ClarabelMethod, CvxpyMethod) if "tangential" in cls.solves)
+class ScsMethod(CvxpyMethod):
+    """cvxpy's statement (:class:`CvxpyMethod`) solved by SCS (a first-order conic solver, asked for
+    1e-12: its own accuracy, not the residual asked for, decides)."""
+
+    name = "scs"
+    default_solver = "SCS"

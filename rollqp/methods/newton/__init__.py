@@ -300,9 +300,9 @@ class NewtonMethod:
         """Never hand back a step whose rollqp residual misses the tolerance.
 
         The iteration stops on ``‖Φ‖∞ <= tolerance·min(1, r)``, which bounds rollqp's own
-        residual (r = 1) by ``tolerance`` in exact arithmetic. With an extreme ``r`` (measured:
-        r = 1e-8, outside the accepted band) round-off in the r-scaled rows breaks that
-        implication; the step is then a failure, not a solution.
+        residual (r = 1) by ``tolerance`` in exact arithmetic. With an extreme ``r`` (outside the
+        accepted band: docs/stability.md, "The augmentation r") round-off in the r-scaled rows breaks
+        that implication; the step is then a failure, not a solution.
         """
         if not sol.residual <= self.tolerance:
             raise SolverError(f"the Newton iteration stopped on its scaled test but rollqp's residual {sol.residual:.3e} exceeds the "

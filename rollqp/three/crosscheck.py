@@ -1,0 +1,193 @@
+r"""The cross-check of a 3D run: a few of its steps solved again by the other route, step by step
+(docs/validation3d.md §6).
+
+A run keeps the records of the steps ``0``, ``K/2`` and ``K`` (:class:`SpotObserver`);
+:func:`cross_check` poses each again — from the state before it, at its loads — and solves it with
+the methods of :data:`rollqp.methods.CROSS_CHECK_METHODS_3D` other than the one that ran: Newton's
+run is checked by Clarabel's QP and SOCP, a conic run by Newton. Differences are from the run's own
+solution, in ``p0`` (pressure) and ``μp0`` (traction); the conic solver's raw answer (before its
+active-set refinement, :mod:`rollqp.three.refine`) is compared too, and every residual is rollqp's.
+
+**A steady state** (state 0 of a rolling start) is the fixed point of the march: one rolling step of
+``Δq = dx`` from it, at its loads, must return it (docs/theory3d.md §6). That one step is a
+transient SOCP — the honest cheap check of a steady state by the conic route, which reaches a
+steady state itself only by marching (``solver.method = "qp-clarabel"`` on a rolling start does).
+
+**A braked start** (phase ``"shift"``): its last static-shift step, from the state before it.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import RollqpError
+from .march import coupled_step
+
+__all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SPOT_BUDGET", "AGREEMENT"]
+
+#: Wall time the default cross-check of ``rollqp run`` may take (seconds, estimated from the scene by
+#: :func:`rollqp.three.advice.conic_step_seconds`: one Clarabel SOCP has twice as many variables as the
+#: contact has elements and a dense Hessian, its cost grows like their cube — 0.35 s at 300 contact
+#: elements, 5.3 s at 812 measured here). ``--cross-check`` forces the three steps whatever they cost.
+SPOT_BUDGET = 12.0
+#: The refined answers of two routes that solve the same step to rollqp's residual 1e-10 agree to about
+#: that times the conditioning of the stick block (measured ≤ 5e-11 μp0, docs/validation3d.md §6); a
+#: different stick/slip partition would differ by 1e-3 or more. Differences above this are reported as
+#: a disagreement.
+AGREEMENT = 1e-7
+
+
+def spot_steps(K: int, contact_elements: int | None = None, budget: float | None = None) -> list[int]:
+    """The steps a run of ``K`` rolling steps keeps for its cross-check: 0, K/2, K — or, with
+    ``contact_elements`` and a ``budget`` (default :data:`SPOT_BUDGET`), as many of them as fit the
+    budget at the estimated cost of one conic step, the last state first (the one the summary
+    reports); ``[]`` if not even one fits."""
+    steps = sorted({0, K // 2, K})
+    if contact_elements is None:
+        return steps
+    from .advice import conic_step_seconds
+    fit = int((SPOT_BUDGET if budget is None else budget) // conic_step_seconds(contact_elements))
+    return sorted(steps[::-1][:max(fit, 0)])
+
+
+class SpotObserver:
+    """``observe(record, contact)`` for :func:`rollqp.three.run.run`: keeps the records of ``steps`` and
+    the state before each (``kept[k] = (record, (p, t) before or None)``)."""
+
+    def __init__(self, steps):
+        self.steps, self.kept, self.contact, self._last = set(steps), {}, None, None
+
+    def __len__(self) -> int:
+        return len(self.kept)
+
+    def __call__(self, rec, contact) -> None:
+        self.contact = contact
+        if rec.k in self.steps:
+            before = rec.info.get("before") if rec.k == 0 else (self._last.p, self._last.t)
+            self.kept[rec.k] = (rec, before)
+        self._last = rec
+
+
+@dataclass
+class CrossCheck:
+    """The cross-check's rows: per method, the largest differences over the steps (``dp`` in p0, ``dt``
+    in μp0, ``dcreep`` in p0/E*), the raw answer's (``dp_raw``, ``dt_raw``), the largest rollqp residual,
+    and the time; or the error it raised. ``str()`` is the summary line of ``rollqp run``."""
+
+    steps: list
+    rows: dict = field(default_factory=dict)
+    steady: bool = False
+    #: ``(method, step) -> differences`` of each step (:meth:`table`).
+    per_step: dict = field(default_factory=dict)
+    ran: str = ""
+
+    def table(self) -> str:
+        """One line per step and method: the differences from the run's solution and rollqp's residual."""
+        head = (f"{'step':>5}  {'method':<14} {'max|dp|/p0':>10} {'max|dt|/mu p0':>13} {'|d creep|':>9} "
+                f"{'residual':>9} {'raw |dp|':>9} {'raw |dt|':>9}")
+        lines = [f"reference: {self.ran} (its solution of each step); each step posed again from the state "
+                 "before it, at its loads", head]
+        for (m, k), d in sorted(self.per_step.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+            raw = (f"{d['dp_raw']:9.1e} {d['dt_raw']:9.1e}" if "dp_raw" in d else f"{'-':>9} {'-':>9}")
+            lines.append(f"{k:>5}  {m:<14} {d['dp']:10.1e} {d['dt']:13.1e} {d['dcreep']:9.1e} {d['residual']:9.1e} "
+                         f"{raw}")
+        return "\n".join(lines)
+
+    def agrees(self) -> bool:
+        return all("error" not in r and max(r["dp"], r["dt"]) <= AGREEMENT for r in self.rows.values())
+
+    def __str__(self) -> str:
+        head = f"{', '.join(self.rows)} on steps {', '.join(map(str, self.steps))}"
+        if self.steady:
+            head += " (state 0 steady: one rolling step of dx from it must return it)"
+        lines = [head]
+        for m, r in self.rows.items():
+            if "error" in r:
+                lines.append(f"{m} failed: {r['error']}")
+                continue
+            verdict = "agree" if max(r["dp"], r["dt"]) <= AGREEMENT else f"DISAGREE (beyond {AGREEMENT:g})"
+            raw = (f"; raw solver answer |dp| {r['dp_raw']:.1e}, |dt| {r['dt_raw']:.1e}"
+                   if r.get("raw") else "")
+            lines.append(f"{m}: {verdict}: max |dp| {r['dp']:.1e} p0, |dt| {r['dt']:.1e} mu p0, |d creepage| "
+                         f"{r['dcreep']:.1e} p0/E*{raw}; residual {r['residual']:.1e}; {r['time']:.2f} s")
+        return "\n".join(lines)
+
+
+def _pose(scene, contact, rec, before):
+    """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
+    if rec.phase == "steady":
+        return "rolling", scene.loads_at(0.0), (rec.p, rec.t), contact.grid.dx
+    if rec.phase == "shift":
+        return "shift", rec.info["loads"], before, None
+    return "rolling", scene.loads_at(rec.q), before, scene.dq
+
+
+def _compare(row, contact, rec, nsol, tsol) -> dict:
+    sc, mu = contact.scales, contact.mu
+    d = {"dp": np.max(np.abs(nsol.p - rec.p)) / sc.stress, "dt": np.max(np.abs(tsol.t - rec.t)) / (mu * sc.stress),
+         "dcreep": max(abs(tsol.xi - rec.xi), abs(tsol.eta - rec.eta)) / sc.slip,
+         "residual": max(nsol.residual, tsol.residual)}
+    rp, rt = nsol.info.get("raw"), tsol.info.get("raw")
+    if rp is not None or rt is not None:
+        row["raw"] = True
+        d["dp_raw"] = np.max(np.abs((rp or {"p": nsol.p})["p"] - rec.p)) / sc.stress
+        d["dt_raw"] = np.max(np.abs((rt or {"t": tsol.t})["t"] - rec.t)) / (mu * sc.stress)
+    for k, v in d.items():
+        row[k] = max(row.get(k, 0.0), float(v))
+    return {k: float(v) for k, v in d.items()}
+
+
+def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance: float = 1e-10) -> CrossCheck:
+    """Solve the kept steps of a run (``observer``) again with ``methods`` (default: the registry's
+    :data:`~rollqp.methods.CROSS_CHECK_METHODS_3D` without ``ran``) and compare (module docstring)."""
+    from ..methods import CROSS_CHECK_METHODS_3D, get_method
+    names = [m for m in (methods or CROSS_CHECK_METHODS_3D) if m != ran]
+    contact, kept = observer.contact, observer.kept
+    out = CrossCheck(sorted(kept), steady=any(rec.phase == "steady" for rec, _ in kept.values()), ran=ran)
+    for name in names:
+        row, k = {}, None
+        t0 = time.perf_counter()
+        try:
+            method = get_method(name, 3, tolerance=tolerance)
+            method.setup(contact)
+            for k in sorted(kept):
+                rec, before = kept[k]
+                kind, loads, previous, dq = _pose(scene, contact, rec, before)
+                nsol, tsol, _ = coupled_step(contact, method, scene.load.normal, kind, loads, previous, dq,
+                                             scene.load.direction)
+                out.per_step[name, k] = _compare(row, contact, rec, nsol, tsol)
+        except RollqpError as err:
+            row = {"error": f"step {k}: {err}" if k is not None else str(err)}
+        row["time"] = time.perf_counter() - t0
+        out.rows[name] = row
+    return out
+
+
+def crossval(scene, step: int | None = None, methods=None, tolerance: float = 1e-10) -> CrossCheck:
+    """``rollqp crossval`` of a 3D scene: run it with its method (``solver.method``), then solve every
+    stored step (or only ``step``) again with each of ``methods`` (default: the installed ones of
+    :data:`rollqp.methods.CROSSVAL_METHODS_3D` other than the run's), each posed from the run's state
+    before it and compared with the run's solution; every residual is rollqp's (module docstring).
+
+    Raises
+    ------
+    InputError
+        ``--step`` outside ``0 … K``, or a method that cannot solve the scene's steps.
+    """
+    from ..errors import InputError
+    from ..methods import CROSSVAL_METHODS_3D, available_methods, require_3d
+    from .run import run
+    K = scene.n_steps
+    if step is not None and not (isinstance(step, int) and 0 <= step <= K):
+        raise InputError("--step", f"must be an integer in [0, {K}] ({scene.name!r} has {K} rolling steps), got "
+                                   f"{step!r}")
+    if methods is None:
+        installed = set(available_methods(3))
+        methods = [m for m in CROSSVAL_METHODS_3D if m in installed]
+    for name in methods:
+        require_3d(name, "--methods")
+    observer = SpotObserver(range(K + 1) if step is None else [step])
+    run(scene, observe=observer)
+    return cross_check(scene, observer, scene.solver.method, methods=methods, tolerance=tolerance)

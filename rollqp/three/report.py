@@ -1,0 +1,164 @@
+"""The summary ``rollqp run`` prints for a 3D scene, and its errors against closed forms and tables
+(docs/validation3d.md).
+
+:func:`summary` has the 2D summary's signature (:func:`rollqp.report.summary`) and rows: the scene,
+the method, the grid, the Hertz ellipse, steps, iterations, wall time, the largest residual, then the
+final forces and moment on body A, the creepages, the stick area, and the errors that apply:
+
+* **Hertz** (state 0): the semi-axes and peak pressure of the computed pressure against the Hertz
+  ellipse (:func:`rollqp.three.post.hertz_field_errors`);
+* **Kalker's linear theory** (a steady state, state 0 of a rolling start, where no more than
+  :data:`LINEAR_SLIP_FRACTION` of the contact slips): the forces of the prescribed creepages against
+  ``Fx = −G c² C11 ξ``, ``Fy = −G c² (C22 η + c C23 φ)`` (eq. 3D.8; Table E.3, interpolated by
+  :func:`rollqp.three.closedforms.kalker_linear`), or the creepages of the prescribed forces against
+  the same relations solved for them. On the grid the difference is the discretization error, first
+  order in the element size (docs/validation3d.md §3 extrapolates it to within 1 %).
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from ..units import unit_names
+from .closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
+from .post import hertz_field_errors
+
+__all__ = ["summary", "closed_form_errors", "stick_fraction", "LINEAR_SLIP_FRACTION"]
+
+#: Largest fraction of the contact elements that may slip for the linear theory to be compared: it is
+#: the limit of vanishing creepage, where nothing slips; a few slipping elements at the trailing edge
+#: change the force by the square of their share (measured: 1e-4 at 1 % slipping).
+LINEAR_SLIP_FRACTION = 0.02
+
+
+def _meta(res) -> dict:
+    meta = res.get("meta") if isinstance(res, dict) else None
+    return json.loads(str(meta)) if meta is not None and not isinstance(meta, dict) else (meta or {})
+
+
+def _force_units(u):
+    force = u.load.rsplit("/", 1)[0]
+    return force, f"{force}·{u.length}"
+
+
+def stick_fraction(state) -> tuple[int, int, int]:
+    """``(contact, stick, slip)`` element counts of a state field (0 separation, 1 stick, 2 slip)."""
+    s = np.asarray(state)
+    stick, slip = int(np.sum(s == 1)), int(np.sum(s == 2))
+    return stick + slip, stick, slip
+
+
+def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
+    """``(name, text)`` for every comparison that applies (module docstring)."""
+    e = scene.ellipse
+    X, Y = np.meshgrid(res["x"], res["y"])
+    h = hertz_field_errors(X, Y, res["pn"][0], float(res["approach"][0]), e)
+    rows = [("error: hertz", f"a {100 * h['a']:+.3f} %, b {100 * h['b']:+.3f} %, p0 {100 * h['p0']:+.3f} %, "
+                             f"approach {100 * h['delta']:+.3f} % (state 0; discretization, docs/validation3d.md §1)")]
+    if scene.load.start == "rolling":
+        rows += _kalker_rows(res, scene)
+    else:
+        rows += _cattaneo_rows(res, scene, X, Y)
+    return rows
+
+
+def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
+    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.7)."""
+    e, m, mu = scene.ellipse, scene.materials, scene.mu
+    FN, Fx = float(res["FN"][0]), float(res["Fx"][0])
+    r = abs(Fx) / (mu * FN)
+    loads = scene.loads_at(0.0)
+    if abs(e.a / e.b - 1) > 1e-9 or m.K != 0 or loads.Fy != 0 or loads.phi != 0 or not 0 < r < 1:
+        return []
+    ref = np.sign(Fx) * cattaneo_traction(np.hypot(X, Y), e.a, e.p0, mu, r)
+    rms = float(np.sqrt(np.mean((res["px"][0] - ref) ** 2))) / (mu * e.p0)
+    shift = -np.sign(Fx) * cattaneo_shift(FN, e.a, mu, r, m.G, m.nu)
+    got = float(_meta(res).get("static_shift", [float("nan")])[0])
+    exact = "exact for nu = 0; for nu > 0 it neglects the lateral traction of the nu XY/rho³ kernel"
+    return [("error: cattaneo", f"rms(px - Cattaneo)/(mu p0) = {rms:.3g}, shift {100 * (got / shift - 1):+.3f} % of "
+                                f"Mindlin's {shift:.5g} (state 0; Cattaneo–Mindlin is {exact}: docs/validation3d.md §2)")]
+
+
+def _kalker_rows(res, scene) -> list[tuple[str, str]]:
+    e, m = scene.ellipse, scene.materials
+    C = kalker_linear(e.a / e.b, m.nu)
+    n, _, slip = stick_fraction(res["state"][0])
+    if C is None or m.K != 0:
+        why = "dissimilar bodies" if m.K != 0 else "a/b outside Table E.3"
+        return [("error: kalker", f"not compared ({why})")]
+    if slip > LINEAR_SLIP_FRACTION * n:
+        return [("error: kalker", f"not compared: {slip} of {n} contact elements slip (the linear theory is the "
+                                  f"limit of no slip; at most {100 * LINEAR_SLIP_FRACTION:g} % compared)")]
+    c, G = e.c, m.G
+    xi, eta, phi = (float(v) for v in res["creepage"][0])
+    ld = scene.load
+    out = []
+    if ld.creepage.longitudinal is not None and xi != 0:
+        ref = -G * c * c * C[0] * xi
+        out.append(f"Fx {100 * (float(res['Fx'][0]) / ref - 1):+.2f} % against -G c² C11 xi = {ref:.5g}")
+    elif ld.creepage.longitudinal is None and float(res["Fx"][0]) != 0:
+        ref = -float(res["Fx"][0]) / (G * c * c * C[0])
+        out.append(f"xi {100 * (xi / ref - 1):+.2f} % against -Fx/(G c² C11) = {ref:.5g}")
+    if ld.creepage.lateral is not None and (eta != 0 or phi != 0):
+        ref = -G * c * c * (C[1] * eta + c * C[2] * phi)
+        out.append(f"Fy {100 * (float(res['Fy'][0]) / ref - 1):+.2f} % against -G c² (C22 eta + c C23 phi) = {ref:.5g}")
+    elif ld.creepage.lateral is None and float(res["Fy"][0]) != 0:
+        ref = (-float(res["Fy"][0]) / (G * c * c) - c * C[2] * phi) / C[1]
+        out.append(f"eta {100 * (eta / ref - 1):+.2f} % against (-Fy/(G c²) - c C23 phi)/C22 = {ref:.5g}")
+    if not out:
+        return []
+    note = (f"(C11, C22, C23 = {C[0]:.4g}, {C[1]:.4g}, {C[2]:.4g}: Kalker 1990 Table E.3 at a/b = {e.a / e.b:.4g}, "
+            f"nu = {m.nu:.4g}; {slip} of {n} elements slip; first order in dx, docs/validation3d.md §3)")
+    return [("error: kalker", "; ".join(out) + " " + note)]
+
+
+def _grid_row(res, scene, u) -> str:
+    nx, ny = res["x"].size, res["y"].size
+    dx, dy = float(np.diff(res["x"][:2])[0]), float(np.diff(res["y"][:2])[0])
+    zx, zy = scene.discretization.zone
+    return (f"{nx} x {ny} elements ({nx * ny}), dx = {dx:.4g}, dy = {dy:.4g} {u.length}, zone ±{zx:g} a × ±{zy:g} b")
+
+
+def _steps_row(res, scene, u) -> str:
+    K = len(res["q"]) - 1
+    start = {"rolling": "steady state (rolling start)", "braked": "braked start (static shift)"}[scene.load.start]
+    return f"{start} + {K} rolling steps of {scene.discretization.step:g} dx ({scene.dq:.4g} {u.length})"
+
+
+def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
+    """The table ``rollqp run`` prints for a 3D scene (module docstring); the arguments as
+    :func:`rollqp.report.summary` (``stresses`` is not computed for 3D scenes)."""
+    u = unit_names(getattr(scene, "units", ""))
+    force, moment = _force_units(u)
+    e, mu = scene.ellipse, scene.mu
+    ran = _meta(res).get("method") or method
+    it, st = np.asarray(res["iterations"]), np.asarray(res["step_time"], dtype=float)
+    n, stick, slip = stick_fraction(res["state"][-1])
+    xi, eta, phi = (float(v) for v in res["creepage"][-1])
+    FN, Fx, Fy, Mz = (float(res[k][-1]) for k in ("FN", "Fx", "Fy", "Mz"))
+    rows = [("scene", f"{scene.name} ({scene.source}), three-dimensional"),
+            ("method", ran),
+            ("grid", _grid_row(res, scene, u)),
+            ("Hertz", f"a = {e.a:.5g} {u.length}, b = {e.b:.5g} {u.length} (a/b = {e.a / e.b:.4g}), p0 = {e.p0:.5g} "
+                      f"{u.stress}, E* = {e.Estar:.5g} {u.stress}, FN = {scene.load.normal:.6g} {force}"),
+            ("steps", _steps_row(res, scene, u)),
+            ("iterations", f"{int(it.sum())} in all ({int(it[0])} for the starting state)"),
+            ("wall time", f"{wall:.3f} s ({float(st.sum()):.3f} s stepping)"),
+            ("max residual", f"{float(np.max(res['residual'])):.2e} (nondimensional, docs/theory3d.md §10)"),
+            ("forces (end)", f"FN = {FN:.6g} {force}, Fx = {Fx:.6g} {force} ({Fx / (mu * FN):+.5f} mu FN), "
+                             f"Fy = {Fy:.6g} {force} ({Fy / (mu * FN):+.5f} mu FN), Mz = {Mz:.6g} {moment}"),
+            ("creepages (end)", f"xi = {xi:.6g}, eta = {eta:.6g}, phi = {phi:.6g} 1/{u.length}"),
+            ("stick area (end)", f"{100 * stick / max(n, 1):.1f} % of the {n} contact elements ({stick} stick, "
+                                 f"{slip} slip)")]
+    note = _meta(res).get("rolling_start")
+    if note:
+        rows.append(("starting state", note))
+    raw = _meta(res).get("raw_distance")
+    if raw:
+        rows.append(("raw conic", f"the solver's own answers (before the active-set refinement) differ from the "
+                                  f"refined ones kept by max |dp| {raw['dp']:.1e} p0, |dt| {raw['dt']:.1e} mu p0 "
+                                  f"over {raw['steps']} steps (interior point: about sqrt(gap); docs/theory3d.md §5)"))
+    rows += closed_form_errors(res, scene)
+    w = max(len(r[0]) for r in rows)
+    return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)

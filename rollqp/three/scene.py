@@ -1,0 +1,495 @@
+r"""Three-dimensional scenes: Kalker's problem as a scene file (docs/scenes.md, "Three dimensions").
+
+A scene with ``[contact] dimension = 3`` (:func:`rollqp.load_scene` reads the key and hands the
+table here) describes two bodies with principal radii in x (rolling) and y (lateral), pressed by a
+normal force and rolling in x with creepages or tangential forces::
+
+    name, description, units
+    [bodies.A] [bodies.B]   radius, radius_y (> 0 or inf), E, nu
+    [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace")
+    [load]                  normal (FN), tangential (Fx/(μFN)), lateral (Fy/(μFN)),
+                            creepage = { longitudinal = ξ, lateral = η, spin = φ },
+                            start, direction, start_steps
+    [discretization]        elements = [nx, ny], zone = [zx, zy], step (Δq/Δx), distance (/a)
+    [solver]                method, tolerance, max_iterations, augmentation
+
+Along x exactly one of ``load.tangential`` and ``load.creepage.longitudinal`` is given (neither:
+``Fx = 0``), along y one of ``load.lateral`` and ``load.creepage.lateral`` (neither: ``Fy = 0``);
+the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a history of q/a
+(:mod:`rollqp.histories`), ``a`` the Hertz semi-axis along x.
+
+Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
+allowed range: radii ``> 0`` (or ``inf``), a concentrated contact (not both bodies straight in one
+direction), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
+element aspect ratio ``dx/dy`` in :data:`rollqp.three.grid.ASPECT_RANGE`, the forces below the sliding
+limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
+method whose record solves 3D tangential steps on the friction disc
+(:func:`rollqp.methods.require_3d`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..errors import InputError
+from ..histories import Constant, History, parse_history
+from ..influence import DEFAULT_MODEL
+from ..methods import DEFAULT_METHOD, require_3d
+from ..scene.checks import MAX_FRICTION, check_scene_name, check_units
+from ..scene.core import SceneBase
+from ..validate import choice, integer, number, string, suggestion
+from .contact import Loads
+from .geometry import Body, curvatures
+from .grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
+from .hertz import hertz
+from .materials import Materials
+
+__all__ = ["Scene3D", "Body3D", "Contact3D", "Creepage3D", "Load3D", "Discretization3D", "Solver3D",
+           "scene_from_dict", "MAX_STEPS", "MAX_RESULT_BYTES"]
+
+#: Largest number of rolling steps of a 3D scene.
+MAX_STEPS = 100_000
+#: Largest result a 3D scene may ask for (bytes: six fields of 8 bytes per element and state).
+MAX_RESULT_BYTES = 4 << 30
+STARTS = ("braked", "rolling")
+
+
+# =========================================================================== parts
+@dataclass(frozen=True)
+class Body3D:
+    """One body: principal radii ``radius`` (x–z plane) and ``radius_y`` (y–z plane), ``> 0`` or
+    ``inf`` (a straight generator; both ``inf``: a plane); Young's modulus ``E > 0``, Poisson's ratio
+    ``nu`` in (−1, 0.5)."""
+
+    radius: float
+    radius_y: float
+    E: float
+    nu: float
+
+
+@dataclass(frozen=True)
+class Contact3D:
+    """``dimension = 3``; Coulomb's coefficient ``friction`` (a number > 0); ``model``: the half-space."""
+
+    friction: float
+    dimension: int = 3
+    model: str = DEFAULT_MODEL
+
+    @property
+    def mu(self) -> float:
+        return float(self.friction)
+
+
+@dataclass(frozen=True)
+class Creepage3D:
+    """Prescribed creepages as histories of q/a: ``longitudinal`` ξ, ``lateral`` η (None: the force
+    along that axis is prescribed instead), ``spin`` φ (1/length; default 0)."""
+
+    longitudinal: History | None = None
+    lateral: History | None = None
+    spin: History = Constant(0.0)
+
+
+@dataclass(frozen=True)
+class Load3D:
+    """The normal force ``normal`` (FN, a force), the tangential forces as histories of q/a —
+    ``tangential`` = Fx/(μFN), ``lateral`` = Fy/(μFN) — or the creepages (:class:`Creepage3D`), the
+    ``start`` (``"braked"``: static shift to the initial forces, then rolling; ``"rolling"``: the
+    steady state), the material's ``direction`` d = ±1 and the braked start's ``start_steps``."""
+
+    normal: float
+    tangential: History | None = None
+    lateral: History | None = None
+    creepage: Creepage3D = field(default_factory=Creepage3D)
+    start: str = "braked"
+    direction: int = -1
+    start_steps: int = 1
+
+
+@dataclass(frozen=True)
+class Discretization3D:
+    """``elements = (nx, ny)`` on the half-widths ``zone = (zx, zy)``·(a, b); rolling steps of
+    ``step``·dx up to ``distance``·a."""
+
+    elements: tuple = (40, 40)
+    zone: tuple = (1.25, 1.25)
+    step: float = 1.0
+    distance: float = 4.0
+
+
+@dataclass(frozen=True)
+class Solver3D:
+    """``method`` (a 3D method of the registry), ``tolerance`` (rollqp's nondimensional residual),
+    ``max_iterations`` (per step; None: the method's own), ``augmentation`` (Newton's ``r``)."""
+
+    method: str = DEFAULT_METHOD
+    tolerance: float = 1e-10
+    max_iterations: int | None = None
+    augmentation: float | None = None
+
+
+# =========================================================================== part checks
+def _radius(key, v) -> float:
+    if not (isinstance(v, (int, float)) and not isinstance(v, bool)) or math.isnan(v) or v <= 0:
+        raise InputError(key, f"must be a number > 0 (or inf for a straight generator), got {v!r}")
+    return float(v)
+
+
+def _body(key, b: Body3D) -> Body3D:
+    return Body3D(_radius(f"{key}.radius", b.radius), _radius(f"{key}.radius_y", b.radius_y),
+                  number(f"{key}.E", b.E, "> 0", lambda x: x > 0),
+                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5))
+
+
+def _contact(c: Contact3D) -> Contact3D:
+    if isinstance(c.friction, dict):
+        raise InputError("contact.friction", "a 3D scene takes Coulomb's coefficient (a number > 0); friction laws "
+                                             "(docs/friction.md) are two-dimensional")
+    mu = number("contact.friction", c.friction, f"in (0, {MAX_FRICTION:g}] (Coulomb's coefficient)",
+                lambda x: 0 < x <= MAX_FRICTION)
+    if c.dimension != 3 or isinstance(c.dimension, bool):
+        raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
+    return Contact3D(mu, 3, choice("contact.model", c.model, (DEFAULT_MODEL,)))
+
+
+def _history(v, key):
+    return None if v is None else parse_history(v, key)
+
+
+def _load(ld: Load3D) -> Load3D:
+    cr = ld.creepage
+    if not isinstance(cr, Creepage3D):
+        raise InputError("load.creepage", "must be a table { longitudinal = ξ, lateral = η, spin = φ } (numbers or "
+                                          f"histories), got {cr!r}")
+    cr = Creepage3D(_history(cr.longitudinal, "load.creepage.longitudinal"),
+                    _history(cr.lateral, "load.creepage.lateral"), parse_history(cr.spin, "load.creepage.spin"))
+    fx, fy = _history(ld.tangential, "load.tangential"), _history(ld.lateral, "load.lateral")
+    for force, creep, name in ((fx, cr.longitudinal, "tangential"), (fy, cr.lateral, "lateral")):
+        if force is not None and creep is not None:
+            raise InputError(f"load.creepage.{'longitudinal' if name == 'tangential' else 'lateral'}",
+                             f"give at most one of load.{name} (a force) and this creepage")
+    fx = fx if fx is not None or cr.longitudinal is not None else Constant(0.0)
+    fy = fy if fy is not None or cr.lateral is not None else Constant(0.0)
+    direction = ld.direction
+    if not isinstance(direction, (int, np.integer)) or isinstance(direction, bool) or direction not in (-1, 1):
+        raise InputError("load.direction", f"must be -1 or +1, got {direction!r}")
+    return Load3D(number("load.normal", ld.normal, "> 0 (the normal force FN)", lambda x: x > 0), fx, fy, cr,
+                  choice("load.start", ld.start, STARTS), int(direction),
+                  integer("load.start_steps", ld.start_steps, ">= 1 (and <= 10000)", lambda n: 1 <= n <= 10_000))
+
+
+def _pair(key, v, what, check) -> tuple:
+    if isinstance(v, (str, bytes, dict)) or not hasattr(v, "__len__") or len(v) != 2:
+        raise InputError(key, f"must be a pair [along x, along y] of {what}, got {v!r}")
+    return tuple(check(f"{key}[{i}]", x) for i, x in enumerate(v))
+
+
+def _discretization(d: Discretization3D) -> Discretization3D:
+    elements = _pair("discretization.elements", d.elements, "integers >= 4",
+                     lambda k, v: integer(k, v, ">= 4 (and <= 10000)", lambda n: 4 <= n <= 10_000))
+    if elements[0] * elements[1] > MAX_ELEMENTS:
+        raise InputError("discretization.elements", f"nx·ny = {elements[0] * elements[1]} exceeds {MAX_ELEMENTS} elements")
+    zone = _pair("discretization.zone", d.zone, "half-widths / (a, b) > 1",
+                 lambda k, v: number(k, v, "> 1 (and <= 100): the grid covers the Hertz ellipse",
+                                     lambda x: 1 < x <= 100))
+    return Discretization3D(elements, zone,
+                            number("discretization.step", d.step, "in (0, 8] (Δq/Δx)", lambda x: 0 < x <= 8),
+                            number("discretization.distance", d.distance, ">= 0 (rolled distance / a)",
+                                   lambda x: x >= 0))
+
+
+def _solver(s: Solver3D) -> Solver3D:
+    return Solver3D(
+        require_3d(s.method, "solver.method"),
+        number("solver.tolerance", s.tolerance, "in [1e-15, 1e-2]", lambda x: 1e-15 <= x <= 1e-2),
+        None if s.max_iterations is None else integer("solver.max_iterations", s.max_iterations,
+                                                      ">= 1 (and <= 100000) or absent", lambda n: 1 <= n <= 100_000),
+        None if s.augmentation is None else number("solver.augmentation", s.augmentation,
+                                                   "in [1e-6, 10] or absent (automatic)", lambda x: 1e-6 <= x <= 10))
+
+
+# =========================================================================== the scene
+@dataclass(frozen=True)
+class Scene3D(SceneBase):
+    """A validated three-dimensional rolling-contact problem (module docstring; docs/scenes.md).
+
+    The parts are checked key by key and the scene as a whole at construction; the derived
+    quantities (:attr:`materials`, :attr:`ellipse`, :attr:`grid`, :attr:`dq`, :attr:`n_steps`) are
+    what the run (:mod:`rollqp.three.run`) builds its contact from.
+
+    Examples
+    --------
+    >>> from rollqp import load_scene
+    >>> s = load_scene("kalker-circular")
+    >>> s.dimension, s.grid.nx, s.grid.ny, round(s.ellipse.a, 4), s.n_steps
+    (3, 40, 40, 0.5857, 64)
+    >>> s.replace(**{"bodies.A.radius": -1.0})
+    Traceback (most recent call last):
+    ...
+    rollqp.errors.InputError: bodies.A.radius: must be a number > 0 (or inf for a straight generator), got -1.0
+    """
+
+    name: str
+    description: str
+    A: Body3D
+    B: Body3D
+    contact: Contact3D
+    load: Load3D
+    discretization: Discretization3D = field(default_factory=Discretization3D)
+    solver: Solver3D = field(default_factory=Solver3D)
+    units: str = ""
+    source: str = field(default="<dict>", compare=False)
+
+    dimension: ClassVar[int] = 3
+
+    def __post_init__(self):
+        put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 - frozen dataclass
+        put("name", check_scene_name("name", self.name))
+        put("description", string("description", self.description))
+        put("A", _body("bodies.A", self.A))
+        put("B", _body("bodies.B", self.B))
+        put("contact", _contact(self.contact))
+        put("load", _load(self.load))
+        put("discretization", _discretization(self.discretization))
+        put("solver", _solver(self.solver))
+        put("units", check_units("units", self.units))
+        put("source", str(self.source))
+        _check_whole(self)
+
+    # ------------------------------------------------------------------ derived
+    @functools.cached_property
+    def materials(self) -> Materials:
+        """Kalker's combined constants G, ν, K (eq. 3D.10)."""
+        return Materials.from_young(self.A.E, self.A.nu, self.B.E, self.B.nu)
+
+    @functools.cached_property
+    def curvatures(self) -> tuple[float, float]:
+        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.1)."""
+        return curvatures(Body(self.A.radius, self.A.radius_y, "A"), Body(self.B.radius, self.B.radius_y, "B"))
+
+    @functools.cached_property
+    def ellipse(self):
+        """The Hertz ellipse of ``load.normal`` (a, b, p0, δ, E*: :class:`~rollqp.three.hertz.HertzEllipse`)."""
+        A, B = self.curvatures
+        return hertz(A, B, self.materials.Estar, self.load.normal)
+
+    @functools.cached_property
+    def grid(self) -> Grid:
+        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.three.grid.Grid.for_ellipse>`)."""
+        e = self.ellipse
+        return Grid.for_ellipse(e.a, e.b, self.discretization.elements, self.discretization.zone)
+
+    @property
+    def mu(self) -> float:
+        return self.contact.mu
+
+    @property
+    def dq(self) -> float:
+        """Rolled distance per step, ``step·dx``."""
+        return self.discretization.step * self.grid.dx
+
+    @property
+    def n_steps(self) -> int:
+        """Rolling steps K: ``distance·a/Δq``, rounded if within 1e-9 of an integer, else up."""
+        ratio = self.discretization.distance * self.ellipse.a / self.dq
+        r = round(ratio)
+        return int(r) if abs(r - ratio) <= 1e-9 * max(ratio, 1.0) else int(math.ceil(ratio))
+
+    @property
+    def q_steps(self) -> np.ndarray:
+        """Rolled distances ``k·Δq``, ``k = 0 … K``."""
+        return np.arange(self.n_steps + 1) * self.dq
+
+    def contact_elements(self) -> int:
+        """The elements whose centres lie inside the Hertz ellipse: about those in contact (the size of
+        a step's conic program, which :mod:`rollqp.three.advice` estimates from)."""
+        e, g = self.ellipse, self.grid
+        X, Y = np.meshgrid(g.x / e.a, g.y / e.b)
+        return int(np.sum(X * X + Y * Y < 1))
+
+    def loads_at(self, q: float) -> Loads:
+        """The tangential loading at the rolled distance ``q`` (length units): forces on A from the
+        ratios (``Fx = tangential·μFN``), creepages as given, the spin."""
+        ld, s = self.load, float(q) / self.ellipse.a
+        cap = self.mu * ld.normal
+        cr = ld.creepage
+        val = lambda h: None if h is None else float(h(s))  # noqa: E731
+        Fx, Fy = val(ld.tangential), val(ld.lateral)
+        return Loads(Fx=None if Fx is None else Fx * cap, xi=val(cr.longitudinal),
+                     Fy=None if Fy is None else Fy * cap, eta=val(cr.lateral), phi=float(cr.spin(s)))
+
+    # ------------------------------------------------------------------ output
+    def to_dict(self) -> dict:
+        """The full scene as a nested plain dict, defaults filled in (constant histories as numbers)."""
+        ld, d = self.load, self.discretization
+        loads = {"normal": ld.normal, **_opt("tangential", ld.tangential), **_opt("lateral", ld.lateral),
+                 "creepage": {**_opt("longitudinal", ld.creepage.longitudinal),
+                              **_opt("lateral", ld.creepage.lateral), "spin": _plain(ld.creepage.spin)},
+                 "start": ld.start, "direction": ld.direction, "start_steps": ld.start_steps}
+        solver = {k.name: getattr(self.solver, k.name) for k in fields(self.solver)
+                  if getattr(self.solver, k.name) is not None}
+        return {"name": self.name, "description": self.description, **({"units": self.units} if self.units else {}),
+                "bodies": {k: dataclasses.asdict(b) for k, b in (("A", self.A), ("B", self.B))},
+                "contact": {"dimension": 3, "friction": self.contact.friction, "model": self.contact.model},
+                "load": loads,
+                "discretization": {"elements": list(d.elements), "zone": list(d.zone), "step": d.step,
+                                   "distance": d.distance},
+                "solver": solver}
+
+    def to_toml(self) -> str:
+        """The scene as TOML text, defaults filled in; reading it back gives an equal scene."""
+        import tomli_w
+        return tomli_w.dumps(self.to_dict())
+
+    def replace(self, **changes: Any) -> "Scene3D":
+        """A new, validated scene with dotted keys changed (``scene.replace(**{"solver.method": "qp-clarabel"})``);
+        ``None`` removes an optional key."""
+        d = self.to_dict()
+        for dotted, value in changes.items():
+            node, parts = d, dotted.split(".")
+            for i, part in enumerate(parts[:-1]):
+                node = node.setdefault(part, {})
+                if not isinstance(node, dict):
+                    raise InputError(".".join(parts[:i + 1]), f"is not a table; cannot set {dotted}")
+            if value is None:
+                node.pop(parts[-1], None)
+            else:
+                node[parts[-1]] = _plain(value)
+        return scene_from_dict(d, source=self.source, default_name=self.name)
+
+
+def _plain(v):
+    if isinstance(v, Constant):
+        return v.value
+    if isinstance(v, History):
+        return v.to_dict()
+    if isinstance(v, np.generic):
+        return v.item()
+    return v
+
+
+def _opt(key, v) -> dict:
+    return {} if v is None else {key: _plain(v)}
+
+
+# =========================================================================== the scene as a whole
+def _check_whole(scene) -> None:
+    """The derived quantities, the grid against the ellipse, the work, the sliding limit (module docstring)."""
+    _check_ellipse(scene)
+    _check_grid(scene)
+    _check_work(scene)
+    _check_sliding_limit(scene)
+
+
+def _check_ellipse(scene) -> None:
+    try:
+        e = scene.ellipse
+    except InputError as err:
+        key = "bodies.A.radius" if err.key in ("A", "bodies.A.radius") else "bodies.A.radius_y"
+        raise InputError(key, str(err).split(": ", 1)[-1]) from None
+    if not all(math.isfinite(v) and v > 0 for v in (e.a, e.b, e.p0, e.delta)):
+        raise InputError("load.normal", f"the Hertz ellipse of FN = {scene.load.normal!r} with these radii and moduli "
+                                        f"is not finite (a = {e.a:.3g}, b = {e.b:.3g}, p0 = {e.p0:.3g}): extreme input")
+
+
+def _check_grid(scene) -> None:
+    e, d = scene.ellipse, scene.discretization
+    (nx, ny), (zx, zy) = d.elements, d.zone
+    dx, dy = 2 * zx * e.a / nx, 2 * zy * e.b / ny
+    lo, hi = ASPECT_RANGE
+    if not lo <= dx / dy <= hi:
+        square = max(4, round(nx * zy * e.b / (zx * e.a)))
+        raise InputError("discretization.elements", f"element aspect ratio dx/dy = {dx / dy:.4g} must be in [{lo:g}, "
+                                                    f"{hi:g}]: the influence coefficients are exact, but the tractions "
+                                                    f"are resolved only to O(max(dx, dy)) (docs/validation3d.md §8); "
+                                                    f"square elements: [{nx}, {square}]")
+    for n, z, axis in ((nx, zx, "x"), (ny, zy, "y")):
+        if z * (1 - 2 / n) < 1:
+            need = math.ceil(2 / (1 - 1 / z)) + 1 if z > 1 else None
+            raise InputError("discretization.zone", f"the grid must cover the Hertz ellipse with a row of elements to "
+                                                    f"spare on each side: zone·(1 − 2/elements) >= 1 along {axis}, got "
+                                                    f"{z:g}·(1 − 2/{n}) = {z * (1 - 2 / n):.4g}; raise the zone or the "
+                                                    f"elements (at least {need} elements along {axis} with zone {z:g})")
+
+
+def _check_work(scene) -> None:
+    K = scene.n_steps
+    if K > MAX_STEPS:
+        raise InputError("discretization.distance", f"asks for {K} rolling steps, more than {MAX_STEPS}: a shorter "
+                                                    "distance or a longer discretization.step")
+    size = 48.0 * (K + 1) * scene.grid.n
+    if size > MAX_RESULT_BYTES:
+        raise InputError("discretization.distance", f"the result of {K + 1} states of {scene.grid.n} elements would be "
+                                                    f"{size / 2 ** 30:.3g} GiB, more than {MAX_RESULT_BYTES >> 30} GiB: "
+                                                    "fewer steps or elements")
+
+
+def _check_sliding_limit(scene) -> None:
+    """Prescribed forces: ``|(Fx, Fy)|/(μFN) < 1`` at every step (and the histories' breakpoints)."""
+    ld = scene.load
+    if ld.tangential is None and ld.lateral is None:
+        return
+    s_end = float(scene.q_steps[-1]) / scene.ellipse.a
+    s = scene.q_steps / scene.ellipse.a
+    for h in (ld.tangential, ld.lateral):
+        if h is not None:
+            s = np.union1d(s, h.critical_points(s_end))
+    fx = ld.tangential(s) if ld.tangential is not None else 0.0
+    fy = ld.lateral(s) if ld.lateral is not None else 0.0
+    r = np.hypot(fx, fy) * np.ones_like(s)
+    k = int(np.argmax(r))
+    if not r[k] < 1:
+        key = "load.tangential" if ld.tangential is not None else "load.lateral"
+        raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a must be < 1: a stick solution "
+                              "exists only below the sliding limit (prescribe creepages for gross sliding)")
+
+
+# =========================================================================== from a dict
+_TABLES = {"contact": Contact3D, "load": Load3D, "discretization": Discretization3D, "solver": Solver3D}
+_TOP = ("name", "description", "units", "bodies", "contact", "load", "discretization", "solver")
+
+
+def _table(d: Any, key: str, cls: type) -> dict:
+    if not isinstance(d, dict):
+        raise InputError(key, f"must be a table [{key}], got {d!r}")
+    names = [f.name for f in fields(cls)]
+    for k in d:
+        if k not in names:
+            raise InputError(f"{key}.{k}", f"unknown key{suggestion(k, names)} (allowed in [{key}] of a 3D scene: "
+                                           f"{', '.join(names)})")
+    required = [f.name for f in fields(cls)
+                if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+    missing = [k for k in required if k not in d]
+    if missing:
+        raise InputError(f"{key}.{missing[0]}", f"missing required key ([{key}] needs {', '.join(required)})")
+    return dict(d)
+
+
+def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene") -> Scene3D:
+    """Build and validate a 3D scene from its nested dict (the parsed TOML); every invalid input is an
+    :class:`InputError` naming the dotted key."""
+    if not isinstance(d, dict):
+        raise InputError("SCENE", f"must be a table of tables, got {type(d).__name__}")
+    for k in d:
+        if k not in _TOP:
+            raise InputError(k, f"unknown key{suggestion(k, _TOP)} (allowed at the top level: {', '.join(_TOP)})")
+    for k in ("bodies", "contact", "load"):
+        if k not in d:
+            raise InputError(k, f"missing required table [{k}]")
+    bodies = d["bodies"]
+    if not isinstance(bodies, dict) or set(bodies) != {"A", "B"}:
+        raise InputError("bodies", "must hold exactly the tables [bodies.A] and [bodies.B] (radius, radius_y, E, nu)")
+    A, B = (Body3D(**_table(bodies[k], f"bodies.{k}", Body3D)) for k in ("A", "B"))
+    parts = {k: _table(d.get(k, {}), k, cls) for k, cls in _TABLES.items()}
+    if "creepage" in parts["load"]:
+        cr = parts["load"]["creepage"]
+        parts["load"]["creepage"] = Creepage3D(**_table(cr, "load.creepage", Creepage3D)) if isinstance(cr, dict) else cr
+    return Scene3D(name=d.get("name", default_name), description=d.get("description", ""), units=d.get("units", ""),
+                   A=A, B=B, contact=Contact3D(**parts["contact"]), load=Load3D(**parts["load"]),
+                   discretization=Discretization3D(**parts["discretization"]), solver=Solver3D(**parts["solver"]),
+                   source=source)
