@@ -302,8 +302,9 @@ def _takes(scene, command: str) -> None:
     if command not in family(scene).commands:
         from .errors import InputError
         dims = " and ".join(f"{d}D" for d, f in FAMILIES.items() if command in f().commands)
+        takes = ", ".join(["run", "show", "scenes", *sorted(family(scene).commands)])
         raise InputError("SCENE", f"{scene.name!r} is a {scene.dimension}D scene; rollqp {command} works on {dims} "
-                                  "scenes (rollqp run, show and scenes take every dimension)")
+                                  f"scenes (a {scene.dimension}D scene: rollqp {takes})")
 
 
 def cmd_run(args) -> int:

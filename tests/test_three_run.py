@@ -278,3 +278,30 @@ def test_an_interrupted_run_writes_its_completed_states(tmp_path):
     assert back["q"].shape == (3,) and "interrupted" in back["meta"]
     with pytest.raises(InputError, match="^--keep-every"):
         run(scene, keep_every=2)
+
+
+class _Killed(BaseException):
+    """Stands for SIGKILL: nothing of the run's own handling runs after it."""
+
+
+def test_a_killed_run_resumes_from_its_journal(tmp_path, capsys, monkeypatch):
+    """Every state is in ``out.journal`` as soon as it is completed: a run stopped with no chance to
+    write its file (here an exception nothing handles, as SIGKILL) resumes from the journal to the
+    same result as an uninterrupted run, and the journal is removed when the file is written."""
+    import rollqp
+    monkeypatch.chdir(tmp_path)
+    scene = coarse("cattaneo-3d", **{"discretization.distance": 1.5})
+    full = run(scene).arrays()
+
+    def kill(rec, contact):
+        if rec.k == 3:
+            raise _Killed
+
+    with pytest.raises(_Killed):
+        run(scene, observe=kill, out="k.npz")
+    assert not (tmp_path / "k.npz").exists() and (tmp_path / "k.npz.journal").stat().st_size > 0
+    assert cli.main(["run", "--resume", "k.npz", "--quiet"]) == 0
+    back = rollqp.load_result("k.npz")
+    assert back["q"].shape == full["q"].shape and back["meta"]["resumed_from"] == 3
+    assert np.max(np.abs(back["px"] - full["px"])) <= 1e-9 * scene.mu * scene.ellipse.p0
+    assert not (tmp_path / "k.npz.journal").exists()

@@ -147,3 +147,36 @@ def test_the_registry_names_the_instances():
     assert m.name == "socp-clarabel" and m.tolerance == 1e-9
     assert method_class("newton", 3) is not method_class("newton", 2)
     assert method_class("newton", 3).capabilities.dimension == 3
+
+
+def _leaves(d, prefix=()):
+    for k, v in d.items():
+        if isinstance(v, dict) and v:
+            yield from _leaves(v, prefix + (k,))
+        else:
+            yield prefix + (k,)
+
+
+BAD_VALUES = [None, "x", -1, 0, [], {}, [1.0], 1e308, float("nan"), float("-inf"), True, [0, 0, 0]]
+
+
+@pytest.mark.parametrize("name", BUILTIN_3D)
+def test_every_key_of_a_3d_scene_set_to_nonsense_is_a_one_line_input_error(name):
+    """Each leaf of a built-in 3D scene (and its removal) replaced by values of every wrong kind: the
+    scene either validates or stops with a one-line InputError naming a key — never another exception."""
+    base = load_scene(name).to_dict()
+    for path in _leaves(base):
+        for value in BAD_VALUES + ["<delete>"]:
+            d = copy.deepcopy(base)
+            node = d
+            for k in path[:-1]:
+                node = node[k]
+            if value == "<delete>":
+                del node[path[-1]]
+            else:
+                node[path[-1]] = value
+            try:
+                scene_from_dict(d)
+            except InputError as err:
+                msg = str(err)
+                assert "\n" not in msg and ": " in msg, (path, value, msg)

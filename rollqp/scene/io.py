@@ -54,7 +54,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     """
     contact = d.get("contact") if isinstance(d, dict) else None
     dimension = contact.get("dimension", 2) if isinstance(contact, dict) else 2
-    if isinstance(dimension, bool) or dimension not in _PARSERS:
+    if isinstance(dimension, bool) or not isinstance(dimension, int) or dimension not in _PARSERS:
         raise InputError("contact.dimension", f"must be one of {', '.join(map(str, _PARSERS))} (default 2), got "
                                               f"{dimension!r}")
     if dimension == 2 and isinstance(contact, dict) and "dimension" in contact:  # the 2D schema has no such key: 2 is its default

@@ -12,10 +12,11 @@ import json
 
 import numpy as np
 
+from ..errors import InputError
 from ..result import save_npz
 from .fields import COLUMNS, FIELDS_3D, GRID_FIELDS, check_arrays, markdown_table, read_checked  # noqa: F401
 
-__all__ = ["FIELDS_3D", "Result3D", "markdown_table", "check_arrays", "read_checked"]
+__all__ = ["FIELDS_3D", "Result3D", "markdown_table", "check_arrays", "read_checked", "journal_arrays"]
 
 
 class Result3D:
@@ -23,11 +24,17 @@ class Result3D:
 
     ``add(record)`` appends a :class:`~rollqp.three.march.StepRecord`; ``arrays()`` gives the result
     file's arrays, ``save(path)`` writes it atomically; ``meta`` is JSON-able.
+
+    With ``out`` (a result file's path) every state is also appended, as it is completed, to the
+    journal ``out.journal`` (:mod:`rollqp.journal`: one frame per state, kept by the kernel when the
+    process is killed, SIGKILL included); :meth:`finish` writes the result file and removes the
+    journal, and ``rollqp run --resume out`` continues a killed run from it (:func:`journal_arrays`).
     """
 
-    def __init__(self, grid, scalars: dict, meta: dict):
-        self.grid, self.scalars, self.meta = grid, dict(scalars), meta
+    def __init__(self, grid, scalars: dict, meta: dict, out=None):
+        self.grid, self.scalars, self.meta, self.out = grid, dict(scalars), meta, out
         self.rows = {k: [] for k, f in FIELDS_3D.items() if f.shape in ("state", "step")}
+        self.journal = None
 
     def add(self, rec) -> None:
         """Append the state of a record (``rec.k`` must be ``len(self)``)."""
@@ -43,10 +50,38 @@ class Result3D:
         self.append(values)
 
     def append(self, values: dict) -> None:
-        """Append one state given every field by name (an interrupted append is not counted)."""
-        new = [(rows, np.array(values[k], copy=True)) for k, rows in self.rows.items()]
+        """Append one state given every field by name (an interrupted append is not counted), and to the
+        journal if the result has one."""
+        new = [(rows, np.array(values[k], copy=True).astype(FIELDS_3D[k].dtype)) for k, rows in self.rows.items()]
+        if self.out is not None:
+            self._journal({k: v for (k, _), (_, v) in zip(self.rows.items(), new)})
         for rows, v in new:
             rows.append(v)
+
+    def _journal(self, values: dict) -> None:
+        from ..journal import Journal, journal_path, layout_dtype, layout_of
+        if self.journal is None:
+            layout = layout_of(values)
+            head = {"x": self.grid.x, "y": self.grid.y, **{k: np.asarray(v, dtype=float) for k, v in self.scalars.items()}}
+            info = {"layout": {"S": layout, "R": layout}, "dimension": 3, "keep_every": 1}
+            self.journal = Journal.create(journal_path(self.out), head, json.dumps(self.meta, sort_keys=True,
+                                                                                  default=_json_default), info)
+        rec = np.zeros((), dtype=layout_dtype(self.journal.header["info"]["layout"]["S"]))
+        for k, v in values.items():
+            rec[k] = v
+        self.journal.append("S", len(self), rec)
+
+    def finish(self, notes: dict | None = None) -> str | None:
+        """The run is over: ``notes`` into ``meta``; with ``out``, the result file written (atomically) and
+        the journal removed. Returns the file's path (None without ``out``)."""
+        self.meta.update(notes or {})
+        if self.out is None:
+            return None
+        path = self.save(self.out)
+        if self.journal is not None:
+            self.journal.remove()
+            self.journal = None
+        return path
 
     def extend(self, arrays: dict) -> None:
         """Append every state of a 3D result file's ``arrays`` (an earlier part of the same run)."""
@@ -76,6 +111,23 @@ class Result3D:
     def save(self, path) -> str:
         """Write the result file atomically."""
         return save_npz(path, self.arrays(), "result file")
+
+
+def journal_arrays(journal) -> dict:
+    """The arrays of a 3D run's journal (a killed run's states, :class:`rollqp.journal.Journal` opened by
+    :func:`rollqp.result.resume_source`), as :func:`rollqp.result.load_result` gives a result file's: each
+    frame's CRC checked, the keys and shapes of :data:`FIELDS_3D`."""
+    from ..npzfile import text_value
+    head = journal.header["arrays"]
+    if int(journal.header["info"].get("dimension", 2)) != 3:
+        raise InputError(journal.arg, f"{journal.path!r} is the journal of a 2D run")
+    n = len(journal)
+    recs = journal.records(np.arange(n)) if n else None
+    out = {k: np.asarray(head[k]) for k in ("x", "y", "a", "b", "p0", "Estar") if k in head}
+    for name in (recs.dtype.names if recs is not None else ()):
+        out[name] = np.asarray(recs[name])
+    out["meta"] = text_value(head, "meta", journal.arg)
+    return read_checked(out, journal.arg)
 
 
 def _json_default(o):

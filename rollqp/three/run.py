@@ -108,15 +108,16 @@ def resumed_record(scene, contact, arrays: dict) -> StepRecord:
                       0, 0.0, float(arrays["residual"][-1]))
 
 
-def new_result(scene, contact, method_name: str) -> Result3D:
-    """An empty :class:`~rollqp.three.result.Result3D` with the scene's scalars and metadata."""
+def new_result(scene, contact, method_name: str, out=None) -> Result3D:
+    """An empty :class:`~rollqp.three.result.Result3D` with the scene's scalars and metadata (``out``: its
+    result file, journaled as the run goes)."""
     from ..version import __version__
     e = scene.ellipse
     meta = {"scene": scene.to_dict(), "method": method_name, "rollqp": __version__, "versions": dict(_versions()),
             "dimension": 3, "dq": scene.dq, "elements": int(contact.grid.n), "coupled": bool(contact.ops.coupled),
             "slip_note": ("state 0 of a braked start: static-shift slip per c = sqrt(ab) of shift"
                           if scene.load.start == "braked" else "state 0: the steady state")}
-    return Result3D(contact.grid, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta)
+    return Result3D(contact.grid, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, out=out)
 
 
 @functools.lru_cache(maxsize=1)
@@ -155,14 +156,20 @@ def resume_arrays(resume):
     a 3D run writes its result file, no journal), or None."""
     if resume is None or isinstance(resume, dict):
         return resume
-    if resume.journal is not None:
-        raise InputError(resume.arg, "a journal beside a 3D result file: 3D runs write no journal; resume from the "
-                                     "result file itself (remove the .journal file)")
+    if resume.journal is not None:      # a killed run's journal (it holds more than the result file)
+        from .result import journal_arrays
+        return journal_arrays(resume.journal)
     return resume.arrays
 
 
 def _started(result, resume) -> None:
-    """A resumed run's result: the earlier states, and what state 0 and the earlier steps noted."""
+    """A resumed run's result: the earlier states, and what state 0 and the earlier steps noted. With a
+    result file, the earlier states are written to it first, so that they are on disk while the new
+    journal is filled (a run killed then resumes from the file)."""
+    if result.out is not None:
+        earlier = Result3D(result.grid, result.scalars, dict(result.meta))
+        earlier.extend(resume)
+        earlier.save(result.out)
     result.extend(resume)
     result.meta["resumed_from"] = len(result) - 1
     earlier = resume.get("meta", {})
@@ -185,8 +192,10 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     """Run a 3D scene and return its :class:`~rollqp.three.result.Result3D` (arguments as
     :func:`rollqp.march.run`: ``progress(k, K)`` after each rolling step, ``observe(record, contact)``
     with every record, ``resume`` an earlier result file's arrays or :func:`resume_arrays`' source,
-    ``out`` the result file written at the end — and, with the completed states and the reason in
-    ``meta["failed"]`` or ``meta["interrupted"]``, when the run fails or is interrupted).
+    ``out`` the result file: every state journaled as it is completed (``out.journal``: a run killed
+    even by SIGKILL loses at most the state in flight), the file written at the end — and, with the
+    completed states and the reason in ``meta["failed"]`` or ``meta["interrupted"]``, when the run
+    fails or is interrupted).
     ``keep_every``: a 3D run keeps every state (None or 1).
 
     Raises
@@ -199,7 +208,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     resume = resume_arrays(resume)
     asked = scene if isinstance(scene, SceneBase) else load_scene(scene)
     scene, meth, contact = prepared = prepare(asked, method)
-    result = new_result(scene, contact, meth.name)
+    result = new_result(scene, contact, meth.name, out)
     if resume is not None:
         _started(result, resume)
     K = scene.n_steps
@@ -214,9 +223,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     except (SolverError, InputError, KeyboardInterrupt) as err:
         err.partial = result
         if out is not None and len(result):
-            result.meta["interrupted" if isinstance(err, KeyboardInterrupt) else "failed"] = str(err) or "interrupted"
-            result.save(out)
+            result.finish({"interrupted" if isinstance(err, KeyboardInterrupt) else "failed": str(err) or "interrupted"})
         raise
-    if out is not None:
-        result.save(out)
+    result.finish()
     return result

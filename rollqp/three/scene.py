@@ -199,8 +199,8 @@ def _discretization(d: Discretization3D) -> Discretization3D:
                                      lambda x: 1 < x <= 100))
     return Discretization3D(elements, zone,
                             number("discretization.step", d.step, "in (0, 8] (Δq/Δx)", lambda x: 0 < x <= 8),
-                            number("discretization.distance", d.distance, ">= 0 (rolled distance / a)",
-                                   lambda x: x >= 0))
+                            number("discretization.distance", d.distance, "in [0, 1e6] (rolled distance / a)",
+                                   lambda x: 0 <= x <= 1e6))
 
 
 def _solver(s: Solver3D) -> Solver3D:
