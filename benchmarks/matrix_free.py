@@ -13,11 +13,12 @@ compares the circulant preconditioner with none (GMRES products per step).
     python benchmarks/matrix_free.py --nodes 321 1281 2561 10001 40001 131073 --dense 2561
     python benchmarks/matrix_free.py --threshold --nodes 161 321 641 1281 2561
     python benchmarks/matrix_free.py --preconditioner --nodes 321 2561 10001
-    python benchmarks/matrix_free.py --transient --nodes 10001 [--distance 6]
+    python benchmarks/matrix_free.py --transient --nodes 10001 [--distance 6] [--source /other/checkout]
 
 ``--transient``: the §6.1.1 transient (``cattaneo-carter``, ``mf-newton``, Δq = 8 Le, the longest step
 allowed) on each ``--nodes``, in a fresh process: wall and CPU seconds, per step (mean, median and by
-eighths of the run), set iterations and operator products per step.
+eighths of the run), set iterations and operator products per step. ``--source`` adds the same run on
+another source tree's rollqp (an earlier checkout), the two alternating, for a before/after ratio.
 """
 from __future__ import annotations
 
@@ -103,19 +104,20 @@ for rec in rollqp.march(sc):
     rows.append((rec.step_time, rec.counters.iterations, (sol.info.get("products") or 0) if sol is not None else 0))
 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
 a = np.array(rows[1:], dtype=float)
-parts = [[float(np.median(b[:, 0])), float(b[:, 1].mean()), float(b[:, 2].mean())] for b in np.array_split(a, 8)]
+parts = [[float(np.median(b[:, 0])), float(b[:, 1].mean()), float(b[:, 2].mean())] for b in np.array_split(a, min(8, len(a)))]
 print(json.dumps({"nodes": sc.n_nodes, "steps": len(a), "wall": wall, "cpu": cpu, "start": rows[0][0],
                   "mean": float(a[:, 0].mean()), "median": float(np.median(a[:, 0])), "sets": float(a[:, 1].mean()),
                   "products": float(a[:, 2].mean()), "parts": parts}))
 """
 
 
-def transient(n, distance):
-    """The §6.1.1 transient on ``n`` nodes with ``mf-newton`` (module docstring), in a fresh process."""
-    src = str(Path(__file__).resolve().parent.parent)
+def transient(n, distance, source=None):
+    """The §6.1.1 transient on ``n`` nodes with ``mf-newton`` (module docstring), in a fresh process (on the
+    rollqp of the source tree ``source``, default this one)."""
+    src = str(Path(source).resolve()) if source else str(Path(__file__).resolve().parent.parent)
     res = subprocess.run([sys.executable, "-c", _TRANSIENT, str(n), str(distance)], env=dict(os.environ, PYTHONPATH=src),
                          cwd=src, capture_output=True, text=True, check=True)
-    return json.loads(res.stdout.strip().splitlines()[-1])
+    return json.loads(res.stdout.strip().splitlines()[-1]) | {"load": os.getloadavg()[0]}
 
 
 def measure(n, kind, repeats, opts=None, what="normal,roll"):
@@ -142,20 +144,24 @@ def main(argv=None):
     ap.add_argument("--preconditioner", action="store_true", help="circulant vs no preconditioner")
     ap.add_argument("--transient", action="store_true", help="the §6.1.1 transient with mf-newton, Δq = 8 Le")
     ap.add_argument("--distance", type=float, default=6.0, help="rolled distance of --transient, in a_H")
+    ap.add_argument("--source", help="--transient also on this source tree's rollqp (before/after)")
     args = ap.parse_args(argv)
     pin_threads()
     cmd = "python benchmarks/matrix_free.py " + " ".join(sys.argv[1:] if argv is None else argv)
     print(machine_table(cmd), "\n", flush=True)
     if args.transient:
         for n in args.nodes:
+            runs = [(args.source, transient(n, args.distance, args.source))] if args.source else []
             r = transient(n, args.distance)
-            print(table(["nodes", "steps", "wall", "CPU", "step: mean", "median", "CPU a step", "sets a step",
-                         "products a step"],
-                        [[r["nodes"], r["steps"], f"{r['wall']:.1f} s", f"{r['cpu']:.1f} s", _fmt(r["mean"]),
-                          _fmt(r["median"]), _fmt(r["cpu"] / r["steps"]), f"{r['sets']:.2f}", f"{r['products']:.1f}"]]))
+            runs.append((None, r))
+            print(table(["source", "load (1 min, after)", "nodes", "steps", "wall", "CPU", "step: mean", "median",
+                         "CPU a step", "sets a step", "products a step"],
+                        [[src or "this tree", f"{x['load']:.1f}", x["nodes"], x["steps"], f"{x['wall']:.1f} s",
+                          f"{x['cpu']:.1f} s", _fmt(x["mean"]), _fmt(x["median"]), _fmt(x["cpu"] / x["steps"]),
+                          f"{x['sets']:.2f}", f"{x['products']:.1f}"] for src, x in runs]))
             print()
             print(table(["steps (eighths of the run)", "median step", "sets a step", "products a step"],
-                        [[f"{k + 1}/8", _fmt(m), f"{s_:.2f}", f"{p:.1f}"] for k, (m, s_, p) in enumerate(r["parts"])]))
+                        [[f"{k + 1}/{len(r['parts'])}", _fmt(m), f"{s_:.2f}", f"{p:.1f}"] for k, (m, s_, p) in enumerate(r["parts"])]))
         return
     if args.threshold:
         rows = []

@@ -27,7 +27,12 @@ Overheads, measured on the way: the sweep's fixed part (validation and store), t
 writes (``StoreWriter.write``, timed in the client, wall and the writing thread's CPU), each
 point's CPU time beside its wall time (in the serial run and on the workers), and
 ``(workers × points' wall − Σ point times)/points``: what a point costs beyond its own
-computation on a worker, its share of the writes, the scheduler and the tail included.
+computation on a worker, its share of the writes, the scheduler and the tail included. A
+**CPU-based ratio**, less sensitive to other jobs on the machine than the wall-clock one: the serial
+run's CPU seconds against the sweep's CPU shared by the workers (the points' CPU on the workers and
+the client process's CPU during the sweep — validation, store, writes, the scheduler's thread —
+divided by ``--workers``): what free cores would give if only CPU counted (the workers' own dask CPU
+between points is not in it).
 
 Control: the machine's parallelism at the moment (``workers`` pure-Python loops in processes at
 once against one alone; 2× on an idle 2-core machine), measured between the repetitions: on a
@@ -107,11 +112,11 @@ class _TimedWriter(dataset.StoreWriter):
 
 def _sweep(base, vary, client, folder, summaries) -> float:
     store = os.path.join(folder, f"s{len(summaries)}.zarr")
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     summary = sweep(base, vary, store, client=client)
     wall = time.perf_counter() - t0
     assert summary.done == summary.total and not summary.failed, summary.table()
-    summaries.append((wall, summary))
+    summaries.append((wall, summary, time.process_time() - c0))
     shutil.rmtree(store)
     return wall
 
@@ -129,9 +134,13 @@ def _creep_command(folder, extra=()) -> float:
 def _rows(size, walls, summaries, workers, startup):
     ser, par = statistics.median(walls[f"serial {size}"]), statistics.median(walls[f"sweep {size}"])
     n = summaries[0][1].total
-    pts = [sum(s.point_times) for _, s in summaries]
-    extra = [(workers * s.wall - p) / n for (_, s), p in zip(summaries, pts)]
-    fixed = [s.prepare for _, s in summaries]
+    pts = [sum(s.point_times) for _, s, _ in summaries]
+    extra = [(workers * s.wall - p) / n for (_, s, _), p in zip(summaries, pts)]
+    fixed = [s.prepare for _, s, _ in summaries]
+    # CPU-based ratio: the serial run's CPU against the sweep's CPU shared by the workers (the points' CPU on
+    # the workers plus the client process's: validation, store, writes, the scheduler's thread), what free
+    # cores would give if nothing but CPU counted (the workers' own dask CPU between points is not in it)
+    sweep_cpu = statistics.median((sum(s.point_cpu) + c) / workers for _, s, c in summaries)
     return [
         (f"**{size}**: points", f"{n} ({summaries[0][1].per_chunk} per task and chunk)"),
         ("serial, one process (median)", f"{ser:.2f} s  ({', '.join(f'{w:.2f}' for w in walls[f'serial {size}'])})"),
@@ -141,7 +150,10 @@ def _rows(size, walls, summaries, workers, startup):
         ("mean point time: serial / on the workers", f"{1e3 * ser / n:.0f} ms / {1e3 * statistics.median(pts) / n:.0f} ms"),
         ("mean point CPU time: serial / on the workers",
          f"{1e3 * statistics.median(CPU[size]) / n:.0f} ms / "
-         f"{1e3 * statistics.median(sum(s.point_cpu) for _, s in summaries) / n:.0f} ms"),
+         f"{1e3 * statistics.median(sum(s.point_cpu) for _, s, _ in summaries) / n:.0f} ms"),
+        ("client process CPU during a sweep (median)", f"{statistics.median(c for _, _, c in summaries):.2f} s"),
+        ("CPU-based ratio: serial CPU / ((Σ point CPU on the workers + client CPU) / workers)",
+         f"{statistics.median(CPU[size]) / sweep_cpu:.2f}×"),
         ("validation and store creation (median)", f"{1e3 * statistics.median(fixed):.0f} ms"),
         ("(workers × points' wall − Σ point times)/points (median)", f"{1e3 * statistics.median(extra):.1f} ms"),
     ]

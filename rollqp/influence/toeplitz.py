@@ -167,8 +167,7 @@ class ToeplitzOperator(Operator):
         even), so ``Ŷ = A X + B conj(X reversed)`` with ``A = (K̂_0 + K̂_1)/2``, ``B = (K̂_0 − K̂_1)/2``. ``L``
         is a fast length (``scipy.fft.next_fast_len``) of at least ``2n − 1`` and ``n − k_min + r``: the
         circular wrap-around of the shifted kernels then falls on indices that are not kept, and the
-        product is the exact linear convolution (before: one transform per local node, three for
-        quadratic elements, and one inverse).
+        product is the exact linear convolution (docs/matrix-free.md, "The operator").
         """
         import scipy.fft  # here: the dense assembly (generators, assemble) needs no scipy.fft
         P, r, n, ne = self._P, self._r, self._n, self._ne

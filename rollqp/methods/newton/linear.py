@@ -299,12 +299,11 @@ class ReducedSystem:
         """``(factorization, released, added)``: of the kept factorizations (:meth:`_keep`), the one whose free
         set differs least from ``m``, and the nodes it must release and add.
 
-        A Newton iterate's free set can swing by hundreds of nodes and back within a step (measured on
-        ``cattaneo-carter`` at 2,561 nodes, steps 550–670: the second iterate of each step sticks ~200
-        nodes that the third releases again), so it is far from the set factored last but within a few
-        nodes of the one factored at the same iterate of the previous step: bordered on that one instead
-        of refactoring twice a step. :meth:`direction` asks for it only where the last factorization is
-        too far to border on (the iterates near it keep bordering on it)."""
+        A Newton iterate's free set can swing by hundreds of nodes and back within a step, so it is far
+        from the set factored last but within a few nodes of the one factored at the same iterate of the
+        previous step: bordered on that one instead of refactoring twice a step (measured in
+        docs/performance.md, "Measured settings of the methods"). :meth:`direction` asks for it only
+        where the last factorization is too far to border on (the iterates near it keep bordering on it)."""
         best, best_k = self._base[with_load], None
         for b in self._factors.values():
             if b[6][0] != with_load:
