@@ -547,6 +547,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Ite
     """
     scene, meth, ops = prepared if prepared is not None else prepare(scene, method)
     m = _March(scene, ops, meth)
+    M = ops.history()  # built (on the dense path: from an n × n matrix) before the start's solver holds its systems
     if resume is not None:
         if verify:
             check_resumed(scene, (scene, meth, ops), resume, march=m)
@@ -558,7 +559,6 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Ite
             raise (err.with_step(0) if err.step is None else err) from err
         yield start
         state, first = start.state, 1
-    M = ops.history()
     qs = m.plan.q
     for k in range(first, qs.size):
         try:

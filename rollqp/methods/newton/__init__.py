@@ -244,7 +244,7 @@ class NewtonMethod:
             self._systems[key] = self._systems.pop(key)  # most recently used last
             self._last = (pb.A, pb.f, pb.kind, dqh, sc, hit)
             return hit
-        n = pb.n
+        n, last = pb.n, None  # (not holding the last step's system while a new one is built)
         self._make_room(key, 8 * n * (n + 1))
         K = np.empty((n, n + 1))  # Â in its first n columns, scaled into K in place (ReducedSystem)
         Ahat = np.multiply(pb.A.dense(), sc.modulus / sc.length, out=K[:, :n])

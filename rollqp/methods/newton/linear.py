@@ -175,6 +175,7 @@ class ReducedSystem:
         K = self.K
         free = np.flatnonzero(m)
         nf = free.size
+        self._make_room(8 * (nf + with_load) ** 2)  # within the size of K also while it is built
         M = np.empty((nf + with_load, nf + with_load), order="F")
         # small n: two takes (np.ix_ costs 2.4× as much at 81 nodes); large n: np.ix_, without the
         # intermediate nf × n rows of the takes, a block of columns at a time (no second nf × nf array)
@@ -201,6 +202,15 @@ class ReducedSystem:
         base = (m.copy(), free, pos, lu, piv, _Store(nf + with_load), key)
         self._keep(key, base)
         return base
+
+    def _make_room(self, nbytes) -> None:
+        """Drop the oldest kept factorizations until one more of ``nbytes`` fits (:meth:`_keep`'s limits): the
+        same ones :meth:`_keep` would drop once it is kept, dropped before it is built, so that the matrix
+        being factored and the kept factors never hold more than ``K`` does (at 2,561 nodes, 52 MB less peak)."""
+        store = self._factors
+        while store and (len(store) >= self.MAX_FACTORS or
+                         sum(b[3].nbytes for b in store.values()) + nbytes > self.K.nbytes):
+            store.pop(next(iter(store)))
 
     def _keep(self, key, base):
         """Keep the factorization ``base`` of the free set ``key`` (:data:`MAX_FACTORS`, within the size of ``K``):
