@@ -305,3 +305,15 @@ def test_a_killed_run_resumes_from_its_journal(tmp_path, capsys, monkeypatch):
     assert back["q"].shape == full["q"].shape and back["meta"]["resumed_from"] == 3
     assert np.max(np.abs(back["px"] - full["px"])) <= 1e-9 * scene.mu * scene.ellipse.p0
     assert not (tmp_path / "k.npz.journal").exists()
+
+
+def test_a_conic_run_is_cross_checked_by_the_other_route_only(tmp_path, capsys, monkeypatch):
+    """socp-clarabel and qp-clarabel are one class: a socp-clarabel run is cross-checked by Newton."""
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "ke.toml"
+    path.write_text(coarse("kalker-elliptic", **{"solver.method": "socp-clarabel"}).to_toml(), encoding="utf-8")
+    assert cli.main(["run", str(path)]) == 0
+    out = capsys.readouterr().out
+    line = next(ln for ln in out.splitlines() if "cross-check" in ln)
+    assert "newton on steps 0" in line and "qp-clarabel" not in line, line
+    assert "raw conic" in out

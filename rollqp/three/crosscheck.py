@@ -142,8 +142,10 @@ def _compare(row, contact, rec, nsol, tsol) -> dict:
 def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance: float = 1e-10) -> CrossCheck:
     """Solve the kept steps of a run (``observer``) again with ``methods`` (default: the registry's
     :data:`~rollqp.methods.CROSS_CHECK_METHODS_3D` without ``ran``) and compare (module docstring)."""
-    from ..methods import CROSS_CHECK_METHODS_3D, get_method
-    names = [m for m in (methods or CROSS_CHECK_METHODS_3D) if m != ran]
+    from ..methods import CROSS_CHECK_METHODS_3D, get_method, method_class
+    if methods is None:      # the other route: not the class that ran (socp-clarabel and qp-clarabel are one)
+        methods = [m for m in CROSS_CHECK_METHODS_3D if method_class(m, 3) is not method_class(ran, 3)]
+    names = [m for m in methods if m != ran]
     contact, kept = observer.contact, observer.kept
     out = CrossCheck(sorted(kept), steady=any(rec.phase == "steady" for rec, _ in kept.values()), ran=ran)
     for name in names:
