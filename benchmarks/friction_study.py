@@ -15,9 +15,11 @@ Sections:
 * ``fixedpoint`` Newton against the fixed point on the bound around qp-clarabel, step by step (V = 450 mm/s);
 * ``sweep``      a ramped falling-friction transient (tests/test_friction_falling.py's scene: V = 10 m/s, 80
                  constant elements, Q ramped to 0.5 μ_s P over 0.9 a_H, 4.5 a_H) for the exponential and
-                 linear laws over v_h = 1 … 1e12 mm/s: each method's run, the two runs against each other, and
-                 every step of Newton's run re-solved from the same state by the fixed point around
-                 qp-clarabel (both at tolerance 1e-12; about 10 min).
+                 linear laws over v_h = 1 … 1e12 mm/s: each method's run (the registry's composition: the
+                 solution of each step selected by the path from the frozen bound), the two runs against each
+                 other, and every step of Newton's run re-solved from the same state by the bare methods
+                 (the slip Newton alone, the fixed point on the bound alone), all at tolerance 1e-12: how
+                 often each bare method returns another solution of the same step (about 40 min).
 """
 from __future__ import annotations
 
@@ -127,33 +129,53 @@ def _marched(sc, method):
         return ts, recs, f"step {err.step}: {err.status}, residual {err.residual:.1e}"
 
 
+def _unselected(sc, recs, mp0):
+    """Every step of the selected run re-solved from the same previous state by each method *without* the
+    selection (the bare slip Newton; the fixed point on the bound around qp-clarabel): per method the steps on
+    which it returns another solution (``> 1e-8`` μ_s p0 away), the largest distance, the largest residual of
+    those other solutions, and the steps it fails on."""
+    out = []
+    for name in ("newton", "qp-clarabel"):
+        raw = get_method(name, tolerance=1e-12)
+        raw = raw if name == "newton" else BoundFixedPoint(raw)
+        raw.setup(prepare(sc, name)[2])
+        other, worst, res, failed = 0, 0.0, 0.0, 0
+        for rec in recs[1:]:
+            try:
+                sol = raw.solve(rec.problem, warm=rec.previous.tsol)
+            except Exception:  # noqa: BLE001 - a SolverError of the bare method: counted
+                failed += 1
+                continue
+            d = float(np.max(np.abs(sol.t - rec.solution.t))) / mp0
+            if d > 1e-8:
+                other, worst, res = other + 1, max(worst, d), max(res, float(sol.residual))
+        out.append(f"{other}" + (f" ({worst:.2f}; {res:.0e})" if other else "") + (f", {failed} failed" if failed else ""))
+    return out
+
+
 def sweep_section():
-    """Newton and the QP fixed point on the ramped falling-friction transient over the velocity scale."""
+    """Newton and the QP fixed point (both with the selection of the path from the frozen bound) on the ramped
+    falling-friction transient over the velocity scale, and the bare methods on the same steps."""
     from rollqp.scene import scene_from_dict
     rows = []
     for law, vh, dist in SWEEP:
         sc = scene_from_dict(SWEEP_SCENE).replace(**{"contact.friction.law": law, "contact.friction.velocity": vh,
                                                      "discretization.distance": dist})
         mp0 = 0.32 * sc.p0
+        t0 = time.perf_counter()
         tn, recs, msg_n = _marched(sc, "newton")
-        tq, _, msg_q = _marched(sc, "qp-clarabel")
+        t1 = time.perf_counter()
+        tq, rq, msg_q = _marched(sc, "qp-clarabel")
+        t2 = time.perf_counter()
         k = min(len(tn), len(tq))
         traj = max(float(np.max(np.abs(a - b))) for a, b in zip(tn[:k], tq[:k])) / mp0
-        fp = BoundFixedPoint(get_method("qp-clarabel", tolerance=1e-12))
-        fp.setup(prepare(sc, "qp-clarabel")[2])
-        worst, other, failed = 0.0, 0, 0
-        for rec in recs[1:]:
-            try:
-                sol = fp.solve(rec.problem, warm=rec.previous.tsol)
-            except Exception:  # noqa: BLE001 - a SolverError of the fixed point: counted
-                failed += 1
-                continue
-            d = float(np.max(np.abs(sol.t - rec.solution.t))) / mp0
-            worst, other = max(worst, d), other + (d > 1e-8)
+        res = max(float(r.solution.residual) for r in recs[1:] + rq[1:])
+        pts = max(r.solution.info.get("path", {}).get("points", 0) for r in recs[1:])
         rows.append([law, f"{vh:g}", f"{dist:g}", f"{len(tn) - 1} ({msg_n})", f"{len(tq) - 1} ({msg_q})",
-                     f"{traj:.1e}", f"{worst:.1e}", other, failed])
+                     f"{traj:.1e}", f"{res:.0e}", pts, f"{t1 - t0:.0f} / {t2 - t1:.0f}", *_unselected(sc, recs, mp0)])
     return table(["law", "v_h [mm/s]", "a_H", "newton steps", "qp-clarabel steps", "runs: max |Δt|/(μ_s p0)",
-                  "same step: max |Δt|/(μ_s p0)", "steps > 1e-8", "fixed point failed"], rows)
+                  "largest residual", "path points (max a step)", "s (newton / qp-clarabel)",
+                  "bare newton: other solutions (max |Δt|; residual)", "bare fixed point: other solutions"], rows)
 
 
 SECTIONS = {"slope": slope_section, "falling": falling_section, "march": march_section,

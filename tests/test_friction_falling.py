@@ -12,7 +12,8 @@ import pytest
 from rollqp.energy import balance
 from rollqp.friction import SlipVelocity
 from friction_cases import contact_velocity, veldep_scene
-from rollqp.march import march, run
+from rollqp.march import march, prepare, run
+from rollqp.methods import get_method
 from rollqp.scene import load_scene, scene_from_dict
 
 #: The ramped falling-friction transient on which the slip-dependent Newton matrix used to become
@@ -53,10 +54,44 @@ def test_the_singular_scene_runs_and_agrees():
 @pytest.mark.parametrize("law, velocity", [("exponential", 100.0), ("linear", 1e4), ("exponential", 1e12)])
 def test_laws_over_the_velocity_scale(law, velocity):
     """A few points of the sweep (benchmarks/friction_study.py --only sweep: v_h = 100 … 1e12 mm/s)."""
-    sc = scene_from_dict(SCENE).replace(**{"contact.friction": {"law": law, "static": 0.32, "kinetic": 0.20,
-                                                                "velocity": velocity, "rolling_speed": 10000.0},
-                                           "discretization.distance": 1.5})
-    assert _agreement(sc) <= 1e-8
+    assert _agreement(_sweep_scene(law, velocity, 1.5)) <= 1e-8
+
+
+def _sweep_scene(law, velocity, distance):
+    return scene_from_dict(SCENE).replace(**{"contact.friction": {"law": law, "static": 0.32, "kinetic": 0.20,
+                                                                  "velocity": velocity, "rolling_speed": 10000.0},
+                                             "discretization.distance": distance})
+
+
+def test_a_step_with_two_solutions_gets_the_selected_one():
+    """Linear law, v_h = 1 mm/s: from about 0.8 a_H on, steps of the ramped transient have two solutions. Newton
+    and the fixed point around qp-clarabel, each composed by the registry, return the same one (the end of the
+    path from the frozen bound, docs/friction.md "Which solution of a step"); the bare slip Newton, from the same
+    previous state, returns the other on some steps — both solve the step to the solver tolerance."""
+    sc = _sweep_scene("linear", 1.0, 0.9).replace(**{"solver.tolerance": 1e-12})
+    recs = list(march(sc, "newton"))
+    qp = _states(sc, "qp-clarabel", 1e-12)
+    assert len(qp) == len(recs) == 31
+    # both at tolerance 1e-12 (_agreement); measured 4e-14 apart
+    assert max(float(np.max(np.abs(r.state.t - t))) for r, t in zip(recs, qp)) <= 1e-8 * 0.32 * sc.p0
+    bare = get_method("newton", tolerance=1e-12)
+    bare.setup(prepare(sc, "newton")[2])
+    other = []
+    for rec in recs[1:]:
+        assert rec.solution.info["path"]["points"] >= 1 and rec.solution.residual <= 1e-12
+        sol = bare.solve(rec.problem, warm=rec.previous.tsol)
+        assert sol.residual <= 1e-12  # solved to the tolerance asked for (measured ≤ 2e-14)
+        other.append(float(np.max(np.abs(sol.t - rec.solution.t))) / (0.32 * sc.p0))
+    # the second solution lies 0.26 … 0.32 μ_s p0 away (measured on steps 27 and 28, the only ones up to 0.9 a_H)
+    assert max(other) > 0.1
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("law", ["exponential", "linear"])
+@pytest.mark.parametrize("velocity", [1.0, 10.0, 100.0, 1e3, 1e4, 1e6, 1e8, 1e10, 1e12])
+def test_sweep_over_the_velocity_scale(law, velocity):
+    """The sweep of docs/friction.md (benchmarks/friction_study.py --only sweep): 4.5 a_H, every state."""
+    assert _agreement(_sweep_scene(law, velocity, 4.5)) <= 1e-8
 
 
 def test_contact_map_halves_the_falling_term_at_sabsh1():

@@ -60,7 +60,10 @@ class FrictionLaw(Protocol):
         ``coefficient(x_hat, q_hat, direction) -> (n,) array`` (``μ`` at the nodes, ``a_H`` units) and
         ``check_strip(half_width_hat, q_end_hat, direction)`` (the scene's check that it meets the
         strip). ``"slip"``: also ``steady(v) -> (μ, dμ/dv)`` of the slip velocity, ``rolling_speed``,
-        ``memory`` and ``weight(dq_hat)`` (:class:`~.bound.SlipBound`).
+        ``memory`` and ``weight(dq_hat)`` (:class:`~.bound.SlipBound`), and for the selection of a step's
+        solution on steep laws (:mod:`rollqp.methods.continuation`) ``steepest`` (the largest ``|dμ/dv|``),
+        ``kinks`` (the velocities where ``μ(v)`` has a kink) and ``branch(v, k) -> (μ, dμ/dv)`` (the ``k``-th
+        smooth piece's formula, continued beyond it).
     reference : float
         The ``μ`` of ``load.tangential = Q/(μ P̄)`` and of the reports.
     largest : float

@@ -34,11 +34,20 @@ __all__ = ["SlipBound", "step_coefficient", "steady_branches"]
 @dataclass(frozen=True)
 class SlipBound:
     """The slip-dependent coefficient ``μ(s)`` of one step (module docstring). ``s`` is the slip per unit
-    rolled distance (the step problems' ``s``, a pure number)."""
+    rolled distance (the step problems' ``s``, a pure number).
+
+    With ``frozen`` (coefficients at the nodes, those of the previous state) the bound is a point of the path
+    from the frozen bound to the law, ``μ_λ(s) = (1 − λ) μ_f + λ μ(s)`` with ``λ = blend`` (docs/friction.md,
+    "Which solution of a step"): a step with such a bound asks for the solution near its warm start
+    (:attr:`on_path`). ``frozen = None``: the law itself.
+    """
 
     law: object                      # rollqp.friction.laws.SlipVelocity
     weight: float = 0.0              # memory weight w
     previous: np.ndarray | None = None  # μ̄ at the nodes (memory); None: w = 0
+    frozen: np.ndarray | None = None    # μ_f of the path from the frozen bound (None: the law itself)
+    blend: float = 1.0                  # λ on that path
+    steady: bool = False                # the bound of a direct steady solve (its operator is not symmetric)
 
     def mu(self, s, contact=None) -> np.ndarray:
         """``μ_i(s_i)``; ``contact`` (a mask, optional): outside it the slip velocity is taken as 0, CONTACT's
@@ -47,14 +56,44 @@ class SlipBound:
         if contact is not None:
             v = np.where(contact, v, 0.0)
         m, _ = self.law.steady(v)
-        return m if self.previous is None else (1.0 - self.weight) * m + self.weight * self.previous
+        m = m if self.previous is None else (1.0 - self.weight) * m + self.weight * self.previous
+        return m if self.frozen is None else (1.0 - self.blend) * self.frozen + self.blend * m
 
     def dmu(self, s) -> np.ndarray:
         """``∂μ_i/∂s_i`` (zero at ``s_i = 0``: the one-sided derivative into slip is taken by the Newton
         method from the sign of the slip it moves to)."""
         V = self.law.rolling_speed
         _, d = self.law.steady(V * np.abs(s))
-        return (1.0 - self.weight) * d * V * np.sign(s)
+        d = (1.0 - self.weight) * d * V * np.sign(s)
+        return d if self.frozen is None else self.blend * d
+
+    @property
+    def on_path(self) -> bool:
+        """A point of the path from the frozen bound (``frozen`` given): its step is solved near the warm start."""
+        return self.frozen is not None
+
+    def homotopy(self, frozen, blend) -> "SlipBound":
+        """This bound as the point ``λ = blend`` of the path from the frozen coefficients ``frozen``."""
+        return SlipBound(self.law, self.weight, self.previous, np.asarray(frozen, dtype=float), float(blend),
+                         self.steady)
+
+    @property
+    def steepness(self) -> float:
+        """The largest ``|∂μ/∂s|`` the law takes: ``(1 − w) V max|dμ/dv|``."""
+        return (1.0 - self.weight) * self.law.rolling_speed * float(self.law.steepest)
+
+    def segment(self, v) -> np.ndarray:
+        """The smooth piece of ``μ(v)`` each slip velocity ``v >= 0`` lies on (:attr:`~.laws.SlipVelocity.kinks`)."""
+        return np.searchsorted(np.asarray(self.law.kinks, dtype=float), v, side="right")
+
+    def branch(self, v, k) -> tuple:
+        """``(μ, ∂μ/∂v)`` of this step's coefficient (the memory included, the path's blend not) at the slip
+        velocities ``v`` on the smooth pieces ``k`` of the law, each piece's formula continued beyond it
+        (:meth:`~.laws.SlipVelocity.branch`)."""
+        m, d = self.law.branch(v, k)
+        if self.previous is None:
+            return m, d
+        return (1.0 - self.weight) * m + self.weight * self.previous, (1.0 - self.weight) * d
 
     def slip_velocity(self, s) -> np.ndarray:
         """``v = V |s|`` (length/time)."""
@@ -99,7 +138,7 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
         return law.coefficient(x_hat, q_hat, direction), None
     static = law.steady(0.0)[0]
     if law.memory == 0.0:
-        return float(static), SlipBound(law)
+        return float(static), SlipBound(law, steady=bool(steady))
     if steady:
         raise InputError("contact.friction.memory", "a direct steady solve cannot carry the friction memory "
                                                     "along the material; use load.start = 'braked' (marching) or "

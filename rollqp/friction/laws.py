@@ -252,6 +252,36 @@ class SlipVelocity:
         e = np.exp(-np.maximum(0.0, v - self.plateau) / vh)
         return self.kinetic + dm * e, np.where(over, -dm * e / vh, 0.0)
 
+    @property
+    def steepest(self) -> float:
+        """The largest ``|dμ/dv|`` over ``v >= 0``: ``Δμ/v_h`` for every form (at ``v = 0``, or just above ``v_p``)."""
+        return (self.static - self.kinetic) / self.velocity
+
+    @property
+    def kinks(self) -> tuple:
+        """The slip velocities where ``μ(v)`` has a kink (its slope jumps): ``v_h`` (linear: μ reaches μ_k),
+        ``v_p`` (plateau: the fall starts); none for the rational and exponential forms."""
+        if self.law == "linear":
+            return (self.velocity,)
+        if self.law == "plateau":
+            return (self.plateau,)
+        return ()
+
+    def branch(self, v, k):
+        """``(μ, dμ/dv)`` of the ``k``-th smooth piece of ``μ(v)`` (between :attr:`kinks` ``k − 1`` and ``k``),
+        evaluated at any ``v`` — also beyond the piece and at ``v < 0``, the piece's own formula continued: the
+        path of solutions (:mod:`rollqp.methods.path`) follows one smooth piece at a time and needs its equations
+        a little past the piece's ends to find where it leaves it. ``k`` an int or an int array like ``v``."""
+        v = np.asarray(v, dtype=float)
+        dm, vh = self.static - self.kinetic, self.velocity
+        if self.law == "linear":  # piece 0: the falling line; piece 1: μ_k
+            return (np.where(k == 0, self.kinetic + dm * (1.0 - v / vh), self.kinetic),
+                    np.where(k == 0, -dm / vh + 0.0 * v, 0.0 * v))
+        if self.law == "plateau":  # piece 0: μ_s; piece 1: the exponential fall from v_p
+            e = np.exp(-(v - self.plateau) / vh)
+            return (np.where(k == 0, self.static, self.kinetic + dm * e), np.where(k == 0, 0.0, -dm * e / vh))
+        return self.steady(v)
+
     def weight(self, dq_hat) -> float:
         """The memory's weight ``w = L/(L + |Δq|)`` of the previous coefficient (0 without memory)."""
         return 0.0 if self.memory == 0.0 else self.memory / (self.memory + abs(dq_hat))

@@ -267,7 +267,9 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
 
     With a slip-dependent friction law (``friction = "slip"``) a method that does not declare
     ``slip_dependent`` runs inside the fixed point on the bound
-    (:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`: each iteration one of its QPs). A method
+    (:class:`~rollqp.methods.fixedpoint.BoundFixedPoint`: each iteration one of its QPs), and every method
+    inside :class:`~rollqp.methods.continuation.SlipContinuation`, which selects the solution of a step that a
+    steep law makes non-unique (the end of the path from the frozen bound, docs/friction.md "Which solution of a step"). A method
     whose coupled step takes a constant coefficient only (``newton``) refuses a law on a coupled
     scene up front, naming the alternatives.
     """
@@ -280,9 +282,12 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
                                           f"{' or '.join(sorted(caps.coupled_friction))} friction only; with a "
                                           f"{friction} friction law on a coupled scene use "
                                           "'nt-newton' (Newton halves in the N–T alternation) or a qp-* method")
-    if friction == "slip" and not caps.slip_dependent:
-        from .fixedpoint import BoundFixedPoint
-        method = BoundFixedPoint(method)
+    if friction == "slip":
+        from .continuation import SlipContinuation
+        if not caps.slip_dependent:
+            from .fixedpoint import BoundFixedPoint
+            method = BoundFixedPoint(method)
+        method = SlipContinuation(method)
     if coupled and "coupled" not in caps.solves:
         if not {"normal", "tangential"} <= caps.solves:
             raise InputError("solver.method", f"method {method.name!r} solves neither coupled steps nor both "

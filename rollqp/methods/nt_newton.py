@@ -5,6 +5,7 @@ import dataclasses
 
 from .alternation import Alternation
 from .base import FRICTION_KINDS, check_options
+from .continuation import SlipContinuation
 from .newton import NewtonMethod
 
 __all__ = ["AlternationNewton"]
@@ -18,7 +19,9 @@ class AlternationNewton(Alternation):
     capabilities = dataclasses.replace(NewtonMethod.capabilities, coupled_friction=FRICTION_KINDS, single_sweeps=True)
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, max_outer: int = 200, **newton):
-        super().__init__(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton),
+        # the halves composed as the registry composes a method (rollqp.methods.compose): a slip-dependent
+        # half's solution selected by the path from the frozen bound (a no-op for every other step)
+        super().__init__(SlipContinuation(NewtonMethod(tolerance=tolerance, max_iterations=max_iterations, **newton)),
                          max_outer=max_outer)
         self.name = "nt-newton"
 

@@ -21,7 +21,11 @@ def solve_slip_step(meth, pb, warm, t0):
     improved; else Newton from zero shear (run to the iteration limit); with ``Q`` prescribed, else the
     creepage search (its ξ-prescribed solves safeguarded alike). A solution with unstable modes is kept only
     if no attempt finds a stable one (``info["unstable"]`` says how many). The first error is raised if all
-    fail, with the best residual reached."""
+    fail, with the best residual reached. A step whose bound is a point of the path from the frozen bound
+    (:attr:`~rollqp.friction.bound.SlipBound.on_path`, :mod:`rollqp.methods.continuation`) is solved by the
+    Newton iteration from ``warm`` alone: the path has chosen the solution."""
+    if pb.law.on_path:  # a point of the path from the frozen bound: the solution near the warm start, no other
+        return meth.checked(solve_slip(meth, pb, warm, t0))
     found = []  # unstable solutions, in the order found
 
     def stable(sol):

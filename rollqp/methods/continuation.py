@@ -1,0 +1,135 @@
+r"""Which solution of a slip-dependent step every method returns: the end of the path from the frozen bound.
+
+A falling friction law can give one step several solutions (docs/friction.md, "Which solution of a step").
+Which one a method finds would then depend on the method (docs/friction.md shows two methods' solutions of
+the same step far apart, both to round-off). :class:`SlipContinuation` makes the choice once, for every method
+that the registry composes with it (:func:`rollqp.methods.compose`): the solution returned is the end at
+``λ = 1`` of the curve of solutions of the steps with the bound
+
+.. math::
+    \mu_\lambda(s) = (1 - \lambda)\,\mu_f + \lambda\,\mu(s), \qquad \mu_f = \mu(s_{\text{warm}}),
+
+through the unique solution at ``λ = 0`` (the frozen bound: a convex QP), followed by arclength through its
+folds and its changes of stick and slip (:mod:`.path`). It is the selection the rolling start makes at the
+scale of the whole contact (the branch continuous with Coulomb at the static value, docs/friction.md), made
+for every step: the solution that grows continuously out of the step with the previous state's friction
+coefficients as the law's dependence on the new slip is switched on.
+
+**What each method does.** The step at ``λ = 0`` is solved by the method itself (a convex QP for the QP
+backends, Newton's constant-bound path for ``newton``); the path is followed by :func:`.path.follow` (rollqp's
+own arithmetic on the step's NCP form, the same for every method); the step at its end is solved by the method
+again, from the path's end, as a point of the path (:attr:`SlipBound.on_path
+<rollqp.friction.bound.SlipBound.on_path>`: Newton's slip path from there, without its search for another
+solution; the fixed point on the bound from there). So each method's answer is its own solution of the step,
+with rollqp's residual, and all of them are the same solution.
+
+**When.** On every step of a falling law (``μ_s > μ_k``): whether a step has more than one solution cannot be
+told from its data at a cost below the path's. A second solution needs the bound map (the fixed point on the
+bound, :mod:`.fixedpoint`) to expand somewhere, i.e. ``|∂μ/∂s|`` times the slip's response to a change of the
+traction over the slip zone above one (docs/theory.md); the per-node estimate :func:`steepness`,
+``κ = max_i |∂μ/∂s|_max p_i⁺ A_ii/Δq``, misses the response of the zone as a whole, so a threshold on it
+that holds on one mesh need not hold on a finer one. On a mild law the path is short (docs/friction.md's
+sweep table, column "path points"). A law that does not fall (``μ_s = μ_k``: a constant coefficient through
+the law's path) and every other step take the method's own path unchanged. ``threshold`` sets another limit on κ (``inf``: never select, the
+methods' own choice).
+
+**Steady solves** are not selected: their operator is far from symmetric, the step at ``λ = 0`` is no convex
+QP and need not have one solution; the branch of a direct steady solve is chosen by its braked start
+(docs/friction.md, "Which steady state a rolling start returns").
+
+**Where the path stops.** A path that cannot be followed to ``λ = 1`` (it runs into gross sliding, or a
+corrector does not converge) leaves the step to the method's own solution (or its ``SolverError``), and
+says so: ``info["path"]`` is then ``{"stopped": message, "lam": λ reached}``.
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from .path import FrozenBoundPath, PathStop, follow
+
+__all__ = ["SlipContinuation", "steepness", "frozen_coefficients", "STEEP"]
+
+#: :func:`steepness` from which a step's solution is selected by the path: every falling law (module docstring).
+STEEP = 0.0
+
+
+def steepness(problem) -> float:
+    """``κ = max_i |∂μ/∂s|_max p_i⁺ |A_ii| / Δq`` of a slip-dependent step (module docstring): the largest factor by
+    which a change of one node's coefficient can feed back on itself through its own slip, with the law at its
+    steepest (:attr:`~rollqp.friction.bound.SlipBound.steepness`)."""
+    d = np.abs(np.asarray(problem.A.diagonal(), dtype=float))
+    return problem.law.steepness * float(np.max(np.maximum(problem.p, 0.0) * d, initial=0.0)) / problem.dq
+
+
+def frozen_coefficients(problem, warm) -> np.ndarray:
+    """``μ_f``: the law's coefficients at the warm start's slip (the previous state's), or at rest without one; at
+    rest also where those carry less than the prescribed load (the frozen step has no solution with stick)."""
+    n, law = problem.n, problem.law
+    s = warm.s if warm is not None and warm.s is not None and np.shape(warm.s) == (n,) else np.zeros(n)
+    mu = law.mu(np.asarray(s, dtype=float))
+    if problem.Q is not None and not abs(problem.Q) < float(problem.f @ (mu * np.maximum(problem.p, 0.0))):
+        mu = law.mu(np.zeros(n))
+    return mu
+
+
+class SlipContinuation:
+    """``inner`` with the solution of its slip-dependent steps selected by the path from the frozen bound (module
+    docstring). Every other step, and a slip-dependent one whose :func:`steepness` is below ``threshold``, goes to
+    ``inner`` unchanged (a law that does not fall has κ = 0). ``info`` of a selected solution: ``path`` (points, changes of piece, turns of ``λ``, the
+    largest ``λ`` before the end) and ``steepness``."""
+
+    def __init__(self, inner, threshold: float = STEEP):
+        self.inner = inner
+        self.name, self.capabilities, self.tolerance = inner.name, inner.capabilities, inner.tolerance
+        self.threshold = float(threshold)
+
+    def __getattr__(self, name):
+        """The inner method's settings (``max_iterations``, …): this wrapper only selects solutions."""
+        if name == "inner":
+            raise AttributeError(name)
+        return getattr(self.inner, name)
+
+    def setup(self, operators) -> None:
+        self.inner.setup(operators)
+
+    def predicting(self, on: bool):
+        """The inner method's (called only where its capabilities declare it)."""
+        return self.inner.predicting(on)
+
+    def single_sweeps(self, on: bool):
+        """The inner method's (called only where its capabilities declare it)."""
+        return self.inner.single_sweeps(on)
+
+    def solve(self, problem, warm=None):
+        law = problem.law
+        if problem.kind != "tangential" or law is None or law.on_path or law.steady:
+            # a steady solve's operator T·A is far from symmetric: its step at λ = 0 is no convex QP and need
+            # not have one solution (module docstring, "Steady solves"; docs/friction.md)
+            return self.inner.solve(problem, warm=warm)
+        kappa = steepness(problem)
+        if not (kappa > 0.0 and kappa >= self.threshold):
+            return self.inner.solve(problem, warm=warm)
+        return self._selected(problem, warm, kappa)
+
+    def _selected(self, problem, warm, kappa):
+        t0 = time.perf_counter()
+        frozen = frozen_coefficients(problem, warm)
+        start = self.inner.solve(problem.replace(mu=frozen, law=None), warm=warm)
+        sc = problem.scales
+        x0 = start.t / sc.stress
+        if problem.Q is not None:
+            x0 = np.append(x0, start.xi / sc.slip)
+        path = FrozenBoundPath(problem, frozen)
+        try:
+            u, stats = follow(path, x0)
+        except PathStop as err:  # the method's own solution, saying that it was not selected
+            sol = self.inner.solve(problem, warm=warm)
+            sol.info.update(path={"stopped": err.message, "lam": err.lam}, steepness=kappa)
+            return sol
+        end = path.solution(u)
+        sol = self.inner.solve(problem.derived(law=problem.law.homotopy(frozen, 1.0)), warm=end)
+        sol.info.update(path=stats, steepness=kappa)
+        sol.time = time.perf_counter() - t0
+        return sol
