@@ -1,4 +1,4 @@
-"""rollqp: 2D transient rolling contact of elastic cylinders.
+"""rollqp: transient rolling contact of elastic bodies: cylinders in 2D, Kalker's problem in 3D.
 
 Every step is posed two ways — as convex QPs solved by external solvers (Clarabel, OSQP,
 cvxpy) and as a complementarity system for a generalized Newton method — so that each
@@ -7,7 +7,7 @@ holds the other to account (González & Abascal 2002; see ``docs/``).
 Public API
 ----------
 load_scene, builtin_scenes, Scene        scenes (docs/scenes.md)
-march, run, StepRecord                   the transient: a stream of step records, or a Result
+march, run, StepRecord                   the transient (2D or 3D): step records, or a Result
 SceneOperators                           what a scene's transient needs, built once
 Result, load_result                      result files
 Strip                                    strip discretization
@@ -32,9 +32,44 @@ from .result import Result, load_result
 from .scene import Scene, builtin_scenes, load_scene
 from .strip import Strip
 from .operators import SceneOperators
-from .march import StepRecord, march, run
+from . import march as _march
+from .march import StepRecord
+from .scene.core import SceneBase as _SceneBase
 from . import energy, wear  # noqa: E402,F401  (register their result fields)
 from .subsurface import stresses  # noqa: E402  (rollqp.stresses(result, step, grid))
+
+
+def _scene(scene):
+    return scene if isinstance(scene, _SceneBase) else load_scene(scene)
+
+
+def run(scene, method=None, progress=None, resume=None, observe=None, **options):
+    """Run a scene's transient and return its result: :func:`rollqp.march.run` for a 2D scene,
+    :func:`rollqp.three.run.run` for a 3D one (``[contact] dimension = 3``), with the same arguments
+    (``out``, ``keep_every``, and the 2D run's ``geometry``, as keywords).
+
+    Examples
+    --------
+    >>> import rollqp
+    >>> r = rollqp.run("kalker-circular")
+    >>> r.arrays()["pn"].shape[1:], round(float(r.arrays()["FN"][-1]))
+    ((40, 40), 1000)
+    """
+    scene = _scene(scene)
+    if scene.dimension == 3:
+        from .three.run import run as run_3d
+        return run_3d(scene, method, progress, resume, observe, **options)
+    return _march.run(scene, method, progress, resume, observe, **options)
+
+
+def march(scene, method=None, **options):
+    """The transient as a stream of step records: :func:`rollqp.march.march` for a 2D scene,
+    :func:`rollqp.three.run.march` for a 3D one (``prepared``, ``resume`` as keywords)."""
+    scene = _scene(scene)
+    if scene.dimension == 3:
+        from .three.run import march as march_3d
+        return march_3d(scene, method, **options)
+    return _march.march(scene, method, **options)
 
 
 def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> StepSolution:

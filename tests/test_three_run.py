@@ -230,9 +230,10 @@ def test_builtin_3d_scene_runs_and_crossvalidates(name, tmp_path):
 
 
 def test_the_2d_api_refuses_a_3d_scene_in_one_line():
-    import rollqp
+    """rollqp.march.run is the 2D run (rollqp.run dispatches on the dimension)."""
+    from rollqp.march import run as run_2d
     with pytest.raises(InputError, match=r"^scene: 'kalker-elliptic' is a 3D scene: rollqp.three.run.run"):
-        rollqp.run("kalker-elliptic")
+        run_2d("kalker-elliptic")
 
 
 def test_load_result_reads_a_3d_file_and_the_cli_resumes_it(braked, tmp_path, capsys, monkeypatch):
@@ -317,3 +318,20 @@ def test_a_conic_run_is_cross_checked_by_the_other_route_only(tmp_path, capsys, 
     line = next(ln for ln in out.splitlines() if "cross-check" in ln)
     assert "newton on steps 0" in line and "qp-clarabel" not in line, line
     assert "raw conic" in out
+
+
+def test_the_package_run_and_march_take_a_scene_of_either_dimension():
+    """``rollqp.run``/``rollqp.march`` dispatch on the scene's dimension: a 3D scene gives the 3D run's
+    result (the same arrays as :func:`rollqp.three.run.run`, bitwise: one deterministic computation), a
+    2D scene the 2D run's."""
+    import rollqp
+    from rollqp.march import run as run_2d
+    scene = coarse("kalker-circular", **{"discretization.distance": 0.5})
+    mine, theirs = rollqp.run(scene).arrays(), run(scene).arrays()
+    assert set(mine) == SPEC_KEYS_3D
+    for key in ("pn", "px", "py", "state", "Fx"):
+        np.testing.assert_array_equal(mine[key], theirs[key])
+    records = list(rollqp.march(scene))
+    assert len(records) == mine["q"].size
+    flat = rollqp.load_scene("cattaneo-carter").replace(**{"discretization.distance": 1.0})
+    np.testing.assert_array_equal(rollqp.run(flat).arrays()["pt"], run_2d(flat).arrays()["pt"])
