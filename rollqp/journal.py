@@ -40,7 +40,7 @@ import numpy as np
 
 from .errors import InputError
 
-__all__ = ["Journal", "MAGIC", "SUFFIX", "layout_dtype", "journal_path"]
+__all__ = ["Journal", "MAGIC", "SUFFIX", "layout_dtype", "journal_path", "json_default"]
 
 MAGIC = b"RQPJNL01"
 #: The journal of ``RESULT.npz`` is ``RESULT.npz.journal``.
@@ -240,7 +240,7 @@ class Journal:
             raise ValueError("the journal is not open for appending")
         payload = values.tobytes()
         if notes:
-            payload += json.dumps(notes, sort_keys=True, default=_json_default).encode()
+            payload += json.dumps(notes, sort_keys=True, default=json_default).encode()
         frame = _frame(kind, 0, index, payload)
         self.frames.add(self.end + HEAD_BYTES, kind, 0, len(payload), index, zlib.crc32(payload))
         try:
@@ -372,7 +372,9 @@ def _notes(raw: bytes, path, arg) -> dict:
     return notes
 
 
-def _json_default(o):
+def json_default(o):
+    """JSON of what ``json.dumps`` does not know (its ``default``): NumPy scalars and arrays as numbers
+    and lists, anything else as its string (a result file's ``meta``, a journal's notes)."""
     if isinstance(o, np.generic):
         return o.item()
     if isinstance(o, np.ndarray):

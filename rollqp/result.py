@@ -32,6 +32,7 @@ from .atomic import (TEMP_PREFIX, OutputLock, alive, held_signals, remove_stale_
                      temporary)
 from .errors import InputError
 from .fields import FIELDS, Rows, dtype_of
+from .journal import json_default as _json_default
 
 __all__ = ["Result", "load_result", "save_npz", "check_output", "resume_source", "OutputLock", "TEMP_PREFIX",
            "remove_stale_temporaries", "encode_meta", "decode_meta"]
@@ -397,14 +398,6 @@ def _copy_thinning(t: _Thinning) -> _Thinning:
     c = _Thinning(t.names, t.keep)
     c.pending = dict(t.pending)
     return c
-
-
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
 
 
 # =========================================================================== in a journal

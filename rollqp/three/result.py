@@ -14,6 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..result import save_npz
+from ..journal import json_default as _json_default
 from .fields import COLUMNS, FIELDS_3D, GRID_FIELDS, check_arrays, markdown_table, read_checked  # noqa: F401
 
 __all__ = ["FIELDS_3D", "Result3D", "markdown_table", "check_arrays", "read_checked", "journal_arrays"]
@@ -130,9 +131,3 @@ def journal_arrays(journal) -> dict:
     return read_checked(out, journal.arg)
 
 
-def _json_default(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    return str(o)
