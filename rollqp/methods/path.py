@@ -52,6 +52,10 @@ FIRST_STEP, LARGEST_STEP, DISTANCE, COSINE, SMALLEST_STEP = 0.1, 0.2, 0.2, 0.95,
 #: steepest steps of docs/friction.md's sweep (column "path points"); a step with no solution (a force above
 #: the creep curve's peak) crawls at a small λ instead of ending, and is given up here.
 MAX_POINTS = 3000
+#: The edge of a piece is located to a margin in ``[0, EDGE]`` inside it (``t̂``/``ŝ`` units: ten times
+#: the corrector's tolerance, so that a point that close is told from the edge); the search aims at the middle
+#: of that window, ``EDGE_AIM``, so that its secant estimates land inside the piece, where it stops.
+EDGE, EDGE_AIM = 1e-12, 0.5e-12
 #: ``|ξ̂|`` beyond which the path runs into gross sliding (a creepage of 1e6 p0/E*: no stick zone is near).
 XI_LIMIT = 1e6
 
@@ -301,26 +305,30 @@ def _overshoot(path, u, uc, pc) -> float:
 
 
 def _turn(path, u, uc, pc, tau, h, st):
-    """Locate the edge of the piece between ``u`` and ``uc`` (regula falsi on the step length along ``tau``,
-    with the Illinois halving), move the node across it, and the new piece's tangent that enters it."""
-    lo, hi, ulo, uhi, side, j = 0.0, h, u, uc, 0, None
+    """Locate the edge of the piece between ``u`` and ``uc`` (regula falsi on the step length along ``tau``
+    with the Illinois weights, aimed at the margin :data:`EDGE_AIM` inside the piece), move the node across
+    it, and the new piece's tangent that enters it."""
+    lo, hi, ulo, uhi, j = 0.0, h, u, uc, None
+    m_lo, m_hi = path.margins(ulo, pc)[0], path.margins(uhi, pc)[0]
+    w_lo, w_hi, last = 1.0, 1.0, 0  # Illinois: the weight of an end kept twice in a row is halved
     for _ in range(200):
-        m_lo, m_hi = path.margins(ulo, pc)[0], path.margins(uhi, pc)[0]
         bad = np.flatnonzero(m_hi < 0.0)
-        frac = np.maximum(m_lo[bad], 0.0) / (np.maximum(m_lo[bad], 0.0) - m_hi[bad])
+        f_lo = w_lo * np.maximum(m_lo[bad] - EDGE_AIM, 0.0)
+        frac = f_lo / (f_lo - w_hi * (m_hi[bad] - EDGE_AIM))
         j, a = int(bad[np.argmin(frac)]), float(np.min(frac))
-        a = 0.5 * a if side == 1 else 0.5 * (1.0 + a) if side == -1 else a
-        hm = lo + min(max(a, 1e-3), 1.0 - 1e-3) * (hi - lo)
+        hm = lo + min(max(a, 1e-9), 1.0 - 1e-9) * (hi - lo)
         um, _ = path.correct(u + hm * tau, tau, pc)
         if um is None:
             raise PathStop(f"the path's edge of a piece is not found near λ = {u[-1]:.6g}", lam=u[-1],
                            residual=_residual(path, u), points=st["points"])
         margin = path.margins(um, pc)[0]
         if np.min(margin) < 0.0:
-            hi, uhi, side = hm, um, -1
+            hi, uhi, m_hi, w_hi = hm, um, margin, 1.0
+            w_lo, last = (0.5 * w_lo if last == -1 else w_lo), -1
         else:
-            lo, ulo, side = hm, um, 1
-            if margin[j] <= 1e-12 or hi - lo <= 1e-15 * h:
+            lo, ulo, m_lo, w_lo = hm, um, margin, 1.0
+            w_hi, last = (0.5 * w_hi if last == 1 else w_hi), 1
+            if margin[j] <= EDGE or hi - lo <= 1e-15 * h:
                 break
     kind = int(path.margins(ulo, pc)[1][j])
     new = path.switched(pc, j, kind, ulo)
