@@ -46,7 +46,9 @@ CORRECTOR_ITERATIONS, CORRECTOR_TOLERANCE = 8, 1e-13
 #: Step control (in the ``u`` norm, ``t̂`` ~ μ, ``λ`` in [0, 1]): first and largest step, the corrector's
 #: largest distance from the predictor and the smallest cosine between successive tangents (a smaller angle
 #: keeps the corrector on the branch it follows: with 0.5 and 0.9 the path jumped onto another branch of the
-#: same step on docs/friction.md's ramped transient at v_h = 1 mm/s), and the step below which the path stops.
+#: same step on docs/friction.md's ramped transient at v_h = 1 mm/s; so did a largest step of 1 with the
+#: corrector's distance capped at 0.04, on the exponential law at v_h = 1 mm/s), and the step below which the
+#: path stops.
 FIRST_STEP, LARGEST_STEP, DISTANCE, COSINE, SMALLEST_STEP = 0.1, 0.2, 0.2, 0.95, 1e-10
 #: Points (predictor–corrector steps and changes of piece) before the path is given up: about five times the
 #: steepest steps of docs/friction.md's sweep (column "path points"); a step with no solution (a force above
