@@ -1,0 +1,72 @@
+"""Where the §6.1.1 Newton rolling step at 81 nodes goes: its parts re-run on one captured step.
+
+``speed.newton_step_ratio()`` compares the median rolling step of ``cattaneo-carter`` (40 quadratic
+elements, 81 nodes, ``newton``) with three dense 81 × 81 products (docs/performance.md, "Speed
+targets"). This script takes the median ``step_time`` of ``rollqp.run`` and then times the parts of
+one step that took one Newton iteration (the common case), each alone and warm (timeit, best of 7):
+the step problem's construction, the whole ``method.solve`` (in it: rollqp's own residuals of the
+solution, ``problem.solution``), the node states of the record (``rollqp.classify``) and a dense
+product. What the parts leave of the median step is the march's own logic around them and the
+memory traffic between steps (a part repeated alone runs on warm caches)::
+
+    python benchmarks/small_step.py [--runs 5]
+
+The solve is timed from the previous state's solution without its kept product ``A t`` (the march
+hands it over), so it does one product more than in the march (about 1.5 µs).
+"""
+from __future__ import annotations
+
+import argparse
+import timeit
+
+import numpy as np
+
+from harness import pin_threads
+
+pin_threads()
+
+import rollqp  # noqa: E402
+from rollqp.march import prepare  # noqa: E402
+
+
+def best(f, number=4000) -> float:
+    """Microseconds a call, the best of 7 repetitions of ``number`` calls."""
+    return min(timeit.repeat(f, number=number, repeat=7)) / number * 1e6
+
+
+def measure(runs=5) -> dict:
+    steps = [np.median(rollqp.run("cattaneo-carter", method="newton").arrays()["step_time"][1:]) for _ in range(runs)]
+    scene, method, ops = prepare("cattaneo-carter", "newton")
+    records = list(rollqp.march(scene, prepared=(scene, method, ops)))
+    k = next(i for i in range(len(records) // 2, len(records)) if records[i].counters.iterations == 1)
+    rec, warm = records[k], records[k - 1].state.tsol
+    pb, sol = rec.problem, rec.solution
+    n = pb.n
+    rng = np.random.default_rng(0)
+    A, x = rng.standard_normal((n, n)), rng.standard_normal(n)
+    mu = float(pb.mu)
+    return {
+        "median step (rollqp.run)": float(np.median(steps)) * 1e6,
+        "step problem (ops.tangential_step)": best(lambda: ops.tangential_step(pb.p, pb.c, pb.dq, Q=pb.Q, xi=pb.xi,
+                                                                               validate=False)),
+        "method.solve, one Newton iteration": best(lambda: method.solve(pb, warm=warm)),
+        "  in it: slip and rollqp's residuals (problem.solution)": best(lambda: pb.solution(sol.t, sol.xi)),
+        "node states (rollqp.classify)": best(lambda: rollqp.classify(rec.state.p, rec.state.t, sol.s, mu, pb.scales,
+                                                                      bound=pb.bound)),
+        "one dense n × n product": best(lambda: A @ x, 20000),
+    }
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=5, help="runs of rollqp.run for the median step (default 5)")
+    args = ap.parse_args(argv)
+    r = measure(args.runs)
+    step = r["median step (rollqp.run)"]
+    print("| part (81 nodes, cattaneo-carter, newton) | µs | share of the median step |\n|---|---|---|")
+    for name, us in r.items():
+        print(f"| {name} | {us:.1f} | {us / step:.0%} |")
+
+
+if __name__ == "__main__":
+    main()
