@@ -14,12 +14,12 @@ are flattened in C order, element ``k = j·nx + i``, for the linear algebra.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import InputError
+from ..validate import positive, scalar
 
 __all__ = ["Grid", "ASPECT_RANGE", "MAX_ELEMENTS"]
 
@@ -38,16 +38,6 @@ def _positive_int(name, v) -> int:
     if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 1:
         raise InputError(name, f"must be an integer >= 1, got {v!r}")
     return int(v)
-
-
-def _finite(name, v, positive=False) -> float:
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        raise InputError(name, f"must be a real number, got {v!r}") from None
-    if not math.isfinite(x) or (positive and x <= 0):
-        raise InputError(name, f"must be a finite number{' > 0' if positive else ''}, got {v!r}")
-    return x
 
 
 @dataclass(frozen=True)
@@ -90,9 +80,9 @@ class Grid:
         object.__setattr__(self, "nx", _positive_int("nx", self.nx))
         object.__setattr__(self, "ny", _positive_int("ny", self.ny))
         for name in ("dx", "dy"):
-            object.__setattr__(self, name, _finite(name, getattr(self, name), positive=True))
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
         for name in ("xl", "yl"):
-            object.__setattr__(self, name, _finite(name, getattr(self, name)))
+            object.__setattr__(self, name, scalar(name, getattr(self, name)))
         if self.nx * self.ny > MAX_ELEMENTS:
             raise InputError("elements", f"nx·ny = {self.nx * self.ny} exceeds {MAX_ELEMENTS} elements")
         lo, hi = ASPECT_RANGE
@@ -103,8 +93,8 @@ class Grid:
     @classmethod
     def centred(cls, nx: int, ny: int, half_x: float, half_y: float) -> "Grid":
         """The grid of ``nx × ny`` elements on ``[−half_x, half_x] × [−half_y, half_y]``."""
-        half_x = _finite("half_x", half_x, positive=True)
-        half_y = _finite("half_y", half_y, positive=True)
+        half_x = positive("half_x", half_x)
+        half_y = positive("half_y", half_y)
         nx, ny = _positive_int("nx", nx), _positive_int("ny", ny)
         return cls(nx, ny, 2 * half_x / nx, 2 * half_y / ny, -half_x, -half_y)
 
@@ -116,7 +106,7 @@ class Grid:
         below 1 would cut the Hertz ellipse, an :class:`InputError` naming ``zone``.
         """
         nx, ny = elements
-        zx, zy = (_finite("zone", z, positive=True) for z in zone)
+        zx, zy = (positive("zone", z) for z in zone)
         if zx <= 1 or zy <= 1:
             raise InputError("zone", f"half-widths / (a, b) must be > 1 so that the grid covers the Hertz "
                                      f"ellipse, got {tuple(zone)}")

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..validate import positive as _positive, scalar
 
 __all__ = ["Scales", "Residuals", "StepSolution", "NormalStep", "TangentialStep", "disc_projection",
            "rigid_slip", "element_states", "SEPARATION", "STICK", "SLIP"]
@@ -142,15 +143,10 @@ def _vector(name, v, n) -> np.ndarray:
 
 
 def _number(name, v, positive=False, allow_none=False):
+    """:func:`rollqp.validate.positive` or :func:`~rollqp.validate.scalar` of ``v``; ``None`` kept where allowed."""
     if v is None and allow_none:
         return None
-    try:
-        x = float(v)
-    except (TypeError, ValueError):
-        raise InputError(name, f"must be a real number, got {v!r}") from None
-    if not math.isfinite(x) or (positive and x <= 0):
-        raise InputError(name, f"must be a finite number{' > 0' if positive else ''}, got {v!r}")
-    return x
+    return _positive(name, v) if positive else scalar(name, v)
 
 
 def _one_of(names, values):
