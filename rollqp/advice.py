@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Plan", "fast_path", "dense_memory", "dense_seconds", "cholesky_seconds", "alternation_note",
+__all__ = ["Plan", "fast_path", "duration", "dense_memory", "dense_seconds", "cholesky_seconds", "alternation_note",
            "DENSE_MEMORY_LIMIT", "DENSE_SECONDS_LIMIT"]
 
 #: Peak bytes of the dense path per n² (doubles: 11; measured 551 MiB at 2,561 nodes, 8.5 GB at 10,001).
@@ -133,7 +133,7 @@ def fast_path(scene) -> Plan:
     if other is None:
         return Plan(scene)
     note = (f"{other}, matrix-free, chosen for {scene.solver.method!r}: the dense path would need about "
-            f"{memory / 2 ** 30:.2g} GiB and {_duration(seconds)} for {scene.n_nodes} nodes and {scene.n_steps} steps "
+            f"{memory / 2 ** 30:.2g} GiB and {duration(seconds)} for {scene.n_nodes} nodes and {scene.n_steps} steps "
             f"(estimate); solver.operator = 'dense' keeps {scene.solver.method!r}")
     return Plan(scene.replace(**{"solver.method": other}), note)
 
@@ -155,7 +155,7 @@ def estimate_note(scene) -> str | None:
     else:
         how = "fewer discretization.elements or a longer discretization.step make it cheaper"
     return (f"{scene.solver.method} on {scene.n_nodes} nodes, {scene.n_steps} steps: the dense path needs about "
-            f"{memory / 2 ** 30:.2g} GiB and {_duration(seconds)} here (estimate for Newton steps: a QP method's take "
+            f"{memory / 2 ** 30:.2g} GiB and {duration(seconds)} here (estimate for Newton steps: a QP method's take "
             f"longer); {how}")
 
 
@@ -174,7 +174,8 @@ def alternation_note(scene) -> str | None:
             "10–100× faster (docs/examples.md, per-method tables). An estimate of this run follows its first step.")
 
 
-def _duration(seconds: float) -> str:
+def duration(seconds: float) -> str:
+    """A time for a person: seconds below two minutes, minutes below two hours, else hours."""
     if seconds < 120:
         return f"{seconds:.0f} s"
     if seconds < 7200:

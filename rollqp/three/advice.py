@@ -10,6 +10,8 @@ above :data:`NOTE_SECONDS`, naming what runs faster.
 """
 from __future__ import annotations
 
+from ..advice import duration
+
 __all__ = ["notes", "conic_step_seconds", "NOTE_SECONDS", "REFERENCE_CONTACT", "REFERENCE_SECONDS"]
 
 #: One Clarabel step (QP + SOCP and the active-set refinement) on 812 contact elements (the 40 × 40
@@ -43,15 +45,7 @@ def notes(scene) -> list[str]:
     total = per * steps
     if total <= NOTE_SECONDS:
         return []
-    return [f"{scene.solver.method} on {n} contact elements: about {_duration(per)} a step (an SOCP with a dense "
-            f"Hessian, growing like the cube of the contact), {steps} steps: about {_duration(total)} in all "
+    return [f"{scene.solver.method} on {n} contact elements: about {duration(per)} a step (an SOCP with a dense "
+            f"Hessian, growing like the cube of the contact), {steps} steps: about {duration(total)} in all "
             "(estimate); solver.method = 'newton' solves the same steps in a fraction of that, and the run's "
             "cross-check solves a few of them by the conic route"]
-
-
-def _duration(seconds: float) -> str:
-    if seconds < 120:
-        return f"{seconds:.0f} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
