@@ -23,7 +23,7 @@ import threading
 
 from .errors import InputError
 
-__all__ = ["TEMP_PREFIX", "process_start", "alive", "remove_stale_temporaries", "temporary", "replace",
+__all__ = ["TEMP_PREFIX", "process_start", "alive", "remove_stale_temporaries", "temporary", "written", "replace",
            "OutputLock", "held_signals", "stop_once"]
 
 #: Temporary files of an atomic write start with this (module docstring).
@@ -90,6 +90,21 @@ def temporary(path, suffix: str = ".npz") -> tuple[int, str]:
     folder = os.path.dirname(os.path.abspath(path))
     remove_stale_temporaries(folder)
     return tempfile.mkstemp(suffix=suffix, dir=folder, prefix=f"{TEMP_PREFIX}{_own_tag()}-")
+
+
+@contextlib.contextmanager
+def written(path, suffix: str = ".npz"):
+    """``with written(path) as (fh, tmp):`` write a temporary file beside ``path`` (binary ``fh``, its name
+    ``tmp``); renamed over ``path`` (:func:`replace`) when the block ends, removed if it raises."""
+    fd, tmp = temporary(path, suffix)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            yield fh, tmp
+        replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
 
 
 def replace(tmp: str, path) -> None:

@@ -29,7 +29,7 @@ import weakref
 import numpy as np
 
 from .atomic import (TEMP_PREFIX, OutputLock, alive, held_signals, remove_stale_temporaries, replace,  # noqa: F401
-                     temporary)
+                     temporary, written)
 from .errors import InputError
 from .fields import FIELDS, Rows, dtype_of
 from .journal import json_default as _json_default
@@ -444,15 +444,9 @@ class _Journaled:
         from .journal import Journal
         source.close()
         if os.path.abspath(source.path) != os.path.abspath(self.path):
-            fd, tmp = temporary(self.path, suffix=".journal")
-            os.close(fd)
-            try:
-                shutil.copyfile(source.path, tmp)
-                os.replace(tmp, self.path)
-            except BaseException:
-                if os.path.exists(tmp):
-                    os.unlink(tmp)
-                raise
+            with written(self.path, suffix=".journal") as (fh, _):
+                with open(source.path, "rb") as src:
+                    shutil.copyfileobj(src, fh)
         self.adopt(Journal.open(self.path, "--resume", writable=True))
 
     def adopt(self, journal) -> None:
@@ -597,27 +591,20 @@ def _assemble(journal, r: Result, path):
 def _write_result(path, r: Result, columns, state_blocks, K1, meta_text, marrays) -> str:
     """Write the result file atomically: a temporary file beside ``path``, then a rename."""
     from .npzfile import NpzStream
-    fd, tmp = temporary(path)
-    try:
-        with os.fdopen(fd, "wb") as fh, NpzStream(fh) as z:
-            z.array("x", r.x)
-            for name in r.names:
-                if name in columns:
-                    z.array(name, columns[name])
-                    continue
-                blocks = state_blocks(name)
-                first = next(blocks)
-                z.rows(name, dtype_of(name), (K1,) + first.shape[1:], _chain(first, blocks))
-            for k, v in r.scalars.items():
-                z.array(k, np.asarray(v))
-            z.array("meta", np.asarray(meta_text))
-            for k, v in marrays.items():
-                z.array(k, v)
-        replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
+    with written(path) as (fh, _), NpzStream(fh) as z:
+        z.array("x", r.x)
+        for name in r.names:
+            if name in columns:
+                z.array(name, columns[name])
+                continue
+            blocks = state_blocks(name)
+            first = next(blocks)
+            z.rows(name, dtype_of(name), (K1,) + first.shape[1:], _chain(first, blocks))
+        for k, v in r.scalars.items():
+            z.array(k, np.asarray(v))
+        z.array("meta", np.asarray(meta_text))
+        for k, v in marrays.items():
+            z.array(k, v)
     return os.fspath(path)
 
 
@@ -675,17 +662,9 @@ def save_npz(path, arrays: dict, what: str = "result file") -> str:
         text, marrays = encode_meta(meta)
         arrays["meta"] = np.asarray(text)
         arrays.update(marrays)
-    with held_signals():
-        fd, tmp = temporary(path)
-        try:
-            with os.fdopen(fd, "wb") as fh, NpzStream(fh) as z:
-                for k, v in arrays.items():
-                    z.array(k, v)
-            replace(tmp, path)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.unlink(tmp)
-            raise
+    with held_signals(), written(path) as (fh, _), NpzStream(fh) as z:
+        for k, v in arrays.items():
+            z.array(k, v)
     return path
 
 
