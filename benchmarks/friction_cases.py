@@ -109,3 +109,19 @@ def patch_scene(mu=0.1, inside=0.05, start=2.0, end=2.5, elements=88, ratio=0.5,
     return base.replace(**{"contact.friction": {"law": "patch", "mu": mu, "inside": inside, "start": start,
                                                 "end": end, "frame": frame},
                            "name": "patch-through-carter"})
+
+
+#: The ramped falling-friction transient of docs/friction.md (rational law, v_h = 3 mm/s, V = 10 m/s, force
+#: ramped to 0.5 μ_s P over 0.9 a_H from a braked start): the tests run its first 0.75 a_H, the velocity
+#: sweep of benchmarks/friction_study.py 4.5 a_H with other laws and scales.
+FALLING_RAMP = {
+    "name": "falling-singular",
+    "bodies": {"A": {"radius": 500.0, "E": 209920.0, "nu": 0.28}, "B": {"radius": 500.0, "E": 209920.0, "nu": 0.28}},
+    "contact": {"friction": {"law": "rational", "static": 0.32, "kinetic": 0.20, "velocity": 3.0,
+                             "rolling_speed": 10000.0}},
+    "load": {"normal": 357.79249665883754, "tangential": {"kind": "ramp", "start": 0.0, "end": 0.5, "over": 0.9},
+             "start": "braked", "direction": -1},
+    "discretization": {"elements": 80, "element": "constant", "zone": 1.2, "step": 1.0, "formulation": "material",
+                       "distance": 0.75},
+    "solver": {"method": "newton", "tolerance": 1e-10},
+}

@@ -33,7 +33,7 @@ from rollqp import closedforms as cf
 from rollqp.methods.fixedpoint import BoundFixedPoint
 from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
-from friction_cases import VELDEP, veldep_scene
+from friction_cases import FALLING_RAMP, VELDEP, veldep_scene
 
 MESHES = (23, 46, 92, 184, 368)
 
@@ -101,17 +101,8 @@ def fixedpoint_section(elements=92, distance=2.0, speed=450.0):
                  [[f"{speed:g}", elements, len(its), f"{worst:.1e}", f"{np.median(its):g}, {max(its)}"]])
 
 
-SWEEP_SCENE = {
-    "name": "falling-sweep",
-    "bodies": {"A": {"radius": 500.0, "E": 209920.0, "nu": 0.28}, "B": {"radius": 500.0, "E": 209920.0, "nu": 0.28}},
-    "contact": {"friction": {"law": "rational", "static": 0.32, "kinetic": 0.20, "velocity": 3.0,
-                             "rolling_speed": 10000.0}},
-    "load": {"normal": 357.79249665883754, "tangential": {"kind": "ramp", "start": 0.0, "end": 0.5, "over": 0.9},
-             "start": "braked", "direction": -1},
-    "discretization": {"elements": 80, "element": "constant", "zone": 1.2, "step": 1.0, "formulation": "material",
-                       "distance": 4.5},
-    "solver": {"method": "newton", "tolerance": 1e-12},
-}
+SWEEP_SCENE = {**FALLING_RAMP, "name": "falling-sweep", "solver": {"method": "newton", "tolerance": 1e-12},
+               "discretization": {**FALLING_RAMP["discretization"], "distance": 4.5}}
 SWEEP = [("rational", 3.0, 0.75)] + [(law, v, 4.5) for law in ("exponential", "linear")
                                     for v in (1.0, 10.0, 100.0, 1e3, 1e4, 1e6, 1e8, 1e10, 1e12)]
 

@@ -11,24 +11,14 @@ import pytest
 
 from rollqp.energy import balance
 from rollqp.friction import SlipVelocity
-from friction_cases import contact_velocity, veldep_scene
+from friction_cases import FALLING_RAMP, contact_velocity, veldep_scene
 from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
 from rollqp.scene import load_scene, scene_from_dict
 
 #: The ramped falling-friction transient on which the slip-dependent Newton matrix used to become
 #: singular (rational law, v_h = 3 mm/s, V = 10 m/s: step 21 of 25).
-SCENE = {
-    "name": "falling-singular",
-    "bodies": {"A": {"radius": 500.0, "E": 209920.0, "nu": 0.28}, "B": {"radius": 500.0, "E": 209920.0, "nu": 0.28}},
-    "contact": {"friction": {"law": "rational", "static": 0.32, "kinetic": 0.20, "velocity": 3.0,
-                             "rolling_speed": 10000.0}},
-    "load": {"normal": 357.79249665883754, "tangential": {"kind": "ramp", "start": 0.0, "end": 0.5, "over": 0.9},
-             "start": "braked", "direction": -1},
-    "discretization": {"elements": 80, "element": "constant", "zone": 1.2, "step": 1.0, "formulation": "material",
-                       "distance": 0.75},
-    "solver": {"method": "newton", "tolerance": 1e-10},
-}
+SCENE = FALLING_RAMP
 
 
 def _states(sc, method, tolerance):
