@@ -1,0 +1,216 @@
+"""What a method carries from one step to the next, journaled so that a resumed march repeats the uninterrupted one.
+
+Newton's iteration keeps the LU factors of the reduced systems of the last few free sets and solves later
+directions on them, bordered (:class:`~rollqp.methods.newton.linear.ReducedSystem`), and it starts each step
+from the product ``A x`` of the last solution. Which factorization a direction is solved on, and what the
+bordered solves have kept on it, change the last bits of the direction; a march that set out without them
+would take other (equally valid) iterations and stop elsewhere within the tolerance. So a march that
+journals its states (:mod:`rollqp.journal`) records, with each state, what it needs to rebuild them
+(:class:`Recorder`), and a resumed march rebuilds them (:func:`restore`): the same LU of the same matrix,
+its store grown by the same bordered solves in the same order, the same flags. The record is small: per
+state the factorizations made (their free sets as runs of nodes) and the bordered solves (the nodes
+added and released), and, when it changed, which ones are kept.
+
+The record of a state, the ``"solver"`` entry of its journal frame's notes::
+
+    {"v": 1,
+     "ev": [["f", system, id, with_load, runs], ["b", system, id, added, released], ...],
+     "sys": [[system, kind, role, dqh, state, last], ...],   # when it changed
+     "nw": {"last": system, "large": int, "dropped": [[kind, role, dqh], ...]}}  # when it changed
+
+``system`` is the recorder's number for a :class:`ReducedSystem`, ``role`` the operator it was built on
+(``"Ann"``, ``"Att"``, or ``None``: another one, e.g. the steady start's, never asked for again),
+``state`` :meth:`ReducedSystem.state`, and ``last`` ``[k, field]``: the state whose ``field`` (``"p"`` or
+``"t"``) is the system's last solution (its product is computed again as it was).
+"""
+from __future__ import annotations
+
+import types
+
+import numpy as np
+
+VERSION = 1
+
+__all__ = ["Recorder", "restore", "newton_of", "VERSION"]
+
+
+def newton_of(meth):
+    """The :class:`~rollqp.methods.newton.NewtonMethod` that solves ``meth``'s uncoupled halves (through the
+    compositions that wrap it: N–T alternation, friction fixed point, continuation), or ``None``."""
+    from .methods.newton import NewtonMethod
+    for _ in range(8):
+        if isinstance(meth, NewtonMethod):
+            return meth
+        meth = vars(meth).get("inner") if hasattr(meth, "__dict__") else None
+        if meth is None:
+            return None
+    return None
+
+
+def _runs(idx) -> list:
+    """Sorted indices as ``[start, stop, start, stop, ...]``."""
+    idx = np.asarray(idx)
+    if idx.size == 0:
+        return []
+    brk = np.flatnonzero(np.diff(idx) != 1)
+    starts = idx[np.concatenate(([0], brk + 1))]
+    stops = idx[np.concatenate((brk, [idx.size - 1]))] + 1
+    return np.column_stack([starts, stops]).ravel().tolist()
+
+
+def _indices(runs) -> np.ndarray:
+    r = np.asarray(runs, dtype=np.intp).reshape(-1, 2)
+    return np.concatenate([np.arange(a, b) for a, b in r]) if r.size else np.zeros(0, np.intp)
+
+
+def _role(ops, A):
+    return "Ann" if A is ops.Ann else "Att" if A is ops.Att else None
+
+
+class Recorder:
+    """Records, state by state, what :func:`restore` needs (module docstring): :meth:`note` after each state."""
+
+    def __init__(self, meth, ops):
+        self.newton, self.ops = newton_of(meth), ops
+        self.tags = 0
+        self.lasts = {}  # system -> (its last solution tuple, [k, field] or None)
+        self.summary = self.hist = None
+        if self.newton is not None:
+            self.newton.record = True  # (an instance attribute: this method's systems only)
+            for s in self.newton._systems.values():
+                if getattr(s, "tag", None) is not None:
+                    self.tags = max(self.tags, s.tag + 1)
+                    if s.events is None:
+                        s.events = []
+
+    def note(self, k: int, state, cache=None) -> dict | None:
+        """The record of state ``k`` (its :class:`~rollqp.march.State` ``state``; ``cache`` the march's
+        :class:`~rollqp.kinematics.HistoryCache`), or ``None`` (nothing to record)."""
+        out = {"v": VERSION}
+        if cache is not None:
+            hist = [[dq, d] for dq, d, _ in cache.items]
+            if hist != self.hist:
+                out["hist"] = self.hist = hist
+        nw = self.newton
+        if nw is None:
+            return out if len(out) > 1 else None
+        ops = self.ops
+        events, systems = [], []
+        for key, s in nw._systems.items():
+            if not hasattr(s, "events"):  # the place of a system that is not rebuilt (:func:`restore`)
+                systems.append([s.tag, None, None, None, None, None])
+                continue
+            if s.tag is None:
+                s.tag, self.tags = self.tags, self.tags + 1
+            if s.events is None:
+                s.events = []
+            for e in s.events:
+                if e[0] == "f":
+                    events.append(["f", s.tag, e[1], int(e[2]), _runs(e[3])])
+                else:
+                    events.append(["b", s.tag, e[1], e[2].tolist(), e[3].tolist()])
+            s.events.clear()
+            systems.append([s.tag, key[0], _role(ops, key[1]), key[4], s.state(), self._last(k, state, s, key[0])])
+        tags = {id(s): s.tag for s in nw._systems.values()}
+        summary = {"sys": systems,
+                   "nw": {"last": None if nw._last is None else tags.get(id(nw._last[5])), "large": nw._large,
+                          "dropped": sorted([k[0], _role(ops, k[1]), k[4]] for k in nw._dropped
+                                            if _role(ops, k[1]) is not None)}}
+        if events:
+            out["ev"] = events
+        if summary != self.summary:
+            out.update(summary)
+            self.summary = summary
+        return out
+
+    def _last(self, k, state, s, kind):
+        """``[k, field]`` of the state whose pressure or traction is the system's last solution."""
+        last = s.last
+        seen = self.lasts.get(s.tag)
+        if seen is not None and seen[0] is last:
+            return seen[1]
+        where = None
+        if last is not None and state is not None:
+            field = "p" if kind == "normal" else "t"
+            x = state.p if field == "p" else state.t
+            if x is not None and (x is last[0] or np.array_equal(x, last[0])):
+                where = [int(k), field]
+        self.lasts[s.tag] = (last, where)
+        return where
+
+
+def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = None):
+    """Rebuild ``meth``'s Newton systems as they were after state ``upto`` from the journal's ``notes``
+    (``[(k, notes), ...]`` in order); ``state_at(k)`` gives ``{"p": …, "t": …}`` of a stored state.
+
+    Returns ``(products, history)``: ``{(k, field): A x}``, the products of the systems' last solutions
+    (the state's ``w`` of a tangential one), and the ``(Δq, d)`` of the march's history operators
+    (:class:`~rollqp.kinematics.HistoryCache`, in order); ``None`` when there is nothing to rebuild from
+    (a journal written without the records, or by another version): the march then sets out without them.
+    """
+    nw = newton_of(meth)
+    made, summary, hist, seen = {}, None, None, False
+    for k, note in notes:
+        rec = note.get("solver") if isinstance(note, dict) else None
+        if rec is None:
+            continue
+        if not isinstance(rec, dict) or rec.get("v") != VERSION:
+            return None
+        if recorder is not None:  # the systems this run makes are named after every one named so far
+            recorder.tags = max([recorder.tags] + [e[1] + 1 for e in rec.get("ev", ())]
+                                + [s[0] + 1 for s in rec.get("sys", ())])
+        if k > upto:
+            continue
+        seen = True
+        if "hist" in rec:
+            hist = rec["hist"]
+        for ev in rec.get("ev", ()):
+            if ev[0] == "f":
+                made[(ev[1], ev[2])] = (bool(ev[3]), _indices(ev[4]), [])
+            else:
+                made[(ev[1], ev[2])][2].append((ev[3], ev[4]))
+        if "sys" in rec:
+            summary = rec
+            alive = {(s[0], i) for s in rec["sys"] for i in s[4]["kept"] + list(s[4]["base"].values())}
+            made = {key: v for key, v in made.items() if key in alive}
+    if not seen:
+        return None
+    if recorder is not None:
+        recorder.hist = None  # (the next state's record says it again)
+    products = {} if nw is None or summary is None else _rebuild(nw, ops, summary, made, state_at, recorder)
+    return products, hist
+
+
+def _rebuild(nw, ops, summary, made, state_at, recorder):
+    from .methods.newton.linear import partial_product
+    nw._systems, nw._last = {}, None
+    nw._large, nw._dropped = int(summary["nw"]["large"]), set()
+    products, tags = {}, {}
+    n = ops.n
+    for tag, kind, role, dqh, state, last in summary["sys"]:
+        if role is None:  # another operator's system (the steady start's): holds its place only
+            nw._systems[("restored", tag)] = types.SimpleNamespace(K=np.broadcast_to(0.0, (n, n + 1)), tag=tag)
+            if recorder is not None:
+                recorder.tags = max(recorder.tags, tag + 1)
+            continue
+        A = ops.Ann if role == "Ann" else ops.Att
+        pb = types.SimpleNamespace(kind=kind, A=A, f=ops.f, scales=ops.scales, n=n)
+        s = nw.system(pb, dqh)
+        s.restore(state, {i: made[(tag, i)] for i in state["kept"] + list(state["base"].values())})
+        s.tag, tags[tag] = tag, (pb, dqh, s)
+        if last is not None:
+            x = np.asarray(state_at(last[0])[last[1]], dtype=float)
+            Ax = A @ x if s.exact else partial_product(A.dense(), np.arange(n), x, np.flatnonzero(x))
+            s.last = (x, Ax)
+            products[(last[0], last[1])] = Ax
+            if recorder is not None:
+                recorder.lasts[tag] = (s.last, last)
+        if recorder is not None:
+            recorder.tags = max(recorder.tags, tag + 1)
+    last = summary["nw"]["last"]
+    if last in tags:
+        pb, dqh, s = tags[last]
+        nw._last = (pb.A, pb.f, pb.kind, dqh, pb.scales, s)
+    for kind, role, dqh in summary["nw"]["dropped"]:
+        nw._dropped.add((kind, ops.Ann if role == "Ann" else ops.Att, ops.f.tobytes(), ops.scales, dqh, nw.r))
+    return products
