@@ -41,6 +41,7 @@ coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import os
 import time
@@ -566,7 +567,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, record
         if verify:
             state = check_resumed(scene, (scene, meth, ops), resume, march=m, recorder=recorder)
         elif state is None:
-            state = resumed_state(scene, ops, resume)
+            state = _with_normal(m, resumed_state(scene, ops, resume), _last_index(resume))
         first = _last_index(resume) + 1
     else:
         try:
@@ -655,14 +656,14 @@ def check_resumed(scene, prepared, arrays: dict, march=None, recorder=None) -> S
     m = march if march is not None else _March(scene, ops, meth)
     k = _last_index(arrays)
     steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(len(arrays["q"]))
-    stored = resumed_state(scene, ops, arrays, -1)
+    stored = _with_normal(m, resumed_state(scene, ops, arrays, -1), k)
     try:
         if k == 0:
             _restore(m, arrays, -1, recorder)
             again = m.start().state
         elif steps.size >= 2 and int(steps[-2]) == k - 1:
             products = _restore(m, arrays, k - 1, recorder)
-            before = resumed_state(scene, ops, arrays, -2, products=products)
+            before = _with_normal(m, resumed_state(scene, ops, arrays, -2, products=products), k - 1)
             again = m.rolling(k, float(m.plan.q[k]), before, ops.history()).state
         else:
             raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
@@ -704,6 +705,19 @@ def _restore(m: _March, arrays, upto, recorder):
     except (KeyError, IndexError, TypeError, ValueError):
         meth.setup(ops)
         return None
+
+
+def _with_normal(m: _March, state: State, k: int) -> State:
+    """A stored state with the normal problem of its step (``State.normal``), which a stored state lacks and a
+    fixed normal half carries from step to step (its gap gives the elastic energy: :mod:`rollqp.energy`)."""
+    ops = m.ops
+    if ops.coupled or state.normal is not None or state.nsol is None or not np.any(state.p):
+        return state
+    _, _, P, _, _, D = m.at[k]
+    if P is not None and P <= 0.0:
+        return state
+    h = ops.gap(float(m.plan.q[k])) if m.moving else None
+    return dataclasses.replace(state, normal=ops.normal_step(P, state.t, delta=D, h=h, validate=False))
 
 
 def _identical(again: State, stored: State) -> bool:
