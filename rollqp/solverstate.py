@@ -20,8 +20,9 @@ The record of a state, the ``"solver"`` entry of its journal frame's notes::
 
 ``system`` is the recorder's number for a :class:`ReducedSystem`, ``role`` the operator it was built on
 (``"Ann"``, ``"Att"``, or ``None``: another one, e.g. the steady start's, never asked for again),
-``state`` :meth:`ReducedSystem.state`, and ``last`` ``[k, field]``: the state whose ``field`` (``"p"`` or
-``"t"``) is the system's last solution (its product is computed again as it was).
+``state`` :meth:`ReducedSystem.state`, and ``last`` ``[field, k]``: the state ``k`` (the record's own
+state if ``k`` is left out) whose ``field`` (``"p"`` or ``"t"``) is the system's last solution (its product
+is computed again as it was).
 """
 from __future__ import annotations
 
@@ -110,10 +111,12 @@ class Recorder:
                 else:
                     events.append(["b", s.tag, e[1], e[2].tolist(), e[3].tolist()])
             s.events.clear()
-            systems.append([s.tag, key[0], _role(ops, key[1]), key[4], s.state(), self._last(k, state, s, key[0])])
-        tags = {id(s): s.tag for s in nw._systems.values()}
+            where = self._last(k, state, s, key[0])  # (this state's as [field]: a record that repeats)
+            systems.append([s.tag, key[0], _role(ops, key[1]), key[4], s.state(),
+                            None if where is None else [where[1]] if where[0] == k else [where[1], where[0]]])
+        last = None if nw._last is None else next((s.tag for s in nw._systems.values() if s is nw._last[5]), None)
         summary = {"sys": systems,
-                   "nw": {"last": None if nw._last is None else tags.get(id(nw._last[5])), "large": nw._large,
+                   "nw": {"last": last, "large": nw._large,
                           "dropped": sorted([k[0], _role(ops, k[1]), k[4]] for k in nw._dropped
                                             if _role(ops, k[1]) is not None)}}
         if events:
@@ -121,7 +124,7 @@ class Recorder:
         if summary != self.summary:
             out.update(summary)
             self.summary = summary
-        return out
+        return out if len(out) > 1 else None  # nothing new: no record (the last one holds)
 
     def _last(self, k, state, s, kind):
         """``[k, field]`` of the state whose pressure or traction is the system's last solution."""
@@ -149,7 +152,7 @@ def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = N
     (a journal written without the records, or by another version): the march then sets out without them.
     """
     nw = newton_of(meth)
-    made, summary, hist, seen = {}, None, None, False
+    made, summary, hist, seen = {}, None, None, False  # (a state without a record: nothing changed)
     for k, note in notes:
         rec = note.get("solver") if isinstance(note, dict) else None
         if rec is None:
@@ -177,11 +180,11 @@ def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = N
         return None
     if recorder is not None:
         recorder.hist = None  # (the next state's record says it again)
-    products = {} if nw is None or summary is None else _rebuild(nw, ops, summary, made, state_at, recorder)
+    products = {} if nw is None or summary is None else _rebuild(nw, ops, summary, upto, made, state_at, recorder)
     return products, hist
 
 
-def _rebuild(nw, ops, summary, made, state_at, recorder):
+def _rebuild(nw, ops, summary, at, made, state_at, recorder):
     from .methods.newton.linear import partial_product
     nw._systems, nw._last = {}, None
     nw._large, nw._dropped = int(summary["nw"]["large"]), set()
@@ -199,12 +202,13 @@ def _rebuild(nw, ops, summary, made, state_at, recorder):
         s.restore(state, {i: made[(tag, i)] for i in state["kept"] + list(state["base"].values())})
         s.tag, tags[tag] = tag, (pb, dqh, s)
         if last is not None:
-            x = np.asarray(state_at(last[0])[last[1]], dtype=float)
+            where = [at if len(last) == 1 else int(last[1]), last[0]]
+            x = np.asarray(state_at(where[0])[where[1]], dtype=float)
             Ax = A @ x if s.exact else partial_product(A.dense(), np.arange(n), x, np.flatnonzero(x))
             s.last = (x, Ax)
-            products[(last[0], last[1])] = Ax
+            products[(where[0], where[1])] = Ax
             if recorder is not None:
-                recorder.lasts[tag] = (s.last, last)
+                recorder.lasts[tag] = (s.last, where)
         if recorder is not None:
             recorder.tags = max(recorder.tags, tag + 1)
     last = summary["nw"]["last"]
