@@ -64,6 +64,29 @@ def _indices(runs) -> np.ndarray:
     return np.concatenate([np.arange(a, b) for a, b in r]) if r.size else np.zeros(0, np.intp)
 
 
+def _counts(kind) -> list:
+    """An array of small codes as ``[value, count, value, count, ...]`` (run lengths)."""
+    kind = np.asarray(kind)
+    if kind.size == 0:
+        return []
+    brk = np.flatnonzero(np.diff(kind)) + 1
+    starts = np.concatenate(([0], brk))
+    counts = np.diff(np.concatenate((starts, [kind.size])))
+    return np.column_stack([kind[starts], counts]).ravel().tolist()
+
+
+def _uncounted(runs) -> np.ndarray:
+    r = np.asarray(runs, dtype=np.int64).reshape(-1, 2)
+    return np.repeat(r[:, 0], r[:, 1]).astype(np.int8)
+
+
+def _coupled_role(ops, A):
+    for name in ("Ann", "Att", "Ant", "Atn"):
+        if A is getattr(ops, name):
+            return name
+    return "other"
+
+
 def _role(ops, A):
     return "Ann" if A is ops.Ann else "Att" if A is ops.Att else None
 
@@ -114,8 +137,9 @@ class Recorder:
             where = self._last(k, state, s, key[0])  # (this state's as [field]: a record that repeats)
             systems.append([s.tag, key[0], _role(ops, key[1]), key[4], s.state(),
                             None if where is None else [where[1]] if where[0] == k else [where[1], where[0]]])
+        coupled = self._coupled(nw, events)
         last = None if nw._last is None else next((s.tag for s in nw._systems.values() if s is nw._last[5]), None)
-        summary = {"sys": systems,
+        summary = {"sys": systems, "cp": coupled,
                    "nw": {"last": last, "large": nw._large,
                           "dropped": sorted([k[0], _role(ops, k[1]), k[4]] for k in nw._dropped
                                             if _role(ops, k[1]) is not None)}}
@@ -125,6 +149,26 @@ class Recorder:
             out.update(summary)
             self.summary = summary
         return out if len(out) > 1 else None  # nothing new: no record (the last one holds)
+
+    def _coupled(self, nw, events) -> list:
+        """The coupled steps' factorizations (:class:`~rollqp.methods.newton.linear.CoupledFactors`): their events
+        appended to ``events``; ``[[tag, roles of A_nn, A_tt, A_nt, A_tn, Δq, P prescribed, Q prescribed], ...]``."""
+        out = []
+        for key, (_, cf) in nw._coupled.items():
+            if cf.tag is None:
+                cf.tag, self.tags = self.tags, self.tags + 1
+            if cf.events is None:
+                cf.events = []
+            for e in cf.events:
+                if e[0] == "F":
+                    events.append(["F", cf.tag, None if e[1] is None else _counts(e[1]),
+                                   None if e[2] is None else float(e[2])])
+                else:
+                    events.append(["C", cf.tag, [int(c) for c in e[1]]])
+            cf.events.clear()
+            roles = [None if a is None else _coupled_role(self.ops, a) for a in key[:4]]
+            out.append([cf.tag, roles, key[6], not key[8], not key[9]])
+        return out
 
     def _last(self, k, state, s, kind):
         """``[k, field]`` of the state whose pressure or traction is the system's last solution."""
@@ -152,7 +196,7 @@ def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = N
     (a journal written without the records, or by another version): the march then sets out without them.
     """
     nw = newton_of(meth)
-    made, summary, hist, seen = {}, None, None, False  # (a state without a record: nothing changed)
+    made, factored, summary, hist, seen = {}, {}, None, None, False  # (a state without a record: nothing changed)
     for k, note in notes:
         rec = note.get("solver") if isinstance(note, dict) else None
         if rec is None:
@@ -170,17 +214,24 @@ def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = N
         for ev in rec.get("ev", ()):
             if ev[0] == "f":
                 made[(ev[1], ev[2])] = (bool(ev[3]), _indices(ev[4]), [])
-            else:
+            elif ev[0] == "b":
                 made[(ev[1], ev[2])][2].append((ev[3], ev[4]))
+            elif ev[0] == "F":
+                factored[ev[1]] = (None if ev[2] is None else _uncounted(ev[2]), ev[3], [])
+            else:
+                factored[ev[1]][2].append(ev[2])
         if "sys" in rec:
             summary = rec
             alive = {(s[0], i) for s in rec["sys"] for i in s[4]["kept"] + list(s[4]["base"].values())}
             made = {key: v for key, v in made.items() if key in alive}
+            factored = {t: v for t, v in factored.items() if t in {c[0] for c in rec.get("cp", ())}}
     if not seen:
         return None
     if recorder is not None:
         recorder.hist = None  # (the next state's record says it again)
     products = {} if nw is None or summary is None else _rebuild(nw, ops, summary, upto, made, state_at, recorder)
+    if nw is not None and summary is not None:
+        _rebuild_coupled(nw, ops, summary.get("cp", ()), factored, recorder)
     return products, hist
 
 
@@ -218,3 +269,21 @@ def _rebuild(nw, ops, summary, at, made, state_at, recorder):
     for kind, role, dqh in summary["nw"]["dropped"]:
         nw._dropped.add((kind, ops.Ann if role == "Ann" else ops.Att, ops.f.tobytes(), ops.scales, dqh, nw.r))
     return products
+
+
+def _rebuild_coupled(nw, ops, coupled, factored, recorder):
+    """The coupled steps' factorizations of the record (:meth:`CoupledFactors.restore
+    <rollqp.methods.newton.linear.CoupledFactors.restore>`), in its order."""
+    nw._coupled = {}
+    for tag, roles, dq, P_given, Q_given in coupled:
+        if recorder is not None:
+            recorder.tags = max(recorder.tags, tag + 1)
+        if "other" in roles:  # another operator's (the steady start's): never asked for again
+            continue
+        Ann, Att, Ant, Atn = (None if r is None else getattr(ops, r) for r in roles)
+        pb = types.SimpleNamespace(Ann=Ann, Att=Att, Ant=Ant, Atn=Atn, f=ops.f, scales=ops.scales, dq=dq,
+                                   P=1.0 if P_given else None, Q=1.0 if Q_given else None, n=ops.n)
+        _, cf = nw.coupled_system(pb)
+        cf.tag = tag
+        if tag in factored:
+            cf.restore(factored[tag])

@@ -278,6 +278,8 @@ class NewtonMethod:
         if hit is None:
             S = coupled_system(pb, self.r)
             hit = (S, CoupledFactors(S))
+            if self.record:  # (rollqp.solverstate)
+                hit[1].events = []
             self._keep(self._coupled, key, hit)
         return hit
 

@@ -658,7 +658,7 @@ class CoupledFactors:
     """
 
     __slots__ = ("S", "n", "N", "kind", "mu", "free", "pinned", "posF", "posP", "lu", "piv", "Rp", "cols",
-                 "factorizations", "updates", "rejected", "scale")
+                 "factorizations", "updates", "rejected", "scale", "events", "tag")
 
     #: Largest number of changed rows solved by the Woodbury update, as a fraction of the factored
     #: (free) size, at least :attr:`UPDATE_MIN`; beyond, refactor. Measured (median rolling step of
@@ -685,6 +685,9 @@ class CoupledFactors:
         self.kind = None
         self.mu = None
         self.factorizations = self.updates = self.rejected = 0
+        #: ``None``, or the list the factorizations and the batches of kept columns are recorded in
+        #: (:meth:`state`, :meth:`restore`), and the recorder's name for them (:mod:`rollqp.solverstate`)
+        self.events, self.tag = None, None
         self.scale = 1.0 + max(float(np.max(np.sum(np.abs(S.KN), axis=1))),
                                float(np.max(np.sum(np.abs(S.KT), axis=1))))
 
@@ -737,9 +740,31 @@ class CoupledFactors:
             lu, piv, info = dgetrf(np.asfortranarray(R[:, free]), overwrite_a=True)
             if info != 0:
                 self.kind = None
+                if self.events is not None:
+                    self.events.append(("F", None, None))
                 return False
             self.lu, self.piv = lu, piv
+        if self.events is not None:
+            self.events.append(("F", kind, mu))
         return True
+
+    def restore(self, factored) -> None:
+        """Factor again as recorded: ``factored = (kind, mu, batches)``, the row kinds and ``μ`` of the last
+        factorization (``kind`` ``None``: none) and the batches of columns kept on it since, in order (each
+        batch solved together, as it was: the same columns, bit for bit)."""
+        kind, mu, batches = factored
+        events, self.events = self.events, None  # (not recorded again)
+        try:
+            if kind is None:
+                self.kind = None
+                return
+            if not self._factor(np.asarray(kind, dtype=np.int8), mu):
+                raise ValueError("the recorded coupled factorization is singular")
+            for batch in batches:
+                if self._columns(np.asarray(batch, dtype=np.intp)) is None:
+                    raise ValueError("a recorded batch of coupled columns failed")
+        finally:
+            self.events = events
 
     def _solve(self, b):
         """``J_f⁻¹ b`` (``b`` of length ``N``)."""
@@ -757,6 +782,8 @@ class CoupledFactors:
         """``Z = J_f⁻¹ E_C``, from the kept columns, computing the missing ones together."""
         miss = [c for c in C.tolist() if c not in self.cols]
         if miss:
+            if self.events is not None:
+                self.events.append(("C", miss))
             miss = np.array(miss)
             m = miss.size
             X = np.zeros((self.N, m))
