@@ -261,14 +261,14 @@ class PlainMarch(Alternation):
 
 def unpredicted(name, tolerance):
     """``name``'s QP backend with the active-set prediction kept off (QPMethod.predicting): every QP of
-    the accelerated start solved by the backend itself, as before the prediction."""
+    the accelerated start solved by the backend itself, without the prediction."""
     meth = rollqp.methods.get_method(name, tolerance=tolerance)
     meth.predicting = lambda on: False  # the accelerated start switches it on through this call
     return meth
 
 
 class AndersonOnly(Alternation):
-    """The accelerated start without its Newton phase: plain steps, then Anderson (before the phase)."""
+    """The accelerated start without its Newton phase: plain steps, then Anderson."""
 
     def __init__(self, *args, **kw):
         super().__init__(*args, **kw)
