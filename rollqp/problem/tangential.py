@@ -82,6 +82,8 @@ class TangentialStep:
     def __post_init__(self, trusted, known_bound):
         self._known_bound = known_bound if trusted else None
         if trusted:
+            if known_bound is not None:  # the cached properties' values at once (their first access takes a lock)
+                self.__dict__["bound"], self.__dict__["bound_hat"] = known_bound.values, known_bound.hat
             return
         _check_arrays(self, ("A",), ("p", "c"))
         _set_scalars(self, ("dq", "Q", "xi") + (() if _per_node(self.mu) else ("mu",)))  # μ per node: _check_friction

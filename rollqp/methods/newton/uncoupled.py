@@ -318,6 +318,8 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     ``start``: ``(x, A x)`` of the start in the problem's units, if the product is known.
     Returns ``(z, iterations, info, x, A x)``, ``x`` the solution's traction in the problem's units.
     """
+    if not sys_.partial:
+        return _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start)
     r = sys_.r
     st = _Iterate(meth, pb, sys_, z, k0, load, ncp, start)
     stop = meth.tolerance * min(1.0, r)
@@ -360,3 +362,115 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
     return st.z, it, info, st.xphys, st.Ax
+
+
+# ------------------------------------------------------------------------------ small n
+def _point(pb, sys_, z, k0, load, ncp, start=None):
+    """``(x, A x, y, Φ)`` at the unknowns ``z`` from a new product ``A x`` of its traction (``start``: the
+    known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers."""
+    n = pb.n
+    if start is None:
+        xphys = z[:n] * pb.scales.stress
+        Ax = pb.A @ xphys
+    else:
+        xphys, Ax = start
+    y = sys_.unit * Ax + k0
+    if load is None:
+        return xphys, Ax, y, ncp.phi(z[:n], y)
+    y += sys_.load_column * z[n]
+    phi = np.empty(n + 1)
+    phi[:n] = ncp.phi(z[:n], y)
+    phi[n] = sys_.fhat @ z[:n] - load
+    return xphys, Ax, y, phi
+
+
+def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
+    """:func:`iterate` below :data:`~.linear.PARTIAL_MIN` nodes: the same iterates and numbers as :class:`_Iterate`
+    there (every iterate its own product ``A x``, ``α = 1`` tried on the full step's product), written out in
+    one loop. At 81 nodes a rolling step takes one iteration, whose arithmetic (a few dozen operations on
+    81-vectors) costs about what the object's method calls around it would."""
+    n, r = pb.n, sys_.r
+    with_load = load is not None
+    stop = meth.tolerance * min(1.0, r)
+    mask = sys_.mask(with_load)
+    two_sigma = 2.0 * meth.sigma
+    xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp, start)
+    merit, history, merits, steps, counts = None, [], [], [], [0, 0, 0]  # backtracks, nonmonotone, shifts
+    it = 0
+    while True:
+        nrm = float(np.abs(phi).max())
+        history.append(nrm)
+        merits.append(0.5 * float(phi @ phi) if merit is None else merit)
+        if nrm <= stop:
+            break
+        if it >= meth.max_iterations:
+            raise not_converged(meth, pb.kind, merits, it, nrm, stop)
+        it += 1
+        m = ncp.mask(z[:n], y)
+        if with_load and not m.any():  # degenerate: _Iterate.rows
+            m, y, phi = _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y)
+            merit = None
+            counts[2] += 1
+        mask[:n] = m
+        d = sys_.direction(mask, phi, with_load)  # reduced system on the free nodes
+        if d is None or not math.isfinite(float(np.add.reduce(d))):  # a NaN or an infinity anywhere (one sum)
+            raise SolverError(f"the {pb.kind} Newton matrix is singular",
+                              method=meth.name, status="singular", iterations=it, residual=nrm)
+        zf = z + d
+        full = _point(pb, sys_, zf, k0, load, ncp)
+        pa = full[3]
+        merit = 0.5 * float(pa @ pa)
+        if merit <= (1.0 - two_sigma) * merits[-1]:  # eq. 75–78 at α = 1
+            steps.append(1.0)
+            z, (xphys, Ax, y, phi) = zf, full
+            continue
+        alpha = _backtrack(meth, z[:n], y, d[:n], full[2] - y, merits[-1], load, ncp, sys_, warm, counts)
+        steps.append(alpha)
+        z = z + alpha * d  # eq. 79
+        xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp)
+        merit = None
+    sys_.settled = False
+    info = {"r": r, "backtracks": counts[0], "merit": merits[-1], "history": history, "merits": merits,
+            "steps": steps, "nonmonotone": counts[1], "shifts": counts[2], "tolerance_phi": stop}
+    return z, it, info, xphys, Ax
+
+
+def _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y):
+    """:meth:`_Iterate.rows` on a degenerate iterate (no node in stick/contact): ``δ̂``/``ξ̂`` moved so that the
+    nearest node lies on its kink (in place in ``z``); ``(mask, y, Φ)`` there, that node with the ``K`` row."""
+    n = pb.n
+    try:
+        j, dy = ncp.nearest(z[:n], y)
+    except SolverError as err:
+        raise SolverError(err.message, method=meth.name, status=err.status) from None
+    z[n] += dy / sys_.K[j, n]
+    _, _, y, phi = _point(pb, sys_, z, k0, load, ncp, (xphys, Ax))  # only δ̂/ξ̂ moved: y from the same product
+    m = ncp.mask(z[:n], y)
+    m[j] = True
+    return m, y, phi
+
+
+def _backtrack(meth, x, y, dx, Kd, theta, load, ncp, sys_, warm, counts):
+    """:meth:`_Iterate.line_search` once the full step is refused: ``α = ρ, ρ², …`` on ``(x, y) + α (d, K d)``;
+    below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start)."""
+    rho, two_sigma = meth.rho, 2.0 * meth.sigma
+    n = x.size
+    alpha = rho
+    counts[0] += 1
+    while True:
+        xa, ya = x + alpha * dx, y + alpha * Kd
+        if load is None:
+            pa = ncp.phi(xa, ya)
+        else:
+            pa = np.empty(n + 1)
+            pa[:n] = ncp.phi(xa, ya)
+            pa[n] = sys_.fhat @ xa - load
+        if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
+            return alpha
+        alpha *= rho
+        counts[0] += 1
+        if alpha < ALPHA_MIN:
+            if warm:
+                raise Stalled()
+            counts[1] += 1
+            return 1.0
