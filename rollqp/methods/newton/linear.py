@@ -351,7 +351,7 @@ class ReducedSystem:
             return d
         r0 = B @ phi_p
         r0 -= phi[rows]
-        u0, info = dgetrs(lu, piv, r0)
+        u0, info = dgetrs(lu, piv, r0, 0, 1)  # (trans = 0, overwrite_b: r0 is this solve's own; positional: cheaper)
         if info != 0:
             return None
         d[rows] = u0

@@ -93,15 +93,15 @@ def solve_normal(meth, pb, warm, t0):
 def solve_tangential(meth, pb, warm, t0):
     """GNMls on the tangential step ``t̂ = Proj_[−b, b](t̂ − r ŝ)``, ``f̂ᵀt̂ = Q̂`` (eq. 60–62, 67)."""
     sc = pb.scales
-    sys_ = meth.system(pb, pb.dq / sc.length)
-    n, r = pb.n, sys_.r
     dqh = pb.dq / sc.length
+    sys_ = meth.system(pb, dqh)
+    n, r = pb.n, sys_.r
     with_load = pb.Q is not None
     Qhat = pb.Q / sc.force if with_load else None
     xi_fixed = None if with_load else pb.xi / sc.slip
     z = np.zeros(n + 1 if with_load else n)  # (t̂, ξ̂) or t̂: the start, Step 1
     start = "cold"
-    if warm is not None and warm.t is not None and np.shape(warm.t) == (n,):
+    if warm is not None and warm.t is not None and _has_shape(warm.t, n):
         np.divide(warm.t, sc.stress, out=z[:n])
         start = "warm"
         if warm.xi is not None and with_load:
@@ -117,6 +117,11 @@ def solve_tangential(meth, pb, warm, t0):
     sys_.last = (sol.t, At)
     sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
+
+
+def _has_shape(a, n) -> bool:
+    """``np.shape(a) == (n,)`` (an array's own shape read first: np.shape's dispatch costs more)."""
+    return (a.shape if type(a) is np.ndarray else np.shape(a)) == (n,)
 
 
 def _friction_rows(sys_, pb):
@@ -379,7 +384,7 @@ def _point(pb, sys_, z, k0, load, ncp, start=None):
         return xphys, Ax, y, ncp.phi(z[:n], y)
     y += sys_.load_column * z[n]
     phi = np.empty(n + 1)
-    phi[:n] = ncp.phi(z[:n], y)
+    ncp.phi(z[:n], y, phi[:n])
     phi[n] = sys_.fhat @ z[:n] - load
     return xphys, Ax, y, phi
 
@@ -413,13 +418,16 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
             counts[2] += 1
         mask[:n] = m
         d = sys_.direction(mask, phi, with_load)  # reduced system on the free nodes
-        if d is None or not math.isfinite(float(np.add.reduce(d))):  # a NaN or an infinity anywhere (one sum)
-            raise SolverError(f"the {pb.kind} Newton matrix is singular",
-                              method=meth.name, status="singular", iterations=it, residual=nrm)
+        if d is None:
+            raise _singular(meth, pb, it, nrm)
         zf = z + d
         full = _point(pb, sys_, zf, k0, load, ncp)
         pa = full[3]
         merit = 0.5 * float(pa @ pa)
+        # d has a NaN or an infinity iff z + d has (z is finite): in x̂, Φ's own row of that node is not finite
+        # (x̂ − Proj(…), with the load row f̂ᵀx̂ too), so the merit is not; in ξ̂, the number itself
+        if not (math.isfinite(merit) and (not with_load or math.isfinite(zf[n]))):
+            raise _singular(meth, pb, it, nrm)
         if merit <= (1.0 - two_sigma) * merits[-1]:  # eq. 75–78 at α = 1
             steps.append(1.0)
             z, (xphys, Ax, y, phi) = zf, full
@@ -433,6 +441,11 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     info = {"r": r, "backtracks": counts[0], "merit": merits[-1], "history": history, "merits": merits,
             "steps": steps, "nonmonotone": counts[1], "shifts": counts[2], "tolerance_phi": stop}
     return z, it, info, xphys, Ax
+
+
+def _singular(meth, pb, it, nrm):
+    return SolverError(f"the {pb.kind} Newton matrix is singular", method=meth.name, status="singular",
+                       iterations=it, residual=nrm)
 
 
 def _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y):
