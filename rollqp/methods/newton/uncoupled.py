@@ -82,7 +82,7 @@ def solve_normal(meth, pb, warm, t0):
     z, start = _normal_start(pb, sys_, warm)
     k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
     known = _last_product(sys_, warm.p if start == "warm" else None)
-    z, it, info, p, Ap = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
+    z, it, info, p, Ap, _, _ = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
     delta = z[n] * u0 if with_load else pb.delta
     info["start"] = start
     sol = pb.solution(p, delta, Ap=Ap)
@@ -110,10 +110,11 @@ def solve_tangential(meth, pb, warm, t0):
     if xi_fixed is not None:
         k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    z, it, info, tt, At = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    z, it, info, tt, At, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
-    sol = pb.solution(tt, xi, At=At)
+    # the slip and rollqp's residuals from the last iterate's own y = r ŝ and load row (TangentialStep.solution)
+    sol = pb.solution(tt, xi, At=At, hat=(z[:n], y / r, phi[n] if with_load else 0.0))
     sys_.last = (sol.t, At)
     sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
@@ -321,7 +322,8 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z);
     ``ncp`` gives ``φ`` and its node cases (:class:`~.ncp.NormalNCP`, :class:`~.ncp.TangentialNCP`);
     ``start``: ``(x, A x)`` of the start in the problem's units, if the product is known.
-    Returns ``(z, iterations, info, x, A x)``, ``x`` the solution's traction in the problem's units.
+    Returns ``(z, iterations, info, x, A x, y, Φ)``, ``x`` the solution's traction in the problem's units and
+    ``y``, ``Φ`` at ``z`` (evaluated from its own product).
     """
     if not sys_.partial:
         return _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start)
@@ -366,10 +368,13 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
-    return st.z, it, info, st.xphys, st.Ax
+    return st.z, it, info, st.xphys, st.Ax, st.y, st.phi
 
 
 # ------------------------------------------------------------------------------ small n
+#: ``a.max()``, ``a.any()`` without their Python-level wrappers (the same reductions)
+_max, _any = np.maximum.reduce, np.logical_or.reduce
+
 def _point(pb, sys_, z, k0, load, ncp, start=None):
     """``(x, A x, y, Φ)`` at the unknowns ``z`` from a new product ``A x`` of its traction (``start``: the
     known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers."""
@@ -403,7 +408,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     merit, history, merits, steps, counts = None, [], [], [], [0, 0, 0]  # backtracks, nonmonotone, shifts
     it = 0
     while True:
-        nrm = float(np.abs(phi).max())
+        nrm = float(_max(np.abs(phi)))
         history.append(nrm)
         merits.append(0.5 * float(phi @ phi) if merit is None else merit)
         if nrm <= stop:
@@ -412,7 +417,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
             raise not_converged(meth, pb.kind, merits, it, nrm, stop)
         it += 1
         m = ncp.mask(z[:n], y)
-        if with_load and not m.any():  # degenerate: _Iterate.rows
+        if with_load and not _any(m):  # degenerate: _Iterate.rows
             m, y, phi = _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y)
             merit = None
             counts[2] += 1
@@ -440,7 +445,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     sys_.settled = False
     info = {"r": r, "backtracks": counts[0], "merit": merits[-1], "history": history, "merits": merits,
             "steps": steps, "nonmonotone": counts[1], "shifts": counts[2], "tolerance_phi": stop}
-    return z, it, info, xphys, Ax
+    return z, it, info, xphys, Ax, y, phi
 
 
 def _singular(meth, pb, it, nrm):
