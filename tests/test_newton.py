@@ -29,7 +29,7 @@ TOL = {
     # central differences of a function that is linear between kinks: error is round-off
     # amplified by 1/h (h = 1e-6 on O(1) entries): ~1e-10.
     "fd": 1e-8,
-    # the issue's agreement target with the QP backends (at their default tolerance 1e-10,
+    # the agreement required with the QP backends (at their default tolerance 1e-10,
     # measured differences: OSQP ≤ 1e-12, Clarabel ≤ 1.4e-10, in p0 or μ p0).
     "qp": 1e-9,
     # the transient: 193 steps, each QP step within ~1e-10 μp0, errors carried by the history.
@@ -450,7 +450,7 @@ def test_transient_matches_osqp():
 
 
 def test_tangential_step_speed():
-    """Issue target: a warm Newton tangential step at 81 nodes is >= 10x faster than Clarabel.
+    """Target: a warm Newton tangential step at 81 nodes is >= 10x faster than Clarabel.
 
     Measured ~0.09 ms against ~11 ms (Clarabel, 4 splitting QPs); min-of-repeats timing.
     """
