@@ -2,7 +2,7 @@
 
 One fresh process per size (peak RSS is per process): ``halfspace_influence`` on ``N`` quadratic
 elements (``2N + 1`` nodes), similar materials. Run from a source tree; ``--source`` times
-another checkout (e.g. main) with the same script, for a before/after table.
+another checkout (e.g. main) with the same script, for a table of the two trees.
 
     python benchmarks/assembly.py --nodes 2561 5121 [--source /path/to/other/checkout]
 """

@@ -17,7 +17,7 @@ Sections (``--only`` names):
                20 … 320) at μ = 1e-4, and a dense sweep of constant meshes;
 * ``friction`` |ξ|/ξ_BJ against μ = 1e-4 … 0.3, both couplings;
 * ``signs``    A ↔ B and d = ±1: the signs of β, ξ and t;
-* ``newton``   where the Newton direct steady solve fails (free rolling at μ = 1e-4);
+* ``newton``   the Newton direct steady solve at μ = 1e-4 (free rolling), mesh by mesh;
 * ``start``    the coupled rolling start with the QP methods: CONTACT's grid, μ = 0.05,
                full coupling; time against ``newton``'s direct steady solve, the answer against it,
                and the ways to reach the steady state that were measured (one N–T sweep per marching
@@ -232,7 +232,7 @@ def section_signs():
 
 
 def section_newton():
-    print("#### Where the Newton direct steady solve fails (free rolling, μ = 1e-4, zone ±1.1 a_H, d = −1)\n")
+    print("#### The Newton direct steady solve at μ = 1e-4 (free rolling, zone ±1.1 a_H, d = −1)\n")
     rows = []
     last = None
     for element in ("constant", "quadratic"):
@@ -261,14 +261,14 @@ class PlainMarch(Alternation):
 
 def unpredicted(name, tolerance):
     """``name``'s QP backend with the active-set prediction kept off (QPMethod.predicting): every QP of
-    the accelerated start solved by the backend itself, as before the prediction."""
+    the accelerated start solved by the backend itself, without the prediction."""
     meth = rollqp.methods.get_method(name, tolerance=tolerance)
     meth.predicting = lambda on: False  # the accelerated start switches it on through this call
     return meth
 
 
 class AndersonOnly(Alternation):
-    """The accelerated start without its Newton phase: plain steps, then Anderson (before the phase)."""
+    """The accelerated start without its Newton phase: plain steps, then Anderson."""
 
     def __init__(self, *args, **kw):
         super().__init__(*args, **kw)

@@ -61,7 +61,7 @@ def main(argv=None):
     rows = [[name, f"{times[(name, 'before')]:.2f}", f"{times[(name, 'now')]:.2f}",
              f"{times[(name, 'before')] / times[(name, 'now')]:.1f}×"] for name in CASES]
     print(f"load average at the end: {os.getloadavg()[0]:.1f}")
-    print(table(["case", "before: CPU s", "now: CPU s", "before / now"], rows))
+    print(table(["case", "--before tree: CPU s", "this tree: CPU s", "ratio"], rows))
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ compares the circulant preconditioner with none (GMRES products per step).
 ``--transient``: the §6.1.1 transient (``cattaneo-carter``, ``mf-newton``, Δq = 8 Le, the longest step
 allowed) on each ``--nodes``, in a fresh process: wall and CPU seconds, per step (mean, median and by
 eighths of the run), set iterations and operator products per step. ``--source`` adds the same run on
-another source tree's rollqp (an earlier checkout), the two alternating, for a before/after ratio.
+another source tree's rollqp (another checkout), the two alternating, for the ratio of the two trees.
 """
 from __future__ import annotations
 
@@ -144,7 +144,7 @@ def main(argv=None):
     ap.add_argument("--preconditioner", action="store_true", help="circulant vs no preconditioner")
     ap.add_argument("--transient", action="store_true", help="the §6.1.1 transient with mf-newton, Δq = 8 Le")
     ap.add_argument("--distance", type=float, default=6.0, help="rolled distance of --transient, in a_H")
-    ap.add_argument("--source", help="--transient also on this source tree's rollqp (before/after)")
+    ap.add_argument("--source", help="--transient also on this source tree's rollqp (the two trees compared)")
     args = ap.parse_args(argv)
     pin_threads()
     cmd = "python benchmarks/matrix_free.py " + " ".join(sys.argv[1:] if argv is None else argv)

@@ -15,24 +15,33 @@ Two kinds of points, both the paper's §6.1.1 scene (``cattaneo-carter``: Δq = 
   values): 48 points;
 * **large**: 80 QCE (~0.5 s a point), Q/(μP) = 0.1 … 0.85 (6) × μ = 0.1, 0.2: 12 points.
 
-**Serial**: the points one after another in this process (``rollqp.run``), BLAS on one thread.
-**Sweep**: ``rollqp.sweep.sweep`` into a new zarr store on a ``LocalCluster`` of ``--workers``
-single-threaded worker processes (default 2: one per core), the whole call timed (validation,
-the store's creation, every task and every write). The cluster is started once, before the
-repetitions: its start is reported apart, and the ratio with it included too. A warm-up sweep
-first (the workers' first import of rollqp). Serial and sweep alternate within each repetition
-(:func:`harness.interleaved`); the ratios are of the medians.
+Three ways to compute the same points, alternating within each repetition
+(:func:`harness.interleaved`; the ratios are of the medians):
+
+* **runs**: the points one after another in this process (``rollqp.run``), BLAS on one thread:
+  the computation alone, no store;
+* **one process**: ``rollqp.sweep.sweep`` in this process (``--workers 0``): the same command and
+  the same store as the sweep below, with one process doing everything;
+* **sweep**: ``rollqp.sweep.sweep`` into a new zarr store on a ``LocalCluster`` of ``--workers``
+  single-threaded worker processes (default 2: one per core), the whole call timed (validation,
+  the store's creation, every task and every write). The cluster is started once, before the
+  repetitions: its start is reported apart, and the ratio with it included too. A warm-up sweep
+  first (the workers' first import of rollqp).
+
+The scaling of ``rollqp sweep`` is **one process / sweep**: the same work (points, result
+arrays, store writes) on one process against ``--workers`` processes. **runs / sweep** also
+charges the sweep with what the store costs.
 
 Overheads, measured on the way: the sweep's fixed part (validation and store), the store
-writes (``StoreWriter.write``, timed in the client, wall and the writing thread's CPU), each
-point's CPU time beside its wall time (in the serial run and on the workers), and
-``(workers × points' wall − Σ point times)/points``: what a point costs beyond its own
-computation on a worker, its share of the writes, the scheduler and the tail included. A
-**CPU-based ratio**, less sensitive to other jobs on the machine than the wall-clock one: the serial
-run's CPU seconds against the sweep's CPU shared by the workers (the points' CPU on the workers and
-the client process's CPU during the sweep — validation, store, writes, the scheduler's thread —
-divided by ``--workers``): what free cores would give if only CPU counted (the workers' own dask CPU
-between points is not in it).
+writes (``StoreWriter.write`` in the one-process sweep: wall and CPU; on a local cluster the
+workers write their own chunks), each point's CPU time beside its wall time (in the runs and on
+the workers), and ``(workers × points' wall − Σ point times)/points``: what a point costs beyond
+its own computation on a worker, its share of the writes, the scheduler and the tail included. A
+**CPU-based ratio**, less sensitive to other jobs on the machine than the wall-clock one: the
+one-process sweep's CPU seconds against the sweep's CPU shared by the workers (the points' CPU on
+the workers, their writes included, and the client process's CPU during the sweep — validation,
+store, dask's scheduler thread — divided by ``--workers``): what free cores would give if only
+CPU counted (the workers' own dask CPU between points is not in it).
 
 Control: the machine's parallelism at the moment (``workers`` pure-Python loops in processes at
 once against one alone; 2× on an idle 2-core machine), measured between the repetitions: on a
@@ -53,7 +62,7 @@ import time  # noqa: E402
 
 import rollqp  # noqa: E402
 from rollqp.sweep import build_sweep, dataset, sweep  # noqa: E402
-from rollqp.sweep.executor import close_client, connect  # noqa: E402
+from rollqp.sweep.executor import InProcess, close_client, connect  # noqa: E402
 
 SIZES = {
     "small": ({"discretization.elements": 40},
@@ -88,19 +97,19 @@ def _parallelism(workers: int) -> float:
     return workers * alone / together
 
 
-CPU = {}  # size -> CPU seconds of each serial run
+CPU = {}  # case -> CPU seconds of each run in this process
 
 
-def _serial(scenes, size) -> float:
+def _runs(scenes, size) -> float:
     t0, c0 = time.perf_counter(), time.process_time()
     for s in scenes:
         rollqp.run(s)
-    CPU.setdefault(size, []).append(time.process_time() - c0)
+    CPU.setdefault(f"runs {size}", []).append(time.process_time() - c0)
     return time.perf_counter() - t0
 
 
 class _TimedWriter(dataset.StoreWriter):
-    """StoreWriter that records the wall time and point count of each write (client side)."""
+    """StoreWriter that records the wall time and point count of each write in this process."""
 
     writes: list = []
 
@@ -111,13 +120,20 @@ class _TimedWriter(dataset.StoreWriter):
 
 
 def _sweep(base, vary, client, folder, summaries) -> float:
-    store = os.path.join(folder, f"s{len(summaries)}.zarr")
+    store = os.path.join(folder, f"s{time.time_ns()}.zarr")
     t0, c0 = time.perf_counter(), time.process_time()
     summary = sweep(base, vary, store, client=client)
     wall = time.perf_counter() - t0
     assert summary.done == summary.total and not summary.failed, summary.table()
     summaries.append((wall, summary, time.process_time() - c0))
     shutil.rmtree(store)
+    return wall
+
+
+def _one_process(base, vary, folder, summaries, size) -> float:
+    c0 = time.process_time()
+    wall = _sweep(base, vary, InProcess(), folder, summaries)
+    CPU.setdefault(f"one process {size}", []).append(time.process_time() - c0)
     return wall
 
 
@@ -132,28 +148,33 @@ def _creep_command(folder, extra=()) -> float:
 
 
 def _rows(size, walls, summaries, workers, startup):
-    ser, par = statistics.median(walls[f"serial {size}"]), statistics.median(walls[f"sweep {size}"])
+    med = {k: statistics.median(walls[f"{k} {size}"]) for k in ("runs", "one process", "sweep")}
+    one, par = med["one process"], med["sweep"]
     n = summaries[0][1].total
     pts = [sum(s.point_times) for _, s, _ in summaries]
     extra = [(workers * s.wall - p) / n for (_, s, _), p in zip(summaries, pts)]
     fixed = [s.prepare for _, s, _ in summaries]
-    # CPU-based ratio: the serial run's CPU against the sweep's CPU shared by the workers (the points' CPU on
-    # the workers plus the client process's: validation, store, writes, the scheduler's thread), what free
-    # cores would give if nothing but CPU counted (the workers' own dask CPU between points is not in it)
+    # CPU-based ratio: the one-process sweep's CPU against the sweep's CPU shared by the workers (the points'
+    # CPU on the workers, their writes included, plus the client process's: validation, store, the scheduler's
+    # thread), what free cores would give if nothing but CPU counted (dask's own CPU on the workers is not in it)
     sweep_cpu = statistics.median((sum(s.point_cpu) + c) / workers for _, s, c in summaries)
+    listed = {k: ", ".join(f"{w:.2f}" for w in walls[f"{k} {size}"]) for k in med}
     return [
         (f"**{size}**: points", f"{n} ({summaries[0][1].per_chunk} per task and chunk)"),
-        ("serial, one process (median)", f"{ser:.2f} s  ({', '.join(f'{w:.2f}' for w in walls[f'serial {size}'])})"),
-        (f"sweep, {workers} workers (median)", f"{par:.2f} s  ({', '.join(f'{w:.2f}' for w in walls[f'sweep {size}'])})"),
-        ("**throughput ratio serial/sweep**", f"**{ser / par:.2f}×**"),
-        ("ratio with the cluster's start in the sweep", f"{ser / (par + startup):.2f}×"),
-        ("mean point time: serial / on the workers", f"{1e3 * ser / n:.0f} ms / {1e3 * statistics.median(pts) / n:.0f} ms"),
-        ("mean point CPU time: serial / on the workers",
-         f"{1e3 * statistics.median(CPU[size]) / n:.0f} ms / "
+        ("runs, one process, no store (median)", f"{med['runs']:.2f} s  ({listed['runs']})"),
+        ("`rollqp sweep --workers 0`: one process (median)", f"{one:.2f} s  ({listed['one process']})"),
+        (f"sweep, {workers} workers (median)", f"{par:.2f} s  ({listed['sweep']})"),
+        ("**scaling: one process / sweep**", f"**{one / par:.2f}×**"),
+        ("runs / sweep", f"{med['runs'] / par:.2f}×"),
+        ("one process / (sweep + the cluster's start)", f"{one / (par + startup):.2f}×"),
+        ("mean point time: runs / on the workers", f"{1e3 * med['runs'] / n:.0f} ms / {1e3 * statistics.median(pts) / n:.0f} ms"),
+        ("mean point CPU time: runs / on the workers",
+         f"{1e3 * statistics.median(CPU[f'runs {size}']) / n:.0f} ms / "
          f"{1e3 * statistics.median(sum(s.point_cpu) for _, s, _ in summaries) / n:.0f} ms"),
-        ("client process CPU during a sweep (median)", f"{statistics.median(c for _, _, c in summaries):.2f} s"),
-        ("CPU-based ratio: serial CPU / ((Σ point CPU on the workers + client CPU) / workers)",
-         f"{statistics.median(CPU[size]) / sweep_cpu:.2f}×"),
+        ("CPU of the one-process sweep / of the client process during a sweep (medians)",
+         f"{statistics.median(CPU[f'one process {size}']):.2f} s / {statistics.median(c for _, _, c in summaries):.2f} s"),
+        ("CPU-based ratio: one-process CPU / ((Σ point CPU on the workers + client CPU) / workers)",
+         f"{statistics.median(CPU[f'one process {size}']) / sweep_cpu:.2f}×"),
         ("validation and store creation (median)", f"{1e3 * statistics.median(fixed):.0f} ms"),
         ("(workers × points' wall − Σ point times)/points (median)", f"{1e3 * statistics.median(extra):.1f} ms"),
     ]
@@ -199,8 +220,10 @@ def main(argv=None):
               os.path.join(folder, "warm.zarr"), client=client)
         _TimedWriter.writes.clear()
         cases = {}
+        one = {s: [] for s in sizes}
         for s in sizes:
-            cases[f"serial {s}"] = lambda s=s: _serial(points[s], s)
+            cases[f"runs {s}"] = lambda s=s: _runs(points[s], s)
+            cases[f"one process {s}"] = lambda s=s: _one_process(scenes[s], SIZES[s][1], folder, one[s], s)
             cases[f"sweep {s}"] = lambda s=s: _sweep(scenes[s], SIZES[s][1], client, folder, summaries[s])
         cases["control"] = lambda: _parallelism(args.workers)
         walls = harness.interleaved(args.repeats, cases, lambda f: f(),
@@ -217,7 +240,7 @@ def main(argv=None):
         rows += _rows(s, walls, summaries[s], args.workers, startup)
     writes = _TimedWriter.writes
     per_point = sum(k for _, k, _ in writes)
-    rows += [("store write of one chunk in the client: wall / CPU (medians; CPU a point)",
+    rows += [("store write of one chunk in the one-process sweep: wall / CPU (medians; CPU a point)",
               f"{1e3 * statistics.median(w for w, _, _ in writes):.1f} ms / "
               f"{1e3 * statistics.median(c for _, _, c in writes):.1f} ms "
               f"({1e3 * sum(c for _, _, c in writes) / per_point:.1f} ms a point)")]

@@ -17,11 +17,10 @@ to the steady state).
 from __future__ import annotations
 
 import argparse
-import re
 import time
-from pathlib import Path
 
 import numpy as np
+import contact3d_cases
 from harness import pin_threads, table
 
 from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
@@ -34,7 +33,6 @@ from rollqp.three.gnm import NewtonMethod
 from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
 from rollqp.three.socp import ClarabelMethod, CvxpyMethod, OsqpMethod
 
-DATA = Path(__file__).resolve().parent.parent / "tests" / "data" / "contact3d"
 FN, MU = 1000.0, 0.3
 A_CURV = 1 / 60
 
@@ -148,76 +146,14 @@ def section_sliding(quick):
 
 
 # ----------------------------------------------------------------------------- CONTACT's examples
-def _cases(text):
-    return text.split("\n Case ")[1:]
-
-
-def contact_cattaneo():
-    """CONTACT's cattaneo case 2 on its grid: shift, approach, counts."""
-    text = (DATA / "cattaneo.ref_out").read_text()
-    blk = _cases(text)[1]
-    vals = re.search(r"FN/G\s+SHIFT X\s+SHIFT Y\s+APPROACH\s+PMAX\s*\n\s*(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)", blk)
-    cnt = re.search(r"NSLIP\s+INORM\s+ITANG\n\s*(\d+)\s+(\d+)\s+(\d+)\s+(\d+)", blk)
-    ref = dict(shift=float(vals.group(2)), delta=float(vals.group(4)), pmax=float(vals.group(5)),
-               ncon=int(cnt.group(2)), nadh=int(cnt.group(3)), nslip=int(cnt.group(4)))
-    m = Materials.from_shear(200.0, 0.42, 200.0, 0.42)
-    c = Contact(Grid(19, 19, 0.13333, 0.13333, -1.26667, -1.26667), m, (0.01, 0.01), 9.1954, 0.4)
-    rec = static_shift(c, NewtonMethod(), 9.1954, Fx=-0.875 * 0.4 * 9.1954)[-1]
-    ours = dict(shift=rec.info["shift"][0], delta=rec.delta, pmax=float(rec.p.max()), ncon=int(np.sum(rec.p > 0)),
-                nadh=int(np.sum(rec.state == 1)), nslip=int(np.sum(rec.state == 2)))
-    return ref, ours
-
-
-def contact_catt_to_cart(steps):
-    """CONTACT's catt_to_cart, first sequence: the braked start, then ``steps`` rolling steps (DQ = DX)."""
-    text = (DATA / "catt_to_cart.ref_out").read_text()
-    ref = []
-    for blk in _cases(text)[:steps + 1]:
-        v = re.search(r"(?:SHIFT|CREEP) X.*\n\s*(\S+)\s+(\S+)", blk)
-        cnt = re.search(r"Tang: final element division: A, S=\s+(\d+)\s+(\d+)", blk)
-        ref.append((float(v.group(2)), int(cnt.group(1)), int(cnt.group(2))))
-    m = Materials.from_shear(1.0, 0.28, 1.0, 0.28)
-    c = Contact(Grid(34, 33, 0.25, 0.25, -4.125, -4.125), m, (0.002963, 0.002963), 0.4705, 0.4013)
-    Fx = -0.657 * 0.4013 * 0.4705
-    start = static_shift(c, NewtonMethod(), 0.4705, Fx=Fx)[-1]
-    ours = [(start.info["shift"][0], int(np.sum(start.state == 1)), int(np.sum(start.state == 2)))]
-    for rec in transient(c, NewtonMethod(), 0.4705, Loads(Fx=Fx, eta=0.0), 0.25, steps, -1, start=start):
-        if rec.k > 0:
-            ours.append((rec.xi, int(np.sum(rec.state == 1)), int(np.sum(rec.state == 2))))
-    return ref, ours
-
-
-def contact_tractcurv(cases):
-    """CONTACT's tractcurv series 1 (steady, CKSI prescribed) on its 48 × 44 grid: FX and counts."""
-    text = (DATA / "tractcurv.ref_out").read_text()
-    ref = []
-    for blk in _cases(text)[:cases]:
-        kin = re.search(r"CKSI\s+CETA\s+CPHI\n\s*\S+\s+\S+\s+\S+\s+(\S+)", blk)
-        tot = re.search(r"FRIC.POWER\n\s*\S+\s+(\S+)", blk)
-        cnt = re.search(r"NSLIP\s+INORM\s+ITANG\n\s*(\d+)\s+(\d+)\s+(\d+)\s+(\d+)", blk)
-        ref.append((float(kin.group(1)), float(tot.group(1)), int(cnt.group(3)), int(cnt.group(4))))
-    m = Materials.from_shear(82000.0, 0.28, 82000.0, 0.28)
-    A = 0.0008
-    B = curvatures_for_ratio(A, 0.5)
-    e = hertz(A, B, m.Estar, 106700.0)
-    c = Contact(Grid(48, 44, 2.2 * e.a / 48, 2.2 * e.b / 44, -1.1 * e.a, -1.1 * e.b), m, (A, B), 106700.0, 0.33)
-    newton = NewtonMethod()
-    p = newton.solve(c.normal_step(106700.0))
-    ours, warm = [], None
-    for xi, *_ in ref:
-        warm = steady(c, newton, 106700.0, Loads(xi=xi, eta=0.0), -1, start=warm, pressure=p)
-        ours.append((warm.Fx, int(np.sum(warm.state == 1)), int(np.sum(warm.state == 2))))
-    return ref, ours
-
-
 def section_contact(quick):
     out = []
-    ref, ours = contact_cattaneo()
+    ref, ours = contact3d_cases.cattaneo()
     rows = [[k, f"{ref[k]:.4g}", f"{ours[k]:.6g}",
              f"{ours[k] / ref[k] - 1:+.1e}" if isinstance(ref[k], float) else str(ours[k] == ref[k])] for k in ref]
     out.append("cattaneo (case 2)\n\n" + table(["quantity", "CONTACT", "rollqp", "rollqp/CONTACT − 1 or equal"], rows))
     steps = 8 if quick else 56
-    ref, ours = contact_catt_to_cart(steps)
+    ref, ours = contact3d_cases.catt_to_cart(steps)
     worst = max(abs(o[0] / r[0] - 1) for r, o in zip(ref, ours))
     same = sum(o[1:] == r[1:] for r, o in zip(ref, ours))
     rows = [[k, f"{r[0]:.4g}", f"{o[0]:.6g}", f"{o[0] / r[0] - 1:+.1e}", f"{o[1]}/{o[2]} ({r[1]}/{r[2]})"]
@@ -226,7 +162,7 @@ def section_contact(quick):
                f"counts equal in {same} of {len(ref)} cases\n\n"
                + table(["case − 1", "CONTACT shift/CKSI", "rollqp", "ratio − 1", "adh/slip (CONTACT)"], rows))
     cases = 6 if quick else 30
-    ref, ours = contact_tractcurv(cases)
+    ref, ours = contact3d_cases.tractcurv(cases)
     worst = max(abs(o[0] / r[1] - 1) for r, o in zip(ref, ours))
     same = sum(o[1:] == r[2:] for r, o in zip(ref, ours))
     rows = [[f"{r[0]:.3g}", f"{r[1]:.4g}", f"{o[0]:.6g}", f"{o[0] / r[1] - 1:+.1e}", f"{o[1]}/{o[2]} ({r[2]}/{r[3]})"]

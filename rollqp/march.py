@@ -269,11 +269,12 @@ class _March:
         mu = ops.mu if problem is None or self.constant_friction else problem.coefficient(tsol.s, tsol.p)
         bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
         nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound)
-        count = np.bincount(nodes, minlength=3)
+        count = np.bincount(nodes, minlength=3).tolist()
         gross = bool(count[SLIP] and not count[STICK])
-        return StepRecord(k=k, phase=phase, q=float(q), P=float(ops.f @ state.p) if P is None else P,
-                          Q=float(ops.f @ state.t), state=state, previous=previous, problem=problem, solution=sol, counters=cnt,
-                          shift=shift, step_time=time.perf_counter() - t0, nodes=nodes, gross_sliding=gross)
+        f = ops.f
+        # (the fields in their order: keywords cost a step as much as a dot product)
+        return StepRecord(k, phase, float(q), float(f @ state.p) if P is None else P, float(f @ state.t), state,
+                          previous, problem, sol, cnt, shift, time.perf_counter() - t0, nodes, gross)
 
     # ------------------------------------------------------------ the phases
     def start(self) -> StepRecord:

@@ -50,7 +50,7 @@ def test_lame_default_mesh():
     """The ring alone on the default counts (19 equal outer, 16 shaft elements): <= 1e-4."""
     err = _lame_error(None, 1)
     # measured 8.9e-5: quadratic interpolation of the Cartesian fields (∝ cos θ) on arcs of
-    # 2π/19, an O(φ³) discretization error (next test); the issue's bar is 1e-4.
+    # 2π/19, an O(φ³) discretization error (next test); the bar is 1e-4.
     assert err <= 1e-4, f"Lamé error on the default ring mesh {err:.3e}"
 
 
@@ -151,7 +151,7 @@ def test_hertz_small_contact(element):
     rms = lambda e: np.sqrt(np.mean(e[inside] ** 2)) / sc.stress  # noqa: E731
     err_hertz = rms(p_b - cf.hertz_pressure(x, sc.length, sc.stress))
     # measured 3.9e-3 (quadratic), 1.10e-2 (linear), 6.2e-3 (constant): the 40-element discretization
-    # error, the same as the half-space's (5.0e-3, 1.17e-2, 5.6e-3); the issue's bar, 1 %, for the
+    # error, the same as the half-space's (5.0e-3, 1.17e-2, 5.6e-3); the bar, 1 %, for the
     # paper's QCE and the constant elements. Linear elements miss it on the half-space too.
     if element != "linear":
         assert err_hertz < 0.01, f"{element}: rms(p - Hertz)/p0 = {err_hertz:.4f}"

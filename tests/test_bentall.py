@@ -27,7 +27,7 @@ DY = 1000 mm strip (16.2019 N/mm: a_H = 0.1 mm), 216 elements of DX = 0.001 mm f
 CHI = 0 is d = −1, refdata README). Its cases 1–2 (μ = 1e-4) run with MAXOUT = 1, i.e. without
 CONTACT's outer (Panagiotopoulos) normal–tangential iteration: the pressure does not see the
 shear, rollqp's ``goodman``; case 4 (μ = 0.05) runs with MAXOUT = 10, the outer iteration, i.e.
-full coupling. The quoted creepages (issue; not in tests/data/contact): |ξ| = 5.260e-4
+full coupling. CONTACT's creepages for these cases (not in tests/data/contact): |ξ| = 5.260e-4
 at μ = 1e-4 and 4.29e-4 at μ = 0.05.
 
 Numbers and the command that prints them: docs/validation.md, "Bentall–Johnson free rolling and
@@ -44,7 +44,7 @@ from rollqp import closedforms as cf
 from refcases import CONTACT_DX, CONTACT_MX, CONTACT_XL, FN_BENTALL as FN, bentall_contact_grid
 from refcases import bentall_scene as _bentall_scene
 
-#: CONTACT's free-rolling creepages (magnitudes), as quoted in the issue, and their coupling.
+#: CONTACT's free-rolling creepages (magnitudes) of its bentall case, and their coupling.
 CONTACT_XI = {1e-4: (5.260e-4, "goodman", 1e-7), 0.05: (4.29e-4, "full", 1e-6)}  # value, coupling, last digit
 
 
@@ -195,7 +195,7 @@ def test_contacts_bentall_case(mu):
     assert abs(xi - ref) <= unit, f"|ξ| = {xi:.6e}, CONTACT {ref:.3e}"
 
 
-# =========================================================================== the Newton issue
+# =========================================================================== Newton at μ = 1e-4
 @pytest.mark.parametrize("elements", [40] + [pytest.param(n, marks=pytest.mark.slow) for n in (20, 30, 60, 80, 120, 160, 200)])
 def test_newton_steady_free_rolling_at_tiny_friction(elements):
     """Newton's direct steady solve gives qp-osqp's marched steady state (the same discrete problem

@@ -101,7 +101,7 @@ def test_sign_conventions_map(transient):
 
 
 def test_transient_creepage_matches_contact(transient, reference):
-    """|ξ_k| against cksi_k at every rolling step, relative to the steady creepage (issue: ≤ 1 %).
+    """|ξ_k| against cksi_k at every rolling step, relative to the steady creepage (required: ≤ 1 %).
 
     Measured: 6.0e-5 (at q = 0.6 a_H), both backends.
     """

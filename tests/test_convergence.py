@@ -57,10 +57,10 @@ def test_paper_6_1_1_closed_forms(paper_runs, method):
     xi = float(r["creepage"][-1])
     assert r["q"][-1] / a == pytest.approx(6.0), "rolled 6 a_H"
     assert hertz <= 0.01, f"Hertz rms error {hertz:.4f} p0"
-    assert catt <= 0.01, f"Cattaneo rms error {catt:.4f} μp0 (issue: ≤ 1 %)"
-    assert carter <= 0.015, f"Carter rms error after 6 a_H {carter:.4f} μp0 (issue: ≤ 1.5 %)"
+    assert catt <= 0.01, f"Cattaneo rms error {catt:.4f} μp0 (required: ≤ 1 %)"
+    assert carter <= 0.015, f"Carter rms error after 6 a_H {carter:.4f} μp0 (required: ≤ 1.5 %)"
     xi_c = cf.carter_creepage(a, R, mu, RATIO)
-    assert abs(xi / xi_c - 1) <= 0.03, f"creepage {xi:.5e} against Carter's {xi_c:.5e} (issue: within 3 %)"
+    assert abs(xi / xi_c - 1) <= 0.03, f"creepage {xi:.5e} against Carter's {xi_c:.5e} (required: within 3 %)"
     law = cf.creep_force_ratio(xi, a, R, mu)
     assert abs(law / RATIO - 1) <= 0.03, f"the creep law gives Q/(μP) = {law:.4f} for rollqp's ξ, not 0.75"
 
@@ -127,7 +127,7 @@ def test_convergence_orders(element):
     Asserted: the fitted order is at least 0.8 × the measured one (room for the solver
     tolerance and platform noise on the coarse meshes, yet a drop to order ½ — what a broken
     edge or stick–slip treatment gives — fails), every refinement lowers the error, and the
-    80-element error is within 25 % of the measured one (a regression of the constant).
+    80-element error is within 25 % of the measured one (a larger error constant fails).
     """
     errs = [_errors(element, n) for n in ELEMENTS]
     for j, key in enumerate(QUANTITIES):

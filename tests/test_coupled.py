@@ -32,7 +32,7 @@ TOL = {
     # alternation stops at coupled residual <= its limit (Newton halves: 1e-10; QP halves:
     # residual_limit = 100·tolerance); traction differences follow within a small factor.
     "nt": 1e-9,
-    # issue target on the exactly symmetric discretization (constant elements).
+    # the agreement required on the exactly symmetric discretization (constant elements).
     "symmetric": 1e-9,
 }
 
@@ -348,10 +348,10 @@ def test_coupled_step_validates_input():
 
 @pytest.mark.parametrize("mu", [0.01, 0.03])
 def test_small_friction_goodman_loading(mu):
-    """Regression: at small μ almost every node slips during the Goodman loading; a warm
-    Newton start then fell on a Newton fixed point with a wrong active set (Armijo fails,
-    the full step reproduces the point). Newton now sweeps the halves (coupled) or restarts
-    cold (halves) and must agree with the alternation."""
+    """At small μ almost every node slips during the Goodman loading; a warm Newton start
+    can then fall on a Newton fixed point with a wrong active set (Armijo fails, the full step
+    reproduces the point). Newton sweeps the halves (coupled) or restarts cold (halves) there
+    and must agree with the alternation."""
     scene = rollqp.load_scene("goodman-bentall").replace(
         **{"contact.friction": mu, "discretization.distance": 0.0, "load.start_steps": 10})
     a, b = rollqp.run(scene, method="newton"), rollqp.run(scene, method="nt-newton")

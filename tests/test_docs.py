@@ -202,9 +202,11 @@ def test_index_lists_every_page():
 
 
 def test_no_internal_issue_numbers():
-    """Docs and code speak of the project, never of its tracker: no "issue N" anywhere users read."""
+    """Docs and code speak of the project, never of its tracker: no "issue N" anywhere users read
+    (the package, its docs, and the tests' and benchmarks' text, which the docs cite)."""
     found = []
-    for path in [ROOT / "README.md", *PAGES, *sorted((ROOT / "rollqp").rglob("*.py"))]:
+    code = [p for d in ("rollqp", "benchmarks", "tests") for p in sorted((ROOT / d).rglob("*.py"))]
+    for path in [ROOT / "README.md", *PAGES, *code]:
         for n, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
             if re.search(r"[Ii]ssues? [0-9]+|\b[Tt]he issue'?s?\b", line):
                 found.append(f"{path.relative_to(ROOT)}:{n}")

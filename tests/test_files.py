@@ -176,7 +176,7 @@ def test_a_result_whose_scalars_are_not_its_scenes_is_refused(result_file, tmp_p
     (("--grid", "3," + "9" * 5000), "--grid"),
 ])
 def test_stresses_grid_arguments(result_file, capsys, args, words):
-    """``--depth 1e-300`` printed NaN peaks with exit 0: now a range error, and the field is checked finite."""
+    """``--depth 1e-300`` is a range error (not NaN peaks with exit 0), and the field is checked finite."""
     path, _ = result_file
     _one_line_cli(capsys, "stresses", str(path), "--step", "-1", *args, words=(words,))
 

@@ -16,8 +16,9 @@ from rollqp.march import march, prepare, run
 from rollqp.methods import get_method
 from rollqp.scene import load_scene, scene_from_dict
 
-#: The ramped falling-friction transient on which the slip-dependent Newton matrix used to become
-#: singular (rational law, v_h = 3 mm/s, V = 10 m/s: step 21 of 25).
+#: The ramped falling-friction transient on which the slip-dependent Newton matrix becomes singular
+#: without the repair of the degenerate iterate (rational law, v_h = 3 mm/s, V = 10 m/s: step 21 of 25;
+#: docs/friction.md).
 SCENE = FALLING_RAMP
 
 

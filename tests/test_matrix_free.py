@@ -213,9 +213,9 @@ def test_load_paths_matrix_free_equal_dense(name, operator):
     """load.rolled (stops, reversals, a cycle at rest) with mf-newton: every state as dense newton's.
 
     The static-shift steps of a stop keep the state: every node is at zero slip, those at the
-    bound also at the friction limit. Loose Krylov solves used to flip them at random (no set
-    repeated: 100 set iterations and a residual of 2.4e-5 at step 97 of stop-reverse on the dense
-    operator, "auto" at 81 nodes); the stall rule and the dead band fix it. Both methods solve to
+    bound also at the friction limit. Loose Krylov solves flip them at random (without the stall rule and
+    the dead band no set repeats: 100 set iterations and a residual of 2.4e-5 at step 97 of stop-reverse
+    on the dense operator, "auto" at 81 nodes); the stall rule and the dead band prevent it. Both methods solve to
     rollqp's residual 1e-10; measured 1.2e-13 p0 and 7.7e-13 μp0."""
     scene = rollqp.load_scene(name)
     dense = list(march(scene, "newton"))

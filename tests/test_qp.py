@@ -426,7 +426,7 @@ def test_qp_hessian_is_built_once_per_operator(quadratic_problem):
     FA = (a.f / sc.length)[:, None] * a.A.dense() * sc.modulus / sc.length / (a.dq / sc.length)
     np.testing.assert_allclose(fa.H * fa.obj_scale, 0.5 * (FA + FA.T), rtol=1e-12)  # rounding of n-term sums
     # another Δq (a load path's variable steps, a reversal): the same normalized Hessian, obj_scale ∝ 1/Δq,
-    # so the backend's solver object is kept (was rebuilt at every step of stop-reverse: 1.7x OSQP iterations)
+    # so the backend's solver object is kept (rebuilt at every step of stop-reverse it costs 1.7x OSQP iterations)
     c = a.replace(dq=0.5 * a.dq)
     fc = c.qp_form()
     assert fc.H is fa.H and fc.obj_scale == pytest.approx(2 * fa.obj_scale, rel=1e-15)

@@ -75,7 +75,7 @@ def test_material_steady_operator_is_the_history_operators_fixed_point(element, 
 def test_material_operator_against_the_upwind_difference(element, ne, step, same):
     """Off the leading node (out of contact, docs/formulation.md §1) the material ``T`` is ``d·D_up``
     exactly where ``R`` interpolates linearly over one step; with QCE and Δq = Le/4 it is not (the
-    case where the direct solve used to leave the march's fixed point)."""
+    case where a steady solve with ``d·D_up`` would miss the march's fixed point)."""
     strip = Strip(1.3, ne, element)
     dq = step * strip.element_length
     for d in (-1, 1):

@@ -77,10 +77,13 @@ def test_sweep_on_two_workers_equals_each_scene_run_alone(client, tmp_path):
     """Method × friction × mesh: 8 points on 2 worker processes, each bitwise equal to run(scene)."""
     store = tmp_path / "s.zarr"
     vary = ["solver.method=newton,qp-osqp", "contact.friction=0.1,0.3", "discretization.elements=10,20"]
-    workers = set()
-    summary = sweep(_small(), vary, store, client=client, on_point=lambda i, out: workers.add(out["worker"]))
+    workers, sent = set(), []
+    summary = sweep(_small(), vary, store, client=client,
+                    on_point=lambda i, out: (workers.add(out["worker"]), sent.append(out)))
     assert summary.done == 8 and not summary.failed and summary.kept == 0
     assert len(workers) == 2, workers  # both worker processes computed points
+    # a local cluster's workers share the client's disk: each wrote its own chunk, and sent back no arrays
+    assert all(out.get("written") and "arrays" not in out for out in sent), sent
     sw = build_sweep(_small(), vary)
     ds = xr.open_zarr(store, chunks=None).load()
     assert ds.sizes["solver.method"] == 2 and ds.sizes["discretization.elements"] == 2
@@ -91,6 +94,28 @@ def test_sweep_on_two_workers_equals_each_scene_run_alone(client, tmp_path):
     assert ds["x"].dims == ("solver.method", "contact.friction", "discretization.elements", "node")  # meshes differ
     for i in range(len(sw.scenes)):
         _assert_point_equals_run(ds, sw, i)
+
+
+@pytest.mark.integration
+def test_a_cluster_at_an_address_sends_its_points_and_the_client_writes_them(client, tmp_path):
+    """Through ``--scheduler`` (a ``Client`` of an address, no shared disk assumed) the workers send the
+    arrays and the client writes them: the same store, bitwise, as the local cluster's own writes."""
+    import distributed
+    vary = ["load.tangential=0.2,0.6", "contact.friction=0.1,0.3"]
+    remote = distributed.Client(client.scheduler.address)
+    try:
+        sent = []
+        summary = sweep(_small(), vary, tmp_path / "r.zarr", client=remote, on_point=lambda i, out: sent.append(out))
+    finally:
+        remote.close()
+    assert summary.done == 4 and not summary.failed
+    assert all(not out.get("written") and "arrays" in out for out in sent)
+    local = sweep(_small(), vary, tmp_path / "l.zarr", client=client)
+    assert local.done == 4
+    a, b = (xr.open_zarr(tmp_path / f, chunks=None).load() for f in ("r.zarr", "l.zarr"))
+    for name in a.data_vars:
+        if name not in TIMES + ("point_time",):
+            np.testing.assert_array_equal(a[name].values, b[name].values, err_msg=name)
 
 
 def _status(store):

@@ -303,3 +303,25 @@ def test_workers_0_imports_no_dask(tmp_path):
             "print(rc, 'distributed' in sys.modules, 'dask' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert out.stdout.split() == ["0", "False", "False"], out.stderr[-2000:]
+
+
+def test_a_task_that_cannot_write_its_chunk_sends_its_arrays_instead(tmp_path):
+    """A worker that shares no disk with the store (here: a store path that is not one) keeps each
+    point's arrays in its answer, unmarked, so that the client writes them; one it can write marks
+    them written and sends none."""
+    from rollqp.sweep.executor import compute_points
+    base = _small().replace(**{"discretization.distance": 1.0})
+    sw = build_sweep(base, ["contact.friction=0.1,0.2"])
+    points = [(i, sw.changes(i)) for i in range(2)]
+    missing = (str(tmp_path / "nowhere.zarr"), sw.fingerprint(), sw.keys, sw.shape)
+    outs = compute_points(base.to_dict(), points, missing)
+    assert [o.get("written") for o in outs] == [None, None] and all("arrays" in o for o in outs)
+    store = tmp_path / "s.zarr"
+    create_store(store, sw, 2)
+    outs = compute_points(base.to_dict(), points, (str(store), sw.fingerprint(), sw.keys, sw.shape))
+    assert all(o["written"] and "arrays" not in o for o in outs)
+    xr = pytest.importorskip("xarray")
+    ds = xr.open_zarr(store, chunks=None).load()
+    assert np.all(ds["status"].values == 1)
+    alone = rollqp.run(sw.scenes[1]).arrays()
+    np.testing.assert_array_equal(ds["pt"].values[1][:alone["pt"].shape[0], :alone["pt"].shape[1]], alone["pt"])

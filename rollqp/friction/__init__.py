@@ -2,10 +2,10 @@ r"""Friction laws as objects: the registry, the scene key ``contact.friction`` a
 
 Friction enters a step only through its bound ``b = μ p⁺`` (paper eq. 57–60, 63). A law
 (:mod:`.laws`) says what ``μ`` depends on; :func:`step_coefficient` turns it into what one step
-problem takes in place of the old number ``mu``:
+problem takes for its coefficient ``mu``:
 
-* a constant law: the ``float`` ``μ`` itself — the step problems and methods then take exactly
-  the code path they took before laws existed (bitwise the same results);
+* a constant law: the ``float`` ``μ`` itself — the step problems and methods then take their
+  constant-coefficient code path, with no law in it;
 * a law varying along the surface: an ``(n,)`` array ``μ_i`` at the nodes, fixed during the
   step (the bound stays independent of the unknowns: each half is still a convex QP);
 * a slip-velocity law: a :class:`~.bound.SlipBound` — ``μ_i(s_i)`` depends on the unknown slip,

@@ -133,7 +133,7 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
     """
     kind = law.kind
     if kind == "constant":
-        return law.mu, None  # the number itself (a plain float): the old code path
+        return law.mu, None  # the number itself (a plain float): the constant-coefficient code path
     if kind == "spatial":
         return law.coefficient(x_hat, q_hat, direction), None
     static = law.steady(0.0)[0]

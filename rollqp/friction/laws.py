@@ -3,7 +3,7 @@ r"""The friction laws: what the coefficient ``μ`` of the bound ``|t| <= μ p`` 
 Three families, each a small frozen record whose fields are the keys of ``[contact.friction]``:
 
 * :class:`Coulomb` — one constant ``μ`` (``contact.friction = 0.3`` is this law; the law object is
-  also the number ``μ``, a ``float``, so that a scene's ``contact.friction`` reads as before);
+  also the number ``μ``, a ``float``, so that a scene's ``contact.friction`` reads as that number);
 * :class:`Patch`, :class:`Table` — ``μ(x)`` varying along the surface, fixed in the contact
   frame (``frame = "fixed"``) or carried by a body's material through the contact
   (``frame = "material"``: the material point at ``x`` at rolled distance ``q`` was at

@@ -93,7 +93,7 @@ class CvxpyQP(QPMethod):
         else:
             kw = clarabel_settings(self.tolerance)
             for k in ("verbose", "presolve_enable", "iterative_refinement_max_iter"):
-                kw.pop(k)  # as before: cvxpy's own defaults for these
+                kw.pop(k)  # left to cvxpy's own defaults
             kw["max_iter"] = int(self.max_iterations or 200)
         kw.update(self.options)
         return kw

@@ -346,7 +346,7 @@ class MapJacobian:
     The operator of each half is the collocation operator of its QP form
     (:func:`~rollqp.methods._qp.collocation_operator`: the Hessian ``sym(F·A)`` with the skew part put
     back, what the splitting's answer solves), so ``K`` is the map's Jacobian for every element type (with
-    the Hessian alone it was an approximation for an asymmetric ``F·A``, and the Newton phase converged
+    the Hessian alone it is an approximation for an asymmetric ``F·A``, and the Newton phase converges
     only linearly on QCE: 32 map evaluations on goodman-bentall's rolling start, 9 with the exact ``K``).
     Dense ``n × n`` products, ``O(n³)`` a call.
     """

@@ -16,6 +16,15 @@ class Scales:
 
     The defaults (all 1) leave an array problem in the user's own units; pass the Hertz
     scales (:meth:`hertz`) for residuals that mean the same in every unit system.
+
+    Attributes
+    ----------
+    displacement : float
+        ``u0 = a_H p0 / E*``: gaps, displacements, approach.
+    slip : float
+        ``p0 / E*``: slips and creepages.
+    force : float
+        ``a_H p0``: loads per unit axial length.
     """
 
     length: float = 1.0
@@ -27,6 +36,11 @@ class Scales:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise InputError(f"scales.{name}", f"must be a finite number > 0, got {v!r}")
+        # the derived units, computed once (read for every step and residual): not fields, so they take no
+        # part in equality, hashing or the repr
+        object.__setattr__(self, "displacement", self.length * self.stress / self.modulus)
+        object.__setattr__(self, "slip", self.stress / self.modulus)
+        object.__setattr__(self, "force", self.length * self.stress)
 
     @classmethod
     def hertz(cls, P: float, R: float, Estar: float) -> "Scales":
@@ -34,18 +48,3 @@ class Scales:
         from ..closedforms import hertz_half_width, hertz_peak_pressure
         a = hertz_half_width(P, R, Estar)
         return cls(length=a, stress=hertz_peak_pressure(P, a), modulus=float(Estar))
-
-    @property
-    def displacement(self) -> float:
-        """``u0 = a_H p0 / E*``: gaps, displacements, approach."""
-        return self.length * self.stress / self.modulus
-
-    @property
-    def slip(self) -> float:
-        """``p0 / E*``: slips and creepages."""
-        return self.stress / self.modulus
-
-    @property
-    def force(self) -> float:
-        """``a_H p0``: loads per unit axial length."""
-        return self.length * self.stress

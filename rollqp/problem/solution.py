@@ -14,18 +14,21 @@ __all__ = ["SEPARATION", "STICK", "SLIP", "friction_residual", "Residuals", "Ste
 SEPARATION, STICK, SLIP = 0, 1, 2
 
 
-def friction_residual(t, s, bound, minus_bound=None):
+def friction_residual(t, s, bound, minus_bound=None, out=None):
     """``t − Proj_[−b, b](t − s)`` (eq. 60): zero iff ``|t| <= b`` and ``t`` opposes the slip ``s``.
 
     The one expression of the friction law's projection residual: rollqp's residuals use it with
     nondimensional ``t̂, ŝ, b̂``; the Newton method with ``r ŝ`` in place of ``ŝ`` (eq. 56, 63).
-    ``minus_bound``: ``−b`` if the caller keeps it.
+    ``minus_bound``: ``−b`` if the caller keeps it; ``out``: the array to write it into.
     """
     if minus_bound is None:
         minus_bound = -bound
     # np.maximum/np.minimum rather than np.clip: the same numbers (``b >= 0``), without np.clip's
     # Python-level dispatch (half the time on a step's vectors, and Newton evaluates it a few times an iteration)
-    return t - np.maximum(np.minimum(t - s, bound), minus_bound)
+    if out is None:
+        return t - np.maximum(np.minimum(t - s, bound), minus_bound)
+    u = np.minimum(t - s, bound)
+    return np.subtract(t, np.maximum(u, minus_bound, out=u), out=out)  # the same operations, in place
 
 
 @dataclass
@@ -114,12 +117,14 @@ def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7, bound=No
     """
     p = np.asarray(p, dtype=float)
     contact = p > tol * scales.stress  # (thresholds scaled, not the arrays: 3 fewer array operations)
-    state = contact.astype(np.int8)  # STICK where in contact, SEPARATION elsewhere
-    if t is not None and s is not None:
-        at_bound = (mu * np.maximum(p, 0) if bound is None else bound) - np.abs(t) <= tol * scales.stress
-        slipping = (np.abs(s) > tol * scales.slip) & at_bound & contact
-        state[slipping] = SLIP
-    return state
+    if t is None or s is None:
+        return contact.astype(np.int8)  # STICK where in contact, SEPARATION elsewhere
+    at_bound = (mu * np.maximum(p, 0) if bound is None else bound) - np.abs(t) <= tol * scales.stress
+    slipping = np.abs(s) > tol * scales.slip
+    slipping &= at_bound
+    slipping &= contact
+    # STICK (1) in contact, SLIP (2) where slipping too (a subset of the contact): the two masks as 0/1 bytes, added
+    return np.add(contact.view(np.int8), slipping.view(np.int8))
 
 
 def compare(a: StepSolution, b: StepSolution, mu: float | None = None, scales: Scales = Scales()) -> dict:

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import dataclasses
-import functools
 from dataclasses import InitVar, dataclass, field
 
 import numpy as np
@@ -80,7 +79,9 @@ class TangentialStep:
     kind = "tangential"
 
     def __post_init__(self, trusted, known_bound):
-        self._known_bound = known_bound if trusted else None
+        known = known_bound if trusted else None
+        # the bound and its nondimensional pair, computed on first use (properties below) or given
+        self._bound, self._bound_hat = (None, None) if known is None else (known.values, known.hat)
         if trusted:
             return
         _check_arrays(self, ("A",), ("p", "c"))
@@ -97,30 +98,31 @@ class TangentialStep:
     def n(self) -> int:
         return self.f.size
 
-    @functools.cached_property
+    @property
     def bound(self) -> np.ndarray:
         """``μ·max(p̄, 0)`` (with a slip-dependent ``law``: at zero slip, the static bound); computed once
         per step problem (read-only: the march, the solver and rollqp's residual each read it), or given
         (``known_bound``)."""
-        if self._known_bound is not None:
-            return self._known_bound.values
-        if self.law is not None:
-            b = self.law.mu(np.zeros(self.n)) * np.maximum(self.p, 0.0)
-        else:
-            b = self.mu * np.maximum(self.p, 0.0)
-        b.flags.writeable = False
+        b = self._bound
+        if b is None:
+            if self.law is not None:
+                b = self.law.mu(np.zeros(self.n)) * np.maximum(self.p, 0.0)
+            else:
+                b = self.mu * np.maximum(self.p, 0.0)
+            b.flags.writeable = False
+            self._bound = b
         return b
 
-    @functools.cached_property
+    @property
     def bound_hat(self) -> tuple:
         """``(b̂, −b̂)``, ``b̂ = μp̄⁺/p0`` of :attr:`bound` (read-only): rollqp's friction residual and
-        Newton's friction rows read them."""
-        if self._known_bound is not None:
-            return self._known_bound.hat
-        bh = self.bound / self.scales.stress
-        nb = -bh
-        bh.flags.writeable = nb.flags.writeable = False
-        return bh, nb
+        Newton's friction rows read them; computed once per step problem, or given (``known_bound``)."""
+        if self._bound_hat is None:
+            bh = self.bound / self.scales.stress
+            nb = -bh
+            bh.flags.writeable = nb.flags.writeable = False
+            self._bound_hat = (bh, nb)
+        return self._bound_hat
 
     def bound_at(self, s) -> np.ndarray:
         """The bound at the slip ``s``: ``μ(s)·max(p̄, 0)`` (``law``), else :attr:`bound`."""
@@ -207,8 +209,20 @@ class TangentialStep:
         xi = self.xi if self.xi is not None else form.unscaled_multiplier(y) * sc.slip
         return self.solution(t, xi, **meta)
 
-    def solution(self, t, xi, At=None, **meta) -> "StepSolution":
-        """``(t, ξ)`` with its slip and residuals (``At``: the product ``A t`` if the caller has it)."""
+    def solution(self, t, xi, At=None, hat=None, **meta) -> "StepSolution":
+        """``(t, ξ)`` with its slip and residuals (``At``: the product ``A t`` if the caller has it).
+
+        ``hat``: ``(t̂, ŝ, f̂ᵀt̂ − Q̂)``, the nondimensional traction, slip and load row of ``(t, ξ)`` if the caller
+        has them (Newton's last iterate: ``ŝ = y/r``): the slip is then ``ŝ·p0/E*`` and the residuals are
+        evaluated on them, without the product, the slip formula and the rescaling (the same numbers to
+        round-off: tests/test_newton.py compares the two).
+        """
         t = np.asarray(t, dtype=float)
+        if hat is not None and self.law is None:
+            t_hat, s_hat, load_hat = hat
+            bh, nb = self.bound_hat
+            fr = friction_residual(t_hat, s_hat, bh, nb)
+            res = Residuals(friction=float(np.abs(fr).max()), load_tangential=0.0 if self.Q is None else abs(float(load_hat)))
+            return StepSolution(t=t, s=s_hat * self.scales.slip, xi=float(xi), p=self.p, residuals=res, **meta)
         s = self.slip(t, xi, At)
         return StepSolution(t=t, s=s, xi=float(xi), p=self.p, residuals=self.residuals(t, xi, s), **meta)

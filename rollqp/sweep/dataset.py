@@ -30,8 +30,8 @@ import numpy as np
 from ..errors import InputError
 from ..fields import FIELDS, dtype_of, fields_for
 
-__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "write_point", "result_fields", "STATUS",
-           "points_per_chunk", "chunk_shape", "FINGERPRINT"]
+__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "Layout", "write_point", "result_fields",
+           "STATUS", "points_per_chunk", "chunk_shape", "FINGERPRINT"]
 
 #: Values of the per-point ``status`` variable.
 STATUS = {"missing": 0, "done": 1, "failed": 2}
@@ -322,6 +322,22 @@ def _chunk_files(group, a):
     return folder, m.compressor, m.dimension_separator, np.dtype(m.dtype.to_native_dtype())
 
 
+class Layout:
+    """The swept keys and the grid's shape: what a :class:`StoreWriter` needs of a sweep (small, sent
+    to the workers that write their own chunks; a :class:`~rollqp.sweep.Sweep` serves as well)."""
+
+    def __init__(self, keys, shape):
+        self.keys, self.shape = tuple(keys), tuple(int(n) for n in shape)
+
+    @property
+    def size(self) -> int:
+        return math.prod(self.shape)
+
+    def index(self, i: int) -> tuple:
+        """The multi-index of point ``i`` (row-major over the axes)."""
+        return tuple(int(j) for j in np.unravel_index(i, self.shape))
+
+
 class StoreWriter:
     """Writes points into a sweep's store, one chunk at a time: every variable's chunk, ``status`` last.
 
@@ -332,7 +348,8 @@ class StoreWriter:
     kill never leaves half a chunk; zarr's asynchronous path costs thread hops per array, ~30
     arrays a chunk, more on a loaded machine. Otherwise zarr writes the
     blocks. Points of the chunk not in the write keep what the store holds (a re-run that
-    computes only a chunk's failed points reads the chunk first).
+    computes only a chunk's failed points reads the chunk first). ``sweep``: the
+    :class:`~rollqp.sweep.Sweep` or its :class:`Layout`.
     """
 
     def __init__(self, group, sweep):
@@ -341,6 +358,9 @@ class StoreWriter:
         self.chunks = tuple(self.arrays["status"].chunks)
         self.names = [k for k in self.arrays if k not in sweep.keys and (k not in ("q", "x") or self.arrays[k].ndim > 1)]
         self.files = {k: _chunk_files(group, self.arrays[k]) for k in self.names + ["status"]}
+        #: Every chunk is written as a file of a store on disk (whose folder is ``root``).
+        self.on_disk = all(spec is not None for spec in self.files.values())
+        self.root = str(group.store.root) if self.on_disk else None
 
     def tasks(self, status) -> list:
         """The points to compute, grouped by chunk: lists of flat indices whose ``status`` is not done."""

@@ -17,9 +17,12 @@
   to one thread inside the task (``threadpoolctl``; a worker started by hand gets the same
   pinning as the local ones), each returning its result arrays and wall time, or its one-line error.
 * :func:`run_sweep` submits one task per chunk of the store holding points not yet done
-  (:meth:`rollqp.sweep.dataset.StoreWriter.tasks`) and writes each task's points as it
-  arrives, one write per variable for the whole chunk, ``status`` last, in the client process
-  (the store needs no shared file system, and a killed client leaves no writer behind); it
+  (:meth:`rollqp.sweep.dataset.StoreWriter.tasks`); each task's points are written as one
+  write per variable for the whole chunk, ``status`` last. On a local cluster (whose workers
+  share the client's disk) the worker that computed a chunk writes it and sends back only each
+  point's status and times; the client's process, which also runs dask's scheduler, then spends
+  its share of the two cores on nothing else. A cluster at ``--scheduler`` needs no shared file
+  system: its workers send the arrays, and the client writes them as they arrive. The loop
   shows progress and returns a :class:`Summary`.
 * :func:`map_jobs` runs any picklable function over independent cases (the benchmark harness
   and the hard-case suite): one task per worker at a time, so a timed case never shares its
@@ -300,12 +303,46 @@ def compute_point(scene) -> dict:
     return {"arrays": arrays, "time": time.perf_counter() - t0, "cpu": time.process_time() - c0, "worker": worker}
 
 
-def compute_points(base, points) -> list:
+#: The stores a worker writes into (path, fingerprint) -> StoreWriter: opened once per sweep.
+_WRITERS: dict = {}
+
+
+def _writer(store):
+    """The :class:`~rollqp.sweep.dataset.StoreWriter` of ``store = (path, fingerprint, keys, shape)``."""
+    import zarr
+
+    from .dataset import Layout, StoreWriter
+    path, fingerprint, keys, shape = store
+    key = (path, fingerprint)
+    if key not in _WRITERS:
+        if len(_WRITERS) >= 4:
+            _WRITERS.pop(next(iter(_WRITERS)))
+        _WRITERS[key] = StoreWriter(zarr.open_group(path, mode="r+", zarr_format=2), Layout(keys, shape))
+    return _WRITERS[key]
+
+
+def compute_points(base, points, store=None) -> list:
     """The task: ``[compute_point(base.replace(**changes)) for _, changes in points]``.
 
     ``base`` is the sweep's base scene as its dict, ``points`` ``(index, changes)`` pairs; the
-    scene of each point is built as the client validated it (``Scene.replace``).
+    scene of each point is built as the client validated it (``Scene.replace``). With ``store``
+    (``(path, fingerprint, keys, shape)``: a worker that shares the client's disk), the points
+    are written into their chunk of the store here, and each result is returned without its
+    arrays, marked ``"written"``.
     """
+    out = _compute_points(base, points)
+    if store is not None:
+        try:
+            _writer(store).write([i for i, _ in points], out)
+        except Exception:  # noqa: BLE001  (the store unreachable here: the client writes, or says why)
+            return out
+        for o in out:
+            o.pop("arrays", None)
+            o["written"] = True
+    return out
+
+
+def _compute_points(base, points) -> list:
     from ..scene import scene_from_dict
     t0 = time.perf_counter()
     try:
@@ -418,14 +455,22 @@ class Progress:
             self.bar.close()
 
 
-def _submit(client, sweep, tasks):
-    """One future per task (chunk) -> its point indices."""
+def _shares_disk(client) -> bool:
+    """The workers of ``client`` write on the client's disk: a ``LocalCluster``'s."""
+    cluster = getattr(client, "cluster", None)
+    return cluster is not None and isinstance(cluster, _dask().LocalCluster)
+
+
+def _submit(client, sweep, tasks, store=None):
+    """One future per task (chunk) -> its point indices; ``store``: where the workers write."""
     import pickle
     base = sweep.base.to_dict()
     if len(pickle.dumps(base)) > SCATTER_BYTES:  # a large table in the scene: sent once to every worker
         base = client.scatter(base, broadcast=True, hash=False)
-    prefix = f"rollqp-points-{sweep.fingerprint()[:10]}-{time.time_ns()}"
-    return {client.submit(compute_points, base, [(i, sweep.changes(i)) for i in points], pure=False,
+    fingerprint = sweep.fingerprint()
+    where = None if store is None else (str(store), fingerprint, sweep.keys, sweep.shape)
+    prefix = f"rollqp-points-{fingerprint[:10]}-{time.time_ns()}"
+    return {client.submit(compute_points, base, [(i, sweep.changes(i)) for i in points], where, pure=False,
                           key=f"{prefix}-{points[0]}"): points for points in tasks}
 
 
@@ -433,7 +478,8 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     """Compute the points of ``sweep`` whose ``status`` is not done, writing them into ``group``.
 
     One task per chunk of the store that holds points to do; each task's points are written
-    together as the task finishes. ``on_point(i, out)`` is called after each point is stored
+    together as the task finishes, by the worker when it shares the client's disk (a local
+    cluster), else here. ``on_point(i, out)`` is called after each point is stored
     (tests, observers). Ctrl-C or SIGTERM cancels the tasks in flight and returns the summary
     with ``interrupted`` set: the stored points stay, and running the sweep again computes only
     the rest.
@@ -448,12 +494,16 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     bar = Progress(todo, "point", quiet)
     t0 = time.perf_counter()
     futures, n = {}, 0
+    store = None
+    if not isinstance(client, InProcess) and writer.on_disk and _shares_disk(client):
+        store = writer.root
     try:
-        futures = _submit(client, sweep, tasks)
+        futures = _submit(client, sweep, tasks, store)
         for fut in as_completed(list(futures)):
             points = futures.pop(fut)
             outs = fut.result()
-            writer.write(points, outs)
+            if not all(o.get("written") for o in outs):
+                writer.write(points, outs)
             for i, out in zip(points, outs):
                 if out.get("error") is None:
                     summary.done += 1

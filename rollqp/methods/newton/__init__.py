@@ -322,7 +322,10 @@ class NewtonMethod:
         """Label a solution with the method, its iterations, ``info`` and the wall time since ``t0``."""
         sol.method, sol.status, sol.iterations = self.name, "solved", it
         sol.backtracks = int(info.pop("backtracks", 0))
-        sol.extras.update(info)
+        if sol.extras:
+            sol.extras.update(info)
+        else:  # a new solution's empty dict: the method's own (the same items, no copy)
+            sol.extras = info
         sol.time = time.perf_counter() - t0
         return sol
 

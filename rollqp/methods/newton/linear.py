@@ -393,14 +393,13 @@ class ReducedSystem:
                 B[free0.size] = self.fhat[pinned]
             store.block = (pinned, rows, B)
         pinned, rows, B = store.block
-        d = np.empty(self.fhat.size + with_load)
-        phi_p = phi[pinned]
-        d[pinned] = -phi_p
+        d = np.negative(phi)  # d_P = −Φ_P; the rows solved for are written below
         if rows.size == 0:
             return d
+        phi_p = phi[pinned]
         r0 = B @ phi_p
         r0 -= phi[rows]
-        u0, info = dgetrs(lu, piv, r0)
+        u0, info = dgetrs(lu, piv, r0, 0, 1)  # (trans = 0, overwrite_b: r0 is this solve's own; positional: cheaper)
         if info != 0:
             return None
         d[rows] = u0

@@ -33,9 +33,9 @@ class NormalNCP:
     #: Rows whose ``y`` enters ``Φ``: all (``None``).
     needs = None
 
-    def phi(self, x, y):
-        """``Φ_i = min(p̂_i, r ĝ_i)`` (eq. 52)."""
-        return np.minimum(x, y)
+    def phi(self, x, y, out=None):
+        """``Φ_i = min(p̂_i, r ĝ_i)`` (eq. 52) (into ``out`` if given)."""
+        return np.minimum(x, y, out=out)
 
     def mask(self, x, y):
         """Nodes with the ``∂(r ĝ_i)`` row: ``p̂_i > r ĝ_i`` (eq. 84); the others ``∂p̂_i`` (eq. 82/83)."""
@@ -63,10 +63,10 @@ class TangentialNCP:
         #: Rows whose ``y`` enters ``Φ``: a zero bound gives ``Φ_i = t̂_i`` whatever ``r ŝ_i`` (eq. 85).
         self.needs = ~self.sep
 
-    def phi(self, x, y):
+    def phi(self, x, y, out=None):
         """``Φ_i = t̂_i − Proj_[−b_i, b_i](t̂_i − r ŝ_i)`` (eq. 60): :func:`~rollqp.problem.friction_residual`
-        with ``−b`` formed once per step (Newton evaluates ``Φ`` a few times an iteration)."""
-        return friction_residual(x, y, self.b, self._minus_b)
+        with ``−b`` formed once per step (Newton evaluates ``Φ`` a few times an iteration; into ``out`` if given)."""
+        return friction_residual(x, y, self.b, self._minus_b, out)
 
     def mask(self, x, y):
         """Nodes with the ``∂(r ŝ_i)`` row: ``|t̂_i − r ŝ_i| <= b_i`` (eq. 86/87, stick); the others

@@ -82,7 +82,7 @@ def solve_normal(meth, pb, warm, t0):
     z, start = _normal_start(pb, sys_, warm)
     k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
     known = _last_product(sys_, warm.p if start == "warm" else None)
-    z, it, info, p, Ap = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
+    z, it, info, p, Ap, _, _ = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
     delta = z[n] * u0 if with_load else pb.delta
     info["start"] = start
     sol = pb.solution(p, delta, Ap=Ap)
@@ -93,15 +93,15 @@ def solve_normal(meth, pb, warm, t0):
 def solve_tangential(meth, pb, warm, t0):
     """GNMls on the tangential step ``t̂ = Proj_[−b, b](t̂ − r ŝ)``, ``f̂ᵀt̂ = Q̂`` (eq. 60–62, 67)."""
     sc = pb.scales
-    sys_ = meth.system(pb, pb.dq / sc.length)
-    n, r = pb.n, sys_.r
     dqh = pb.dq / sc.length
+    sys_ = meth.system(pb, dqh)
+    n, r = pb.n, sys_.r
     with_load = pb.Q is not None
     Qhat = pb.Q / sc.force if with_load else None
     xi_fixed = None if with_load else pb.xi / sc.slip
     z = np.zeros(n + 1 if with_load else n)  # (t̂, ξ̂) or t̂: the start, Step 1
     start = "cold"
-    if warm is not None and warm.t is not None and np.shape(warm.t) == (n,):
+    if warm is not None and warm.t is not None and _has_shape(warm.t, n):
         np.divide(warm.t, sc.stress, out=z[:n])
         start = "warm"
         if warm.xi is not None and with_load:
@@ -110,13 +110,19 @@ def solve_tangential(meth, pb, warm, t0):
     if xi_fixed is not None:
         k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    z, it, info, tt, At = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    z, it, info, tt, At, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
-    sol = pb.solution(tt, xi, At=At)
+    # the slip and rollqp's residuals from the last iterate's own y = r ŝ and load row (TangentialStep.solution)
+    sol = pb.solution(tt, xi, At=At, hat=(z[:n], y / r, phi[n] if with_load else 0.0))
     sys_.last = (sol.t, At)
     sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
+
+
+def _has_shape(a, n) -> bool:
+    """``np.shape(a) == (n,)`` (an array's own shape read first: np.shape's dispatch costs more)."""
+    return (a.shape if type(a) is np.ndarray else np.shape(a)) == (n,)
 
 
 def _friction_rows(sys_, pb):
@@ -316,8 +322,11 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z);
     ``ncp`` gives ``φ`` and its node cases (:class:`~.ncp.NormalNCP`, :class:`~.ncp.TangentialNCP`);
     ``start``: ``(x, A x)`` of the start in the problem's units, if the product is known.
-    Returns ``(z, iterations, info, x, A x)``, ``x`` the solution's traction in the problem's units.
+    Returns ``(z, iterations, info, x, A x, y, Φ)``, ``x`` the solution's traction in the problem's units and
+    ``y``, ``Φ`` at ``z`` (evaluated from its own product).
     """
+    if not sys_.partial:
+        return _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start)
     r = sys_.r
     st = _Iterate(meth, pb, sys_, z, k0, load, ncp, start)
     stop = meth.tolerance * min(1.0, r)
@@ -361,4 +370,127 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
-    return st.z, it, info, st.xphys, st.Ax
+    return st.z, it, info, st.xphys, st.Ax, st.y, st.phi
+
+
+# ------------------------------------------------------------------------------ small n
+#: ``a.max()``, ``a.any()`` without their Python-level wrappers (the same reductions)
+_max, _any = np.maximum.reduce, np.logical_or.reduce
+
+def _point(pb, sys_, z, k0, load, ncp, start=None):
+    """``(x, A x, y, Φ)`` at the unknowns ``z`` from a new product ``A x`` of its traction (``start``: the
+    known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers."""
+    n = pb.n
+    if start is None:
+        xphys = z[:n] * pb.scales.stress
+        Ax = pb.A @ xphys
+    else:
+        xphys, Ax = start
+    y = sys_.unit * Ax + k0
+    if load is None:
+        return xphys, Ax, y, ncp.phi(z[:n], y)
+    y += sys_.load_column * z[n]
+    phi = np.empty(n + 1)
+    ncp.phi(z[:n], y, phi[:n])
+    phi[n] = sys_.fhat @ z[:n] - load
+    return xphys, Ax, y, phi
+
+
+def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
+    """:func:`iterate` below :data:`~.linear.PARTIAL_MIN` nodes: the same iterates and numbers as :class:`_Iterate`
+    there (every iterate its own product ``A x``, ``α = 1`` tried on the full step's product), written out in
+    one loop. At 81 nodes a rolling step takes one iteration, whose arithmetic (a few dozen operations on
+    81-vectors) costs about what the object's method calls around it would."""
+    n, r = pb.n, sys_.r
+    with_load = load is not None
+    stop = meth.tolerance * min(1.0, r)
+    mask = sys_.mask(with_load)
+    two_sigma = 2.0 * meth.sigma
+    xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp, start)
+    merit, history, merits, steps, counts = None, [], [], [], [0, 0, 0]  # backtracks, nonmonotone, shifts
+    it = 0
+    while True:
+        nrm = float(_max(np.abs(phi)))
+        history.append(nrm)
+        merits.append(0.5 * float(phi @ phi) if merit is None else merit)
+        if nrm <= stop:
+            break
+        if it >= meth.max_iterations:
+            raise not_converged(meth, pb.kind, merits, it, nrm, stop)
+        it += 1
+        m = ncp.mask(z[:n], y)
+        if with_load and not _any(m):  # degenerate: _Iterate.rows
+            m, y, phi = _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y)
+            merit = None
+            counts[2] += 1
+        mask[:n] = m
+        d = sys_.direction(mask, phi, with_load)  # reduced system on the free nodes
+        if d is None:
+            raise _singular(meth, pb, it, nrm)
+        zf = z + d
+        full = _point(pb, sys_, zf, k0, load, ncp)
+        pa = full[3]
+        merit = 0.5 * float(pa @ pa)
+        # d has a NaN or an infinity iff z + d has (z is finite): in x̂, Φ's own row of that node is not finite
+        # (x̂ − Proj(…), with the load row f̂ᵀx̂ too), so the merit is not; in ξ̂, the number itself
+        if not (math.isfinite(merit) and (not with_load or math.isfinite(zf[n]))):
+            raise _singular(meth, pb, it, nrm)
+        if merit <= (1.0 - two_sigma) * merits[-1]:  # eq. 75–78 at α = 1
+            steps.append(1.0)
+            z, (xphys, Ax, y, phi) = zf, full
+            continue
+        alpha = _backtrack(meth, z[:n], y, d[:n], full[2] - y, merits[-1], load, ncp, sys_, warm, counts)
+        steps.append(alpha)
+        z = z + alpha * d  # eq. 79
+        xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp)
+        merit = None
+    sys_.settled = False
+    info = {"r": r, "backtracks": counts[0], "merit": merits[-1], "history": history, "merits": merits,
+            "steps": steps, "nonmonotone": counts[1], "shifts": counts[2], "tolerance_phi": stop}
+    return z, it, info, xphys, Ax, y, phi
+
+
+def _singular(meth, pb, it, nrm):
+    return SolverError(f"the {pb.kind} Newton matrix is singular", method=meth.name, status="singular",
+                       iterations=it, residual=nrm)
+
+
+def _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y):
+    """:meth:`_Iterate.rows` on a degenerate iterate (no node in stick/contact): ``δ̂``/``ξ̂`` moved so that the
+    nearest node lies on its kink (in place in ``z``); ``(mask, y, Φ)`` there, that node with the ``K`` row."""
+    n = pb.n
+    try:
+        j, dy = ncp.nearest(z[:n], y)
+    except SolverError as err:
+        raise SolverError(err.message, method=meth.name, status=err.status) from None
+    z[n] += dy / sys_.K[j, n]
+    _, _, y, phi = _point(pb, sys_, z, k0, load, ncp, (xphys, Ax))  # only δ̂/ξ̂ moved: y from the same product
+    m = ncp.mask(z[:n], y)
+    m[j] = True
+    return m, y, phi
+
+
+def _backtrack(meth, x, y, dx, Kd, theta, load, ncp, sys_, warm, counts):
+    """:meth:`_Iterate.line_search` once the full step is refused: ``α = ρ, ρ², …`` on ``(x, y) + α (d, K d)``;
+    below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start)."""
+    rho, two_sigma = meth.rho, 2.0 * meth.sigma
+    n = x.size
+    alpha = rho
+    counts[0] += 1
+    while True:
+        xa, ya = x + alpha * dx, y + alpha * Kd
+        if load is None:
+            pa = ncp.phi(xa, ya)
+        else:
+            pa = np.empty(n + 1)
+            pa[:n] = ncp.phi(xa, ya)
+            pa[n] = sys_.fhat @ xa - load
+        if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
+            return alpha
+        alpha *= rho
+        counts[0] += 1
+        if alpha < ALPHA_MIN:
+            if warm:
+                raise Stalled()
+            counts[1] += 1
+            return 1.0
