@@ -375,22 +375,23 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
 #: ``a.max()``, ``a.any()`` without their Python-level wrappers (the same reductions)
 _max, _any = np.maximum.reduce, np.logical_or.reduce
 
-def _point(pb, sys_, z, k0, load, ncp, start=None):
+def _point(ev, z, k0, load, start=None):
     """``(x, A x, y, Φ)`` at the unknowns ``z`` from a new product ``A x`` of its traction (``start``: the
-    known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers."""
-    n = pb.n
+    known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers.
+    ``ev``: the step's constants (:func:`_iterate_dense`)."""
+    n, stress, A, unit, lc, fhat, phi_rows = ev
     if start is None:
-        xphys = z[:n] * pb.scales.stress
-        Ax = pb.A @ xphys
+        xphys = z[:n] * stress
+        Ax = A @ xphys
     else:
         xphys, Ax = start
-    y = sys_.unit * Ax + k0
+    y = unit * Ax + k0
     if load is None:
-        return xphys, Ax, y, ncp.phi(z[:n], y)
-    y += sys_.load_column * z[n]
+        return xphys, Ax, y, phi_rows(z[:n], y)
+    y += lc * z[n]
     phi = np.empty(n + 1)
-    ncp.phi(z[:n], y, phi[:n])
-    phi[n] = sys_.fhat @ z[:n] - load
+    phi_rows(z[:n], y, phi[:n])
+    phi[n] = fhat @ z[:n] - load
     return xphys, Ax, y, phi
 
 
@@ -400,11 +401,12 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     one loop. At 81 nodes a rolling step takes one iteration, whose arithmetic (a few dozen operations on
     81-vectors) costs about what the object's method calls around it would."""
     n, r = pb.n, sys_.r
+    ev = (n, pb.scales.stress, pb.A.dense(), sys_.unit, sys_.load_column, sys_.fhat, ncp.phi)
     with_load = load is not None
     stop = meth.tolerance * min(1.0, r)
     mask = sys_.mask(with_load)
     two_sigma = 2.0 * meth.sigma
-    xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp, start)
+    xphys, Ax, y, phi = _point(ev, z, k0, load, start)
     merit, history, merits, steps, counts = None, [], [], [], [0, 0, 0]  # backtracks, nonmonotone, shifts
     it = 0
     while True:
@@ -416,17 +418,17 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
         if it >= meth.max_iterations:
             raise not_converged(meth, pb.kind, merits, it, nrm, stop)
         it += 1
-        m = ncp.mask(z[:n], y)
+        m = ncp.mask(z[:n], y, mask[:n])  # the node rows, straight into the mask
         if with_load and not _any(m):  # degenerate: _Iterate.rows
-            m, y, phi = _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y)
+            m, y, phi = _repair(meth, ev, sys_, z, k0, load, ncp, xphys, Ax, y)
+            mask[:n] = m
             merit = None
             counts[2] += 1
-        mask[:n] = m
         d = sys_.direction(mask, phi, with_load)  # reduced system on the free nodes
         if d is None:
             raise _singular(meth, pb, it, nrm)
         zf = z + d
-        full = _point(pb, sys_, zf, k0, load, ncp)
+        full = _point(ev, zf, k0, load)
         pa = full[3]
         merit = 0.5 * float(pa @ pa)
         # d has a NaN or an infinity iff z + d has (z is finite): in x̂, Φ's own row of that node is not finite
@@ -440,7 +442,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
         alpha = _backtrack(meth, z[:n], y, d[:n], full[2] - y, merits[-1], load, ncp, sys_, warm, counts)
         steps.append(alpha)
         z = z + alpha * d  # eq. 79
-        xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp)
+        xphys, Ax, y, phi = _point(ev, z, k0, load)
         merit = None
     sys_.settled = False
     info = {"r": r, "backtracks": counts[0], "merit": merits[-1], "history": history, "merits": merits,
@@ -453,16 +455,16 @@ def _singular(meth, pb, it, nrm):
                        iterations=it, residual=nrm)
 
 
-def _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y):
+def _repair(meth, ev, sys_, z, k0, load, ncp, xphys, Ax, y):
     """:meth:`_Iterate.rows` on a degenerate iterate (no node in stick/contact): ``δ̂``/``ξ̂`` moved so that the
     nearest node lies on its kink (in place in ``z``); ``(mask, y, Φ)`` there, that node with the ``K`` row."""
-    n = pb.n
+    n = ev[0]
     try:
         j, dy = ncp.nearest(z[:n], y)
     except SolverError as err:
         raise SolverError(err.message, method=meth.name, status=err.status) from None
     z[n] += dy / sys_.K[j, n]
-    _, _, y, phi = _point(pb, sys_, z, k0, load, ncp, (xphys, Ax))  # only δ̂/ξ̂ moved: y from the same product
+    _, _, y, phi = _point(ev, z, k0, load, (xphys, Ax))  # only δ̂/ξ̂ moved: y from the same product
     m = ncp.mask(z[:n], y)
     m[j] = True
     return m, y, phi
