@@ -85,7 +85,9 @@ class Counters:
         elif half == "tangential":
             self.inner_tangential += sol.iterations
         self.backtracks += sol.backtracks
-        self._residual(sol.residual)
+        r = sol.residual
+        if r > self.residual or r != r:  # (_residual, written out: once a step)
+            self.residual = r
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
@@ -265,7 +267,8 @@ class _March:
         ops = self.ops
         tsol = state.tsol
         mu = ops.mu if problem is None or self.constant_friction else problem.coefficient(tsol.s, tsol.p)
-        bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
+        bound = None if problem is None or problem.kind != "tangential" else \
+            problem.bound if problem.law is None else problem.bound_at(tsol.s)
         nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound, contact=self._contact(state.p))
         count = np.bincount(nodes, minlength=3).tolist()
         gross = bool(count[SLIP] and not count[STICK])
