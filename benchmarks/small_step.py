@@ -4,10 +4,12 @@
 elements, 81 nodes, ``newton``) with three dense 81 × 81 products (docs/performance.md, "Speed
 targets"). This script takes the median ``step_time`` of ``rollqp.run`` and then times the parts of
 one step that took one Newton iteration (the common case), each alone and warm (timeit, best of 7):
-the step problem's construction, the whole ``method.solve`` (in it: rollqp's own residuals of the
-solution, ``problem.solution``), the node states of the record (``rollqp.classify``) and a dense
+the step problem's construction, the whole ``method.solve`` (in it: the solution with its slip and
+rollqp's own residuals, ``problem.solution``, as Newton calls it: on its last iterate's nondimensional
+traction, slip and load row), the node states of the record (``rollqp.classify``) and a dense
 product. What the parts leave of the median step is the march's own logic around them and the
-memory traffic between steps (a part repeated alone runs on warm caches)::
+memory traffic between steps (a part repeated alone runs on warm caches). The mean step (the first
+rolling steps take more iterations, and a new free set a new factorization) is printed too::
 
     python benchmarks/small_step.py [--runs 5]
 
@@ -35,7 +37,8 @@ def best(f, number=4000) -> float:
 
 
 def measure(runs=5) -> dict:
-    steps = [np.median(rollqp.run("cattaneo-carter", method="newton").arrays()["step_time"][1:]) for _ in range(runs)]
+    times = [rollqp.run("cattaneo-carter", method="newton").arrays()["step_time"][1:] for _ in range(runs)]
+    steps = [np.median(t) for t in times]
     scene, method, ops = prepare("cattaneo-carter", "newton")
     records = list(rollqp.march(scene, prepared=(scene, method, ops)))
     k = next(i for i in range(len(records) // 2, len(records)) if records[i].counters.iterations == 1)
@@ -45,12 +48,16 @@ def measure(runs=5) -> dict:
     rng = np.random.default_rng(0)
     A, x = rng.standard_normal((n, n)), rng.standard_normal(n)
     mu = float(pb.mu)
+    sc = pb.scales
+    load = 0.0 if pb.Q is None else float(pb.f @ sol.t - pb.Q) / sc.force
+    hat = (sol.t / sc.stress, sol.s / sc.slip, load)  # what Newton hands over: t̂, ŝ = y/r, the load row
     return {
         "median step (rollqp.run)": float(np.median(steps)) * 1e6,
+        "mean step (rollqp.run)": float(np.median([np.mean(t) for t in times])) * 1e6,
         "step problem (ops.tangential_step)": best(lambda: ops.tangential_step(pb.p, pb.c, pb.dq, Q=pb.Q, xi=pb.xi,
                                                                                validate=False)),
         "method.solve, one Newton iteration": best(lambda: method.solve(pb, warm=warm)),
-        "  in it: slip and rollqp's residuals (problem.solution)": best(lambda: pb.solution(sol.t, sol.xi)),
+        "  in it: slip and rollqp's residuals (problem.solution)": best(lambda: pb.solution(sol.t, sol.xi, hat=hat)),
         "node states (rollqp.classify)": best(lambda: rollqp.classify(rec.state.p, rec.state.t, sol.s, mu, pb.scales,
                                                                       bound=pb.bound)),
         "one dense n × n product": best(lambda: A @ x, 20000),
