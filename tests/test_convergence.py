@@ -127,7 +127,7 @@ def test_convergence_orders(element):
     Asserted: the fitted order is at least 0.8 × the measured one (room for the solver
     tolerance and platform noise on the coarse meshes, yet a drop to order ½ — what a broken
     edge or stick–slip treatment gives — fails), every refinement lowers the error, and the
-    80-element error is within 25 % of the measured one (a regression of the constant).
+    80-element error is within 25 % of the measured one (a larger error constant fails).
     """
     errs = [_errors(element, n) for n in ELEMENTS]
     for j, key in enumerate(QUANTITIES):
