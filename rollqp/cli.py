@@ -13,7 +13,9 @@
     rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
-that did not converge (the completed steps are written to the result file first).
+that did not converge (the completed steps are written to the result file first), 4 for a
+result that could not be written (a full disk: the completed steps stay in the journal, and
+``run --resume`` continues once there is room).
 ``check-step`` exits 1 when the candidate fails, with one line per failed condition.
 BLAS threads are pinned to one: numpy's and scipy's wheels each bundle OpenBLAS, and two
 pools competing for 2 cores can make a dense solve 100× slower.
@@ -28,6 +30,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 EXIT_INPUT, EXIT_SOLVER = 2, 3
+#: The journal or the result file could not be written (a full disk, a file size limit).
+EXIT_WRITE = 4
 #: Interrupted by Ctrl-C (SIGINT) or SIGTERM: the shell's 128 + signal number.
 EXIT_INTERRUPTED, EXIT_TERMINATED = 130, 143
 
@@ -307,6 +311,23 @@ def _takes(scene, command: str) -> None:
                                   f"scenes (a {scene.dimension}D scene: rollqp {takes})")
 
 
+def _unwritten(err: OSError, out) -> str:
+    """The one line of a run whose journal or result file could not be written: what, why, and what is kept."""
+    from .errors import InputError
+    from .journal import Journal, journal_path
+    what = f"cannot write {err.filename or out} ({err.strerror or err})"
+    try:
+        j = Journal.open(journal_path(out), "journal")
+    except (InputError, OSError):
+        return f"{what}; no state was kept"
+    try:
+        n = len(j)
+    finally:
+        j.close()
+    return (f"{what}: the {n} completed states are in {journal_path(out)} (continue once there is room: "
+            f"rollqp run --resume {out})")
+
+
 def cmd_run(args) -> int:
     import signal
 
@@ -340,6 +361,10 @@ def cmd_run(args) -> int:
                 close()
                 print(f"rollqp: {_saved(err, out, 'interrupted')}", file=sys.stderr)
                 return EXIT_TERMINATED if isinstance(err, Terminated) else EXIT_INTERRUPTED
+            except OSError as err:  # the journal or the result file could not be written (a full disk)
+                close()
+                print(f"rollqp: error: {_unwritten(err, out)}", file=sys.stderr)
+                return EXIT_WRITE
             except Exception as err:
                 if getattr(err, "partial", None) is not None:
                     err.args = (_saved(err, out, str(err)),)

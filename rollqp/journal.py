@@ -245,10 +245,12 @@ class Journal:
         self.frames.add(self.end + HEAD_BYTES, kind, 0, len(payload), index, zlib.crc32(payload))
         try:
             _write_all(self.fd, frame)
-        except BaseException:
+        except BaseException as exc:
             self.frames.n -= 1
             os.ftruncate(self.fd, self.end)
             os.lseek(self.fd, self.end, os.SEEK_SET)
+            if isinstance(exc, OSError) and exc.filename is None:  # (a full disk: ENOSPC; a file size limit: EFBIG)
+                raise OSError(exc.errno, exc.strerror, self.path) from None
             raise
         self.end += len(frame)
         now = time.monotonic()

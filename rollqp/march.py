@@ -41,6 +41,7 @@ coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import os
 import time
@@ -164,6 +165,9 @@ class StepRecord:
     tau: float | None = None
     direction: int = 0
     note: str | None = None
+    #: What the method carries to the next step, for the journal (:mod:`rollqp.solverstate`; ``None``
+    #: unless the march records it)
+    solver: dict | None = field(repr=False, default=None)
 
     @property
     def normal(self):
@@ -537,7 +541,8 @@ def prepare(scene, method=None, *, geometry=None):
     return scene, meth, ops
 
 
-def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Iterator[StepRecord]:
+def march(scene, method=None, *, prepared=None, resume=None, verify=True, record=False,
+          state=None, _march=None) -> Iterator[StepRecord]:
     """The transient of ``scene`` as a stream of :class:`StepRecord` (module docstring).
 
     Parameters
@@ -554,7 +559,13 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Ite
         last state (:func:`resumed_state`) and yields only the steps after it.
     verify : bool
         With ``resume``: check first that the last stored state solves its own step
-        (:func:`check_resumed`).
+        (:func:`check_resumed`, which also rebuilds what the method carried across steps).
+    record : bool or Recorder
+        Record with each state what the method carries to the next step (``StepRecord.solver``, for the
+        journal; :mod:`rollqp.solverstate`); a :class:`~rollqp.solverstate.Recorder` made before.
+    state : State, optional
+        With ``resume`` and ``verify=False``: the state to continue from (:func:`check_resumed`'s; and
+        ``_march``, the march it was checked on).
 
     Yields
     ------
@@ -570,17 +581,25 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Ite
         stored states are another scene's, or the last one does not solve its step.
     """
     scene, meth, ops = prepared if prepared is not None else prepare(scene, method)
-    m = _March(scene, ops, meth)
+    m = _march if _march is not None else _March(scene, ops, meth)
     M = ops.history()  # built (on the dense path: from an n × n matrix) before the start's solver holds its systems
+    recorder = None if record is None or record is False else record
+    if record is True:
+        from .solverstate import Recorder
+        recorder = Recorder(meth, ops)
     if resume is not None:
         if verify:
-            check_resumed(scene, (scene, meth, ops), resume, march=m)
-        state, first = resumed_state(scene, ops, resume), _last_index(resume) + 1
+            state = check_resumed(scene, (scene, meth, ops), resume, march=m, recorder=recorder)
+        elif state is None:
+            state = _with_normal(m, resumed_state(scene, ops, resume), _last_index(resume))
+        first = _last_index(resume) + 1
     else:
         try:
             start = m.start()
         except SolverError as err:  # the start is state 0
             raise (err.with_step(0) if err.step is None else err) from err
+        if recorder is not None:
+            start.solver = recorder.note(0, start.state, m.cache)
         yield start
         state, first = start.state, 1
     qs = m.plan.q
@@ -589,6 +608,8 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True) -> Ite
             rec = m.rolling(k, float(qs[k]), state, M)
         except SolverError as err:
             raise (err.with_step(k) if err.step is None else err) from err
+        if recorder is not None:
+            rec.solver = recorder.note(k, rec.state, m.cache)
         state = rec.state
         yield rec
 
@@ -604,14 +625,14 @@ def _last_index(arrays) -> int:
 RESUME_TOL = 1e-6
 
 
-def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1) -> State:
+def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1, products=None) -> State:
     """A stored state of a result file of ``scene`` (the last one, ``row = -1``), as the march continues from it.
 
     Tractions, approach and creepage are the stored ones (float64, as the march keeps them), and a
     friction law's memory (the stored ``friction_coefficient``); ``w`` is recomputed from the
-    tractions (eq. 28). The continuation equals an uninterrupted run to round-off: the warm starts
-    are the same numbers, but what a method built during the first part (Newton's reused
-    factorizations, a QP solver's internal state) is built anew.
+    tractions (eq. 28), with the product ``A_tt t`` the method computed for the state if
+    ``products`` has it (``{(k, "t"): A_tt t}``, :func:`rollqp.solverstate.restore`). The warm starts are
+    the same numbers; what a method built during the first part is rebuilt by :func:`check_resumed`.
 
     Raises
     ------
@@ -628,35 +649,54 @@ def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1) -> St
         raise InputError("--resume", f"the result file's rolled distances are not this scene's "
                                      f"(it has {q.size} states, the scene {qs.size}): another scene")
     p, t = np.array(arrays["pn"][row], dtype=float), np.array(arrays["pt"][row], dtype=float)
-    nsol = StepSolution(p=p, g=np.array(arrays["gap"][row], dtype=float), delta=float(arrays["approach"][row]),
-                        method="resumed", status="resumed")
-    tsol = StepSolution(t=t, s=np.array(arrays["slip"][row], dtype=float), xi=float(arrays["creepage"][row]),
-                        method="resumed", status="resumed")
+    g, slip = np.array(arrays["gap"][row], dtype=float), np.array(arrays["slip"][row], dtype=float)
+    delta, xi = float(arrays["approach"][row]), float(arrays["creepage"][row])
+    if ops.coupled:  # one solution of both halves: a coupled step's warm start reads p, t, δ and ξ from it
+        nsol = tsol = StepSolution(p=p, t=t, g=g, s=slip, delta=delta, xi=xi, method="resumed", status="resumed")
+    else:
+        nsol = StepSolution(p=p, g=g, delta=delta, method="resumed", status="resumed")
+        tsol = StepSolution(t=t, s=slip, xi=xi, method="resumed", status="resumed")
     if "friction_coefficient" in arrays:  # a friction law's memory: the next step's μ starts from it
         tsol.mu = np.array(arrays["friction_coefficient"][row], dtype=float)
-    return State(p, t, ops.w(p, t), nsol, tsol, None)
+    At = None if not products else products.get((int(steps[row]), "t"))
+    if At is not None:
+        tsol.At = (t, At)
+    return State(p, t, ops.w(p, t, At), nsol, tsol, None)
 
 
-def check_resumed(scene, prepared, arrays: dict, march=None) -> None:
-    """The last stored state of ``arrays`` solves its own step: that step is solved again from the state
-    before it (from the start for state 0) and must agree to :data:`RESUME_TOL`, else the file was
-    changed or is corrupt (an :class:`InputError` on ``--resume``, one line, nothing run)."""
+def check_resumed(scene, prepared, arrays: dict, march=None, recorder=None) -> State:
+    """The state to continue from: the last stored state of ``arrays``, checked to solve its own step.
+
+    That step is solved again from the state before it (from the start for state 0), with what the
+    method carried across steps rebuilt as it was after that state (:func:`rollqp.solverstate.restore`, from
+    the journal's records, ``arrays["_notes"]``): the same computation as the uninterrupted run's, so
+    it gives the stored state bit for bit, and the march continues from it (and from the method as it
+    was). Otherwise (a file without the records, or a method whose state is not all rebuilt: a QP
+    solver's internals) it must agree to :data:`RESUME_TOL` and the march continues from the stored
+    state; else the file was changed or is corrupt (an :class:`InputError` on ``--resume``, one line,
+    nothing run). ``recorder``: the march's :class:`~rollqp.solverstate.Recorder`, which goes on from the
+    records."""
     scene, meth, ops = prepared
     m = march if march is not None else _March(scene, ops, meth)
     k = _last_index(arrays)
     steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(len(arrays["q"]))
-    stored = resumed_state(scene, ops, arrays, -1)
+    stored = _with_normal(m, resumed_state(scene, ops, arrays, -1), k)
     try:
         if k == 0:
+            _restore(m, arrays, -1, recorder)
             again = m.start().state
         elif steps.size >= 2 and int(steps[-2]) == k - 1:
-            again = m.rolling(k, float(m.plan.q[k]), resumed_state(scene, ops, arrays, -2), ops.history()).state
+            products = _restore(m, arrays, k - 1, recorder)
+            before = _with_normal(m, resumed_state(scene, ops, arrays, -2, products=products), k - 1)
+            again = m.rolling(k, float(m.plan.q[k]), before, ops.history()).state
         else:
             raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
                                          "which it needs to be continued")
     except SolverError as err:
         raise InputError("--resume", f"the last state ({k}) cannot be checked: its step, solved again, failed "
                                      f"({str(err)[:120]})") from None
+    if _identical(again, stored):
+        return again
     p0, mu = ops.scales.stress, max(float(getattr(ops, "mu", 0.0) or 0.0), 1e-300)
     dp = float(np.max(np.abs(again.p - stored.p))) / p0
     dt = float(np.max(np.abs(again.t - stored.t))) / (min(mu, 1.0) * p0) if mu > 1e-300 else 0.0
@@ -664,6 +704,54 @@ def check_resumed(scene, prepared, arrays: dict, march=None) -> None:
         raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
                                      f"state before it, its pressure differs by {dp:.3g} p0 and its traction by "
                                      f"{dt:.3g} mu p0 (more than {RESUME_TOL:g}): the file was changed or is corrupt")
+    return stored
+
+
+def _restore(m: _March, arrays, upto, recorder):
+    """:func:`rollqp.solverstate.restore` on the march ``m`` from the records of ``arrays``: the method's systems
+    and the march's history operators as they were after state ``upto``; the products of
+    :func:`rollqp.solverstate.restore` (``None`` without records). A record that cannot be rebuilt leaves the
+    method as set up (the march then sets out without what it carried)."""
+    from .solverstate import restore
+    notes = arrays.get("_notes")
+    if not notes:
+        return None
+    meth, ops = m.method, m.ops
+    try:
+        got = restore(meth, ops, notes, upto, arrays["_state_at"], recorder)
+        if got is None:
+            return None
+        products, hist = got
+        if hist and m.cache is not None:
+            form = m.scene.discretization.formulation
+            m.cache.items = [(float(dq), int(d), ops.build_history(form, float(dq), int(d))) for dq, d in hist]
+        return products
+    except (KeyError, IndexError, TypeError, ValueError):
+        meth.setup(ops)
+        return None
+
+
+def _with_normal(m: _March, state: State, k: int) -> State:
+    """A stored state with the normal problem of its step (``State.normal``), which a stored state lacks and a
+    fixed normal half carries from step to step (its gap gives the elastic energy: :mod:`rollqp.energy`)."""
+    ops = m.ops
+    if ops.coupled or state.normal is not None or state.nsol is None or not np.any(state.p):
+        return state
+    _, _, P, _, _, D = m.at[k]
+    if P is not None and P <= 0.0:
+        return state
+    h = ops.gap(float(m.plan.q[k])) if m.moving else None
+    return dataclasses.replace(state, normal=ops.normal_step(P, state.t, delta=D, h=h, validate=False))
+
+
+def _identical(again: State, stored: State) -> bool:
+    """``again`` is ``stored`` bit for bit (pressures, tractions, gaps, slips, approach, creepage, μ)."""
+    a, b = again, stored
+    same = all(np.array_equal(np.asarray(x, dtype=float), np.asarray(y, dtype=float)) for x, y in (
+        (a.p, b.p), (a.t, b.t), (a.tsol.s, b.tsol.s), (a.nsol.g, b.nsol.g), (a.nsol.delta, b.nsol.delta),
+        (a.tsol.xi, b.tsol.xi)))
+    mu = getattr(b.tsol, "mu", None)
+    return same and (mu is None or np.array_equal(np.broadcast_to(getattr(a.tsol, "mu", np.nan), mu.shape), mu))
 
 
 def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None,
@@ -720,27 +808,34 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         from .scene.checks import check_result_memory
         check_result_memory(fast_path(asked).scene if method is None or isinstance(method, str) else asked, keep)
     scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method, geometry=geometry)
-    tail = None
+    tail = state = recorder = None
+    if out is not None:  # a journal: each state with what the method carries (rollqp.solverstate)
+        from .solverstate import Recorder
+        recorder = Recorder(meth, ops)
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
-        check_resumed(scene, prepared, tail)
+        checked = _March(scene, ops, meth)  # the march goes on from it (its history operators)
+        state = check_resumed(scene, prepared, tail, march=checked, recorder=recorder)
     result = new_result(asked, ops, meth.name, keep_every=keep, out=out)  # meta: the scene as given, the method that ran it
     if scene.solver.method != asked.solver.method:
         from .advice import fast_path
         result.meta["method_note"] = fast_path(asked).note
     from .atomic import stop_once
     with stop_once():  # a second Ctrl-C never interrupts the writing of what the first one saves
-        return _run(scene, prepared, result, source, tail, observe, progress)
+        return _run(scene, prepared, result, source, (tail, state, recorder, checked if source is not None else None),
+                    observe, progress)
 
 
-def _run(scene, prepared, result, source, tail, observe, progress) -> Result:
+def _run(scene, prepared, result, source, resumed, observe, progress) -> Result:
     """:func:`run`'s loop: the records into ``result``; on a failure or a signal, the result finished with a note."""
     ops, K = prepared[2], scene.n_steps
+    tail, state, recorder, checked = resumed
     try:
         if source is not None:
             result.resume(source)
             result.meta["resumed_from"] = _last_index(tail)
-        for rec in march(scene, prepared=prepared, resume=tail, verify=False):
+        for rec in march(scene, prepared=prepared, resume=tail, verify=False, record=recorder, state=state,
+                         _march=checked):
             result.add(rec, ops)
             if observe is not None:
                 observe(rec, ops)

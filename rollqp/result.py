@@ -117,6 +117,8 @@ class Result:
         if rec.note is not None:
             notes["start_note"] = rec.note
         _apply_notes(self.meta, rec.k, notes)
+        if rec.solver is not None:  # what the method carries to the next step (journal only: rollqp.solverstate)
+            notes["solver"] = rec.solver
         self._store.append(values, notes)
         self._cache = None
 
@@ -203,6 +205,8 @@ def _step_length(rec) -> float:
 
 def _apply_notes(meta: dict, k: int, notes: dict) -> None:
     for key, value in notes.items():
+        if key == "solver":  # the method's record, for a resumed march (rollqp.solverstate), not the file's
+            continue
         if key == "gross_sliding":
             meta.setdefault("gross_sliding", []).append(int(k))
         else:
@@ -853,7 +857,17 @@ class ResumeSource:
         qs = [j.records(ids)["q"] for ids in _journal_blocks(j, np.arange(n))]
         out.update(x=np.asarray(j.header["arrays"]["x"]), q=np.concatenate(qs) if qs else np.zeros(0),
                    step=self.steps)
+        out["_notes"] = j.notes  # the method's records (rollqp.solverstate) and a stored state's p and t
+        out["_state_at"] = self._state_at
         return out
+
+    def _state_at(self, k: int) -> dict:
+        """``{"p": pn, "t": pt}`` of the stored state ``k`` (a journal's)."""
+        i = int(np.searchsorted(self.steps, k))
+        if i >= self.steps.size or self.steps[i] != k:
+            raise KeyError(k)
+        rec = self.journal.records([i])[0]
+        return {"p": np.array(rec["pn"], dtype=float), "t": np.array(rec["pt"], dtype=float)}
 
     def rows(self, names):
         """Every stored state as ``{name: value}`` of ``names`` (an earlier part to import)."""

@@ -155,15 +155,24 @@ def _states_on_disk(folder) -> int:
 
 
 def _equal_within_the_tolerance(res, full, scene):
-    """Equal to the solver's tolerance, not bit for bit: a resumed march rebuilds Newton's kept factorizations,
-    so its steps take other (equally valid) iterations and stop elsewhere within the tolerance (1e-10 of the
-    nondimensional residual); the tractions must agree to ten times that (measured after four SIGKILLs and
-    resumes: 3.8e-11 to 4.3e-11 μp0, three seeds, the pressures identical)."""
+    """Equal to the solver's tolerance, not bit for bit: a run resumed from the result file an interruption wrote
+    (which keeps the states, not the method's records) sets out without Newton's kept factorizations, so its
+    steps take other (equally valid) iterations and stop elsewhere within the tolerance (1e-10 of the
+    nondimensional residual); the tractions must agree to ten times that (measured: 2.4e-11 μp0)."""
     assert np.array_equal(res["q"], full["q"]) and np.array_equal(res["state"], full["state"])
     assert np.max(np.abs(res["pt"] - full["pt"])) <= 1e-9 * scene.contact.mu * scene.p0
     assert np.max(np.abs(res["pn"] - full["pn"])) <= 1e-9 * scene.p0
     for key in ("friction_work", "load_work", "elastic_energy"):  # the derived and computed fields too
         assert np.allclose(res[key], full[key], rtol=1e-7, atol=1e-9 * np.abs(full[key]).max()), key
+
+
+def _bit_for_bit(res, full):
+    """Every array of the result (``step_time`` and ``meta`` apart) is the uninterrupted run's, bit for bit: a march
+    resumed from its journal rebuilds what the method carried across steps (rollqp.solverstate)."""
+    for key, value in full.items():
+        if key in ("meta", "step_time") or np.asarray(value).dtype.kind not in "fiub":
+            continue
+        assert np.array_equal(np.asarray(res[key]), np.asarray(value), equal_nan=True), key
 
 
 def _journal_bytes(folder) -> int:
@@ -204,7 +213,46 @@ def test_sigkill_at_random_moments_then_resume_equals_the_uninterrupted_run(long
     assert not (tmp_path / "r.npz.journal").exists()
     res = load_result(tmp_path / "r.npz")
     assert res["meta"]["resumed_from"] >= seen - 1
-    _equal_within_the_tolerance(res, full, scene)
+    _bit_for_bit(res, full)
+
+
+def _file_size_limit(nbytes):
+    """In the child before exec: files may not grow beyond ``nbytes`` (RLIMIT_FSIZE), and a write beyond fails
+    with EFBIG (SIGXFSZ ignored, as a full disk fails with ENOSPC), as on a disk that fills up mid-run."""
+    def limit():
+        import resource
+        _default_sigint()
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (nbytes, nbytes))
+    return limit
+
+
+def test_a_full_disk_mid_run_keeps_every_written_state_and_resumes_bit_for_bit(tmp_path):
+    """The journal's write fails mid-run (a file size limit): one line naming the file and the reason, exit 4
+    (the result could not be written), every state written before it kept in the journal; once the limit is
+    lifted, ``run --resume`` completes the run to the uninterrupted result, bit for bit."""
+    from rollqp.cli import EXIT_WRITE
+    scene = rollqp.load_scene("ramp")
+    (tmp_path / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
+    full = rollqp.run(scene).arrays()
+    proc = subprocess.run([sys.executable, "-m", "rollqp.cli", "run", "scene.toml", "--out", "r.npz", "--quiet"],
+                          cwd=tmp_path, capture_output=True, text=True, preexec_fn=_file_size_limit(200_000),
+                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1"), timeout=120)
+    assert proc.returncode == EXIT_WRITE == 4, proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert proc.stderr.startswith("rollqp: error: cannot write r.npz.journal (File too large): the "), proc.stderr
+    j = Journal.open(tmp_path / "r.npz.journal", "journal")
+    kept = len(j)
+    j.close()
+    assert 1 < kept < scene.n_steps and f"the {kept} completed states are in" in proc.stderr, (kept, proc.stderr)
+    assert not (tmp_path / "r.npz").exists() and os.path.getsize(tmp_path / "r.npz.journal") <= 200_000
+    again = _cli("run", "--resume", "r.npz", "--quiet", cwd=tmp_path)
+    _, err = again.communicate(timeout=120)
+    assert again.returncode == 0 and not err, err
+    res = load_result(tmp_path / "r.npz")
+    assert res["meta"]["resumed_from"] == kept - 1 and not (tmp_path / "r.npz.journal").exists()
+    for key in ("pn", "pt", "slip", "gap", "state", "creepage", "iterations", "friction_work"):
+        assert np.array_equal(res[key], full[key]), key
 
 
 @pytest.mark.integration

@@ -137,6 +137,9 @@ class NewtonMethod:
     #: (:class:`~.linear.CoupledFactors`); ``False`` solves a new reduced system every iteration
     #: (:func:`~.linear.direct_coupled_direction`, the reference the tests compare with).
     coupled_reuse = True
+    #: Record the factorizations of the uncoupled systems (:attr:`ReducedSystem.events
+    #: <.linear.ReducedSystem.events>`), for a march that journals its states (:mod:`rollqp.solverstate`)
+    record = False
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 200, r: float | None = None,
                  rho: float = 0.9, sigma: float = 0.1):
@@ -260,6 +263,8 @@ class NewtonMethod:
             last, t_scale = np.ones(pb.n), dqh  # ∂(r ŝ)/∂ξ̂ = r, ∂(r ŝ)/∂t̂ = r Â/Δq̂
         sys_ = ReducedSystem(pb.A, pb.f, Ahat, fhat, r, last, t_scale, unit=sc.modulus / sc.length / sc.stress,
                              workspace=K, a_scale=sc.modulus / sc.length)
+        if self.record:  # a march that journals its states records the factorizations (rollqp.solverstate)
+            sys_.events = []
         self._keep(self._systems, key, sys_)
         self._last = (pb.A, pb.f, pb.kind, dqh, sc, sys_)
         return sys_
@@ -273,6 +278,8 @@ class NewtonMethod:
         if hit is None:
             S = coupled_system(pb, self.r)
             hit = (S, CoupledFactors(S))
+            if self.record:  # (rollqp.solverstate)
+                hit[1].events = []
             self._keep(self._coupled, key, hit)
         return hit
 

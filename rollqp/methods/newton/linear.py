@@ -83,7 +83,7 @@ class ReducedSystem:
     """
 
     __slots__ = ("A", "f", "a_scale", "fhat", "r", "K", "_K_nl", "load_column", "unit", "partial", "last", "settled", "_base",
-                 "factorizations", "updates", "_factors", "_masks", "ncp")
+                 "factorizations", "updates", "_factors", "_masks", "ncp", "exact", "events", "_serial", "tag")
 
     #: Largest change of the active set, against the factored one, solved by a Schur complement
     #: (as a fraction of the factored size; at least :attr:`UPDATE_MIN` nodes); beyond, refactor.
@@ -127,6 +127,13 @@ class ReducedSystem:
         self._factors = {}  # (with_load, mask bytes) -> the same, for the last few free sets (:meth:`_keep`)
         self.factorizations = 0  # LU factorizations of a reduced matrix (diagnostics)
         self.updates = 0  # directions solved by a Schur complement on an older factorization
+        #: ``last``'s product was the whole ``A x`` (``True``), not the product over the columns where ``x ≠ 0``
+        self.exact = not self.partial
+        #: ``None``, or the list the factorizations made and the bordered solves on them are recorded in
+        #: (:meth:`state`, :meth:`restore`: a resumed march rebuilds them as they were)
+        self.events = None
+        self._serial = 0  # the number of the next factorization (its ``_Store.id``)
+        self.tag = None  # the recorder's name for the system (:mod:`rollqp.solverstate`)
 
     def ahat_product(self, x) -> np.ndarray:
         """``Â x``, ``Â = A·E*/L`` the nondimensional influence matrix (the normal step's starting guesses)."""
@@ -170,12 +177,21 @@ class ReducedSystem:
         return J
 
     def _factor(self, m, with_load):
-        """LU of the reduced matrix on the free set ``m`` (below); ``None`` if singular."""
+        """LU of the reduced matrix on the free set ``m`` (below), kept (:meth:`_keep`); ``None`` if singular."""
+        self._make_room(8 * (np.count_nonzero(m) + with_load) ** 2)  # within the size of K also while it is built
+        base = self._build(m, with_load)
+        if base is not None:
+            self._keep(base[6], base)
+            if self.events is not None:
+                self.events.append(("f", base[5].id, with_load, base[1]))
+        return base
+
+    def _build(self, m, with_load):
+        """The factorization of :meth:`_factor`, not kept: ``(mask, free, pos, lu, piv, store, key)``."""
         n = self.fhat.size
         K = self.K
         free = np.flatnonzero(m)
         nf = free.size
-        self._make_room(8 * (nf + with_load) ** 2)  # within the size of K also while it is built
         M = np.empty((nf + with_load, nf + with_load), order="F")
         # small n: two takes (np.ix_ costs 2.4× as much at 81 nodes); large n: np.ix_, without the
         # intermediate nf × n rows of the takes, a block of columns at a time (no second nf × nf array)
@@ -198,10 +214,9 @@ class ReducedSystem:
         pos = np.full(n, -1)
         pos[free] = np.arange(nf)
         self.factorizations += 1
-        key = (with_load, m.tobytes())
-        base = (m.copy(), free, pos, lu, piv, _Store(nf + with_load), key)
-        self._keep(key, base)
-        return base
+        store = _Store(nf + with_load)
+        store.id, self._serial = self._serial, self._serial + 1
+        return (m.copy(), free, pos, lu, piv, store, (with_load, m.tobytes()))
 
     def _make_room(self, nbytes) -> None:
         """Drop the oldest kept factorizations until one more of ``nbytes`` fits (:meth:`_keep`'s limits): the
@@ -221,6 +236,40 @@ class ReducedSystem:
         while len(store) > self.MAX_FACTORS or (len(store) > 1 and sum(b[3].nbytes for b in store.values())
                                                  > self.K.nbytes):
             store.pop(next(iter(store)))
+
+    def state(self) -> dict:
+        """What identifies the kept factorizations (the numbers of :meth:`_factor`'s records, in :meth:`_keep`'s
+        order; the last one used per ``with_load``) and the flags the next iteration reads."""
+        base = {int(w): b[5].id for w, b in self._base.items() if b is not None}
+        return {"kept": [b[5].id for b in self._factors.values()], "base": base, "settled": bool(self.settled),
+                "exact": bool(self.exact), "serial": self._serial}
+
+    def restore(self, state: dict, made: dict) -> None:
+        """Rebuild the kept factorizations of :meth:`state`: ``made[id] = (with_load, free, borders)``, each the
+        same LU of the same matrix, its store grown by the same bordered solves in the same order (so a
+        resumed march solves its directions as the uninterrupted one did, bit for bit)."""
+        n = self.fhat.size
+        built = {}
+        for fid in dict.fromkeys(state["kept"] + list(state["base"].values())):
+            with_load, free, borders = made[fid]
+            m = np.zeros(n, dtype=bool)
+            m[free] = True
+            base = self._build(m, with_load)
+            if base is None:
+                raise ValueError(f"the kept factorization {fid} is singular")
+            base[5].id = fid
+            K = self.K if with_load else self.K_nl
+            for added, released in borders:
+                added, released = np.asarray(added, dtype=np.intp), np.asarray(released, dtype=np.intp)
+                grown = self._grow(K, base, added, released, np.zeros(base[1].size + with_load), with_load)
+                if grown is None:
+                    raise ValueError(f"a bordered solve on the kept factorization {fid} failed")
+                store = base[5]
+                store.products([store.rslot[a] for a in added.tolist()], [store.cslot[c] for c in grown[1]])
+            built[fid] = base
+        self._factors = {built[i][6]: built[i] for i in state["kept"]}
+        self._base = {bool(int(w)): built[i] for w, i in state["base"].items()}
+        self.settled, self.exact, self._serial = bool(state["settled"]), bool(state["exact"]), int(state["serial"])
 
     def direction(self, mask, phi, with_load):
         r"""The Newton direction ``d``: ``J d = −Φ`` solved on the free nodes (eq. 80).
@@ -379,6 +428,43 @@ class ReducedSystem:
         m0, free0, pos0, lu, piv, store, _ = base
         nf0 = free0.size
         k = released.size + added.size
+        grown = self._grow(K, base, added, released, r0, with_load)
+        if grown is None:
+            return None
+        u0, keys = grown
+        if self.events is not None:
+            self.events.append(("b", store.id, added, released))
+        na = added.size
+        cs = [store.cslot[c] for c in keys]
+        rs = [store.rslot[a] for a in added.tolist()]
+        Z = store.Z[:, cs]
+        S = np.empty((k, k))
+        S[:na] = -store.products(rs, cs)
+        S[na:] = -Z[pos0[released]]
+        S[:na, :na] += K[np.ix_(added, added)]
+        Cu0 = np.empty(k)
+        Cu0[:na] = store.R[rs] @ u0
+        Cu0[na:] = u0[pos0[released]]
+        rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu0
+        try:
+            vw = np.linalg.solve(S, rhs)
+        except np.linalg.LinAlgError:
+            return None
+        u = u0 - Z @ vw
+        d[free0] = u[:nf0]
+        d[released] = -phi[released]  # what the last block pins them to, without round-off
+        d[added] = vw[:na]
+        if with_load:
+            d[n] = u[nf0]
+        self.updates += 1
+        return d
+
+    def _grow(self, K, base, added, released, r0, with_load):
+        """``(u0, keys)`` of :meth:`_bordered`: ``u0 = M0⁻¹ r0``, and the store of ``base`` grown by what this
+        border needs (``keys``: its columns' keys); ``None`` if the solve fails."""
+        n = self.fhat.size
+        m0, free0, pos0, lu, piv, store, _ = base
+        nf0 = free0.size
         # bordered solve on the old factors: Z = M0⁻¹ [B, E_R], S = [[D, 0], [0, 0]] − [C; E_Rᵀ] Z.
         # The columns of Z, the rows C of the added nodes and their products C Z are kept per node
         # (``store``): as the set drifts away from the factored one, each step adds a node or two,
@@ -410,29 +496,7 @@ class ReducedSystem:
             if with_load:
                 rows[:, nf0] = K[new_rows, n]
             store.add_rows(new_rows, rows)
-        cs = [store.cslot[c] for c in keys]
-        rs = [store.rslot[a] for a in added.tolist()]
-        Z = store.Z[:, cs]
-        S = np.empty((k, k))
-        S[:na] = -store.products(rs, cs)
-        S[na:] = -Z[pos0[released]]
-        S[:na, :na] += K[np.ix_(added, added)]
-        Cu0 = np.empty(k)
-        Cu0[:na] = store.R[rs] @ u0
-        Cu0[na:] = u0[pos0[released]]
-        rhs = np.concatenate([-phi[added] - Ke[added], d[released]]) - Cu0
-        try:
-            vw = np.linalg.solve(S, rhs)
-        except np.linalg.LinAlgError:
-            return None
-        u = u0 - Z @ vw
-        d[free0] = u[:nf0]
-        d[released] = -phi[released]  # what the last block pins them to, without round-off
-        d[added] = vw[:na]
-        if with_load:
-            d[n] = u[nf0]
-        self.updates += 1
-        return d
+        return u0, keys
 
 
 class _Store:
@@ -442,6 +506,7 @@ class _Store:
 
     def __init__(self, m):
         self.m = m
+        self.id = -1  # the factorization's number (:meth:`ReducedSystem.state`)
         #: ``(pinned, rows, [K_FP; f̂_Pᵀ])`` of :meth:`ReducedSystem._on_factors`, made on first use
         self.block = None
         self.cslot, self.rslot = {}, {}
@@ -592,7 +657,7 @@ class CoupledFactors:
     """
 
     __slots__ = ("S", "n", "N", "kind", "mu", "free", "pinned", "posF", "posP", "lu", "piv", "Rp", "cols",
-                 "factorizations", "updates", "rejected", "scale")
+                 "factorizations", "updates", "rejected", "scale", "events", "tag")
 
     #: Largest number of changed rows solved by the Woodbury update, as a fraction of the factored
     #: (free) size, at least :attr:`UPDATE_MIN`; beyond, refactor. Measured (median rolling step of
@@ -619,6 +684,9 @@ class CoupledFactors:
         self.kind = None
         self.mu = None
         self.factorizations = self.updates = self.rejected = 0
+        #: ``None``, or the list the factorizations and the batches of kept columns are recorded in
+        #: (:meth:`state`, :meth:`restore`), and the recorder's name for them (:mod:`rollqp.solverstate`)
+        self.events, self.tag = None, None
         self.scale = 1.0 + max(float(np.max(np.sum(np.abs(S.KN), axis=1))),
                                float(np.max(np.sum(np.abs(S.KT), axis=1))))
 
@@ -671,9 +739,31 @@ class CoupledFactors:
             lu, piv, info = dgetrf(np.asfortranarray(R[:, free]), overwrite_a=True)
             if info != 0:
                 self.kind = None
+                if self.events is not None:
+                    self.events.append(("F", None, None))
                 return False
             self.lu, self.piv = lu, piv
+        if self.events is not None:
+            self.events.append(("F", kind, mu))
         return True
+
+    def restore(self, factored) -> None:
+        """Factor again as recorded: ``factored = (kind, mu, batches)``, the row kinds and ``μ`` of the last
+        factorization (``kind`` ``None``: none) and the batches of columns kept on it since, in order (each
+        batch solved together, as it was: the same columns, bit for bit)."""
+        kind, mu, batches = factored
+        events, self.events = self.events, None  # (not recorded again)
+        try:
+            if kind is None:
+                self.kind = None
+                return
+            if not self._factor(np.asarray(kind, dtype=np.int8), mu):
+                raise ValueError("the recorded coupled factorization is singular")
+            for batch in batches:
+                if self._columns(np.asarray(batch, dtype=np.intp)) is None:
+                    raise ValueError("a recorded batch of coupled columns failed")
+        finally:
+            self.events = events
 
     def _solve(self, b):
         """``J_f⁻¹ b`` (``b`` of length ``N``)."""
@@ -691,6 +781,8 @@ class CoupledFactors:
         """``Z = J_f⁻¹ E_C``, from the kept columns, computing the missing ones together."""
         miss = [c for c in C.tolist() if c not in self.cols]
         if miss:
+            if self.events is not None:
+                self.events.append(("C", miss))
             miss = np.array(miss)
             m = miss.size
             X = np.zeros((self.N, m))

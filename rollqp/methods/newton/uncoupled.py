@@ -366,6 +366,8 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         else:
             st.update(st.z + alpha * d, alpha, full[1][2] - st.y if Kd is None else Kd)  # eq. 79
     sys_.settled = sys_.partial and it == 1
+    if it or start is None:  # a product of this iteration's (else the start's): how it was taken
+        sys_.exact = st.exact or not sys_.partial
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
