@@ -56,6 +56,7 @@ from .operators import SceneOperators
 from .problem import SLIP, STICK, State, StepSolution, classify
 from .result import Result
 from .scene import Scene, load_scene
+from .strip import RowSparse
 
 __all__ = ["State", "StepRecord", "march", "run", "prepare"]
 
@@ -85,7 +86,9 @@ class Counters:
         elif half == "tangential":
             self.inner_tangential += sol.iterations
         self.backtracks += sol.backtracks
-        self._residual(sol.residual)
+        r = sol.residual
+        if r > self.residual or r != r:  # (_residual, written out: once a step)
+            self.residual = r
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
@@ -185,6 +188,7 @@ class _March:
         self.constant_friction = ops.friction.kind == "constant"  # one μ: the step problems' fast path
         self.at = self._loads_at(self.plan.tau)
         self.fixed = self._normal_fixed()
+        self._last_contact = self._negated = None  # (p, p > 1e-7 p0) of the last record; (M, −M dense or None)
 
     def _loads_at(self, tau) -> list:
         """``(τ, d, P, Q, ξ, δ)`` at each step of the plan: ``d`` its direction; the normal load ``P`` (None
@@ -267,14 +271,33 @@ class _March:
         ops = self.ops
         tsol = state.tsol
         mu = ops.mu if problem is None or self.constant_friction else problem.coefficient(tsol.s, tsol.p)
-        bound = problem.bound_at(tsol.s) if problem is not None and problem.kind == "tangential" else None
-        nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound)
+        bound = None if problem is None or problem.kind != "tangential" else \
+            problem.bound if problem.law is None else problem.bound_at(tsol.s)
+        nodes = classify(state.p, state.t, tsol.s, mu, ops.scales, bound=bound, contact=self._contact(state.p))
         count = np.bincount(nodes, minlength=3).tolist()
         gross = bool(count[SLIP] and not count[STICK])
         f = ops.f
         # (the fields in their order: keywords cost a step as much as a dot product)
         return StepRecord(k, phase, float(q), float(f @ state.p) if P is None else P, float(f @ state.t), state,
                           previous, problem, sol, cnt, shift, time.perf_counter() - t0, nodes, gross)
+
+    def _contact(self, p):
+        """``p > 1e-7·p0`` (:func:`~rollqp.problem.classify`'s contact), kept while the pressure is the same array (a
+        fixed normal half hands the same one to every step)."""
+        last = self._last_contact
+        if last is None or last[0] is not p or p is None:
+            last = self._last_contact = (p, None if p is None else np.asarray(p, dtype=float) > 1e-7 * self.ops.scales.stress)
+        return last[1]
+
+    def history_term(self, M, w):
+        """``c = −M w``, the history vector (eq. 37, 48). A :class:`~rollqp.strip.RowSparse` ``M`` small enough to be
+        multiplied as a dense matrix (:data:`~rollqp.strip.RowSparse.DENSE_MAX`) is multiplied so, negated once: the
+        same numbers (a negation is exact, and so is each sum with every term's sign flipped), one operation less."""
+        last = self._negated
+        if last is None or last[0] is not M:
+            small = isinstance(M, RowSparse) and M.shape[0] * M.shape[1] <= RowSparse.DENSE_MAX
+            last = self._negated = (M, -M.dense() if small else None)
+        return -(M @ w) if last[1] is None else last[1] @ w
 
     # ------------------------------------------------------------ the phases
     def start(self) -> StepRecord:
@@ -465,7 +488,7 @@ class _March:
         elif pl.rolled:
             c, dq, phase = -(self.cache.get(float(pl.dq[k]), d) @ state.w), float(pl.dq[k]), "rolling"
         else:
-            c, dq, phase = -(M @ state.w), scene.dq, "rolling"
+            c, dq, phase = self.history_term(M, state.w), scene.dq, "rolling"
         new, problem, sol = self.step(state, cnt, P=P, c=c, dq=dq, Q=Q, xi=xi,
                                       normal_fixed=self.fixed, delta=D, h=h,
                                       q=q, transport=self._transport(k, dq) if phase == "rolling" else None)

@@ -109,14 +109,16 @@ class StepSolution:
         return self.residuals.max
 
 
-def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7, bound=None) -> np.ndarray:
+def classify(p, t, s, mu, scales: Scales = Scales(), tol: float = 1e-7, bound=None, contact=None) -> np.ndarray:
     """Node states: 0 separation (``p̂ <= tol``), 2 slip (``|ŝ| > tol`` at the bound), 1 stick.
 
     ``t`` or ``s`` may be ``None`` (normal problem only): contact nodes are then stick. ``bound``:
-    ``μ max(p, 0)`` if the caller has it (a step problem's :attr:`TangentialStep.bound`).
+    ``μ max(p, 0)`` if the caller has it (a step problem's :attr:`TangentialStep.bound`); ``contact``:
+    ``p > tol·p0`` (boolean) likewise (a march whose pressure stays the same array from step to step).
     """
     p = np.asarray(p, dtype=float)
-    contact = p > tol * scales.stress  # (thresholds scaled, not the arrays: 3 fewer array operations)
+    if contact is None:
+        contact = p > tol * scales.stress  # (thresholds scaled, not the arrays: 3 fewer array operations)
     if t is None or s is None:
         return contact.astype(np.int8)  # STICK where in contact, SEPARATION elsewhere
     at_bound = (mu * np.maximum(p, 0) if bound is None else bound) - np.abs(t) <= tol * scales.stress

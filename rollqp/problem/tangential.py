@@ -222,7 +222,7 @@ class TangentialStep:
             t_hat, s_hat, load_hat = hat
             bh, nb = self.bound_hat
             fr = friction_residual(t_hat, s_hat, bh, nb)
-            res = Residuals(friction=float(np.abs(fr).max()), load_tangential=0.0 if self.Q is None else abs(float(load_hat)))
+            res = Residuals(0.0, float(np.maximum.reduce(np.abs(fr))), 0.0, 0.0 if self.Q is None else abs(float(load_hat)))
             return StepSolution(t=t, s=s_hat * self.scales.slip, xi=float(xi), p=self.p, residuals=res, **meta)
         s = self.slip(t, xi, At)
         return StepSolution(t=t, s=s, xi=float(xi), p=self.p, residuals=self.residuals(t, xi, s), **meta)

@@ -115,7 +115,7 @@ class ReducedSystem:
         #: ``K_nl x̂ = unit · (A x)`` for a traction ``x`` in the problem's units (``x̂ = x/p0``)
         self.unit = (r / t_scale) * unit
         self.partial = n >= PARTIAL_MIN
-        #: ``(x, A x)`` of the last solution: the next step, warm-started from ``x``, needs no new product
+        #: ``(x, A x)`` of the last solution (and ``unit·A x``, if kept): the next step, warm-started from ``x``, needs no new product
         self.last = None
         #: The last step converged in one iteration (the iteration then multiplies at the full step
         #: instead of carrying y: :func:`~.uncoupled.iterate`)

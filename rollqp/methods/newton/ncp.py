@@ -37,9 +37,9 @@ class NormalNCP:
         """``Φ_i = min(p̂_i, r ĝ_i)`` (eq. 52) (into ``out`` if given)."""
         return np.minimum(x, y, out=out)
 
-    def mask(self, x, y):
+    def mask(self, x, y, out=None):
         """Nodes with the ``∂(r ĝ_i)`` row: ``p̂_i > r ĝ_i`` (eq. 84); the others ``∂p̂_i`` (eq. 82/83)."""
-        return x > y
+        return np.greater(x, y, out=out)
 
     def nearest(self, x, y):
         """All ``p̂ <= r ĝ``: the node with the smallest ``r ĝ − p̂`` reaches contact when ``r ĝ`` drops by it."""
@@ -62,16 +62,17 @@ class TangentialNCP:
         self.sep = b <= 0.0
         #: Rows whose ``y`` enters ``Φ``: a zero bound gives ``Φ_i = t̂_i`` whatever ``r ŝ_i`` (eq. 85).
         self.needs = ~self.sep
+        self._b_stick = np.where(self.needs, b, -1.0)  # |u| <= this: stick where the bound is positive, never elsewhere
 
     def phi(self, x, y, out=None):
         """``Φ_i = t̂_i − Proj_[−b_i, b_i](t̂_i − r ŝ_i)`` (eq. 60): :func:`~rollqp.problem.friction_residual`
         with ``−b`` formed once per step (Newton evaluates ``Φ`` a few times an iteration; into ``out`` if given)."""
         return friction_residual(x, y, self.b, self._minus_b, out)
 
-    def mask(self, x, y):
+    def mask(self, x, y, out=None):
         """Nodes with the ``∂(r ŝ_i)`` row: ``|t̂_i − r ŝ_i| <= b_i`` (eq. 86/87, stick); the others
-        ``∂t̂_i``: slip (eq. 88, ``b`` fixed) or a zero bound (eq. 85, separation)."""
-        return (np.abs(x - y) <= self.b) & self.needs
+        ``∂t̂_i``: slip (eq. 88, ``b`` fixed) or a zero bound (eq. 85, separation) (into ``out`` if given)."""
+        return np.less_equal(np.abs(x - y), self._b_stick, out=out)
 
     def nearest(self, x, y):
         """All ``|t̂ − r ŝ| > b``: the node with the smallest excess sticks when ``r ŝ`` moves by it."""

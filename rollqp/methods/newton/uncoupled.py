@@ -82,7 +82,7 @@ def solve_normal(meth, pb, warm, t0):
     z, start = _normal_start(pb, sys_, warm)
     k0 = r * (hhat - (dhat_fixed if dhat_fixed is not None else 0.0))
     known = _last_product(sys_, warm.p if start == "warm" else None)
-    z, it, info, p, Ap, _, _ = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
+    z, it, info, (p, Ap, *_), _, _ = iterate(meth, pb, sys_, z, k0, Phat, NormalNCP(), start == "warm", known)
     delta = z[n] * u0 if with_load else pb.delta
     info["start"] = start
     sol = pb.solution(p, delta, Ap=Ap)
@@ -110,12 +110,13 @@ def solve_tangential(meth, pb, warm, t0):
     if xi_fixed is not None:
         k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    z, it, info, tt, At, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    z, it, info, product, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    tt, At = product[0], product[1]
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
     # the slip and rollqp's residuals from the last iterate's own y = r ŝ and load row (TangentialStep.solution)
     sol = pb.solution(tt, xi, At=At, hat=(z[:n], y / r, phi[n] if with_load else 0.0))
-    sys_.last = (sol.t, At)
+    sys_.last = (sol.t,) + product[1:]  # (t, A t[, unit·A t]): the next step's start needs no product
     sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
 
@@ -136,7 +137,7 @@ def _friction_rows(sys_, pb):
 
 
 def _last_product(sys_, x):
-    """``(x, A x)`` if the system's last solution was the traction ``x`` (the warm start), else None."""
+    """``(x, A x[, unit·A x])`` if the system's last solution was the traction ``x`` (the warm start), else None."""
     last = sys_.last
     if x is None or last is None or not (last[0] is x or np.array_equal(last[0], x)):
         return None
@@ -174,7 +175,7 @@ class _Iterate:
         if start is None:
             self.refresh()
         else:  # the traction of the last step and its product A x
-            self.xphys, self.Ax = start
+            self.xphys, self.Ax = start[0], start[1]
             self._y_from_product()
         self.history, self.merits, self.steps = [], [], []
         self.backtracks = self.nonmono = self.shifts = 0
@@ -322,8 +323,8 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     ``x = z[:n]`` is the traction, ``y`` the augmented gap/slip ``r ĝ``/``r ŝ`` (linear in z);
     ``ncp`` gives ``φ`` and its node cases (:class:`~.ncp.NormalNCP`, :class:`~.ncp.TangentialNCP`);
     ``start``: ``(x, A x)`` of the start in the problem's units, if the product is known.
-    Returns ``(z, iterations, info, x, A x, y, Φ)``, ``x`` the solution's traction in the problem's units and
-    ``y``, ``Φ`` at ``z`` (evaluated from its own product).
+    Returns ``(z, iterations, info, product, y, Φ)``: ``product`` is ``(x, A x)`` or ``(x, A x, unit·A x)``,
+    ``x`` the solution's traction in the problem's units; ``y``, ``Φ`` at ``z`` (evaluated from its own product).
     """
     if not sys_.partial:
         return _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start)
@@ -370,30 +371,33 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
-    return st.z, it, info, st.xphys, st.Ax, st.y, st.phi
+    return st.z, it, info, (st.xphys, st.Ax), st.y, st.phi
 
 
 # ------------------------------------------------------------------------------ small n
 #: ``a.max()``, ``a.any()`` without their Python-level wrappers (the same reductions)
 _max, _any = np.maximum.reduce, np.logical_or.reduce
 
-def _point(pb, sys_, z, k0, load, ncp, start=None):
+def _point(ev, z, k0, load, start=None):
     """``(x, A x, y, Φ)`` at the unknowns ``z`` from a new product ``A x`` of its traction (``start``: the
-    known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers."""
-    n = pb.n
+    known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers.
+    ``ev``: the step's constants (:func:`_iterate_dense`)."""
+    n, stress, A, unit, lc, fhat, phi_rows = ev
     if start is None:
-        xphys = z[:n] * pb.scales.stress
-        Ax = pb.A @ xphys
-    else:
-        xphys, Ax = start
-    y = sys_.unit * Ax + k0
+        xphys = z[:n] * stress
+        Ax = A @ xphys
+        uAx = unit * Ax
+    else:  # the last step's (x, A x) and, if it kept it, unit·(A x): the same numbers as formed here
+        xphys, Ax = start[0], start[1]
+        uAx = start[2] if len(start) > 2 else unit * Ax
+    y = uAx + k0
     if load is None:
-        return xphys, Ax, y, ncp.phi(z[:n], y)
-    y += sys_.load_column * z[n]
+        return xphys, Ax, y, phi_rows(z[:n], y), uAx
+    y += lc * z[n]
     phi = np.empty(n + 1)
-    ncp.phi(z[:n], y, phi[:n])
-    phi[n] = sys_.fhat @ z[:n] - load
-    return xphys, Ax, y, phi
+    phi_rows(z[:n], y, phi[:n])
+    phi[n] = fhat @ z[:n] - load
+    return xphys, Ax, y, phi, uAx
 
 
 def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
@@ -402,11 +406,12 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     one loop. At 81 nodes a rolling step takes one iteration, whose arithmetic (a few dozen operations on
     81-vectors) costs about what the object's method calls around it would."""
     n, r = pb.n, sys_.r
+    ev = (n, pb.scales.stress, pb.A.dense(), sys_.unit, sys_.load_column, sys_.fhat, ncp.phi)
     with_load = load is not None
     stop = meth.tolerance * min(1.0, r)
     mask = sys_.mask(with_load)
     two_sigma = 2.0 * meth.sigma
-    xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp, start)
+    xphys, Ax, y, phi, uAx = _point(ev, z, k0, load, start)
     merit, history, merits, steps, counts = None, [], [], [], [0, 0, 0]  # backtracks, nonmonotone, shifts
     it = 0
     while True:
@@ -418,17 +423,17 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
         if it >= meth.max_iterations:
             raise not_converged(meth, pb.kind, merits, it, nrm, stop)
         it += 1
-        m = ncp.mask(z[:n], y)
+        m = ncp.mask(z[:n], y, mask[:n])  # the node rows, straight into the mask
         if with_load and not _any(m):  # degenerate: _Iterate.rows
-            m, y, phi = _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y)
+            m, y, phi = _repair(meth, ev, sys_, z, k0, load, ncp, xphys, Ax, y)
+            mask[:n] = m
             merit = None
             counts[2] += 1
-        mask[:n] = m
         d = sys_.direction(mask, phi, with_load)  # reduced system on the free nodes
         if d is None:
             raise _singular(meth, pb, it, nrm)
         zf = z + d
-        full = _point(pb, sys_, zf, k0, load, ncp)
+        full = _point(ev, zf, k0, load)
         pa = full[3]
         merit = 0.5 * float(pa @ pa)
         # d has a NaN or an infinity iff z + d has (z is finite): in x̂, Φ's own row of that node is not finite
@@ -437,17 +442,17 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
             raise _singular(meth, pb, it, nrm)
         if merit <= (1.0 - two_sigma) * merits[-1]:  # eq. 75–78 at α = 1
             steps.append(1.0)
-            z, (xphys, Ax, y, phi) = zf, full
+            z, (xphys, Ax, y, phi, uAx) = zf, full
             continue
         alpha = _backtrack(meth, z[:n], y, d[:n], full[2] - y, merits[-1], load, ncp, sys_, warm, counts)
         steps.append(alpha)
         z = z + alpha * d  # eq. 79
-        xphys, Ax, y, phi = _point(pb, sys_, z, k0, load, ncp)
+        xphys, Ax, y, phi, uAx = _point(ev, z, k0, load)
         merit = None
     sys_.settled = False
     info = {"r": r, "backtracks": counts[0], "merit": merits[-1], "history": history, "merits": merits,
             "steps": steps, "nonmonotone": counts[1], "shifts": counts[2], "tolerance_phi": stop}
-    return z, it, info, xphys, Ax, y, phi
+    return z, it, info, (xphys, Ax, uAx), y, phi
 
 
 def _singular(meth, pb, it, nrm):
@@ -455,16 +460,16 @@ def _singular(meth, pb, it, nrm):
                        iterations=it, residual=nrm)
 
 
-def _repair(meth, pb, sys_, z, k0, load, ncp, xphys, Ax, y):
+def _repair(meth, ev, sys_, z, k0, load, ncp, xphys, Ax, y):
     """:meth:`_Iterate.rows` on a degenerate iterate (no node in stick/contact): ``δ̂``/``ξ̂`` moved so that the
     nearest node lies on its kink (in place in ``z``); ``(mask, y, Φ)`` there, that node with the ``K`` row."""
-    n = pb.n
+    n = ev[0]
     try:
         j, dy = ncp.nearest(z[:n], y)
     except SolverError as err:
         raise SolverError(err.message, method=meth.name, status=err.status) from None
     z[n] += dy / sys_.K[j, n]
-    _, _, y, phi = _point(pb, sys_, z, k0, load, ncp, (xphys, Ax))  # only δ̂/ξ̂ moved: y from the same product
+    _, _, y, phi, _ = _point(ev, z, k0, load, (xphys, Ax))  # only δ̂/ξ̂ moved: y from the same product
     m = ncp.mask(z[:n], y)
     m[j] = True
     return m, y, phi
