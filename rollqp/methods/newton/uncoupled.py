@@ -110,12 +110,13 @@ def solve_tangential(meth, pb, warm, t0):
     if xi_fixed is not None:
         k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    z, it, info, product, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    run = iterate if sys_.partial else _iterate_dense  # (small n: iterate's own choice, made here)
+    z, it, info, product, y, phi = run(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
     tt, At = product[0], product[1]
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
     # the slip and rollqp's residuals from the last iterate's own y = r ŝ and load row (TangentialStep.solution)
-    sol = pb.solution(tt, xi, At=At, hat=(z[:n], y / r, phi[n] if with_load else 0.0))
+    sol = pb.solution(tt, xi, At, (z[:n], y / r, phi[n] if with_load else 0.0))  # (At, hat)
     sys_.last = (sol.t,) + product[1:]  # (t, A t[, unit·A t]): the next step's start needs no product
     sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
