@@ -301,7 +301,7 @@ class _March:
         if last is None or last[0] is not M:
             small = isinstance(M, RowSparse) and M.shape[0] * M.shape[1] <= RowSparse.DENSE_MAX
             last = self._negated = (M, -M.dense() if small else None)
-        return -(M @ w) if last[1] is None else last[1] @ w
+        return -(M @ w) if last[1] is None else last[1].dot(w)  # (ndarray.dot: @'s numbers, without matmul's dispatch)
 
     # ------------------------------------------------------------ the phases
     def start(self) -> StepRecord:
@@ -525,7 +525,7 @@ class _March:
         nodes = classify(p, t, tsol.s, ops.mu, ops.scales, bound=pb.bound, contact=self._contact(p))
         count = np.bincount(nodes, minlength=3).tolist()
         f = ops.f
-        rec = StepRecord(k, "rolling", float(q), float(f @ p) if P is None else P, float(f @ t), new, state, pb, tsol,
+        rec = StepRecord(k, "rolling", float(q), float(f.dot(p)) if P is None else P, float(f.dot(t)), new, state, pb, tsol,
                          cnt, 0.0, time.perf_counter() - t0, nodes, bool(count[SLIP] and not count[STICK]))
         rec.tau, rec.direction = tau, d
         return rec

@@ -384,20 +384,21 @@ def _point(ev, z, k0, load, start=None):
     known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers.
     ``ev``: the step's constants (:func:`_iterate_dense`)."""
     n, stress, A, unit, lc, fhat, phi_rows = ev
+    x = z[:n]
     if start is None:
-        xphys = z[:n] * stress
-        Ax = A @ xphys
+        xphys = x * stress
+        Ax = A.dot(xphys)  # (ndarray.dot: the same BLAS call and numbers as @, without matmul's ufunc dispatch)
         uAx = unit * Ax
     else:  # the last step's (x, A x) and, if it kept it, unit·(A x): the same numbers as formed here
         xphys, Ax = start[0], start[1]
         uAx = start[2] if len(start) > 2 else unit * Ax
     y = uAx + k0
     if load is None:
-        return xphys, Ax, y, phi_rows(z[:n], y), uAx
+        return xphys, Ax, y, phi_rows(x, y), uAx
     y += lc * z[n]
     phi = np.empty(n + 1)
-    phi_rows(z[:n], y, phi[:n])
-    phi[n] = fhat @ z[:n] - load
+    phi_rows(x, y, phi[:n])
+    phi[n] = fhat.dot(x) - load
     return xphys, Ax, y, phi, uAx
 
 
@@ -418,7 +419,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     while True:
         nrm = float(_max(np.abs(phi)))
         history.append(nrm)
-        merits.append(0.5 * float(phi @ phi) if merit is None else merit)
+        merits.append(0.5 * float(phi.dot(phi)) if merit is None else merit)
         if nrm <= stop:
             break
         if it >= meth.max_iterations:
@@ -436,7 +437,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
         zf = z + d
         full = _point(ev, zf, k0, load)
         pa = full[3]
-        merit = 0.5 * float(pa @ pa)
+        merit = 0.5 * float(pa.dot(pa))
         # d has a NaN or an infinity iff z + d has (z is finite): in x̂, Φ's own row of that node is not finite
         # (x̂ − Proj(…), with the load row f̂ᵀx̂ too), so the merit is not; in ξ̂, the number itself
         if not (math.isfinite(merit) and (not with_load or math.isfinite(zf[n]))):
