@@ -104,6 +104,14 @@ def coupled_step(contact, method, FN, kind, loads, previous=None, dq=None, direc
                       iterations=MAX_SWEEPS, residual=max(nres, tsol.residual))
 
 
+def _warm_of(rec):
+    """``(normal, tangential)``: the warm start of the step after a resumed state ``rec``, the numbers the
+    step that computed it hands to the next (pressure and approach; tractions and creepages)."""
+    from .problem import Residuals, StepSolution
+    return (StepSolution(residuals=Residuals(), p=rec.p, g=rec.g, delta=rec.delta),
+            StepSolution(residuals=Residuals(), t=rec.t, s=rec.s, xi=rec.xi, eta=rec.eta))
+
+
 def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_states):
     Fx, Fy, Mz = contact.moments(tsol.t)
     return StepRecord(k=k, phase=phase, q=q, p=nsol.p, g=nsol.g, t=tsol.t, s=tsol.s, state=tprob_states,
@@ -267,7 +275,7 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                            FN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, nsol.delta, nsol.iterations, 0.0, nsol.residual,
                            {"normal": nsol.info})
     yield start
-    prev, warm = start, None
+    prev, warm = start, (_warm_of(start) if start.phase == "resumed" else None)
     fixed = None
     if not contact.ops.coupled:
         fixed = normal(contact, method, FN, warm=None)
