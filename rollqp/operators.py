@@ -271,13 +271,14 @@ class SceneOperators:
             return TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=dq, Q=Q, xi=xi, scales=self.scales, law=law)
         _finite("c", c)
         last = self._last_bound  # (p, μ, FrictionBound, sliding limit) of the last march-built step
-        known = last is not None and last[0] is p and last[1] is mu and law is None
-        # the same pressure (a fixed normal half) and μ: the same bound, handed to the step
-        pb = TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
-                            scales=self.scales, law=law, trusted=True, known_bound=last[2] if known else None)
-        if known:
+        if last is not None and last[0] is p and last[1] is mu and law is None:
+            # the same pressure (a fixed normal half) and μ: the same bound, handed to the step (the fields in
+            # their order: keywords cost as much as the construction)
+            pb = TangentialStep(Att, self.f, p, mu, c, float(dq), _float(Q), _float(xi), self.scales, None, True, last[2])
             _check_sliding_limit(pb, last[3])
         else:
+            pb = TangentialStep(A=Att, f=self.f, p=p, mu=mu, c=c, dq=float(dq), Q=_float(Q), xi=_float(xi),
+                                scales=self.scales, law=law, trusted=True)
             _finite("p", pb.bound)
             if law is None:
                 self._last_bound = (p, mu, FrictionBound(pb.bound, pb.bound_hat), _check_sliding_limit(pb))

@@ -223,6 +223,7 @@ class TangentialStep:
             bh, nb = self.bound_hat
             fr = friction_residual(t_hat, s_hat, bh, nb)
             res = Residuals(0.0, float(np.maximum.reduce(np.abs(fr))), 0.0, 0.0 if self.Q is None else abs(float(load_hat)))
-            return StepSolution(t=t, s=s_hat * self.scales.slip, xi=float(xi), p=self.p, residuals=res, **meta)
+            # (the fields p, t, g, s, δ, ξ, residuals in their order: keywords cost as much as the construction)
+            return StepSolution(self.p, t, None, s_hat * self.scales.slip, None, float(xi), res, **meta)
         s = self.slip(t, xi, At)
         return StepSolution(t=t, s=s, xi=float(xi), p=self.p, residuals=self.residuals(t, xi, s), **meta)

@@ -110,12 +110,13 @@ def solve_tangential(meth, pb, warm, t0):
     if xi_fixed is not None:
         k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    z, it, info, product, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    run = iterate if sys_.partial else _iterate_dense  # (small n: iterate's own choice, made here)
+    z, it, info, product, y, phi = run(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
     tt, At = product[0], product[1]
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
     # the slip and rollqp's residuals from the last iterate's own y = r ŝ and load row (TangentialStep.solution)
-    sol = pb.solution(tt, xi, At=At, hat=(z[:n], y / r, phi[n] if with_load else 0.0))
+    sol = pb.solution(tt, xi, At, (z[:n], y / r, phi[n] if with_load else 0.0))  # (At, hat)
     sys_.last = (sol.t,) + product[1:]  # (t, A t[, unit·A t]): the next step's start needs no product
     sol.At = (sol.t, At)  # w = A_tt t (+ A_tn p) of the state needs no new product (rollqp.march)
     return meth.finish(sol, it, info, t0)
@@ -383,20 +384,21 @@ def _point(ev, z, k0, load, start=None):
     known ``(x, A x)``): :meth:`_Iterate.product` and :meth:`_Iterate.residual` in one call, the same numbers.
     ``ev``: the step's constants (:func:`_iterate_dense`)."""
     n, stress, A, unit, lc, fhat, phi_rows = ev
+    x = z[:n]
     if start is None:
-        xphys = z[:n] * stress
-        Ax = A @ xphys
+        xphys = x * stress
+        Ax = A.dot(xphys)  # (ndarray.dot: the same BLAS call and numbers as @, without matmul's ufunc dispatch)
         uAx = unit * Ax
     else:  # the last step's (x, A x) and, if it kept it, unit·(A x): the same numbers as formed here
         xphys, Ax = start[0], start[1]
         uAx = start[2] if len(start) > 2 else unit * Ax
     y = uAx + k0
     if load is None:
-        return xphys, Ax, y, phi_rows(z[:n], y), uAx
+        return xphys, Ax, y, phi_rows(x, y), uAx
     y += lc * z[n]
     phi = np.empty(n + 1)
-    phi_rows(z[:n], y, phi[:n])
-    phi[n] = fhat @ z[:n] - load
+    phi_rows(x, y, phi[:n])
+    phi[n] = fhat.dot(x) - load
     return xphys, Ax, y, phi, uAx
 
 
@@ -417,7 +419,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
     while True:
         nrm = float(_max(np.abs(phi)))
         history.append(nrm)
-        merits.append(0.5 * float(phi @ phi) if merit is None else merit)
+        merits.append(0.5 * float(phi.dot(phi)) if merit is None else merit)
         if nrm <= stop:
             break
         if it >= meth.max_iterations:
@@ -435,7 +437,7 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
         zf = z + d
         full = _point(ev, zf, k0, load)
         pa = full[3]
-        merit = 0.5 * float(pa @ pa)
+        merit = 0.5 * float(pa.dot(pa))
         # d has a NaN or an infinity iff z + d has (z is finite): in x̂, Φ's own row of that node is not finite
         # (x̂ − Proj(…), with the load row f̂ᵀx̂ too), so the merit is not; in ξ̂, the number itself
         if not (math.isfinite(merit) and (not with_load or math.isfinite(zf[n]))):
