@@ -104,7 +104,7 @@ class Recorder:
         self.newton, self.ops = newton_of(meth), ops
         self.tags = 0
         self.lasts = {}  # system -> (its last solution tuple, [k, field] or None)
-        self.summary = self.hist = None
+        self.summary = self.hist = self.sig = None
         if self.newton is not None:
             self.newton.record = True  # (an instance attribute: this method's systems only)
             for s in self.newton._systems.values():
@@ -123,6 +123,9 @@ class Recorder:
                 out["hist"] = self.hist = hist
         nw = self.newton
         if nw is None:
+            return out if len(out) > 1 else None
+        sig = self._signature(nw, k, state)
+        if sig is not None and sig == self.sig:  # nothing happened that the record would say
             return out if len(out) > 1 else None
         ops = self.ops
         events, systems = [], []
@@ -154,7 +157,32 @@ class Recorder:
         if summary != self.summary:
             out.update(summary)
             self.summary = summary
+        self.sig = self._signature(nw, k, state)
         return out if len(out) > 1 else None  # nothing new: no record (the last one holds)
+
+    def _signature(self, nw, k, state):
+        """What the summary of :meth:`note` says, as a tuple of numbers (cheap to form and compare); ``None`` if a
+        system has events to record or no name yet (the record is then made in full)."""
+        sig = []
+        for key, s in nw._systems.items():
+            events = getattr(s, "events", False)
+            if events is False:  # a placeholder (:func:`restore`)
+                sig.append(s.tag)
+                continue
+            if events or s.tag is None:
+                return None
+            where = self._last(k, state, s, key[0])
+            b0, b1 = s._base.get(False), s._base.get(True)
+            sig.append((s.tag, tuple([b[5].id for b in s._factors.values()]), None if b0 is None else b0[5].id,
+                        None if b1 is None else b1[5].id, s.settled, s.exact, s._serial,
+                        None if where is None else where[1] if where[0] == k else (where[1], where[0])))
+        for _, cf in nw._coupled.values():
+            if cf.events or cf.tag is None:
+                return None
+            sig.append(("coupled", cf.tag))
+        last = nw._last
+        sig.append((None if last is None else getattr(last[5], "tag", None), nw._large, len(nw._dropped)))
+        return tuple(sig)
 
     def _coupled(self, nw, events) -> list:
         """The coupled steps' factorizations (:class:`~rollqp.methods.newton.linear.CoupledFactors`): their events
