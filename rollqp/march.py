@@ -740,6 +740,20 @@ def check_resumed(scene, prepared, arrays: dict, march=None, recorder=None) -> S
         raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
                                      f"state before it, its pressure differs by {dp:.3g} p0 and its traction by "
                                      f"{dt:.3g} mu p0 (more than {RESUME_TOL:g}): the file was changed or is corrupt")
+    # the gap, approach, slip and creepage it hands on (a fixed normal half carries its solution to every later step)
+    sc = ops.scales
+    for what, a, b, scale, unit in (("gap", again.nsol.g, stored.nsol.g, sc.displacement, "u0"),
+                                    ("approach", again.nsol.delta, stored.nsol.delta, sc.displacement, "u0"),
+                                    ("slip", again.tsol.s, stored.tsol.s, sc.slip, "p0/E*"),
+                                    ("creepage", again.tsol.xi, stored.tsol.xi, sc.slip, "p0/E*")):
+        if a is None or b is None:
+            continue
+        d = np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) / scale
+        worst = float(np.max(d)) if np.all(np.isfinite(d)) else np.inf
+        if not worst <= RESUME_TOL:
+            raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
+                                         f"state before it, its {what} differs by {worst:.3g} {unit} (more than "
+                                         f"{RESUME_TOL:g}): the file was changed or is corrupt")
     return stored
 
 
@@ -762,8 +776,8 @@ def _restore(m: _March, arrays, upto, recorder):
             form = m.scene.discretization.formulation
             m.cache.items = [(float(dq), int(d), ops.build_history(form, float(dq), int(d))) for dq, d in hist]
         return products
-    except (KeyError, IndexError, TypeError, ValueError):
-        meth.setup(ops)
+    except (KeyError, IndexError, TypeError, ValueError, AttributeError, OverflowError, ArithmeticError):
+        meth.setup(ops)  # (a record that is not rollqp's: the check below then decides, to the tolerance)
         return None
 
 

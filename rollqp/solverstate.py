@@ -59,8 +59,11 @@ def _runs(idx) -> list:
     return np.column_stack([starts, stops]).ravel().tolist()
 
 
-def _indices(runs) -> np.ndarray:
+def _indices(runs, n: int) -> np.ndarray:
+    """The indices of ``[start, stop, ...]`` runs, each within ``0 … n`` (a record is read from a file)."""
     r = np.asarray(runs, dtype=np.intp).reshape(-1, 2)
+    if r.size and (r.min() < 0 or r.max() > n or np.any(r[:, 1] < r[:, 0])):
+        raise ValueError("a recorded free set outside the nodes")
     return np.concatenate([np.arange(a, b) for a, b in r]) if r.size else np.zeros(0, np.intp)
 
 
@@ -75,8 +78,11 @@ def _counts(kind) -> list:
     return np.column_stack([kind[starts], counts]).ravel().tolist()
 
 
-def _uncounted(runs) -> np.ndarray:
+def _uncounted(runs, size: int) -> np.ndarray:
+    """The codes of :func:`_counts`, ``size`` of them (a record is read from a file)."""
     r = np.asarray(runs, dtype=np.int64).reshape(-1, 2)
+    if r.size and (r[:, 1].min() < 0 or r[:, 1].sum() != size or r[:, 0].min() < 0 or r[:, 0].max() > 5):
+        raise ValueError("recorded row kinds that are not the coupled step's")
     return np.repeat(r[:, 0], r[:, 1]).astype(np.int8)
 
 
@@ -213,11 +219,11 @@ def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = N
             hist = rec["hist"]
         for ev in rec.get("ev", ()):
             if ev[0] == "f":
-                made[(ev[1], ev[2])] = (bool(ev[3]), _indices(ev[4]), [])
+                made[(ev[1], ev[2])] = (bool(ev[3]), _indices(ev[4], ops.n), [])
             elif ev[0] == "b":
                 made[(ev[1], ev[2])][2].append((ev[3], ev[4]))
             elif ev[0] == "F":
-                factored[ev[1]] = (None if ev[2] is None else _uncounted(ev[2]), ev[3], [])
+                factored[ev[1]] = (None if ev[2] is None else ev[2], ev[3], [])
             else:
                 factored[ev[1]][2].append(ev[2])
         if "sys" in rec:
@@ -286,4 +292,5 @@ def _rebuild_coupled(nw, ops, coupled, factored, recorder):
         _, cf = nw.coupled_system(pb)
         cf.tag = tag
         if tag in factored:
-            cf.restore(factored[tag])
+            kind, mu, batches = factored[tag]
+            cf.restore((None if kind is None else _uncounted(kind, cf.N), mu, batches))

@@ -261,6 +261,9 @@ class ReducedSystem:
             K = self.K if with_load else self.K_nl
             for added, released in borders:
                 added, released = np.asarray(added, dtype=np.intp), np.asarray(released, dtype=np.intp)
+                if (np.any(m[added]) or not np.all(m[released]) or added.min(initial=0) < 0
+                        or released.min(initial=0) < 0):  # (read from a file: nodes of this set's border)
+                    raise ValueError(f"a recorded bordered solve on the kept factorization {fid} is not its border")
                 grown = self._grow(K, base, added, released, np.zeros(base[1].size + with_load), with_load)
                 if grown is None:
                     raise ValueError(f"a bordered solve on the kept factorization {fid} failed")
