@@ -66,6 +66,11 @@ __all__ = ["State", "StepRecord", "march", "run", "prepare"]
 STEADY_TOL = 1e-8
 #: … or after this many a_H of rolling (Carter's transient dies out within ~3 a_H).
 STEADY_MAX_DISTANCE = 40.0
+#: A rolling step that is its tangential half alone (a fixed normal half, one Coulomb μ, uncoupled, the
+#: scene's Δq and profile) takes :meth:`_March._tangential_only`: the general step and record written out for
+#: that case, the same calls and numbers without the general step's branches (a tenth of the step at 81 nodes:
+#: docs/performance.md). ``False``: every step takes the general path (tests/test_perf_paths.py compares them).
+FAST_ROLLING_STEP = True
 
 
 @dataclass
@@ -190,8 +195,8 @@ class _March:
         self.fixed = self._normal_fixed()
         # a rolling step is its tangential half alone (:meth:`_tangential_only`): a fixed normal half, Coulomb's one
         # μ, uncoupled, the scene's Δq and profile
-        self.plain = (self.fixed and self.constant_friction and not ops.coupled and not self.frictionless
-                      and not self.moving and not self.plan.rolled and type(ops.mu) is float)
+        self.plain = (FAST_ROLLING_STEP and self.fixed and self.constant_friction and not ops.coupled
+                      and not self.frictionless and not self.moving and not self.plan.rolled)
         self._last_contact = self._negated = None  # (p, p > 1e-7 p0) of the last record; (M, −M dense or None)
 
     def _loads_at(self, tau) -> list:

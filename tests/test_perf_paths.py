@@ -9,10 +9,14 @@
   of the changed rows on the factored J) against the direct reduced solve
   (rollqp.methods.newton.linear.direct_coupled_direction): direction by direction on random case patterns, the
   fallbacks (singular, ill-conditioned, inaccurate updates), and whole coupled runs.
+* The march's tangential-only rolling step (``rollqp.march.FAST_ROLLING_STEP``) against the general
+  step and record: every array of whole runs bitwise equal.
 * The QP backends' solver cache keyed by a Hessian fingerprint: a changed Hessian builds a
   new solver object, the same Hessian reuses it.
 """
 from __future__ import annotations
+
+import importlib
 
 import numpy as np
 import pytest
@@ -312,3 +316,28 @@ def test_coupled_reuse_same_run_as_direct(monkeypatch, scene_changes, direct_bel
     mu, p0 = scene.contact.friction, scene.p0
     assert np.max(np.abs(fast["pt"] - plain["pt"])) <= TOL["transient"] * mu * p0
     assert np.max(np.abs(fast["pn"] - plain["pn"])) <= TOL["transient"] * p0
+
+
+@pytest.mark.parametrize("name, method, changes", [
+    ("cattaneo-carter", "newton", {}), ("cattaneo-carter", "nt-newton", {}), ("cattaneo-carter", "qp-osqp", {}),
+    ("cattaneo-carter", "qp-clarabel", {}), ("ramp", "newton", {}),
+    ("cattaneo-carter", "newton", {"discretization.element": "linear", "discretization.elements": 60})])
+def test_tangential_only_rolling_step_is_the_general_step(monkeypatch, name, method, changes):
+    """The written-out rolling step of a scene whose rolling steps are their tangential half alone (these
+    scenes' are: a fixed normal half, one μ, uncoupled, a fixed profile) gives, bit for bit, every array
+    the general step and record give (the same calls on the same numbers)."""
+    march_module = importlib.import_module("rollqp.march")
+    scene = rollqp.load_scene(name).replace(**{"solver.method": method, **changes})
+    if scene.discretization.distance > 3.0:
+        scene = scene.replace(**{"discretization.distance": 3.0})
+    fast = rollqp.run(scene).arrays()
+    with monkeypatch.context() as mp:
+        mp.setattr(march_module, "FAST_ROLLING_STEP", False)
+        plain = rollqp.run(scene).arrays()
+    compared = 0
+    for key, value in fast.items():
+        if key in ("meta", "step_time"):   # the wall times differ between any two runs
+            continue
+        np.testing.assert_array_equal(value, plain[key], err_msg=f"{name}, {method}: {key}")
+        compared += 1
+    assert compared >= 20
