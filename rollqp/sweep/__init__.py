@@ -63,7 +63,7 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
         ``on_point(i, out)`` after point ``i`` is stored.
     per_chunk : int, optional
         Points per chunk of a new store, and so per task (default
-        :func:`~.dataset.points_per_chunk`: ⌈√(N/(4·workers))⌉ of N points, at most 32); a
+        :func:`~.dataset.points_per_chunk`: ⌈√(N/(4·workers))⌉ of N points, raised to a divisor of the last axis's length within twice that, at most 32); a
         store that exists keeps its own.
     """
     import time
@@ -84,15 +84,16 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
         startup = time.perf_counter() - t1 if own else 0.0
         try:
             t2 = time.perf_counter()
-            opened = open_store(path, sw)
-            if opened is None:
+            opened, create = open_store(path, sw), None
+            if opened is None:  # made by run_sweep, on a local cluster while the first points compute
                 n = per_chunk or points_per_chunk(sw, max(len(client.scheduler_info()["workers"]), 1))
-                group, status = create_store(path, sw, n), np.zeros(sw.size, dtype="int8")
+                group, status = None, np.zeros(sw.size, dtype="int8")
+                create = (path, n, lambda: create_store(path, sw, n))
             else:
                 group, status = opened
             prepared += time.perf_counter() - t2
-            summary = run_sweep(sw, group, status, client, quiet=quiet, on_point=on_point)
-            summary.startup, summary.prepare = startup, prepared
+            summary = run_sweep(sw, group, status, client, quiet=quiet, on_point=on_point, create=create)
+            summary.startup, summary.prepare = startup, summary.prepare + prepared
             return summary
         finally:
             if own:

@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import InputError
 from ..fields import FIELDS, dtype_of, fields_for
 
-__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "Layout", "write_point", "result_fields",
+__all__ = ["open_result", "create_store", "open_store", "StoreWriter", "Layout", "chunk_tasks", "write_point", "result_fields",
            "STATUS", "points_per_chunk", "chunk_shape", "FINGERPRINT"]
 
 #: Values of the per-point ``status`` variable.
@@ -101,7 +101,8 @@ def result_fields(sweep) -> list:
 
 
 def points_per_chunk(sweep, workers: int = 1) -> int:
-    """Points in one chunk of the store (and in one task of the sweep): ``⌈√(N/(4·workers))⌉``.
+    """Points in one chunk of the store (and in one task of the sweep): ``⌈√(N/(4·workers))⌉``, raised
+    to a divisor of the last axis's length when one is within twice that (:func:`_even`).
 
     A task costs a round trip through the scheduler and a write of ~30 files whatever its
     points, and the last tasks leave workers idle while the others finish: for N points of
@@ -113,8 +114,17 @@ def points_per_chunk(sweep, workers: int = 1) -> int:
     """
     f = sweep.facts
     per_point = int(f.states.max()) * int(f.nodes.max()) * 8
-    balance = math.ceil(math.sqrt(sweep.size / (4 * max(workers, 1))))
+    balance = _even(math.ceil(math.sqrt(sweep.size / (4 * max(workers, 1)))), sweep.shape[-1])
     return max(1, min(MAX_POINTS_PER_CHUNK, CHUNK_BYTES // max(per_point, 1), balance))
+
+
+def _even(b: int, last: int) -> int:
+    """``b`` points a chunk, raised to the nearest divisor of the last axis's length ``last`` up to 2·b,
+    so that the chunks tile its rows evenly: 3 a chunk of rows of 8 would make tasks of 3, 3 and 2
+    points, 4 makes two tasks of 4 (fewer tasks, the same points each)."""
+    if b >= last:
+        return b
+    return next((d for d in range(b, min(2 * b, last) + 1) if last % d == 0), b)
 
 
 def chunk_shape(shape: tuple, per_chunk: int) -> tuple:
@@ -322,6 +332,20 @@ def _chunk_files(group, a):
     return folder, m.compressor, m.dimension_separator, np.dtype(m.dtype.to_native_dtype())
 
 
+def chunk_tasks(shape: tuple, chunks: tuple, status) -> list:
+    """The points of a sweep of ``shape`` stored in ``chunks`` whose ``status`` is not done, grouped by
+    chunk: lists of flat indices (one task each)."""
+    index = np.arange(math.prod(shape)).reshape(shape)
+    todo = (np.asarray(status).reshape(shape) != STATUS["done"])
+    out = []
+    for region in itertools.product(*(range(0, n, c) for n, c in zip(shape, chunks))):
+        sel = tuple(slice(s, s + c) for s, c in zip(region, chunks))
+        points = index[sel][todo[sel]]
+        if points.size:
+            out.append([int(i) for i in points])
+    return out
+
+
 class Layout:
     """The swept keys and the grid's shape: what a :class:`StoreWriter` needs of a sweep (small, sent
     to the workers that write their own chunks; a :class:`~rollqp.sweep.Sweep` serves as well)."""
@@ -364,15 +388,7 @@ class StoreWriter:
 
     def tasks(self, status) -> list:
         """The points to compute, grouped by chunk: lists of flat indices whose ``status`` is not done."""
-        index = np.arange(self.sweep.size).reshape(self.sweep.shape)
-        todo = (np.asarray(status).reshape(self.sweep.shape) != STATUS["done"])
-        out = []
-        for region in itertools.product(*(range(0, n, c) for n, c in zip(self.sweep.shape, self.chunks))):
-            sel = tuple(slice(s, s + c) for s, c in zip(region, self.chunks))
-            points = index[sel][todo[sel]]
-            if points.size:
-                out.append([int(i) for i in points])
-        return out
+        return chunk_tasks(self.sweep.shape, self.chunks, status)
 
     def _region(self, points) -> tuple:
         """The chunk of the first of ``points``, as slices (clipped at the arrays' ends)."""

@@ -368,7 +368,8 @@ class Summary:
 
     ``wall`` is the time of the points' phase (submission to the last write); ``startup`` the
     cluster's start (or the connection to ``--scheduler``), ``prepare`` the validation of the
-    points and the store's creation: their sum is the sweep's whole time.
+    points and the store's creation (on a local cluster a new store is made while the first
+    points compute: its time is then in ``wall``): their sum is the sweep's whole time.
     """
 
     total: int
@@ -474,7 +475,7 @@ def _submit(client, sweep, tasks, store=None):
                           key=f"{prefix}-{points[0]}"): points for points in tasks}
 
 
-def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) -> Summary:
+def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, create=None) -> Summary:
     """Compute the points of ``sweep`` whose ``status`` is not done, writing them into ``group``.
 
     One task per chunk of the store that holds points to do; each task's points are written
@@ -483,22 +484,41 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None) 
     (tests, observers). Ctrl-C or SIGTERM cancels the tasks in flight and returns the summary
     with ``interrupted`` set: the stored points stay, and running the sweep again computes only
     the rest.
+
+    A new store: ``group`` is None and ``create = (path, per_chunk, make)``, ``make()`` creating it.
+    On a local cluster the tasks go out first and the store is made while the first points
+    compute (a task that ends before the store exists sends its arrays, written here); else the
+    store is made first.
     """
-    from .dataset import StoreWriter
+    from .dataset import StoreWriter, chunk_shape, chunk_tasks
     as_completed = iter if isinstance(client, InProcess) else _dask().as_completed
-    writer = StoreWriter(group, sweep)
-    tasks = writer.tasks(status)
+    early = group is None and not isinstance(client, InProcess) and _shares_disk(client)
+    made = time.perf_counter()
+    if group is None and not early:
+        group = create[2]()
+    made = time.perf_counter() - made
+    if early:  # a store made by create_store is zarr-2 files on disk: the workers can write it
+        writer, store = None, os.path.abspath(create[0])
+        tasks = chunk_tasks(sweep.shape, chunk_shape(sweep.shape, create[1]), status)
+    else:
+        writer = StoreWriter(group, sweep)
+        tasks = writer.tasks(status)
+        local = not isinstance(client, InProcess) and writer.on_disk and _shares_disk(client)
+        store = writer.root if local else None
     todo = sum(len(t) for t in tasks)
     summary = Summary(total=sweep.size, kept=sweep.size - todo, workers=len(client.scheduler_info()["workers"]),
-                      per_chunk=max((len(t) for t in tasks), default=1))
+                      per_chunk=max((len(t) for t in tasks), default=1), prepare=made)
     bar = Progress(todo, "point", quiet)
     t0 = time.perf_counter()
     futures, n = {}, 0
-    store = None
-    if not isinstance(client, InProcess) and writer.on_disk and _shares_disk(client):
-        store = writer.root
     try:
         futures = _submit(client, sweep, tasks, store)
+        if writer is None:
+            try:
+                writer = StoreWriter(create[2](), sweep)
+            except BaseException:
+                client.cancel(list(futures))
+                raise
         for fut in as_completed(list(futures)):
             points = futures.pop(fut)
             outs = fut.result()
