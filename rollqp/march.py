@@ -91,9 +91,7 @@ class Counters:
         elif half == "tangential":
             self.inner_tangential += sol.iterations
         self.backtracks += sol.backtracks
-        r = sol.residual
-        if r > self.residual or r != r:  # (_residual, written out: once a step)
-            self.residual = r
+        self._residual(sol.residual)
 
     def add_coupled(self, sol):
         """Count a coupled solution: Newton iterations, or N–T outer and inner iterations."""
@@ -522,9 +520,9 @@ class _March:
         p = nsol.p
         pb = ops.tangential_step(p, self.history_term(M, state.w), dq, Q, xi, False, None, False)
         tsol = self.method.solve(pb, state.tsol)
-        it, r = tsol.iterations, tsol.residual
-        # Counters().add(tsol, "tangential"): a new counter's residual 0.0 is replaced by r if larger or NaN
-        cnt = Counters(it, r if (r > 0.0 or r != r) else 0.0, 0, it, tsol.backtracks)
+        it = tsol.iterations
+        cnt = Counters(it, 0.0, 0, it, tsol.backtracks)  # Counters().add(tsol, "tangential")
+        cnt._residual(tsol.residual)
         t = tsol.t
         new = State(p, t, ops.w(p, t, _product(tsol, pb, ops.Att)), nsol, tsol, state.normal)
         nodes = classify(p, t, tsol.s, ops.mu, ops.scales, bound=pb.bound, contact=self._contact(p))

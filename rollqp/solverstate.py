@@ -133,11 +133,7 @@ class Recorder:
             if not hasattr(s, "events"):  # the place of a system that is not rebuilt (:func:`restore`)
                 systems.append([s.tag, None, None, None, None, None])
                 continue
-            if s.tag is None:
-                s.tag, self.tags = self.tags, self.tags + 1
-            if s.events is None:
-                s.events = []
-            for e in s.events:
+            for e in self._events(s):
                 if e[0] == "f":
                     events.append(["f", s.tag, e[1], int(e[2]), _runs(e[3])])
                 else:
@@ -184,16 +180,21 @@ class Recorder:
         sig.append((None if last is None else getattr(last[5], "tag", None), nw._large, len(nw._dropped)))
         return tuple(sig)
 
+    def _events(self, system) -> list:
+        """The events of ``system`` (a reduced system or coupled factors) since its last record, which the caller
+        empties; the system gets its tag the first time it is seen."""
+        if system.tag is None:
+            system.tag, self.tags = self.tags, self.tags + 1
+        if system.events is None:
+            system.events = []
+        return system.events
+
     def _coupled(self, nw, events) -> list:
         """The coupled steps' factorizations (:class:`~rollqp.methods.newton.linear.CoupledFactors`): their events
         appended to ``events``; ``[[tag, roles of A_nn, A_tt, A_nt, A_tn, Δq, P prescribed, Q prescribed], ...]``."""
         out = []
         for key, (_, cf) in nw._coupled.items():
-            if cf.tag is None:
-                cf.tag, self.tags = self.tags, self.tags + 1
-            if cf.events is None:
-                cf.events = []
-            for e in cf.events:
+            for e in self._events(cf):
                 if e[0] == "F":
                     events.append(["F", cf.tag, None if e[1] is None else _counts(e[1]),
                                    None if e[2] is None else float(e[2])])
