@@ -69,7 +69,7 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
     import time
 
     from ..result import OutputLock
-    from .dataset import create_store, open_store, points_per_chunk
+    from .dataset import open_store, points_per_chunk
     from .executor import close_client, connect, run_sweep
     if per_chunk is not None and (not isinstance(per_chunk, int) or isinstance(per_chunk, bool)
                                   or not 1 <= per_chunk <= MAX_POINTS):
@@ -88,7 +88,7 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
             if opened is None:  # made by run_sweep, on a local cluster while the first points compute
                 n = per_chunk or points_per_chunk(sw, max(len(client.scheduler_info()["workers"]), 1))
                 group, status = None, np.zeros(sw.size, dtype="int8")
-                create = (path, n, lambda: create_store(path, sw, n))
+                create = (path, n)
             else:
                 group, status = opened
             prepared += time.perf_counter() - t2

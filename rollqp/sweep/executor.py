@@ -485,17 +485,17 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
     with ``interrupted`` set: the stored points stay, and running the sweep again computes only
     the rest.
 
-    A new store: ``group`` is None and ``create = (path, per_chunk, make)``, ``make()`` creating it.
+    A new store: ``group`` is None and ``create = (path, per_chunk)`` (:func:`~.dataset.create_store`).
     On a local cluster the tasks go out first and the store is made while the first points
     compute (a task that ends before the store exists sends its arrays, written here); else the
     store is made first.
     """
-    from .dataset import StoreWriter, chunk_shape, chunk_tasks
+    from .dataset import StoreWriter, chunk_shape, chunk_tasks, create_store
     as_completed = iter if isinstance(client, InProcess) else _dask().as_completed
     early = group is None and not isinstance(client, InProcess) and _shares_disk(client)
     made = time.perf_counter()
     if group is None and not early:
-        group = create[2]()
+        group = create_store(create[0], sweep, create[1])
     made = time.perf_counter() - made
     if early:  # a store made by create_store is zarr-2 files on disk: the workers can write it
         writer, store = None, os.path.abspath(create[0])
@@ -515,7 +515,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
         futures = _submit(client, sweep, tasks, store)
         if writer is None:
             try:
-                writer = StoreWriter(create[2](), sweep)
+                writer = StoreWriter(create_store(create[0], sweep, create[1]), sweep)
             except BaseException:
                 client.cancel(list(futures))
                 raise
