@@ -209,7 +209,7 @@ class _Iterate:
     def product(self, z, with_y=True):
         """``(x, A x, y)`` at the unknowns ``z`` (``x`` the traction in the problem's units)."""
         x = z[:self.n] * self.pb.scales.stress
-        if self.sys.partial and not self.exact:  # the columns where x ≠ 0 (the contact: zero traction outside)
+        if not self.exact:  # the columns where x ≠ 0 (the contact: zero traction outside)
             Ax = partial_product(self.pb.A.dense(), np.arange(self.n), x, np.flatnonzero(x))
         else:
             Ax = self.pb.A @ x
@@ -241,7 +241,7 @@ class _Iterate:
         self.z = z
         self.x = z[:self.n]
         self.since += 1
-        if self.since >= REFRESH_EVERY or not self.sys.partial or self.exact:  # small n: a product costs less
+        if self.since >= REFRESH_EVERY or self.exact:
             self.refresh()
             return
         self.y = self.y + alpha * Kd
@@ -252,8 +252,7 @@ class _Iterate:
         """``K d`` on the rows ``Φ`` reads. On the free rows (``mask``) the Newton equations give it,
         ``K_F d = −Φ_F``; the others are multiplied by the blocks of ``K`` they need (the columns
         where ``d ≠ 0``); rows whose ``y`` does not enter ``Φ`` (a zero friction bound) are left 0."""
-        sys_ = self.sys
-        if not sys_.partial or self.exact:
+        if self.exact:
             return self.K @ d
         n = self.n
         F = mask[:n]
@@ -353,9 +352,9 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         if d is None or not math.isfinite(float(np.add.reduce(d))):  # a NaN or an infinity anywhere (one sum)
             raise SolverError(f"the {pb.kind} Newton matrix is singular",
                               method=meth.name, status="singular", iterations=it, residual=nrm)
-        if not sys_.partial or (it == 1 and sys_.settled):
-            # small n, or the last step took one iteration (so this one likely does too): the product at
-            # the full step gives K d (all rows) and, if the step is taken, the iterate's own y and Φ
+        if it == 1 and sys_.settled:
+            # the last step took one iteration (so this one likely does too): the product at the full step
+            # gives K d (all rows) and, if the step is taken, the iterate's own y and Φ
             zf = st.z + d
             full, Kd = (zf, st.product(zf)), None  # K d = y(z + d) − y, if the full step is refused
         else:
@@ -366,9 +365,9 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
             st.take(full[0], full[1], *at_full)  # eq. 79, α = 1
         else:
             st.update(st.z + alpha * d, alpha, full[1][2] - st.y if Kd is None else Kd)  # eq. 79
-    sys_.settled = sys_.partial and it == 1
+    sys_.settled = it == 1
     if it or start is None:  # a product of this iteration's (else the start's): how it was taken
-        sys_.exact = st.exact or not sys_.partial
+        sys_.exact = st.exact
     info = {"r": r, "backtracks": st.backtracks, "merit": st.merits[-1], "history": st.history,
             "merits": st.merits, "steps": st.steps, "nonmonotone": st.nonmono, "shifts": st.shifts,
             "tolerance_phi": stop}
