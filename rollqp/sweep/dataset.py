@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..fields import FIELDS, dtype_of, fields_for
 
 __all__ = ["open_result", "create_store", "open_store", "StoreWriter", "Layout", "chunk_tasks", "write_point", "result_fields",
-           "STATUS", "points_per_chunk", "chunk_shape", "FINGERPRINT"]
+           "STATUS", "points_per_chunk", "chunk_shape", "FINGERPRINT", "COMPRESSOR"]
 
 #: Values of the per-point ``status`` variable.
 STATUS = {"missing": 0, "done": 1, "failed": 2}
@@ -274,38 +274,142 @@ def _check_schema(path, group, sweep) -> None:
             chunks = mine[:d]
 
 
-def create_store(path, sweep, per_chunk: int = 1):
+#: The compressor of every array of a store: zarr's default for zarr-2 arrays, named here so that both
+#: ways of writing a store (:func:`create_store`) give the same files.
+COMPRESSOR = {"id": "blosc", "cname": "lz4", "clevel": 5, "shuffle": 1, "blocksize": 0}
+#: dtype kinds whose metadata and chunks :func:`create_store` writes itself (others go through zarr).
+_DIRECT_KINDS = "fiU"
+
+
+def create_store(path, sweep, per_chunk: int = 1, *, direct: bool = True, group: bool = True):
     """Create the empty store of ``sweep`` (metadata and coordinates only) and return its zarr group.
 
-    Written with zarr in xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes,
-    consolidated metadata), chunked ``per_chunk`` points per chunk (:func:`chunk_shape`), every
-    state and node of a point in its chunk; ``xarray.open_zarr`` reads it. zarr builds the store
-    in memory, whose files are then written into a new folder renamed to ``path`` at the end:
-    a store is there whole or not at all, and ~70 small files cost milliseconds, not zarr's
-    asynchronous round trip per file.
+    xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes, consolidated metadata ``.zmetadata``),
+    chunked ``per_chunk`` points per chunk (:func:`chunk_shape`), every state and node of a point in
+    its chunk, every array compressed with :data:`COMPRESSOR`; ``xarray.open_zarr`` reads it. The
+    files are written into a new folder renamed to ``path`` at the end: a store is there whole or not
+    at all.
+
+    ``direct``: the metadata files (``.zgroup``, ``.zattrs``, each array's ``.zarray`` and
+    ``.zattrs``, ``.zmetadata``) are written here as the JSON zarr writes, and the coordinates'
+    chunks encoded with the arrays' compressor, as zarr does (no chunk that holds only the fill
+    value); ``False`` (or a coordinate of another type than numbers and words): zarr builds them in
+    memory. The two give the same files (tests/test_sweep_hardening.py); the direct way costs a few
+    milliseconds of CPU where zarr's asynchronous API costs tens. ``group = False``: return ``None``,
+    not the opened group (a store that :meth:`StoreWriter.at` writes).
     """
+    files = _direct_files(sweep, per_chunk) if direct else None
+    if files is None:
+        files = _zarr_files(sweep, per_chunk)
+    tmp = f"{path}.creating-{os.getpid()}"
+    if os.path.lexists(tmp):  # left by a killed process of the same id
+        import shutil
+        shutil.rmtree(tmp)
+    _write_tree(tmp, files)
+    os.rename(tmp, path)
+    if not group:
+        return None
     import zarr
-    from zarr.storage import MemoryStore
+    return zarr.open_group(path, mode="r+", zarr_format=2)
+
+
+def _arrays(sweep, per_chunk: int):
+    """``(name, dims, shape, chunks, dtype, fill, attrs, values)`` of every array of the store (``values``:
+    a coordinate's, else ``None``)."""
     chunks = chunk_shape(sweep.shape, per_chunk)
     sizes = dict(zip(sweep.keys, sweep.shape), step=int(sweep.facts.states.max()), node=int(sweep.facts.nodes.max()))
-    files = {}
-    memory = MemoryStore(store_dict=files)
-    group = zarr.open_group(memory, mode="w-", zarr_format=2, attributes=_global_attrs(sweep))
     point = dict(zip(sweep.keys, chunks))
     for name, (dims, values, attrs, chunk) in _coords(sweep, chunks).items():
         fill = None if values.dtype.kind == "U" else np.nan if values.dtype.kind == "f" else 0
-        arr = group.create_array(name, shape=values.shape, chunks=chunk or values.shape, dtype=values.dtype,
-                                 fill_value=fill, attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
-        arr[...] = values
+        yield (name, dims, values.shape, tuple(chunk or values.shape), values.dtype, fill,
+               dict(attrs, _ARRAY_DIMENSIONS=list(dims)), values)
     for name, (dims, dt, fill, attrs) in _variables(sweep, result_fields(sweep)).items():
-        group.create_array(name, shape=tuple(sizes[d] for d in dims), chunks=tuple(point.get(d, sizes[d]) for d in dims),
-                           dtype=dt, fill_value=fill, attributes=dict(attrs, _ARRAY_DIMENSIONS=list(dims)))
+        yield (name, dims, tuple(sizes[d] for d in dims), tuple(point.get(d, sizes[d]) for d in dims), dt, fill,
+               dict(attrs, _ARRAY_DIMENSIONS=list(dims)), None)
+
+
+def _zarr_files(sweep, per_chunk: int) -> dict:
+    """``key -> bytes`` of the store, built by zarr in memory."""
+    import zarr
+    from numcodecs import get_codec
+    from zarr.storage import MemoryStore
+    files = {}
+    memory = MemoryStore(store_dict=files)
+    group = zarr.open_group(memory, mode="w-", zarr_format=2, attributes=_global_attrs(sweep))
+    for name, _, shape, chunks, dt, fill, attrs, values in _arrays(sweep, per_chunk):
+        arr = group.create_array(name, shape=shape, chunks=chunks, dtype=dt, fill_value=fill, attributes=attrs,
+                                 compressors=get_codec(dict(COMPRESSOR)))
+        if values is not None:
+            arr[...] = values
     zarr.consolidate_metadata(memory, zarr_format=2)
-    tmp = f"{path}.creating-{os.getpid()}"
-    for key, buf in files.items():
-        _write_file(os.path.join(tmp, *key.split("/")), buf.to_bytes(), atomic=False)
-    os.rename(tmp, path)
-    return zarr.open_group(path, mode="r+", zarr_format=2)
+    return {key: buf.to_bytes() for key, buf in files.items()}
+
+
+def _direct_files(sweep, per_chunk: int):
+    """``key -> bytes`` of the store, the JSON written here (zarr's own layout and encoding: its
+    ``ArrayV2Metadata.to_buffer_dict``); ``None`` for a coordinate of a type not in :data:`_DIRECT_KINDS`."""
+    from numcodecs import get_codec
+    codec = get_codec(dict(COMPRESSOR))
+    attrs = _global_attrs(sweep)
+    meta = {".zgroup": {"zarr_format": 2}, ".zattrs": attrs}
+    files = {}
+    # zarr's order of the consolidated metadata (casefolded names): the same bytes, not only the same JSON
+    for name, _, shape, chunks, dt, fill, array_attrs, values in sorted(_arrays(sweep, per_chunk),
+                                                                         key=lambda a: (a[0].casefold(), a[0])):
+        if dt.kind not in _DIRECT_KINDS:
+            return None
+        zarray = {"shape": list(shape), "chunks": list(chunks), "dtype": dt.str, "fill_value": _json_fill(fill),
+                  "order": "C", "filters": None, "dimension_separator": ".", "compressor": dict(COMPRESSOR),
+                  "zarr_format": 2}
+        meta[f"{name}/.zattrs"], meta[f"{name}/.zarray"] = array_attrs, zarray
+        if values is not None:
+            files.update(_coordinate_chunks(name, values, chunks, dt, fill, codec))
+    for key, doc in meta.items():
+        files[key] = json.dumps(doc, indent=2, allow_nan=True).encode()
+    files[".zmetadata"] = json.dumps({"metadata": meta, "zarr_consolidated_format": 1}, allow_nan=True).encode()
+    return files
+
+
+def _json_fill(fill):
+    """A fill value as zarr-2 metadata spells it (``"NaN"`` for a float NaN, ``null`` for none)."""
+    if fill is None:
+        return None
+    if isinstance(fill, float):
+        return "NaN" if math.isnan(fill) else "Infinity" if fill == math.inf else "-Infinity" if fill == -math.inf \
+            else fill
+    return int(fill)
+
+
+def _coordinate_chunks(name, values, chunks, dt, fill, codec) -> dict:
+    """``key -> bytes`` of the chunks of a coordinate: each padded with the fill value to the whole chunk
+    and encoded with ``codec``; a chunk that holds only the fill value is not written (as zarr does)."""
+    out = {}
+    fill_value = np.zeros((), dt)[()] if fill is None else fill
+    for index in itertools.product(*(range(-(-n // c)) for n, c in zip(values.shape, chunks))):
+        sel = tuple(slice(i * c, min(i * c + c, n)) for i, c, n in zip(index, chunks, values.shape))
+        part = values[sel]
+        if dt.kind == "f" and np.isnan(fill_value) and np.isnan(part).all() or np.all(part == fill_value):
+            continue
+        block = np.full(chunks, fill_value, dtype=dt)
+        block[tuple(slice(0, s.stop - s.start) for s in sel)] = part
+        out[f"{name}/{'.'.join(map(str, index))}"] = codec.encode(block)
+    return out
+
+
+def _write_tree(root: str, files: dict) -> None:
+    """``files`` (``key -> bytes``, keys ``/``-separated) as new files under the new folder ``root``."""
+    folders = {os.path.dirname(key) for key in files} - {""}
+    os.mkdir(root)
+    for folder in sorted(folders):
+        os.makedirs(os.path.join(root, *folder.split("/")), exist_ok=True)
+    for key, data in files.items():
+        fd = os.open(os.path.join(root, *key.split("/")), os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+        try:
+            view = memoryview(data)
+            while view:
+                view = view[os.write(fd, view):]
+        finally:
+            os.close(fd)
 
 
 def _write_file(target: str, data: bytes, atomic: bool = True) -> None:
@@ -319,17 +423,6 @@ def _write_file(target: str, data: bytes, atomic: bool = True) -> None:
         fh.write(data)
     if atomic:
         os.replace(tmp, target)
-
-
-def _chunk_files(group, a):
-    """``(folder, codec, separator, dtype)`` to write whole chunks of the zarr-2 array ``a`` as
-    files, or ``None`` when zarr must write them (another format, filters, a store not on disk)."""
-    from zarr.storage import LocalStore
-    m = a.metadata
-    if getattr(m, "zarr_format", None) != 2 or not isinstance(group.store, LocalStore) or m.filters or m.order != "C":
-        return None
-    folder = os.path.join(str(group.store.root), *[p for p in a.path.split("/") if p])
-    return folder, m.compressor, m.dimension_separator, np.dtype(m.dtype.to_native_dtype())
 
 
 def chunk_tasks(shape: tuple, chunks: tuple, status) -> list:
@@ -362,29 +455,122 @@ class Layout:
         return tuple(int(j) for j in np.unravel_index(i, self.shape))
 
 
+class _Array:
+    """One array of a store as :class:`StoreWriter` sees it: shape, dtype, fill value, chunks, and how
+    its chunks are written: as files (``folder``, ``codec``, ``separator``: zarr-2 on disk) or by
+    zarr (``zarr``: the opened array)."""
+
+    __slots__ = ("shape", "dtype", "fill", "chunks", "folder", "codec", "separator", "zarr")
+
+    def __init__(self, shape, dtype, fill, chunks, folder=None, codec=None, separator=".", zarr=None):
+        self.shape, self.dtype, self.chunks = tuple(shape), np.dtype(dtype), tuple(chunks)
+        self.fill = np.zeros((), self.dtype)[()] if fill is None else fill
+        self.folder, self.codec, self.separator, self.zarr = folder, codec, separator, zarr
+
+    @property
+    def ndim(self) -> int:
+        return len(self.shape)
+
+    def key(self, chunk: tuple) -> str:
+        """The file of the chunk at ``chunk`` (indices over the swept dimensions; 0 over the others)."""
+        name = self.separator.join(str(c) for c in chunk + (0,) * (self.ndim - len(chunk)))
+        return os.path.join(self.folder, *name.split("/"))
+
+    def read(self, chunk: tuple) -> np.ndarray:
+        """The whole chunk at ``chunk`` as stored (the fill value where no file is)."""
+        try:
+            with open(self.key(chunk), "rb") as fh:
+                data = fh.read()
+        except FileNotFoundError:
+            return np.full(self.chunks, self.fill, dtype=self.dtype)
+        raw = self.codec.decode(data) if self.codec is not None else data
+        return np.frombuffer(raw, dtype=self.dtype).reshape(self.chunks).copy()
+
+
+def _fill_from_json(value, dtype):
+    """A zarr-2 ``fill_value`` as a number (``"NaN"``, ``"Infinity"``, ``"-Infinity"`` for floats)."""
+    if value is None:
+        return None
+    if isinstance(value, str):
+        return float(value.replace("Infinity", "inf"))
+    return np.asarray(value, dtype=dtype)[()]
+
+
+def _arrays_from_metadata(root: str):
+    """``name -> _Array`` of the zarr-2 store at ``root`` read from its consolidated metadata, every chunk
+    a file; ``None`` when the store is not plain zarr-2 files (no ``.zmetadata``, filters, another
+    order, a dtype zarr must convert): zarr then writes."""
+    from numcodecs import get_codec
+    try:
+        with open(os.path.join(root, ".zmetadata"), "rb") as fh:
+            meta = json.loads(fh.read())["metadata"]
+        out = {}
+        for key, m in meta.items():
+            if not key.endswith("/.zarray"):
+                continue
+            name, dt, sep = key[:-len("/.zarray")], np.dtype(m["dtype"]), m.get("dimension_separator", ".")
+            if "/" in name or m.get("zarr_format") != 2 or m.get("filters") or m.get("order", "C") != "C" \
+                    or dt.kind not in "biufU" or sep not in (".", "/"):
+                return None
+            codec = get_codec(dict(m["compressor"])) if m.get("compressor") else None
+            out[name] = _Array(m["shape"], dt, _fill_from_json(m.get("fill_value"), dt), m["chunks"],
+                               os.path.join(root, name), codec, sep)
+        return out if "status" in out else None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return None
+
+
+def _arrays_from_zarr(group) -> dict:
+    """``name -> _Array`` of every array of ``group``, opened by zarr (each written by zarr)."""
+    out = {}
+    for k in group.array_keys():
+        a = group[k]
+        out[k] = _Array(a.shape, a.dtype, a.fill_value, a.chunks, zarr=a)
+    return out
+
+
 class StoreWriter:
     """Writes points into a sweep's store, one chunk at a time: every variable's chunk, ``status`` last.
 
     A write is the points of one chunk (one task of the sweep): each variable's block of that
     chunk is filled in memory and written whole. In a zarr-2 store on disk (what
-    :func:`create_store` makes) a block is encoded with the array's own compressor and written
-    as its chunk file (zarr-2's key ``i.j.k``) through a temporary file renamed over it, so a
-    kill never leaves half a chunk; zarr's asynchronous path costs thread hops per array, ~30
-    arrays a chunk, more on a loaded machine. Otherwise zarr writes the
-    blocks. Points of the chunk not in the write keep what the store holds (a re-run that
-    computes only a chunk's failed points reads the chunk first). ``sweep``: the
-    :class:`~rollqp.sweep.Sweep` or its :class:`Layout`.
+    :func:`create_store` makes) the arrays are known from the store's consolidated metadata
+    (``.zmetadata``, one file read: no zarr array is opened) and a block is encoded with the
+    array's own compressor and written as its chunk file (zarr-2's key ``i.j.k``) through a
+    temporary file renamed over it, so a kill never leaves half a chunk; zarr's asynchronous path
+    costs thread hops per array, ~30 arrays a chunk, more on a loaded machine. Otherwise (a store
+    in memory, another layout) zarr opens the arrays and writes the blocks. Points of the chunk not
+    in the write keep what the store holds (a re-run that computes only a chunk's failed points
+    reads the chunk first). ``sweep``: the :class:`~rollqp.sweep.Sweep` or its :class:`Layout`.
     """
 
     def __init__(self, group, sweep):
-        self.sweep = sweep
-        self.arrays = {k: group[k] for k in group.array_keys()}
-        self.chunks = tuple(self.arrays["status"].chunks)
-        self.names = [k for k in self.arrays if k not in sweep.keys and (k not in ("q", "x") or self.arrays[k].ndim > 1)]
-        self.files = {k: _chunk_files(group, self.arrays[k]) for k in self.names + ["status"]}
+        from zarr.storage import LocalStore
+        local = isinstance(group.store, LocalStore) and getattr(group.metadata, "zarr_format", None) == 2
+        root = os.path.join(str(group.store.root), *[p for p in group.path.split("/") if p]) if local else None
+        arrays = _arrays_from_metadata(root) if local else None
+        self._setup(sweep, arrays or _arrays_from_zarr(group), root)
+
+    @classmethod
+    def at(cls, path, sweep) -> "StoreWriter":
+        """The writer of the store at ``path`` from its files alone; zarr opens it only when they are
+        not plain zarr-2 files with consolidated metadata."""
+        path = os.fspath(path)
+        arrays = _arrays_from_metadata(path)
+        if arrays is None:
+            import zarr
+            return cls(zarr.open_group(path, mode="r+", zarr_format=2), sweep)
+        self = cls.__new__(cls)
+        self._setup(sweep, arrays, path)
+        return self
+
+    def _setup(self, sweep, arrays: dict, root) -> None:
+        self.sweep, self.arrays = sweep, arrays
+        self.chunks = tuple(arrays["status"].chunks)
+        self.names = [k for k in arrays if k not in sweep.keys and (k not in ("q", "x") or arrays[k].ndim > 1)]
         #: Every chunk is written as a file of a store on disk (whose folder is ``root``).
-        self.on_disk = all(spec is not None for spec in self.files.values())
-        self.root = str(group.store.root) if self.on_disk else None
+        self.on_disk = all(arrays[k].folder is not None for k in self.names + ["status"])
+        self.root = root if self.on_disk else None
 
     def tasks(self, status) -> list:
         """The points to compute, grouped by chunk: lists of flat indices whose ``status`` is not done."""
@@ -400,18 +586,20 @@ class StoreWriter:
         region = self._region(points)
         return all(s.start <= j < s.stop for i in points for j, s in zip(self.sweep.index(i), region))
 
+    def _block(self, name, region, whole: bool) -> np.ndarray:
+        """The whole chunk at ``region`` of array ``name``: the fill value, or (not ``whole``) as stored."""
+        a = self.arrays[name]
+        if not whole and a.zarr is None:
+            return a.read(tuple(s.start // c for s, c in zip(region, self.chunks)))
+        block = np.full(self.chunks + a.shape[len(region):], a.fill, dtype=a.dtype)
+        if not whole:  # keep the chunk's other points
+            block[tuple(slice(0, s.stop - s.start) for s in region)] = a.zarr[region]
+        return block
+
     def _blocks(self, region, points, outs) -> dict:
         """``name -> block`` of the whole chunk at ``region`` with ``outs`` (one per point) filled in."""
-        clipped = tuple(s.stop - s.start for s in region)
-        whole = len(points) == int(np.prod(clipped))
-        blocks = {}
-        for name in self.names + ["status"]:
-            a = self.arrays[name]
-            fill = a.fill_value if a.fill_value is not None else np.zeros((), a.dtype)[()]
-            block = np.full(self.chunks + tuple(a.shape[len(region):]), fill, dtype=a.dtype)
-            if not whole:  # keep the chunk's other points
-                block[tuple(slice(0, n) for n in clipped)] = a[region]
-            blocks[name] = block
+        whole = len(points) == math.prod(s.stop - s.start for s in region)
+        blocks = {name: self._block(name, region, whole) for name in self.names + ["status"]}
         for i, out in zip(points, outs):
             local = tuple(j - s.start for j, s in zip(self.sweep.index(i), region))
             for name, value in _point_items(out):
@@ -425,18 +613,13 @@ class StoreWriter:
         """Write the chunk at ``region`` of each array in ``names``."""
         clipped = tuple(slice(0, s.stop - s.start) for s in region)
         chunk = tuple(s.start // c for s, c in zip(region, self.chunks))
-        slow = []
         for name in names:
-            spec = self.files[name]
-            if spec is None:
-                slow.append(name)
+            a = self.arrays[name]
+            if a.zarr is not None:
+                a.zarr[region] = blocks[name][clipped]
                 continue
-            folder, codec, sep, dt = spec
-            data = np.ascontiguousarray(blocks[name], dtype=dt)
-            key = sep.join(str(c) for c in chunk + (0,) * (data.ndim - len(chunk)))
-            _write_file(os.path.join(folder, *key.split("/")), codec.encode(data) if codec is not None else data.tobytes())
-        for name in slow:
-            self.arrays[name][region] = blocks[name][clipped]
+            data = np.ascontiguousarray(blocks[name], dtype=a.dtype)
+            _write_file(a.key(chunk), a.codec.encode(data) if a.codec is not None else data.tobytes())
 
     def write(self, points, outs) -> None:
         """Store the points ``points`` (flat indices, all in one chunk) with their results ``outs``

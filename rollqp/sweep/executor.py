@@ -308,16 +308,15 @@ _WRITERS: dict = {}
 
 
 def _writer(store):
-    """The :class:`~rollqp.sweep.dataset.StoreWriter` of ``store = (path, fingerprint, keys, shape)``."""
-    import zarr
-
+    """The :class:`~rollqp.sweep.dataset.StoreWriter` of ``store = (path, fingerprint, keys, shape)``,
+    made from the store's files (:meth:`~rollqp.sweep.dataset.StoreWriter.at`)."""
     from .dataset import Layout, StoreWriter
     path, fingerprint, keys, shape = store
     key = (path, fingerprint)
     if key not in _WRITERS:
         if len(_WRITERS) >= 4:
             _WRITERS.pop(next(iter(_WRITERS)))
-        _WRITERS[key] = StoreWriter(zarr.open_group(path, mode="r+", zarr_format=2), Layout(keys, shape))
+        _WRITERS[key] = StoreWriter.at(path, Layout(keys, shape))
     return _WRITERS[key]
 
 
@@ -495,13 +494,13 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
     early = group is None and not isinstance(client, InProcess) and _shares_disk(client)
     made = time.perf_counter()
     if group is None and not early:
-        group = create_store(create[0], sweep, create[1])
+        create_store(create[0], sweep, create[1], group=False)
     made = time.perf_counter() - made
     if early:  # a store made by create_store is zarr-2 files on disk: the workers can write it
         writer, store = None, os.path.abspath(create[0])
         tasks = chunk_tasks(sweep.shape, chunk_shape(sweep.shape, create[1]), status)
     else:
-        writer = StoreWriter(group, sweep)
+        writer = StoreWriter(group, sweep) if group is not None else StoreWriter.at(create[0], sweep)
         tasks = writer.tasks(status)
         local = not isinstance(client, InProcess) and writer.on_disk and _shares_disk(client)
         store = writer.root if local else None
@@ -513,9 +512,9 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
     futures, n = {}, 0
     try:
         futures = _submit(client, sweep, tasks, store)
-        if writer is None:
-            try:
-                writer = StoreWriter(create_store(create[0], sweep, create[1]), sweep)
+        if early:  # made while the first points compute; the workers write into it, the client only
+            try:   # what a task sends back unwritten (its writer opened then)
+                create_store(create[0], sweep, create[1], group=False)
             except BaseException:
                 client.cancel(list(futures))
                 raise
@@ -523,6 +522,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
             points = futures.pop(fut)
             outs = fut.result()
             if not all(o.get("written") for o in outs):
+                writer = writer or StoreWriter.at(create[0], sweep)
                 writer.write(points, outs)
             for i, out in zip(points, outs):
                 if out.get("error") is None:
