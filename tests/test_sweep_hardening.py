@@ -325,3 +325,114 @@ def test_a_task_that_cannot_write_its_chunk_sends_its_arrays_instead(tmp_path):
     assert np.all(ds["status"].values == 1)
     alone = rollqp.run(sw.scenes[1]).arrays()
     np.testing.assert_array_equal(ds["pt"].values[1][:alone["pt"].shape[0], :alone["pt"].shape[1]], alone["pt"])
+
+
+# --------------------------------------------------------------------------- the store's files
+def _files(root) -> dict:
+    """``key -> bytes`` of every file under ``root`` (keys ``/``-separated)."""
+    import os
+    out = {}
+    for folder, _, names in os.walk(root):
+        for name in names:
+            path = os.path.join(folder, name)
+            with open(path, "rb") as fh:
+                out[os.path.relpath(path, root).replace(os.sep, "/")] = fh.read()
+    return out
+
+
+STORES = [  # (vary, points per chunk): numeric axes; a word axis with a swept mesh (2-D q and x);
+    (["contact.friction=0.1,0.2,0.3"], 2),  # chunks that do not tile the grid (padded edge chunks)
+    (["discretization.elements=20,40,60", "solver.method=newton,qp-osqp"], 4),
+    (["discretization.step=0.25,0.5", "contact.friction=0.1:0.3:3"], 5),
+]
+
+
+@pytest.mark.parametrize("vary, per_chunk", STORES)
+def test_a_store_written_directly_has_zarrs_files(tmp_path, vary, per_chunk):
+    """The metadata and coordinate chunks written by create_store itself are zarr's own: the same keys,
+    the same JSON documents, the same chunk bytes (encoded with the same compressor), and xarray
+    reads the same dataset from both."""
+    import json
+
+    import xarray as xr
+    sw = build_sweep(_small().replace(**{"discretization.distance": 1.0}), vary)
+    create_store(tmp_path / "direct.zarr", sw, per_chunk)
+    create_store(tmp_path / "zarr.zarr", sw, per_chunk, direct=False)
+    mine, theirs = _files(tmp_path / "direct.zarr"), _files(tmp_path / "zarr.zarr")
+    assert sorted(mine) == sorted(theirs)
+    assert {k for k in mine if not k.rsplit("/", 1)[-1].startswith(".")}  # coordinate chunks are compared too
+    for key in mine:
+        if key.rsplit("/", 1)[-1] in (".zarray", ".zattrs", ".zgroup", ".zmetadata"):
+            assert json.loads(mine[key]) == json.loads(theirs[key]), key
+        else:
+            assert mine[key] == theirs[key], key
+    a = xr.open_zarr(tmp_path / "direct.zarr", chunks=None).load()
+    b = xr.open_zarr(tmp_path / "zarr.zarr", chunks=None).load()
+    xr.testing.assert_identical(a, b)
+    assert a.sizes[sw.keys[-1]] == sw.shape[-1] and a.attrs[FINGERPRINT] == sw.fingerprint()
+
+
+def _outs(sw, points, fail=()):
+    """Each point's result as a task returns it (``fail``: points given an error instead)."""
+    from rollqp.sweep.executor import compute_points
+    outs = compute_points(sw.base.to_dict(), [(i, sw.changes(i)) for i in points])
+    for i, out in zip(points, outs):
+        if i in fail:
+            out.pop("arrays")
+            out["error"] = "SolverError: made to fail here"
+    return outs
+
+
+def test_a_writer_from_the_files_writes_what_zarr_writes(tmp_path):
+    """StoreWriter.at (the arrays known from .zmetadata, chunks written as files) and a writer through
+    zarr (a store without consolidated metadata) store the same points alike, a chunk written again
+    for one of its points (a resumed sweep's failed point) keeping the others."""
+    import os
+
+    import xarray as xr
+
+    from rollqp.sweep.dataset import StoreWriter
+    sw = build_sweep(_small().replace(**{"discretization.distance": 1.0}), ["contact.friction=0.1,0.2,0.3"])
+    first, again = _outs(sw, [0, 1, 2], fail=(1,)), _outs(sw, [1])
+    for name in ("files", "zarr"):
+        create_store(tmp_path / f"{name}.zarr", sw, 2)
+        if name == "zarr":
+            os.remove(tmp_path / "zarr.zarr" / ".zmetadata")
+            writer = StoreWriter(zarr.open_group(str(tmp_path / "zarr.zarr"), mode="r+", zarr_format=2), sw)
+            assert not writer.on_disk
+        else:
+            writer = StoreWriter.at(tmp_path / "files.zarr", sw)
+            assert writer.on_disk and writer.root == str(tmp_path / "files.zarr")
+        writer.write([0, 1], first[:2])
+        writer.write([2], first[2:])
+        assert list(np.asarray(zarr.open_group(str(tmp_path / f"{name}.zarr"), mode="r")["status"])) == [1, 2, 1]
+        writer.write([1], again)
+    a = xr.open_zarr(tmp_path / "files.zarr", chunks=None, consolidated=True).load()
+    b = xr.open_zarr(tmp_path / "zarr.zarr", chunks=None, consolidated=False).load()
+    xr.testing.assert_identical(a.drop_vars("point_time"), b.drop_vars("point_time"))
+    assert list(a["status"].values) == [1, 1, 1] and list(a["error"].values) == ["", "", ""]
+    alone = rollqp.run(sw.scenes[1]).arrays()
+    np.testing.assert_array_equal(a["pt"].values[1][:alone["pt"].shape[0], :alone["pt"].shape[1]], alone["pt"])
+    np.testing.assert_array_equal(a["pt"].values[0], b["pt"].values[0])
+
+
+def test_a_sweep_resumes_a_store_made_by_zarr(tmp_path):
+    """A store whose files zarr wrote (create_store(..., direct=False)) is continued by a sweep like one
+    of its own: the points already done kept, the others computed into it."""
+    import xarray as xr
+
+    from rollqp.sweep import sweep
+    from rollqp.sweep.dataset import StoreWriter
+    base = _small().replace(**{"discretization.distance": 1.0})
+    vary = ["contact.friction=0.1,0.2,0.3,0.4"]
+    sw = build_sweep(base, vary)
+    store = tmp_path / "s.zarr"
+    create_store(store, sw, 2, direct=False)
+    StoreWriter.at(store, sw).write([0, 1], _outs(sw, [0, 1]))
+    summary = sweep(base, vary, store, workers=0)
+    assert summary.kept == 2 and summary.done == 2
+    ds = xr.open_zarr(store, chunks=None).load()
+    assert list(ds["status"].values) == [1, 1, 1, 1]
+    for i in range(4):
+        alone = rollqp.run(sw.scenes[i]).arrays()
+        np.testing.assert_array_equal(ds["pn"].values[i][:alone["pn"].shape[0], :alone["pn"].shape[1]], alone["pn"])
