@@ -197,6 +197,9 @@ class InProcess:
     def submit(self, fn, *args, key=None, pure=None):
         return _Deferred(fn, args)
 
+    def map(self, fn, *iterables, key=None, pure=None) -> list:
+        return [_Deferred(fn, args) for args in zip(*iterables)]
+
     def scatter(self, data, **kwargs):
         return data
 
@@ -470,8 +473,11 @@ def _submit(client, sweep, tasks, store=None):
     fingerprint = sweep.fingerprint()
     where = None if store is None else (str(store), fingerprint, sweep.keys, sweep.shape)
     prefix = f"rollqp-points-{fingerprint[:10]}-{time.time_ns()}"
-    return {client.submit(compute_points, base, [(i, sweep.changes(i)) for i in points], where, pure=False,
-                          key=f"{prefix}-{points[0]}"): points for points in tasks}
+    n = len(tasks)
+    # one message to the scheduler for all the tasks (one graph), not one per task
+    futures = client.map(compute_points, [base] * n, [[(i, sweep.changes(i)) for i in points] for points in tasks],
+                         [where] * n, key=[f"{prefix}-{points[0]}" for points in tasks], pure=False)
+    return dict(zip(futures, tasks))
 
 
 def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, create=None) -> Summary:
