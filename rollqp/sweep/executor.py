@@ -14,14 +14,15 @@
   has answered as a dask scheduler is trusted as dask trusts it (it could as well send pickles).
 * :func:`compute_points` is the task: some points of one chunk of the store, each scene
   (the base scene's dict and the point's changes) run by :func:`rollqp.run` with BLAS pinned
-  to one thread inside the task (``threadpoolctl``; a worker started by hand gets the same
+  to one thread for the task (``threadpoolctl``; a worker started by hand gets the same
   pinning as the local ones), each returning its result arrays and wall time, or its one-line error.
 * :func:`run_sweep` submits one task per chunk of the store holding points not yet done
-  (:meth:`rollqp.sweep.dataset.StoreWriter.tasks`); each task's points are written as one
-  write per variable for the whole chunk, ``status`` last. On a local cluster (whose workers
-  share the client's disk) the worker that computed a chunk writes it and sends back only each
-  point's status and times; the client's process, which also runs dask's scheduler, then spends
-  its share of the two cores on nothing else. A cluster at ``--scheduler`` needs no shared file
+  (:meth:`rollqp.sweep.dataset.StoreWriter.tasks`), all in one message to the scheduler; each
+  task's points are written as one write per variable for the whole chunk, ``status`` last. On
+  a local cluster (whose workers share the client's disk) the worker that computed a chunk
+  writes it (its writer made from the store's metadata file, no zarr array opened) and sends
+  back only each point's status and times; the client's process, which also runs dask's
+  scheduler, then spends its share of the two cores on little else. A cluster at ``--scheduler`` needs no shared file
   system: its workers send the arrays, and the client writes them as they arrive. The loop
   shows progress and returns a :class:`Summary`.
 * :func:`map_jobs` runs any picklable function over independent cases (the benchmark harness
@@ -290,17 +291,21 @@ def compute_point(scene) -> dict:
     "cpu", "worker"}`` (wall and CPU seconds of the worker's process), or ``{"error", "time", "cpu",
     "worker"}`` with its one-line error."""
     from threadpoolctl import threadpool_limits
+    with threadpool_limits(limits=1):
+        return _run_point(scene)
 
+
+def _run_point(scene) -> dict:
+    """:func:`compute_point` with BLAS already pinned (by the caller, once for a task's points)."""
     from ..march import run
     from ..scene import scene_from_dict
     t0, c0 = time.perf_counter(), time.process_time()
     worker = f"{socket.gethostname()}:{os.getpid()}"
-    with threadpool_limits(limits=1):
-        try:
-            result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene, geometry=_geometry())
-        except Exception as err:  # an input the method cannot run, or a bug: one line, the sweep goes on
-            return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0,
-                    "cpu": time.process_time() - c0, "worker": worker}
+    try:
+        result = run(scene_from_dict(scene) if isinstance(scene, dict) else scene, geometry=_geometry())
+    except Exception as err:  # an input the method cannot run, or a bug: one line, the sweep goes on
+        return {"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t0,
+                "cpu": time.process_time() - c0, "worker": worker}
     arrays = result.arrays()
     arrays.pop("meta")
     return {"arrays": arrays, "time": time.perf_counter() - t0, "cpu": time.process_time() - c0, "worker": worker}
@@ -352,15 +357,17 @@ def _compute_points(base, points) -> list:
     except Exception as err:  # validated on the client: a worker of another rollqp version?
         msg = f"{type(err).__name__}: {err}".splitlines()[0]
         return [{"error": msg, "time": time.perf_counter() - t0} for _ in points]
+    from threadpoolctl import threadpool_limits
     out = []
-    for _, changes in points:
-        t1 = time.perf_counter()
-        try:
-            point = scene.replace(**changes)
-        except Exception as err:
-            out.append({"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t1})
-            continue
-        out.append(compute_point(point))
+    with threadpool_limits(limits=1):  # once for the task (a few hundred microseconds each time)
+        for _, changes in points:
+            t1 = time.perf_counter()
+            try:
+                point = scene.replace(**changes)
+            except Exception as err:
+                out.append({"error": f"{type(err).__name__}: {err}".splitlines()[0], "time": time.perf_counter() - t1})
+                continue
+            out.append(_run_point(point))
     return out
 
 
@@ -492,8 +499,8 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
 
     A new store: ``group`` is None and ``create = (path, per_chunk)`` (:func:`~.dataset.create_store`).
     On a local cluster the tasks go out first and the store is made while the first points
-    compute (a task that ends before the store exists sends its arrays, written here); else the
-    store is made first.
+    compute (a task that ends before the store exists sends its arrays, written here by a writer
+    made then); else the store is made first.
     """
     from .dataset import StoreWriter, chunk_shape, chunk_tasks, create_store
     as_completed = iter if isinstance(client, InProcess) else _dask().as_completed
