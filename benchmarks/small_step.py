@@ -1,6 +1,6 @@
 """Where the §6.1.1 Newton rolling step at 81 nodes goes: its parts re-run on one captured step.
 
-``speed.newton_step_ratio()`` compares the median rolling step of ``cattaneo-carter`` (40 quadratic
+``speed.newton_step_ratio()`` compares the rolling step of ``cattaneo-carter`` (each step's best over runs; 40 quadratic
 elements, 81 nodes, ``newton``) with three dense 81 × 81 products (docs/performance.md, "Speed
 targets"). This script takes the median ``step_time`` of ``rollqp.run`` and then times the parts of
 one step that took one Newton iteration (the common case), each alone and warm (timeit, best of 7):

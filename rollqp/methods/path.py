@@ -308,10 +308,10 @@ def _overshoot(path, u, uc, pc) -> float:
 
 def _turn(path, u, uc, pc, tau, h, st):
     """Locate the edge of the piece between ``u`` and ``uc`` (:func:`_edge`; where one of its trial points
-    is not put back on the curve, :func:`_edge_halving`), move the node across it, and the new piece's
+    is not put back on the curve, its halving trials), move the node across it, and the new piece's
     tangent that enters it."""
     found = _edge(path, u, uc, pc, tau, h)
-    found = found if found is not None else _edge_halving(path, u, uc, pc, tau, h)
+    found = found if found is not None else _edge(path, u, uc, pc, tau, h, halving=True)
     if found is None:
         raise PathStop(f"the path's edge of a piece is not found near λ = {u[-1]:.6g}", lam=u[-1],
                        residual=_residual(path, u), points=st["points"])
@@ -329,54 +329,40 @@ def _turn(path, u, uc, pc, tau, h, st):
     return ulo, new, tn
 
 
-def _edge(path, u, uc, pc, tau, h):
-    """``(point, node)`` of the edge between ``u`` and ``uc``: regula falsi on the step length along ``tau``
-    with the Illinois weights, aimed at the margin :data:`EDGE_AIM` inside the piece, every trial point put
-    back on the curve by the corrector; None where the corrector fails at a trial point."""
+def _edge(path, u, uc, pc, tau, h, halving=False):
+    """``(point, node)`` of the edge between ``u`` and ``uc``: regula falsi on the step length along ``tau``,
+    every trial point put back on the curve by the corrector; None where the corrector fails at a trial point.
+
+    The trial: with the Illinois weights (the weight of an end kept twice in a row is halved), aimed at the
+    margin :data:`EDGE_AIM` inside the piece; ``halving``: the secant's trial moved halfway towards the end
+    just replaced, aimed at the edge itself (slower: about 25 corrector solves an edge at 45 m/s; its trial
+    points differ, so it passes where a trial of the first is not put back on the curve)."""
+    aim, clamp = (0.0, 1e-3) if halving else (EDGE_AIM, 1e-9)
     lo, hi, ulo, j = 0.0, h, u, None
     m_lo, m_hi = path.margins(u, pc)[0], path.margins(uc, pc)[0]
-    w_lo, w_hi, last = 1.0, 1.0, 0  # Illinois: the weight of an end kept twice in a row is halved
+    w_lo, w_hi, last = 1.0, 1.0, 0  # last: the end replaced last (1 the low end, −1 the high one)
     for _ in range(200):
         bad = np.flatnonzero(m_hi < 0.0)
-        f_lo = w_lo * np.maximum(m_lo[bad] - EDGE_AIM, 0.0)
-        frac = f_lo / (f_lo - w_hi * (m_hi[bad] - EDGE_AIM))
+        f_lo = w_lo * np.maximum(m_lo[bad] - aim, 0.0)
+        frac = f_lo / (f_lo - w_hi * (m_hi[bad] - aim))
         j, a = int(bad[np.argmin(frac)]), float(np.min(frac))
-        hm = lo + min(max(a, 1e-9), 1.0 - 1e-9) * (hi - lo)
+        if halving:
+            a = 0.5 * a if last == 1 else 0.5 * (1.0 + a) if last == -1 else a
+        hm = lo + min(max(a, clamp), 1.0 - clamp) * (hi - lo)
         um, _ = path.correct(u + hm * tau, tau, pc)
         if um is None:
             return None
         margin = path.margins(um, pc)[0]
         if np.min(margin) < 0.0:
-            hi, m_hi, w_hi = hm, margin, 1.0
-            w_lo, last = (0.5 * w_lo if last == -1 else w_lo), -1
+            hi, m_hi = hm, margin
+            if not halving:
+                w_hi, w_lo = 1.0, (0.5 * w_lo if last == -1 else w_lo)
+            last = -1
         else:
-            lo, ulo, m_lo, w_lo = hm, um, margin, 1.0
-            w_hi, last = (0.5 * w_hi if last == 1 else w_hi), 1
-            if margin[j] <= EDGE or hi - lo <= 1e-15 * h:
-                break
-    return ulo, j
-
-
-def _edge_halving(path, u, uc, pc, tau, h):
-    """:func:`_edge` by regula falsi whose trial is moved halfway towards the end just replaced (slower:
-    about 25 corrector solves an edge at 45 m/s; its trial points differ, so it passes where a trial of
-    :func:`_edge` is not put back on the curve); None where its corrector fails too."""
-    lo, hi, ulo, uhi, side, j = 0.0, h, u, uc, 0, None
-    for _ in range(200):
-        m_lo, m_hi = path.margins(ulo, pc)[0], path.margins(uhi, pc)[0]
-        bad = np.flatnonzero(m_hi < 0.0)
-        frac = np.maximum(m_lo[bad], 0.0) / (np.maximum(m_lo[bad], 0.0) - m_hi[bad])
-        j, a = int(bad[np.argmin(frac)]), float(np.min(frac))
-        a = 0.5 * a if side == 1 else 0.5 * (1.0 + a) if side == -1 else a
-        hm = lo + min(max(a, 1e-3), 1.0 - 1e-3) * (hi - lo)
-        um, _ = path.correct(u + hm * tau, tau, pc)
-        if um is None:
-            return None
-        margin = path.margins(um, pc)[0]
-        if np.min(margin) < 0.0:
-            hi, uhi, side = hm, um, -1
-        else:
-            lo, ulo, side = hm, um, 1
+            lo, ulo, m_lo = hm, um, margin
+            if not halving:
+                w_lo, w_hi = 1.0, (0.5 * w_hi if last == 1 else w_hi)
+            last = 1
             if margin[j] <= EDGE or hi - lo <= 1e-15 * h:
                 break
     return ulo, j
