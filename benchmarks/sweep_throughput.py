@@ -7,6 +7,7 @@ Usage::
     python benchmarks/sweep_throughput.py --creep         # also the docs' creep-curve command, whole,
                                                           # on a local cluster and with --workers 0
     python benchmarks/sweep_throughput.py --validate      # only: validating a sweep of 100,000 points
+    python benchmarks/sweep_throughput.py --sizes small --per-chunk 4   # chunks of 4 points, not the default
 
 Two kinds of points, both the paper's §6.1.1 scene (``cattaneo-carter``: Δq = Le/2, 6 a_H,
 ``newton``) over load ratio × friction:
@@ -42,6 +43,10 @@ one-process sweep's CPU seconds against the sweep's CPU shared by the workers (t
 the workers, their writes included, and the client process's CPU during the sweep — validation,
 store, dask's scheduler thread — divided by ``--workers``): what free cores would give if only
 CPU counted (the workers' own dask CPU between points is not in it).
+
+Points per task and chunk: each sweep's own default, as a user gets it
+(``rollqp.sweep.dataset.points_per_chunk`` of its number of workers: 8 in both for the small
+points; for the large ones 4 in one process and 2 on 2 workers), or ``--per-chunk B`` for both.
 
 Control: the machine's parallelism at the moment (``workers`` pure-Python loops in processes at
 once against one alone; 2× on an idle 2-core machine), measured between the repetitions: on a
@@ -119,10 +124,10 @@ class _TimedWriter(dataset.StoreWriter):
         _TimedWriter.writes.append((time.perf_counter() - t0, len(points), time.thread_time() - c0))
 
 
-def _sweep(base, vary, client, folder, summaries) -> float:
+def _sweep(base, vary, client, folder, summaries, per_chunk=None) -> float:
     store = os.path.join(folder, f"s{time.time_ns()}.zarr")
     t0, c0 = time.perf_counter(), time.process_time()
-    summary = sweep(base, vary, store, client=client)
+    summary = sweep(base, vary, store, client=client, per_chunk=per_chunk)
     wall = time.perf_counter() - t0
     assert summary.done == summary.total and not summary.failed, summary.table()
     summaries.append((wall, summary, time.process_time() - c0))
@@ -130,9 +135,9 @@ def _sweep(base, vary, client, folder, summaries) -> float:
     return wall
 
 
-def _one_process(base, vary, folder, summaries, size) -> float:
+def _one_process(base, vary, folder, summaries, size, per_chunk=None) -> float:
     c0 = time.process_time()
-    wall = _sweep(base, vary, InProcess(), folder, summaries)
+    wall = _sweep(base, vary, InProcess(), folder, summaries, per_chunk)
     CPU.setdefault(f"one process {size}", []).append(time.process_time() - c0)
     return wall
 
@@ -199,6 +204,8 @@ def main(argv=None):
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--sizes", default="small,large", help="comma-separated: small, large")
+    ap.add_argument("--per-chunk", type=int, default=None,
+                    help="points per task and chunk in both sweeps (default: points_per_chunk's)")
     ap.add_argument("--creep", action="store_true", help="also time the docs' creep-curve command (new processes)")
     ap.add_argument("--validate", action="store_true", help="only time the validation of 100,000 points")
     args = ap.parse_args(argv)
@@ -223,8 +230,8 @@ def main(argv=None):
         one = {s: [] for s in sizes}
         for s in sizes:
             cases[f"runs {s}"] = lambda s=s: _runs(points[s], s)
-            cases[f"one process {s}"] = lambda s=s: _one_process(scenes[s], SIZES[s][1], folder, one[s], s)
-            cases[f"sweep {s}"] = lambda s=s: _sweep(scenes[s], SIZES[s][1], client, folder, summaries[s])
+            cases[f"one process {s}"] = lambda s=s: _one_process(scenes[s], SIZES[s][1], folder, one[s], s, args.per_chunk)
+            cases[f"sweep {s}"] = lambda s=s: _sweep(scenes[s], SIZES[s][1], client, folder, summaries[s], args.per_chunk)
         cases["control"] = lambda: _parallelism(args.workers)
         walls = harness.interleaved(args.repeats, cases, lambda f: f(),
                                     log=lambda k, i, n: print(f"  {k} {i}/{n}", flush=True))

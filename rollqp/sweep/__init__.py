@@ -63,7 +63,7 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
         ``on_point(i, out)`` after point ``i`` is stored.
     per_chunk : int, optional
         Points per chunk of a new store, and so per task (default
-        :func:`~.dataset.points_per_chunk`: ⌈√(N/(4·workers))⌉ of N points, raised to a divisor of the last axis's length within twice that, at most 32); a
+        :func:`~.dataset.points_per_chunk`: ⌈√(N/workers)⌉ of N points, raised to a divisor of the last axis's length within twice that, at most 32); a
         store that exists keeps its own.
     """
     import time

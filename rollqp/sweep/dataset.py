@@ -101,20 +101,22 @@ def result_fields(sweep) -> list:
 
 
 def points_per_chunk(sweep, workers: int = 1) -> int:
-    """Points in one chunk of the store (and in one task of the sweep): ``⌈√(N/(4·workers))⌉``, raised
+    """Points in one chunk of the store (and in one task of the sweep): ``⌈√(N/workers)⌉``, raised
     to a divisor of the last axis's length when one is within twice that (:func:`_even`).
 
     A task costs a round trip through the scheduler and a write of ~30 files whatever its
     points, and the last tasks leave workers idle while the others finish: for N points of
     cost c each, a per-task cost o and B points a task, the wall time is about
     ``(N·c + (N/B)·o)/workers + B·c/2``, least at ``B = √(2·N·o/(workers·c))`` — the formula
-    above for o/c ≈ 1/8 (a §6.1.1 point against a task's round trip and write: docs/sweeps.md).
-    At most :data:`MAX_POINTS_PER_CHUNK`, and at most :data:`CHUNK_BYTES` of the largest field
-    per chunk; at least one.
+    above for o/c ≈ 1/2. Measured (docs/sweeps.md): a task's fixed cost is 10–20 ms (the write
+    of its chunk, most of it ~30 file creations, and dask's handling), against ~25 ms for a §6.1.1
+    point at 40 QCE (o/c ≈ 0.5–0.8), ~100 ms at 80 QCE (≈ 0.15) and ~5 ms for a steady point of
+    the creep curve (≈ 2). At most :data:`MAX_POINTS_PER_CHUNK`, and at most :data:`CHUNK_BYTES`
+    of the largest field per chunk; at least one.
     """
     f = sweep.facts
     per_point = int(f.states.max()) * int(f.nodes.max()) * 8
-    balance = _even(math.ceil(math.sqrt(sweep.size / (4 * max(workers, 1)))), sweep.shape[-1])
+    balance = _even(math.ceil(math.sqrt(sweep.size / max(workers, 1))), sweep.shape[-1])
     return max(1, min(MAX_POINTS_PER_CHUNK, CHUNK_BYTES // max(per_point, 1), balance))
 
 
