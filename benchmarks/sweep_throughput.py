@@ -48,6 +48,9 @@ Points per task and chunk: each sweep's own default, as a user gets it
 (``rollqp.sweep.dataset.points_per_chunk`` of its number of workers: 8 in both for the small
 points; for the large ones 4 in one process and 2 on 2 workers), or ``--per-chunk B`` for both.
 
+The store's own costs, at the end with the cluster closed: its creation written directly against
+through zarr's API, and a writer made from ``.zmetadata`` against one through zarr (CPU medians).
+
 Control: the machine's parallelism at the moment (``workers`` pure-Python loops in processes at
 once against one alone; 2× on an idle 2-core machine), measured between the repetitions: on a
 shared machine it bounds what any parallel run can gain.
@@ -185,6 +188,35 @@ def _rows(size, walls, summaries, workers, startup):
     ]
 
 
+def _store_costs(base, vary, folder, repeats: int = 9) -> list:
+    """CPU medians, in this process with the cluster closed, of making the store of ``vary`` over ``base``
+    (the sweeps' chunking) written directly and through zarr's API (``create_store(direct=False)``), and of
+    a writer made from the store's ``.zmetadata`` and through zarr (``StoreWriter`` of the opened group,
+    the store's ``.zmetadata`` removed so that zarr opens every array)."""
+    import zarr
+    sw = build_sweep(base, vary)
+    per_chunk = dataset.points_per_chunk(sw, 1)
+    cpu = {k: [] for k in ("direct", "zarr", "writer at", "writer zarr")}
+    for i in range(repeats):
+        for how in ("direct", "zarr"):
+            path = os.path.join(folder, f"c{i}-{how}.zarr")
+            c0 = time.process_time()
+            dataset.create_store(path, sw, per_chunk, direct=how == "direct", group=False)
+            cpu[how].append(time.process_time() - c0)
+        c0 = time.process_time()
+        dataset.StoreWriter.at(os.path.join(folder, f"c{i}-direct.zarr"), sw)
+        cpu["writer at"].append(time.process_time() - c0)
+        os.remove(os.path.join(folder, f"c{i}-zarr.zarr", ".zmetadata"))
+        c0 = time.process_time()
+        dataset.StoreWriter(zarr.open_group(os.path.join(folder, f"c{i}-zarr.zarr"), mode="r+", zarr_format=2), sw)
+        cpu["writer zarr"].append(time.process_time() - c0)
+    med = {k: 1e3 * statistics.median(v) for k, v in cpu.items()}
+    return [("store creation, CPU: written directly / through zarr's API (medians, this process alone)",
+             f"{med['direct']:.1f} ms / {med['zarr']:.1f} ms"),
+            ("a writer of the store, CPU: from .zmetadata / zarr opening every array (medians)",
+             f"{med['writer at']:.1f} ms / {med['writer zarr']:.1f} ms")]
+
+
 def _validate():
     """Wall and CPU seconds of validating §6.1.1 over 1,000 friction values × 100 load ratios."""
     import resource
@@ -241,6 +273,7 @@ def main(argv=None):
     for _ in range(args.repeats if args.creep else 0):  # alternating, as the sweeps above
         for extra in creep:
             creep[extra].append(_creep_command(folder, extra.split()))
+    store_rows = _store_costs(scenes[sizes[0]], SIZES[sizes[0]][1], folder)
     shutil.rmtree(folder, ignore_errors=True)
     rows = [(f"local cluster start ({args.workers} workers; once, not in the sweep times)", f"{startup:.2f} s")]
     for s in sizes:
@@ -251,6 +284,7 @@ def main(argv=None):
               f"{1e3 * statistics.median(w for w, _, _ in writes):.1f} ms / "
               f"{1e3 * statistics.median(c for _, _, c in writes):.1f} ms "
               f"({1e3 * sum(c for _, _, c in writes) / per_point:.1f} ms a point)")]
+    rows += store_rows
     rows += [(f"control: {args.workers} pure-Python loops in processes at once vs one alone (median)",
               f"{statistics.median(walls['control']):.2f}× ({', '.join(f'{w:.2f}' for w in walls['control'])}; "
               f"{args.workers}× on an idle machine)")]
