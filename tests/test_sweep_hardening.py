@@ -436,3 +436,20 @@ def test_a_sweep_resumes_a_store_made_by_zarr(tmp_path):
     for i in range(4):
         alone = rollqp.run(sw.scenes[i]).arrays()
         np.testing.assert_array_equal(ds["pn"].values[i][:alone["pn"].shape[0], :alone["pn"].shape[1]], alone["pn"])
+
+
+def test_a_coordinate_of_another_type_is_written_by_zarr(tmp_path):
+    """A swept key whose values are neither numbers nor words (booleans, possible through the Python
+    API's Sweep) gets its store through zarr: the same files as create_store(..., direct=False)."""
+    from rollqp.sweep import Axis, Sweep
+    sw = build_sweep(_small(), ["contact.friction=0.1,0.2"])
+    odd = Sweep(sw.base, (Axis("contact.friction", (True, False)),), sw.facts)
+    create_store(tmp_path / "a.zarr", odd, 2)
+    create_store(tmp_path / "b.zarr", odd, 2, direct=False)
+    import json
+    mine, theirs = _files(tmp_path / "a.zarr"), _files(tmp_path / "b.zarr")
+    assert sorted(mine) == sorted(theirs) and "contact.friction/0" in mine
+    for key in mine:
+        meta = key.rsplit("/", 1)[-1].startswith(".")
+        assert (json.loads(mine[key]) == json.loads(theirs[key])) if meta else mine[key] == theirs[key], key
+    assert zarr.open_group(str(tmp_path / "a.zarr"), mode="r")["contact.friction"].dtype == np.dtype(bool)
