@@ -296,8 +296,8 @@ def create_store(path, sweep, per_chunk: int = 1, *, direct: bool = True, group:
     ``.zattrs``, ``.zmetadata``) are written here as the JSON zarr writes, and the coordinates'
     chunks encoded with the arrays' compressor, as zarr does (no chunk that holds only the fill
     value); ``False`` (or a coordinate of another type than numbers and words): zarr builds them in
-    memory. The two give the same files (tests/test_sweep_hardening.py); the direct way costs about
-    half the CPU of zarr's asynchronous API, most of it the file creations themselves (docs/sweeps.md).
+    memory. The two give the same files (tests/test_sweep_hardening.py); the direct way costs a fifth
+    to a half of the CPU of zarr's asynchronous API, most of it the file creations themselves (docs/sweeps.md).
     ``group = False``: return ``None``, not the opened group (a store that :meth:`StoreWriter.at` writes).
     """
     files = _direct_files(sweep, per_chunk) if direct else None
