@@ -453,3 +453,27 @@ def test_a_coordinate_of_another_type_is_written_by_zarr(tmp_path):
         meta = key.rsplit("/", 1)[-1].startswith(".")
         assert (json.loads(mine[key]) == json.loads(theirs[key])) if meta else mine[key] == theirs[key], key
     assert zarr.open_group(str(tmp_path / "a.zarr"), mode="r")["contact.friction"].dtype == np.dtype(bool)
+
+
+def test_a_store_made_again_at_the_same_path_gets_a_writer_of_its_own(tmp_path):
+    """A process that wrote into a store keeps its writer for the next tasks; a store deleted and made
+    again at the same path with other chunks (the same sweep, another per_chunk) is written with its
+    own chunks, not the first store's."""
+    import shutil
+
+    import xarray as xr
+
+    from rollqp.sweep.executor import compute_points
+    base = _small().replace(**{"discretization.distance": 1.0})
+    sw = build_sweep(base, ["contact.friction=0.1,0.2"])
+    store = tmp_path / "s.zarr"
+    where = (str(store), sw.fingerprint(), sw.keys, sw.shape)
+    create_store(store, sw, 2)
+    assert all(o["written"] for o in compute_points(base.to_dict(), [(i, sw.changes(i)) for i in range(2)], where))
+    shutil.rmtree(store)
+    create_store(store, sw, 1)
+    assert compute_points(base.to_dict(), [(1, sw.changes(1))], where)[0]["written"]
+    ds = xr.open_zarr(store, chunks=None).load()
+    assert ds["status"].encoding["chunks"] == (1,) and list(ds["status"].values) == [0, 1]
+    alone = rollqp.run(sw.scenes[1]).arrays()
+    np.testing.assert_array_equal(ds["pt"].values[1][:alone["pt"].shape[0], :alone["pt"].shape[1]], alone["pt"])

@@ -311,7 +311,8 @@ def _run_point(scene) -> dict:
     return {"arrays": arrays, "time": time.perf_counter() - t0, "cpu": time.process_time() - c0, "worker": worker}
 
 
-#: The stores a worker writes into (path, fingerprint) -> StoreWriter: opened once per sweep.
+#: The stores a worker writes into (path, fingerprint, its metadata file's inode and time) -> StoreWriter:
+#: made once per sweep.
 _WRITERS: dict = {}
 
 
@@ -320,7 +321,8 @@ def _writer(store):
     made from the store's files (:meth:`~rollqp.sweep.dataset.StoreWriter.at`)."""
     from .dataset import Layout, StoreWriter
     path, fingerprint, keys, shape = store
-    key = (path, fingerprint)
+    meta = os.stat(os.path.join(path, ".zmetadata"))  # a store made again at the same path is another store
+    key = (path, fingerprint, meta.st_ino, meta.st_mtime_ns)
     if key not in _WRITERS:
         if len(_WRITERS) >= 4:
             _WRITERS.pop(next(iter(_WRITERS)))
