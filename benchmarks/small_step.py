@@ -1,8 +1,8 @@
 """Where the §6.1.1 Newton rolling step at 81 nodes goes: its parts re-run on one captured step.
 
-``speed.newton_step_ratio()`` compares the rolling step of ``cattaneo-carter`` (each step's best over runs; 40 quadratic
-elements, 81 nodes, ``newton``) with three dense 81 × 81 products (docs/performance.md, "Speed
-targets"). This script takes the median ``step_time`` of ``rollqp.run`` and then times the parts of
+``speed.newton_step_ratio()`` compares the rolling step of ``cattaneo-carter`` (40 quadratic elements, 81
+nodes, ``newton``) with three dense 81 × 81 products, each step against three products timed right after
+it in the march (docs/performance.md, "Speed targets"). This script takes the median ``step_time`` of ``rollqp.run`` and then times the parts of
 one step that took one Newton iteration (the common case), each alone and warm (timeit, best of 7):
 the step problem's construction, the whole ``method.solve`` (in it: the solution with its slip and
 rollqp's own residuals, ``problem.solution``, as Newton calls it: on its last iterate's nondimensional
@@ -14,7 +14,8 @@ rolling steps take more iterations, and a new free set a new factorization) is p
     python benchmarks/small_step.py [--runs 5] [--source /other/checkout [--rounds 3]]
 
 ``--source`` measures ``speed.newton_step_ratio()`` (the speed table's figure) instead, in fresh processes on
-this source tree and on another one (another checkout's rollqp and benchmarks), the two alternating
+this source tree and on another one (another checkout's rollqp, measured by this checkout's benchmarks), the
+two alternating
 ``--rounds`` times: the two trees' ratios under the same load.
 
 The solve is timed from the previous state's solution without its kept product ``A t`` (the march
@@ -72,9 +73,10 @@ def measure(runs=5) -> dict:
     }
 
 
-#: The child of ``--source``: ``speed.newton_step_ratio()`` on the source tree given as its argument.
+#: The child of ``--source``: ``speed.newton_step_ratio()`` of this checkout's benchmarks (its second argument) on
+#: the rollqp of the source tree given as its first argument: the same measurement of both trees.
 CHILD = """import os, sys
-sys.path[:0] = [sys.argv[1], os.path.join(sys.argv[1], "benchmarks")]
+sys.path[:0] = [sys.argv[1], sys.argv[2]]
 import harness, speed
 harness.pin_threads()
 r = speed.newton_step_ratio()
@@ -90,7 +92,8 @@ def compare(source, rounds=3) -> list:
     out = []
     for _ in range(rounds):
         for tree in trees:
-            got = subprocess.run([sys.executable, "-c", CHILD, tree], capture_output=True, text=True, env=env,
+            got = subprocess.run([sys.executable, "-c", CHILD, tree, str(Path(__file__).resolve().parent)],
+                                 capture_output=True, text=True, env=env,
                                  check=True, cwd=tree).stdout.split()
             out.append((tree, *map(float, got)))
     return out
@@ -103,7 +106,7 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=3, help="--source: rounds of the two trees (default 3)")
     args = ap.parse_args(argv)
     if args.source:
-        print("| source tree | median step µs | product µs | step / 3 products | load (1 min, after) |\n|---|---|---|---|---|")
+        print("| source tree | median step µs | product in the march µs | step / 3 products, step by step | load (1 min, after) |\n|---|---|---|---|---|")
         for tree, step, product, ratio, load in compare(args.source, args.rounds):
             print(f"| {tree} | {1e6 * step:.1f} | {1e6 * product:.2f} | {ratio:.1f} | {load:.1f} |")
         return
