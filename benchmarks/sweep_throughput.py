@@ -201,7 +201,7 @@ def _store_costs(base, vary, folder, repeats: int = 9) -> list:
         for how in ("direct", "zarr"):
             path = os.path.join(folder, f"c{i}-{how}.zarr")
             c0 = time.process_time()
-            dataset.create_store(path, sw, per_chunk, direct=how == "direct", group=False)
+            dataset.create_store(path, sw, per_chunk, direct=how == "direct")
             cpu[how].append(time.process_time() - c0)
         c0 = time.process_time()
         dataset.StoreWriter.at(os.path.join(folder, f"c{i}-direct.zarr"), sw)

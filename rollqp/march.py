@@ -67,7 +67,7 @@ STEADY_TOL = 1e-8
 #: … or after this many a_H of rolling (Carter's transient dies out within ~3 a_H).
 STEADY_MAX_DISTANCE = 40.0
 #: A rolling step that is its tangential half alone (a fixed normal half, one Coulomb μ, uncoupled, the
-#: scene's Δq and profile) takes :meth:`_March._tangential_only`: the general step and record written out for
+#: scene's Δq and profile) takes :meth:`_March._tangential_only`: the general step written out for
 #: that case, the same calls and numbers without the general step's branches (a tenth of the step at 81 nodes:
 #: docs/performance.md). ``False``: every step takes the general path (tests/test_perf_paths.py compares them).
 FAST_ROLLING_STEP = True
@@ -511,25 +511,19 @@ class _March:
 
     def _tangential_only(self, k, q, state, M, t0, tau, d, P, Q, xi) -> StepRecord:
         """:meth:`rolling` where the step is its tangential half alone (:attr:`plain`: the normal half of ``state``
-        kept, Coulomb's one ``μ``, the scene's ``Δq``): :meth:`step` and :meth:`record` written out for that case,
-        the same calls and numbers without the branches and keywords of the general step (at 81 nodes they cost
-        a tenth of the step)."""
+        kept, Coulomb's one ``μ``, the scene's ``Δq``): :meth:`step` written out for that case, the same calls and
+        numbers without the branches and keywords of the general step (at 81 nodes they cost a tenth of the
+        step)."""
         ops = self.ops
-        dq = self.scene.dq
         nsol = state.nsol
         p = nsol.p
-        pb = ops.tangential_step(p, self.history_term(M, state.w), dq, Q, xi, False, None, False)
+        pb = ops.tangential_step(p, self.history_term(M, state.w), self.scene.dq, Q, xi, False, None, False)
         tsol = self.method.solve(pb, state.tsol)
-        it = tsol.iterations
-        cnt = Counters(it, 0.0, 0, it, tsol.backtracks)  # Counters().add(tsol, "tangential")
-        cnt._residual(tsol.residual)
+        cnt = Counters()
+        cnt.add(tsol, "tangential")
         t = tsol.t
         new = State(p, t, ops.w(p, t, _product(tsol, pb, ops.Att)), nsol, tsol, state.normal)
-        nodes = classify(p, t, tsol.s, ops.mu, ops.scales, bound=pb.bound, contact=self._contact(p))
-        count = np.bincount(nodes, minlength=3).tolist()
-        f = ops.f
-        rec = StepRecord(k, "rolling", float(q), float(f.dot(p)) if P is None else P, float(f.dot(t)), new, state, pb, tsol,
-                         cnt, 0.0, time.perf_counter() - t0, nodes, bool(count[SLIP] and not count[STICK]))
+        rec = self.record(k, "rolling", q, new, state, pb, tsol, cnt, P=P, shift=0.0, t0=t0)
         rec.tau, rec.direction = tau, d
         return rec
 

@@ -283,8 +283,8 @@ COMPRESSOR = {"id": "blosc", "cname": "lz4", "clevel": 5, "shuffle": 1, "blocksi
 _DIRECT_KINDS = "fiU"
 
 
-def create_store(path, sweep, per_chunk: int = 1, *, direct: bool = True, group: bool = True):
-    """Create the empty store of ``sweep`` (metadata and coordinates only) and return its zarr group.
+def create_store(path, sweep, per_chunk: int = 1, *, direct: bool = True) -> None:
+    """Create the empty store of ``sweep`` (metadata and coordinates only) at ``path``.
 
     xarray's zarr-2 layout (``_ARRAY_DIMENSIONS``, CF attributes, consolidated metadata ``.zmetadata``),
     chunked ``per_chunk`` points per chunk (:func:`chunk_shape`), every state and node of a point in
@@ -298,7 +298,6 @@ def create_store(path, sweep, per_chunk: int = 1, *, direct: bool = True, group:
     value); ``False`` (or a coordinate of another type than numbers and words): zarr builds them in
     memory. The two give the same files (tests/test_sweep_hardening.py); the direct way costs a fifth
     to a half of the CPU of zarr's asynchronous API, most of it the file creations themselves (docs/sweeps.md).
-    ``group = False``: return ``None``, not the opened group (a store that :meth:`StoreWriter.at` writes).
     """
     files = _direct_files(sweep, per_chunk) if direct else None
     if files is None:
@@ -309,10 +308,6 @@ def create_store(path, sweep, per_chunk: int = 1, *, direct: bool = True, group:
         shutil.rmtree(tmp)
     _write_tree(tmp, files)
     os.rename(tmp, path)
-    if not group:
-        return None
-    import zarr
-    return zarr.open_group(path, mode="r+", zarr_format=2)
 
 
 def _arrays(sweep, per_chunk: int):

@@ -509,7 +509,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
     early = group is None and not isinstance(client, InProcess) and _shares_disk(client)
     made = time.perf_counter()
     if group is None and not early:
-        create_store(create[0], sweep, create[1], group=False)
+        create_store(create[0], sweep, create[1])
     made = time.perf_counter() - made
     if early:  # a store made by create_store is zarr-2 files on disk: the workers can write it
         writer, store = None, os.path.abspath(create[0])
@@ -529,7 +529,7 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
         futures = _submit(client, sweep, tasks, store)
         if early:  # made while the first points compute; the workers write into it, the client only
             try:   # what a task sends back unwritten (its writer opened then)
-                create_store(create[0], sweep, create[1], group=False)
+                create_store(create[0], sweep, create[1])
             except BaseException:
                 client.cancel(list(futures))
                 raise

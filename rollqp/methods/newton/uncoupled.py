@@ -110,8 +110,7 @@ def solve_tangential(meth, pb, warm, t0):
     if xi_fixed is not None:
         k0 += r * xi_fixed
     known = _last_product(sys_, warm.t if start == "warm" else None)
-    run = iterate if sys_.partial else _iterate_dense  # (small n: iterate's own choice, made here)
-    z, it, info, product, y, phi = run(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
+    z, it, info, product, y, phi = iterate(meth, pb, sys_, z, k0, Qhat, _friction_rows(sys_, pb), start == "warm", known)
     tt, At = product[0], product[1]
     xi = z[n] * sc.slip if with_load else pb.xi
     info["start"] = start
@@ -294,6 +293,7 @@ class _Iterate:
         rho, two_sigma = meth.rho, 2.0 * meth.sigma
         dx = d[:self.n]
         theta = self.merits[-1]
+        alpha = 1.0
         if full is not None:
             pa = self.residual(full[0][:self.n], full[1][2])
             merit = 0.5 * float(pa @ pa)
@@ -302,19 +302,10 @@ class _Iterate:
             alpha = rho
             self.backtracks += 1
             Kd = full[1][2] - self.y
-        else:
-            alpha = 1.0
-        while True:
-            pa = self.residual(self.x + alpha * dx, self.y + alpha * Kd)
-            if 0.5 * float(pa @ pa) <= (1.0 - two_sigma * alpha) * theta:
-                return alpha, None
-            alpha *= rho
-            self.backtracks += 1
-            if alpha < ALPHA_MIN:
-                if warm:
-                    raise Stalled()
-                self.nonmono += 1
-                return 1.0, None
+        counts = [self.backtracks, self.nonmono]
+        alpha = _backtrack(meth, self.x, self.y, dx, Kd, theta, self.load, self.ncp, self.sys, warm, counts, alpha)
+        self.backtracks, self.nonmono = counts
+        return alpha, None
 
 
 def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
@@ -350,8 +341,7 @@ def iterate(meth, pb, sys_, z, k0, load, ncp, warm=False, start=None):
         st.rows(mask)
         d = sys_.direction(mask, st.phi, st.with_load)  # reduced system on the free nodes
         if d is None or not math.isfinite(float(np.add.reduce(d))):  # a NaN or an infinity anywhere (one sum)
-            raise SolverError(f"the {pb.kind} Newton matrix is singular",
-                              method=meth.name, status="singular", iterations=it, residual=nrm)
+            raise _singular(meth, pb, it, nrm)
         if it == 1 and sys_.settled:
             # the last step took one iteration (so this one likely does too): the product at the full step
             # gives K d (all rows) and, if the step is taken, the iterate's own y and Φ
@@ -445,7 +435,8 @@ def _iterate_dense(meth, pb, sys_, z, k0, load, ncp, warm, start):
             steps.append(1.0)
             z, (xphys, Ax, y, phi, uAx) = zf, full
             continue
-        alpha = _backtrack(meth, z[:n], y, d[:n], full[2] - y, merits[-1], load, ncp, sys_, warm, counts)
+        counts[0] += 1  # the full step refused: α = ρ next
+        alpha = _backtrack(meth, z[:n], y, d[:n], full[2] - y, merits[-1], load, ncp, sys_, warm, counts, meth.rho)
         steps.append(alpha)
         z = z + alpha * d  # eq. 79
         xphys, Ax, y, phi, uAx = _point(ev, z, k0, load)
@@ -476,13 +467,13 @@ def _repair(meth, ev, sys_, z, k0, load, ncp, xphys, Ax, y):
     return m, y, phi
 
 
-def _backtrack(meth, x, y, dx, Kd, theta, load, ncp, sys_, warm, counts):
-    """:meth:`_Iterate.line_search` once the full step is refused: ``α = ρ, ρ², …`` on ``(x, y) + α (d, K d)``;
-    below :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start)."""
+def _backtrack(meth, x, y, dx, Kd, theta, load, ncp, sys_, warm, counts, alpha):
+    """The Armijo line search (eq. 75–78, ``s = 1``) on ``(x, y) + α (d, K d)`` from ``α = alpha`` (1, or ``ρ``
+    once the full step was refused): the first ``α = alpha·ρ^m`` with ``θ <= (1 − 2σα) θ(z)``; below
+    :data:`ALPHA_MIN` the full step (cold start) or :class:`Stalled` (warm start). ``counts[0]``, ``counts[1]``:
+    the backtracks and the non-monotone steps, counted on."""
     rho, two_sigma = meth.rho, 2.0 * meth.sigma
     n = x.size
-    alpha = rho
-    counts[0] += 1
     while True:
         xa, ya = x + alpha * dx, y + alpha * Kd
         if load is None:
