@@ -11,11 +11,11 @@ import time
 import numpy as np
 from harness import pin_threads, pyplot
 
-from rollqp.three.contact import Contact, Loads
+from rollqp.operators.grid import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import steady
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
 
 
 def run(elements):

@@ -29,13 +29,13 @@ import time
 import numpy as np
 from harness import pin_threads, table
 
-from rollqp.three.contact import Contact, Loads
-from rollqp.three.grid import Grid
+from rollqp.operators.grid import Contact, Loads
+from rollqp.discretization.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import normal, steady
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.socp import ClarabelMethod
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.methods.socp import ClarabelMethod
 
 FN, MU = 1000.0, 0.3
 STEEL = Materials.from_young(210e3, 0.28, 210e3, 0.28)

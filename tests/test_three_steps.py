@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 
 from rollqp.errors import InputError, SolverError
-from rollqp.three.contact import Contact, Loads
+from rollqp.operators.grid import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import coupled_step, static_shift, steady, transient
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.problem import SLIP, STICK, Scales, TangentialStep
-from rollqp.three.socp import ClarabelMethod, CvxpyMethod, OsqpMethod, raw_solution
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.problem.grid import SLIP, STICK, Scales, TangentialStep
+from rollqp.methods.socp import ClarabelMethod, CvxpyMethod, OsqpMethod, raw_solution
 
 #: Agreement asked of two routes: both are solved to a residual of 1e-10 (Newton stops at
 #: ‖Φ‖∞ ≤ 1e-10·min(1, r), the refined conic answers below it); on these grids the residual's

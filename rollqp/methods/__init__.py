@@ -16,7 +16,7 @@ its meaning across dimensions — ``newton`` is rollqp's generalized Newton meth
 convex programs on that external solver — and each dimension has its own table of classes:
 
 ========================  ==========================================================
-``newton``                generalized Newton on the disc projection (:mod:`rollqp.three.gnm`)
+``newton``                generalized Newton on the disc projection (:mod:`rollqp.methods.newton.disc`)
 ``qp-clarabel``           Clarabel: the normal QP and the tangential SOCP (one cone per element)
 ``socp-clarabel``         the same (the name says the cone)
 ``qp-cvxpy``              cvxpy's statement of the QP and the SOCP, solved by Clarabel
@@ -73,13 +73,13 @@ _REGISTRY = {
 
 # name -> (module, class, extra) of the methods of three-dimensional scenes (rollqp.three)
 _REGISTRY_3D = {
-    "newton": ("rollqp.three.gnm", "NewtonMethod", None),
-    "qp-clarabel": ("rollqp.three.socp", "ClarabelMethod", None),
-    "socp-clarabel": ("rollqp.three.socp", "ClarabelMethod", None),
-    "qp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
-    "socp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
-    "socp-scs": ("rollqp.three.socp", "ScsMethod", "cvxpy"),
-    "qp-osqp": ("rollqp.three.socp", "OsqpMethod", None),
+    "newton": ("rollqp.methods.newton.disc", "NewtonMethod", None),
+    "qp-clarabel": ("rollqp.methods.socp", "ClarabelMethod", None),
+    "socp-clarabel": ("rollqp.methods.socp", "ClarabelMethod", None),
+    "qp-cvxpy": ("rollqp.methods.socp", "CvxpyMethod", "cvxpy"),
+    "socp-cvxpy": ("rollqp.methods.socp", "CvxpyMethod", "cvxpy"),
+    "socp-scs": ("rollqp.methods.socp", "ScsMethod", "cvxpy"),
+    "qp-osqp": ("rollqp.methods.socp", "OsqpMethod", None),
 }
 _TABLES = {2: _REGISTRY, 3: _REGISTRY_3D}
 

@@ -24,7 +24,7 @@ __all__ = ["Scene", "SceneBase", "scene_from_dict"]
 
 class SceneBase:
     """What every scene is, whatever its dimension: ``dimension`` (a scene file's ``[contact]
-    dimension``: 2, this package's :class:`Scene`; 3, :class:`rollqp.three.scene.Scene3D`), and the
+    dimension``: 2, this package's :class:`Scene`; 3, :class:`rollqp.scene.grid.Scene3D`), and the
     interface the command line and a run read — ``name``, ``source``, ``solver``, ``n_steps``,
     ``to_dict()``, ``to_toml()``, ``replace(**changes)``."""
 

@@ -35,7 +35,7 @@ MAX_FILE_BYTES = 16 << 20
 
 
 def _parse_3d(d: dict, source: str, default_name: str):
-    from ..three.scene import scene_from_dict as parse  # imported on first use: import rollqp stays light
+    from .grid import scene_from_dict as parse  # imported on first use: import rollqp stays light
     return parse(d, source=source, default_name=default_name)
 
 
@@ -45,7 +45,7 @@ _PARSERS = {2: scene_from_dict_2d, 3: _parse_3d}
 
 def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene"):
     """Build and validate a scene from its nested dict, of the dimension its ``[contact] dimension``
-    names (default 2: :class:`~rollqp.scene.Scene`; 3: :class:`~rollqp.three.scene.Scene3D`).
+    names (default 2: :class:`~rollqp.scene.Scene`; 3: :class:`~rollqp.scene.grid.Scene3D`).
 
     Raises
     ------
@@ -77,7 +77,7 @@ def _table_keys(dimension: int) -> dict:
         classes = {"bodies": Body, "contact": Contact, "load": Load, "discretization": Discretization,
                    "solver": SolverSettings}
     else:
-        from ..three.scene import Body3D, Contact3D, Discretization3D, Load3D, Solver3D
+        from .grid import Body3D, Contact3D, Discretization3D, Load3D, Solver3D
         classes = {"bodies": Body3D, "contact": Contact3D, "load": Load3D, "discretization": Discretization3D,
                    "solver": Solver3D}
     return {t: {f.name for f in dataclasses.fields(c)} for t, c in classes.items()}

@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, SolverError
-from .contact import Loads
-from .problem import disc_projection, element_states
+from ..operators.grid import Loads
+from ..problem.grid import disc_projection, element_states
 
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
@@ -73,7 +73,7 @@ class StepRecord:
 
 def normal(contact, method, FN: float, t=None, warm=None):
     """The normal step (eq. 3D.14) solved by ``method``, from ``warm`` or the Hertz pressure
-    (:meth:`~rollqp.three.contact.Contact.hertz_start`)."""
+    (:meth:`~rollqp.operators.grid.Contact.hertz_start`)."""
     return method.solve(contact.normal_step(FN, t), warm if warm is not None else contact.hertz_start(FN))
 
 
@@ -107,7 +107,7 @@ def coupled_step(contact, method, FN, kind, loads, previous=None, dq=None, direc
 def _warm_of(rec):
     """``(normal, tangential)``: the warm start of the step after a resumed state ``rec``, the numbers the
     step that computed it hands to the next (pressure and approach; tractions and creepages)."""
-    from .problem import Residuals, StepSolution
+    from ..problem.grid import Residuals, StepSolution
     return (StepSolution(residuals=Residuals(), p=rec.p, g=rec.g, delta=rec.delta),
             StepSolution(residuals=Residuals(), t=rec.t, s=rec.s, xi=rec.xi, eta=rec.eta))
 
@@ -122,7 +122,7 @@ def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_stat
 
 
 def _states(contact, p, t, s):
-    """0 separation, 1 stick, 2 slip (:func:`~rollqp.three.problem.element_states`)."""
+    """0 separation, 1 stick, 2 slip (:func:`~rollqp.problem.grid.element_states`)."""
     return element_states(np.asarray(t), np.asarray(s), contact.mu * np.maximum(p, 0.0), contact.scales)
 
 
@@ -158,7 +158,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
 
     ``accelerate``: ``"chord"`` (similar bodies; default) Newton's method on the march map
-    (:mod:`rollqp.three.chord`, eq. 3D.29), every iterate evaluated by the method; ``"anderson"`` the
+    (:mod:`rollqp.methods.chord`, eq. 3D.29), every iterate evaluated by the method; ``"anderson"`` the
     march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
     0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
     bodies; solved here if ``None``)."""
@@ -178,9 +178,9 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
 
 
 def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure=None):
-    """The fixed point of the march by Newton's method on the march map (:func:`rollqp.three.chord.chord_step`),
+    """The fixed point of the march by Newton's method on the march map (:func:`rollqp.methods.chord.chord_step`),
     a march step wherever a Newton iterate does not reduce the change by :data:`NEWTON_DECREASE`."""
-    from .chord import chord_step
+    from ..methods.chord import chord_step
     nsol = pressure or normal(contact, method, FN)
     dx, n = contact.grid.dx, contact.grid.n
     shifted = contact.ops.shifted("tt", -direction * dx)

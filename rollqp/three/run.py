@@ -25,7 +25,7 @@ import numpy as np
 from ..errors import InputError, SolverError
 from ..scene import load_scene
 from ..scene.core import SceneBase
-from .contact import Contact
+from ..operators.grid import Contact
 from .march import StepRecord, static_shift, steady, transient
 from .result import Result3D
 
@@ -135,7 +135,7 @@ def _versions() -> tuple:
 
 def _raw_distance(meta: dict, rec: StepRecord, contact) -> None:
     """A conic method's raw answers (the solver's own, before the active-set refinement,
-    :mod:`rollqp.three.refine`) against the refined ones the run keeps: the largest distance over the
+    :mod:`rollqp.methods.refine`) against the refined ones the run keeps: the largest distance over the
     run in ``meta["raw_distance"]`` (``dp`` in p0, ``dt`` in μp0, ``steps`` compared); nothing for a
     method without a raw answer (Newton)."""
     sc = contact.scales

@@ -161,7 +161,7 @@ class NormalStep:
 
     Parameters
     ----------
-    A : rollqp.three.operator.BlockToeplitz
+    A : rollqp.influence.blocktoeplitz.BlockToeplitz
         ``A_nn`` (1 × 1 blocks) on the grid of ``n`` elements.
     area : float
         Element area ``dx·dy``.
@@ -229,7 +229,7 @@ class TangentialStep:
 
     Parameters
     ----------
-    B : rollqp.three.operator.BlockToeplitz
+    B : rollqp.influence.blocktoeplitz.BlockToeplitz
         The 2 × 2 slip operator: ``A_tt`` (shift, transient) or ``A_tt − A_tt(· − d Δx)``
         (steady rolling, eq. 3D.17).
     area : float

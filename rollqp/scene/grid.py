@@ -21,7 +21,7 @@ the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a
 Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
 allowed range: radii ``> 0`` (or ``inf``), a concentrated contact (not both bodies straight in one
 direction), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
-element aspect ratio ``dx/dy`` in :data:`rollqp.three.grid.ASPECT_RANGE`, the forces below the sliding
+element aspect ratio ``dx/dy`` in :data:`rollqp.discretization.grid.ASPECT_RANGE`, the forces below the sliding
 limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
 (:func:`rollqp.methods.require_3d`).
@@ -40,14 +40,14 @@ from ..errors import InputError
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL
 from ..methods import DEFAULT_METHOD, require_3d
-from ..scene.checks import MAX_FRICTION, check_scene_name, check_units
-from ..scene.core import SceneBase
+from .checks import MAX_FRICTION, check_scene_name, check_units
+from .core import SceneBase
 from ..validate import choice, integer, number, string, suggestion
-from .contact import Loads
-from .geometry import Body, curvatures
-from .grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
-from .hertz import hertz
-from .materials import Materials
+from ..operators.grid import Loads
+from ..profiles.surface import Body, curvatures
+from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
+from ..three.hertz import hertz
+from ..materials import Materials
 
 __all__ = ["Scene3D", "Body3D", "Contact3D", "Creepage3D", "Load3D", "Discretization3D", "Solver3D",
            "scene_from_dict", "MAX_STEPS", "MAX_RESULT_BYTES"]
@@ -280,7 +280,7 @@ class Scene3D(SceneBase):
 
     @functools.cached_property
     def grid(self) -> Grid:
-        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.three.grid.Grid.for_ellipse>`)."""
+        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.discretization.grid.Grid.for_ellipse>`)."""
         e = self.ellipse
         return Grid.for_ellipse(e.a, e.b, self.discretization.elements, self.discretization.zone)
 

@@ -1,7 +1,7 @@
 r"""Generalized Newton method with line search for the 3D steps (docs/theory3d.md §7).
 
 The 2D project's GNMls (González & Abascal 2002 §4; Pang 1990) carried to the disc. In the
-nondimensional variables of :mod:`rollqp.three.problem` the steps are the nonsmooth equations
+nondimensional variables of :mod:`rollqp.problem.grid` the steps are the nonsmooth equations
 
 .. math::
     \Phi_N = \begin{bmatrix} \min(\hat p,\ r\hat g) \\ \hat a\sum\hat p − \hat F_N\end{bmatrix},
@@ -42,9 +42,9 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..errors import InputError, SolverError
-from ..methods.base import Capabilities, check_options
-from .problem import disc_projection
+from ...errors import InputError, SolverError
+from ..base import Capabilities, check_options
+from ...problem.grid import disc_projection
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 
@@ -131,8 +131,8 @@ class NewtonMethod:
         """Nothing to build: the dense blocks are memoized by the operators themselves."""
 
     def solve(self, problem, warm=None):
-        """Solve a :class:`~rollqp.three.problem.NormalStep` or
-        :class:`~rollqp.three.problem.TangentialStep`; ``warm``: a previous solution."""
+        """Solve a :class:`~rollqp.problem.grid.NormalStep` or
+        :class:`~rollqp.problem.grid.TangentialStep`; ``warm``: a previous solution."""
         t0 = time.perf_counter()
         if problem.kind == "normal":
             sol = _solve_normal(self, problem, warm)

@@ -1,9 +1,9 @@
 r"""One 3D contact, built once: geometry, materials, grid, operators, scales (docs/theory3d.md §2–4).
 
 :class:`Contact` is what every step of a 3D problem shares — the analog of the 2D project's
-scene operators: the grid and its :class:`~rollqp.three.operators.ContactOperators`, the
+scene operators: the grid and its :class:`~rollqp.influence.grid.ContactOperators`, the
 undeformed distance on the grid, the Hertz ellipse of the nominal load and the scales of the
-residuals — and it makes the step problems of :mod:`rollqp.three.problem`:
+residuals — and it makes the step problems of :mod:`rollqp.problem.grid`:
 
 * :meth:`Contact.normal_step` (eq. 3D.14), with the shear's gap ``A_nt t`` for dissimilar bodies;
 * :meth:`Contact.tangential_step` of a *shift* (eq. 3D.16 with no offset, ``Δq`` the length unit
@@ -18,11 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .geometry import QuadraticProfile
-from .grid import Grid
-from .hertz import hertz
-from .operators import ContactOperators
-from .problem import NormalStep, Residuals, Scales, StepSolution, TangentialStep
+from ..profiles.surface import QuadraticProfile
+from ..discretization.grid import Grid
+from ..three.hertz import hertz
+from ..influence.grid import ContactOperators
+from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
 __all__ = ["Contact", "Loads"]
 
@@ -44,8 +44,8 @@ class Contact:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
-    materials : rollqp.three.materials.Materials
+    grid : rollqp.discretization.grid.Grid
+    materials : rollqp.materials.Materials
     curvatures : (float, float)
         ``(A, B)`` of eq. 3D.1 (for the Hertz ellipse and the default profile).
     FN : float
@@ -58,7 +58,7 @@ class Contact:
 
     Examples
     --------
-    >>> from rollqp.three.materials import Materials
+    >>> from rollqp.materials import Materials
     >>> c = Contact.hertzian(Materials.from_young(210e3, 0.25, 210e3, 0.25), (1 / 60, 1 / 60), 1000.0, 0.3,
     ...                      elements=(20, 20))
     >>> round(c.ellipse.a, 4), c.grid.nx, c.ops.coupled

@@ -2,7 +2,7 @@ r"""The 3D steps on external conic solvers: Clarabel natively, OSQP (normal step
 (docs/theory3d.md §5–6).
 
 Each backend poses the normal step as the QP of eq. 3D.20 and the tangential step as the SOCP
-of eq. 3D.21 (:mod:`rollqp.three.forms`), maps the answer back (pressures, tractions, and the
+of eq. 3D.21 (:mod:`rollqp.problem.conic`), maps the answer back (pressures, tractions, and the
 load rows' multipliers as the approach and the creepages, eq. 3D.22) and evaluates it with
 rollqp's own residuals on the step problem. On top of the solver:
 
@@ -12,7 +12,7 @@ rollqp's own residuals on the step problem. On top of the solver:
   the skew part at the previous iterate (docs/formulation.md §8); a splitting that does not
   contract is a :class:`~rollqp.errors.SolverError` (the steady operator: its skew part dominates;
   the SOCP route reaches the steady state by marching, :mod:`rollqp.three.steady`);
-* **active-set refinement** (:mod:`rollqp.three.refine`): an interior point method ends with every
+* **active-set refinement** (:mod:`rollqp.methods.refine`): an interior point method ends with every
   complementary pair small but not zero, so elements at the edge of the contact or of the stick area
   are off by about ``√gap``. The answer is refined by the conic program's own KKT system on the
   active set the solver identified (eq. 3D.28: Newton iterations on smooth equations, the active set
@@ -34,8 +34,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError, MissingBackendError, SolverError
-from ..methods.base import Capabilities, check_options
-from .forms import normal_form, tangential_form
+from .base import Capabilities, check_options
+from ..problem.conic import normal_form, tangential_form
 from .refine import active_set_refine
 
 __all__ = ["ConicMethod", "ClarabelMethod", "OsqpMethod", "CvxpyMethod", "ScsMethod", "raw_solution"]
@@ -91,7 +91,7 @@ class ConicMethod:
     def solve(self, problem, warm=None):
         """Solve a normal or tangential step (eq. 3D.20/3D.21); rollqp's residuals decide."""
         if problem.kind not in self.capabilities.solves:
-            from ..methods import cone_methods
+            from . import cone_methods
             raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step "
                                               f"(methods that can: {', '.join(cone_methods())})")
         t0 = time.perf_counter()
@@ -140,7 +140,7 @@ class ConicMethod:
         return x, y, info
 
     def _refined(self, problem, sol):
-        """:func:`~rollqp.three.refine.active_set_refine` of the solver's answer, kept if rollqp's
+        """:func:`~rollqp.methods.refine.active_set_refine` of the solver's answer, kept if rollqp's
         residual drops; the raw answer and its residual in ``info``."""
         raw = {"raw_residual": sol.residual, "raw": _unknowns(sol)}
         ref = active_set_refine(problem, sol)
