@@ -110,7 +110,7 @@ def matrix_free_alternative(scene, same_method: bool = True) -> str | None:
     own = scene.method_capabilities.solves - {"coupled"}
     for name in METHOD_NAMES:
         caps = capabilities(name)
-        if not (caps.matrix_free and _needs(scene) <= caps.solves and caps.dimension == 2):
+        if not (caps.matrix_free and _needs(scene) <= caps.solves and 2 in caps.dimensions):
             continue
         if not same_method or caps.solves - {"coupled"} == own:
             return name

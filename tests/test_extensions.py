@@ -237,8 +237,8 @@ def test_the_capabilities_are_checked():
     with pytest.raises(rollqp.InputError, match="capabilities.solves"):
         Capabilities(solves=frozenset({"normal", "sideways"}))
     three = Halves()
-    three.capabilities = dataclasses.replace(Halves.capabilities, dimension=3, traction_components=2,
+    three.capabilities = dataclasses.replace(Halves.capabilities, dimensions=frozenset({3}), traction_components=2,
                                              friction_set="disc")
     with pytest.raises(rollqp.InputError, match="solver.method.*3D steps"):
         compose(three, coupled=False)
-    assert compose(Halves(), coupled=False).capabilities.dimension == 2
+    assert compose(Halves(), coupled=False).capabilities.dimensions == {2}

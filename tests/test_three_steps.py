@@ -12,6 +12,7 @@ from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.problem.grid import SLIP, STICK, Scales, TangentialStep
+from rollqp.methods import compose_3d
 from rollqp.methods.socp import ClarabelMethod, CvxpyMethod, OsqpMethod, raw_solution
 
 #: Agreement asked of two routes: both are solved to a residual of 1e-10 (Newton stops at
@@ -129,6 +130,10 @@ def test_osqp_refuses_a_cone_in_one_line(contact, pressure):
     prob = contact.tangential_step("shift", pressure.p, SHIFT_LOADS[0])
     with pytest.raises(InputError) as err:
         OsqpMethod().solve(prob)
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("solver.method:") and "tangential" in msg
+    with pytest.raises(InputError) as err:   # the registry refuses it before any step, naming the methods that can
+        compose_3d(OsqpMethod())
     msg = str(err.value)
     assert "\n" not in msg and msg.startswith("solver.method:")
     assert all(name in msg for name in ("newton", "qp-clarabel", "socp-clarabel", "qp-cvxpy", "socp-scs"))

@@ -64,7 +64,7 @@ class ConicMethod:
 
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "conic"
-    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimension=3, traction_components=2,
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimensions=frozenset({3}), traction_components=2,
                                 friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, refine: bool = True, max_iterations: int | None = None,
@@ -90,10 +90,9 @@ class ConicMethod:
 
     def solve(self, problem, warm=None):
         """Solve a normal or tangential step (eq. 3D.20/3D.21); rollqp's residuals decide."""
-        if problem.kind not in self.capabilities.solves:
-            from . import cone_methods
-            raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step "
-                                              f"(methods that can: {', '.join(cone_methods())})")
+        if problem.kind not in self.capabilities.solves:   # a scene is refused up front by the registry, naming the methods that can
+            raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step (it solves: "
+                                              f"{', '.join(sorted(self.capabilities.solves))}; its capabilities)")
         t0 = time.perf_counter()
         elements = predicted_contact(problem, warm) if problem.kind == "normal" else None
         sol, info = self._solve_on(problem, elements)
@@ -290,7 +289,7 @@ class OsqpMethod(ConicMethod):
 
     name = "osqp"
     #: No cones: the friction disc cannot be posed, so it solves the normal QP only.
-    capabilities = Capabilities(solves=frozenset({"normal"}), dimension=3, traction_components=2,
+    capabilities = Capabilities(solves=frozenset({"normal"}), dimensions=frozenset({3}), traction_components=2,
                                 friction_set="interval")
 
     def _solve_form(self, form, q):

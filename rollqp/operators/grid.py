@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..friction import as_law
 from ..profiles.surface import QuadraticProfile
 from ..discretization.grid import Grid
 from ..three.hertz import hertz
@@ -66,13 +67,8 @@ class Contact:
     """
 
     def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None):
-        try:
-            coefficient = float(mu) if not isinstance(mu, (bool, str)) else math.nan
-        except (TypeError, ValueError):
-            coefficient = math.nan
-        if not (math.isfinite(coefficient) and coefficient >= 0):   # Coulomb's constant μ only (no laws in 3D yet)
-            raise InputError("contact.friction", f"must be a finite number >= 0, got {mu!r}")
-        self.grid, self.materials, self.mu = grid, materials, coefficient
+        # Coulomb's constant μ only (no laws in 3D yet): a scene's law as it is, a number checked once here
+        self.grid, self.materials, self.mu = grid, materials, as_law(mu).mu
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
         self.scales = Scales.hertz(self.ellipse)

@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
+from ..methods import record
 from .schema import BETA_ZERO
 
 __all__ = ["Derived"]
@@ -39,8 +40,7 @@ class Derived:
     def method_capabilities(self):
         """What the scene's ``solver.method`` declares (:class:`~rollqp.methods.base.Capabilities`, asked of the
         method registry by name): whether it needs the influence matrix, what it solves."""
-        from ..methods import capabilities
-        return capabilities(self.solver.method)
+        return record(self.solver.method).capabilities
 
     @property
     def bem_mesh(self) -> tuple[int, int]:

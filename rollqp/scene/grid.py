@@ -37,6 +37,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError
+from ..friction import Coulomb
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL
 from ..methods import DEFAULT_METHOD, require_3d
@@ -154,7 +155,7 @@ def _contact(c: Contact3D) -> Contact3D:
                 lambda x: 0 < x <= MAX_FRICTION)
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-    return Contact3D(mu, 3, choice("contact.model", c.model, (DEFAULT_MODEL,)))
+    return Contact3D(Coulomb.checked(mu), 3, choice("contact.model", c.model, (DEFAULT_MODEL,)))
 
 
 def _history(v, key):

@@ -104,7 +104,7 @@ class NewtonMethod:
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "newton-3d"
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
-                                dimension=3, traction_components=2, friction_set="disc")
+                                dimensions=frozenset({3}), traction_components=2, friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, r: float | None = None,
                  rho: float = 0.5, sigma: float = 1e-4, path: str = "auto"):
