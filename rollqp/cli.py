@@ -17,8 +17,9 @@ that did not converge (the completed steps are written to the result file first)
 result that could not be written (a full disk: the completed steps stay in the journal, and
 ``run --resume`` continues once there is room).
 ``check-step`` exits 1 when the candidate fails, with one line per failed condition.
-BLAS threads are pinned to one: numpy's and scipy's wheels each bundle OpenBLAS, and two
-pools competing for 2 cores can make a dense solve 100× slower.
+BLAS threads are pinned to ``$ROLLQP_THREADS`` (default one) before numpy and scipy load
+(:mod:`rollqp.threads`): their wheels each bundle OpenBLAS, and two pools competing for 2 cores
+made a 3D run 3× slower.
 """
 from __future__ import annotations
 
@@ -499,11 +500,11 @@ def _spot_steps(args, scene):
 
 
 def cmd_scenes(args) -> int:
-    from .scene import builtin_scenes
+    from .scene import builtin_scenes, load_scene
     names = builtin_scenes()
     w = max(map(len, names))
-    for k, v in names.items():
-        print(f"{k:<{w}}  {v}")
+    for k, v in names.items():      # every scene tagged by its dimension, the same way
+        print(f"{k:<{w}}  {load_scene(k).dimension}D  {v}")
     return 0
 
 
@@ -684,16 +685,13 @@ def main(argv=None) -> int:
     else:
         args = _parser().parse_args(argv)
     from .errors import InputError, RollqpError, SolverError
+    from .threads import limited
     try:
-        from threadpoolctl import threadpool_limits
-        limiter = threadpool_limits(limits=int(os.environ.get("ROLLQP_THREADS", "1")))
-    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        limiter = None
-    try:
-        return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
-                "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
-                "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
-                "stresses": cmd_stresses}[args.command](args)
+        with limited():  # every BLAS pool at $ROLLQP_THREADS (default 1), scipy's included (rollqp.threads)
+            return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
+                    "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
+                    "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
+                    "stresses": cmd_stresses}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
@@ -710,9 +708,6 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("rollqp: interrupted", file=sys.stderr)
         return 130
-    finally:
-        if limiter is not None:
-            limiter.unregister() if hasattr(limiter, "unregister") else None
 
 
 # ----------------------------------------------------------------------------- stresses
@@ -743,8 +738,12 @@ def cmd_stresses(args) -> int:
     _check_plot(args.plot)
     names = {"nx": "--grid", "nz": "--grid", "width": "--width", "depth": "--depth", "step": "--step",
              "result": "RESULT.npz"}
+    loaded = load_result(args.result, "RESULT.npz")
+    if "py" in loaded:                  # a 3D result: its lateral traction
+        raise InputError("RESULT.npz", f"{args.result} is a 3D result (Kalker's problem): rollqp stresses computes the "
+                                       "subsurface field of 2D results (docs/stresses.md)")
     try:
-        arrays, scene = _source(load_result(args.result, "RESULT.npz"))
+        arrays, scene = _source(loaded)
         sf = stresses(arrays, args.step, default_grid(scene, nx, nz, args.width, args.depth), body=args.body)
     except InputError as err:
         raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None

@@ -294,8 +294,9 @@ class Shape:
 
 # =========================================================================== parsing
 def _radius(key, v) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v <= 0:
-        raise InputError(key, f"must be a number > 0 (or inf for a straight generator), got {v!r}")
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or math.isnan(v) or v == 0:
+        raise InputError(key, f"must be a nonzero number (> 0 convex, < 0 concave, inf for a straight generator), "
+                              f"got {v!r}")
     return float(v)
 
 
@@ -341,8 +342,8 @@ def parse_body(table: dict, key: str) -> BodyShape:
         base = _lateral(k, item) if kind == "lateral" else _surface(k, item)
     out = []
     for k, kind, item in feats:
-        if kind == "flat" and (rx is None or math.isinf(rx)):
-            raise InputError(f"{k}.kind", "a flat is cut into the rolling radius: the body needs a finite radius")
+        if kind == "flat" and (rx is None or math.isinf(rx) or rx < 0):
+            raise InputError(f"{k}.kind", "a flat is cut into the rolling radius: the body needs a finite radius > 0")
         out.append(_defect(k, item) if kind == "defect" else _flat(k, item, rx))
     return BodyShape(rx, ry, base, tuple(out))
 
