@@ -506,11 +506,11 @@ def _spot_steps(args, scene):
 
 
 def cmd_scenes(args) -> int:
-    from .scene import builtin_scenes
+    from .scene import builtin_scenes, load_scene
     names = builtin_scenes()
     w = max(map(len, names))
-    for k, v in names.items():
-        print(f"{k:<{w}}  {v}")
+    for k, v in names.items():      # every scene tagged by its dimension, the same way
+        print(f"{k:<{w}}  {load_scene(k).dimension}D  {v}")
     return 0
 
 
@@ -744,8 +744,12 @@ def cmd_stresses(args) -> int:
     _check_plot(args.plot)
     names = {"nx": "--grid", "nz": "--grid", "width": "--width", "depth": "--depth", "step": "--step",
              "result": "RESULT.npz"}
+    loaded = load_result(args.result, "RESULT.npz")
+    if "py" in loaded:                  # a 3D result: its lateral traction
+        raise InputError("RESULT.npz", f"{args.result} is a 3D result (Kalker's problem): rollqp stresses computes the "
+                                       "subsurface field of 2D results (docs/stresses.md)")
     try:
-        arrays, scene = _source(load_result(args.result, "RESULT.npz"))
+        arrays, scene = _source(loaded)
         sf = stresses(arrays, args.step, default_grid(scene, nx, nz, args.width, args.depth), body=args.body)
     except InputError as err:
         raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None

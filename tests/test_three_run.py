@@ -210,7 +210,7 @@ def test_cli_refuses_osqp_on_a_3d_scene(tmp_path, capsys, monkeypatch):
 
 # ------------------------------------------------------------------------------- the built-ins
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["kalker-circular", "kalker-elliptic", "cattaneo-3d"])
+@pytest.mark.parametrize("name", ["kalker-circular", "kalker-elliptic", "cattaneo-3d", "ball-in-groove"])
 def test_builtin_3d_scene_runs_and_crossvalidates(name, tmp_path):
     """The built-in scene at its own grid: run with Newton (seconds), its figure, and every step
     solved again by the SOCP backends (the conic solves take minutes on the 40 × 40 grid)."""

@@ -146,14 +146,14 @@ def _pose(scene, contact, rec, before):
 
 def _compare(row, contact, rec, nsol, tsol) -> dict:
     sc, mu = contact.scales, contact.mu
-    d = {"dp": np.max(np.abs(nsol.p - rec.p)) / sc.stress, "dt": np.max(np.abs(tsol.t - rec.t)) / (mu * sc.stress),
+    d = {"dp": np.max(np.abs(nsol.p - rec.p)) / sc.stress, "dt": np.max(np.abs(tsol.t - rec.t)) / ((mu or 1.0) * sc.stress),
          "dcreep": max(abs(tsol.xi - rec.xi), abs(tsol.eta - rec.eta)) / sc.slip,
          "residual": max(nsol.residual, tsol.residual)}
     rp, rt = nsol.info.get("raw"), tsol.info.get("raw")
     if rp is not None or rt is not None:
         row["raw"] = True
         d["dp_raw"] = np.max(np.abs((rp or {"p": nsol.p})["p"] - rec.p)) / sc.stress
-        d["dt_raw"] = np.max(np.abs((rt or {"t": tsol.t})["t"] - rec.t)) / (mu * sc.stress)
+        d["dt_raw"] = np.max(np.abs((rt or {"t": tsol.t})["t"] - rec.t)) / ((mu or 1.0) * sc.stress)
     for k, v in d.items():
         row[k] = max(row.get(k, 0.0), float(v))
     return {k: float(v) for k, v in d.items()}
