@@ -68,7 +68,7 @@ def _scene(name: str):
     return scene.replace(**over) if over else scene
 
 
-def run(folder: Path, only: list[str] | None = None) -> None:
+def run(folder: Path, only: list[str] | None = None, methods: list[str] | None = None) -> None:
     folder.mkdir(parents=True, exist_ok=True)
     log = {}
     t_all = time.perf_counter()
@@ -79,7 +79,7 @@ def run(folder: Path, only: list[str] | None = None) -> None:
         out = folder / name
         out.mkdir(exist_ok=True)
         for method in SCENE_METHOD_NAMES:
-            if method in SLOW and name not in SLOW[method]:
+            if method in SLOW and name not in SLOW[method] or methods and method not in methods:
                 continue
             key = f"{name}/{method}"
             try:
@@ -155,6 +155,8 @@ def compare(old: Path, new: Path) -> int:
         for f in sorted(scene_dir.iterdir()):
             key = f"{scene_dir.name}/{f.name}"
             g = new / scene_dir.name / f.name
+            if not (new / scene_dir.name).exists():
+                continue   # a scene the new run left out (--scene)
             if not g.exists():
                 print(f"{key}: missing in {new}")
                 bad += 1
@@ -180,7 +182,7 @@ def compare(old: Path, new: Path) -> int:
                 bad += 1
     for scene_dir in sorted(p for p in new.iterdir() if p.is_dir()):
         for g in scene_dir.iterdir():
-            if not (old / scene_dir.name / g.name).exists():
+            if (old / scene_dir.name).exists() and not (old / scene_dir.name / g.name).exists():
                 print(f"{scene_dir.name}/{g.name}: only in {new}")
                 bad += 1
     print(f"{rows} results compared; {bad} differences outside the wall-clock arrays {VOLATILE}")
@@ -193,12 +195,13 @@ def main(argv=None) -> int:
     r = sub.add_parser("run", help="run every built-in scene with every method; save the arrays")
     r.add_argument("folder", type=Path)
     r.add_argument("--scene", action="append", help="only these scenes (repeatable)")
+    r.add_argument("--method", action="append", help="only these methods (repeatable)")
     c = sub.add_parser("compare", help="the largest difference per array between two saves")
     c.add_argument("old", type=Path)
     c.add_argument("new", type=Path)
     args = ap.parse_args(argv)
     if args.cmd == "run":
-        run(args.folder, args.scene)
+        run(args.folder, args.scene, args.method)
         return 0
     return compare(args.old, args.new)
 
