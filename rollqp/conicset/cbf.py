@@ -33,6 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
+from .forms import ascii_text
 
 __all__ = ["write", "read", "Conic", "standard_form", "epigraph_point", "VERSION"]
 
@@ -84,7 +85,7 @@ def write(path, d, comment: str = "") -> None:
     keep = bv != 0
     br, bv = br[keep], bv[keep]
     var = [("L+", d.m), ("F", 1)] if d.kind == "normal" else [("F", d.m + 1)]
-    out = [f"# {_ascii(line)}" for line in comment.splitlines()]
+    out = [f"# {ascii_text(line)}" for line in comment.splitlines()]
     out += ["VER", str(VERSION), "", "OBJSENSE", "MIN", "", "VAR", f"{d.m + 1} {len(var)}"]
     out += [f"{name} {size}" for name, size in var] + [""]
     out += ["CON", f"{nrows} {len(cones)}"] + [f"{name} {size}" for name, size in cones] + [""]
@@ -94,14 +95,6 @@ def write(path, d, comment: str = "") -> None:
     out += ["BCOORD", str(bv.size)] + [f"{r} {v!r}" for r, v in zip(br, bv.tolist())] + [""]
     with open(path, "w", encoding="ascii") as f:
         f.write("\n".join(out))
-
-
-def _ascii(text: str) -> str:
-    """A comment in ASCII (CBF files are ASCII): Greek letters spelled, other marks decomposed or dropped."""
-    import unicodedata
-    for a, b in (("μ", "mu"), ("–", "-"), ("—", "-"), ("·", "*"), ("½", "1/2"), ("ᵀ", "'"), ("Δ", "d"), ("δ", "delta")):
-        text = text.replace(a, b)
-    return unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")
 
 
 def epigraph_point(d, x) -> np.ndarray:

@@ -36,7 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import MissingBackendError
-from .forms import disc_projection
+from .forms import ascii_text, disc_projection
 
 __all__ = ["write", "read", "residual", "SPACEDIM"]
 
@@ -73,8 +73,9 @@ def write(path, W, q, mu, r=None, u=None, title="", description="", math_info=""
         vec.create_dataset("mu", data=np.asarray(mu, dtype=float))
         info = loc.create_group("info")
         for key, text in (("title", title), ("description", description), ("math_info", math_info)):
-            if text:
-                info.create_dataset(key, data=np.bytes_(text))
+            if text:   # a fixed-length, null-terminated ASCII string, as H5LTmake_dataset_string writes
+                raw = ascii_text(text).encode("ascii") + b"\0"
+                info.create_dataset(key, data=np.array(raw, dtype=f"S{len(raw)}"))
         if r is not None:
             sol = f.create_group("solution")
             sol.create_dataset("u", data=np.asarray(u, dtype=float))

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["ProgramData", "from_form", "residual", "objective", "kkt_gradient", "disc_projection"]
+__all__ = ["ProgramData", "from_form", "residual", "objective", "kkt_gradient", "disc_projection", "ascii_text"]
 
 
 @dataclass(frozen=True)
@@ -115,3 +115,12 @@ def objective(d: ProgramData, x) -> float:
     """``½xᵀHx + qᵀx``."""
     x = np.asarray(x, dtype=float)
     return float(0.5 * x @ (d.H @ x) + d.q @ x)
+
+
+def ascii_text(text: str) -> str:
+    """``text`` in ASCII (CBF comments, FCLib's info strings): Greek letters spelled, marks dropped."""
+    import unicodedata
+    for a, b in (("μ", "mu"), ("–", "-"), ("—", "-"), ("·", "*"), ("½", "1/2"), ("ᵀ", "'"), ("Δ", "d"),
+                 ("δ", "delta"), ("ξ", "xi"), ("η", "eta"), ("φ", "phi"), ("≥", ">="), ("≤", "<=")):
+        text = text.replace(a, b)
+    return unicodedata.normalize("NFKD", text).encode("ascii", "ignore").decode("ascii")

@@ -35,8 +35,9 @@ __all__ = ["SOLVERS", "SETTINGS", "Answer", "available", "solve", "run_set", "HI
 
 #: qpbenchmark's high-accuracy tolerance, for every gap and feasibility tolerance of the ``high`` settings.
 HIGH_ACCURACY = 1e-9
-#: Seconds per solve (Clarabel, SCS); ECOS and CVXOPT by their iteration limits (:func:`_native`).
-TIME_LIMIT = 120.0
+#: Wall seconds per solve: each solve runs in a forked process, ended at this limit (ECOS and CVXOPT have
+#: no time limit of their own) and counted a failure; Clarabel and SCS are also given it as their own.
+TIME_LIMIT = 40.0
 #: The accuracy a cross-check needs: rollqp's ``check-step`` tolerance on ``max|x − x*|`` in ``p0``.
 WITHIN = 1e-6
 #: The solvers (``route-name``): native on the CBF file, cvxpy on the program's arrays.
@@ -103,7 +104,7 @@ def _scs(c, G, h, dims, Aeq, beq, high):
 
 def _ecos(c, G, h, dims, Aeq, beq, high):
     import ecos
-    opts = dict(verbose=False, max_iters=200 if high else 100)
+    opts = dict(verbose=False)
     if high:
         opts.update(abstol=HIGH_ACCURACY, reltol=HIGH_ACCURACY, feastol=HIGH_ACCURACY)
     kw = dict(A=sp.csc_matrix(Aeq), b=beq) if Aeq.shape[0] else {}
@@ -120,7 +121,7 @@ def _cvxopt(c, G, h, dims, Aeq, beq, high):
     def spm(M):
         M = sp.coo_matrix(M)
         return cvxopt.spmatrix(M.data.tolist(), M.row.tolist(), M.col.tolist(), size=M.shape)
-    opts = {"show_progress": False, "maxiters": 200 if high else 100}
+    opts = {"show_progress": False}
     if high:
         opts.update(abstol=HIGH_ACCURACY, reltol=HIGH_ACCURACY, feastol=HIGH_ACCURACY)
     args = dict(A=spm(Aeq), b=cvxopt.matrix(beq)) if Aeq.shape[0] else {}
@@ -151,9 +152,8 @@ def _cvxpy(d: ProgramData, solver: str, high: bool):
     if high:
         opts.update({"CLARABEL": dict(tol_gap_abs=HIGH_ACCURACY, tol_gap_rel=HIGH_ACCURACY, tol_feas=HIGH_ACCURACY),
                      "SCS": dict(eps_abs=HIGH_ACCURACY, eps_rel=HIGH_ACCURACY, max_iters=1_000_000),
-                     "ECOS": dict(abstol=HIGH_ACCURACY, reltol=HIGH_ACCURACY, feastol=HIGH_ACCURACY, max_iters=200),
-                     "CVXOPT": dict(abstol=HIGH_ACCURACY, reltol=HIGH_ACCURACY, feastol=HIGH_ACCURACY,
-                                    max_iters=200)}[name])
+                     "ECOS": dict(abstol=HIGH_ACCURACY, reltol=HIGH_ACCURACY, feastol=HIGH_ACCURACY),
+                     "CVXOPT": dict(abstol=HIGH_ACCURACY, reltol=HIGH_ACCURACY, feastol=HIGH_ACCURACY)}[name])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
@@ -167,8 +167,41 @@ def _cvxpy(d: ProgramData, solver: str, high: bool):
     return xv, y, str(prob.status), prob.status == "optimal", int(iters or 0)
 
 
-def solve(solver: str, settings: str, d: ProgramData, conic=None):
-    """``(x, y, status, ok, iterations, seconds)`` of one solve; ``conic`` the CBF problem (native routes)."""
+def _child(pipe, solver, settings, d, conic):
+    try:
+        pipe.send(_solve_here(solver, settings, d, conic))
+    except Exception as err:   # anything a solver raises is its answer: a failed solve, with its message
+        pipe.send((np.full(d.m, np.nan), np.zeros(d.k), f"error: {type(err).__name__}: {str(err)[:80]}", False, 0,
+                   float("nan")))
+    finally:
+        pipe.close()
+
+
+def solve(solver: str, settings: str, d: ProgramData, conic=None, limit: float = TIME_LIMIT):
+    """``(x, y, status, ok, iterations, seconds)`` of one solve in a forked process, ended after ``limit``
+    seconds (status ``"time limit"``); ``conic`` the CBF problem (native routes)."""
+    import multiprocessing
+    ctx = multiprocessing.get_context("fork")
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_child, args=(send, solver, settings, d, conic), daemon=True)
+    t0 = time.perf_counter()
+    proc.start()
+    send.close()
+    out = recv.recv() if recv.poll(limit + 5.0) else None
+    if proc.is_alive():
+        proc.kill()
+    proc.join()
+    if out is None:
+        return np.full(d.m, np.nan), np.zeros(d.k), "time limit", False, 0, time.perf_counter() - t0
+    x, y, status, ok, it, sec = out
+    sec = sec if np.isfinite(sec) else time.perf_counter() - t0
+    if not sec <= limit:
+        ok, status = False, f"time limit ({status})"
+    return x, y, status, ok, it, sec
+
+
+def _solve_here(solver: str, settings: str, d: ProgramData, conic=None):
+    """``(x, y, status, ok, iterations, seconds)`` of one solve in this process."""
     high = settings == "high"
     t0 = time.perf_counter()
     if solver.startswith("cvxpy-"):
