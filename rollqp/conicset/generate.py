@@ -30,7 +30,6 @@ from ..three.contact import Contact, Loads
 from ..three.forms import normal_form, tangential_form
 from ..three.gnm import NewtonMethod
 from ..three.march import coupled_step, normal, static_shift
-from ..three.materials import Materials
 from . import cbf, fclib
 from .forms import ProgramData, from_form, objective, residual
 
@@ -69,9 +68,10 @@ def _contact(scene_name, elements, materials=None, **changes):
     of elements around the ellipse), and its :class:`Contact`."""
     scene = load_scene(scene_name)
     zone = [max(z, 1.02 / (1 - 2 / e)) for z, e in zip(scene.discretization.zone, elements)]
+    if materials is not None:   # the bodies' own: the grid is laid over their Hertz ellipse
+        changes.update(zip(("bodies.A.E", "bodies.A.nu", "bodies.B.E", "bodies.B.nu"), materials))
     scene = scene.replace(**{"discretization.elements": list(elements), "discretization.zone": zone}, **changes)
-    mats = Materials.from_young(*materials) if materials is not None else scene.materials
-    return scene, Contact(scene.grid, mats, scene.curvatures, scene.load.normal, scene.mu)
+    return scene, Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu)
 
 
 def _newton():
