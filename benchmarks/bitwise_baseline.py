@@ -52,6 +52,8 @@ SHORTEN = {
     "cattaneo-3d": {"discretization.elements": [16, 16], "discretization.distance": 2.0},
     "kalker-circular": {"discretization.elements": [20, 20]},
     "kalker-elliptic": {"discretization.elements": [12, 24]},
+    "ball-in-groove": {"discretization.elements": [10, 30]},
+    "quartic-roller": {"discretization.elements": [12, 24]},
 }
 #: Slow methods run on these scenes only (first-order solvers and the optional QP backends on
 #: every 2D scene would take tens of minutes; one scene each still checks their path).

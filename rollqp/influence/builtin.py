@@ -9,6 +9,7 @@ import math
 import time
 
 from ..errors import InputError
+from .grid import ContactOperators
 from .halfspace import halfspace_influence
 from .model import Model
 
@@ -103,6 +104,9 @@ def bem_rows(m: dict) -> list[tuple[str, str]]:
 
 HALFSPACE = Model("halfspace", halfspace_of, "elastic half-spaces (docs/formulation.md §3)",
                   keys=("contact.reference_distance", "contact.coupling"), operators=halfspace_operators_of)
+#: Boussinesq–Cerruti on the rectangles of a grid (three dimensions, docs/theory3d.md §3–4).
+HALFSPACE_3D = Model("halfspace", ContactOperators, "elastic half-spaces, Boussinesq–Cerruti on rectangles "
+                     "(docs/theory3d.md §3)", dimensions=frozenset({3}))
 BEM = Model("bem", bem_of, "true roller geometry on rigid shafts by BEM (docs/bem.md)",
             keys=("contact.bem_outer_elements", "contact.bem_inner_elements", "contact.coupling",
                   "bodies.A.shaft_radius", "bodies.B.shaft_radius"),

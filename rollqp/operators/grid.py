@@ -22,7 +22,7 @@ from ..friction import as_law
 from ..profiles.surface import QuadraticProfile
 from ..discretization.grid import Grid
 from ..three.hertz import hertz
-from ..influence.grid import ContactOperators
+from ..influence import DEFAULT_MODEL, get_model
 from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
 __all__ = ["Contact", "Loads"]
@@ -56,6 +56,9 @@ class Contact:
     profile : callable, optional
         ``h(x, y)``, the undeformed distance; default ``A x² + B y²`` (the seam for
         non-Hertzian profiles).
+    model : str
+        The influence model (``contact.model``) of 3D scenes that builds the operators from the grid and
+        the materials (:func:`rollqp.influence.get_model`; default the Boussinesq–Cerruti half-space).
 
     Examples
     --------
@@ -66,13 +69,14 @@ class Contact:
     (0.5857, 20, False)
     """
 
-    def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None):
+    def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None,
+                 model: str = DEFAULT_MODEL):
         # Coulomb's constant μ only (no laws in 3D yet): a scene's law as it is, a number checked once here
         self.grid, self.materials, self.mu = grid, materials, as_law(mu).mu
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
         self.scales = Scales.hertz(self.ellipse)
-        self.ops = ContactOperators(grid, materials)
+        self.ops = get_model(model, "contact.model", dimension=3).build(grid, materials)
         self.x, self.y = grid.centres()
         h = np.asarray(self.profile(self.x, self.y), dtype=float)
         if h.shape != (grid.n,) or not np.all(np.isfinite(h)):

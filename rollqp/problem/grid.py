@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..friction.projection import project
 from ..validate import positive as _positive, scalar
 
 __all__ = ["Scales", "Residuals", "StepSolution", "NormalStep", "TangentialStep", "disc_projection",
@@ -123,11 +124,9 @@ class StepSolution:
 
 
 def disc_projection(z: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``Proj_{|·| ≤ b_i}(z_i)`` element by element (eq. 3D.19); ``z`` of shape ``(2, n)``, ``b ≥ 0``."""
-    norm = np.hypot(z[0], z[1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.where(norm > b, b / norm, 1.0)
-    return z * k
+    """``Proj_{|·| ≤ b_i}(z_i)`` element by element (eq. 3D.19); ``z`` of shape ``(2, n)``, ``b ≥ 0``: the
+    ball of radius ``b`` for ``k = 2`` (:func:`rollqp.friction.projection.project`)."""
+    return project(z, b)
 
 
 def rigid_slip(xi: float, eta: float, phi: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:

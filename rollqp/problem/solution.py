@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..friction.projection import residual as projection_residual
 from .scales import Scales
 
 __all__ = ["SEPARATION", "STICK", "SLIP", "friction_residual", "Residuals", "StepSolution", "classify", "compare"]
@@ -21,14 +22,7 @@ def friction_residual(t, s, bound, minus_bound=None, out=None):
     nondimensional ``t̂, ŝ, b̂``; the Newton method with ``r ŝ`` in place of ``ŝ`` (eq. 56, 63).
     ``minus_bound``: ``−b`` if the caller keeps it; ``out``: the array to write it into.
     """
-    if minus_bound is None:
-        minus_bound = -bound
-    # np.maximum/np.minimum rather than np.clip: the same numbers (``b >= 0``), without np.clip's
-    # Python-level dispatch (half the time on a step's vectors, and Newton evaluates it a few times an iteration)
-    if out is None:
-        return t - np.maximum(np.minimum(t - s, bound), minus_bound)
-    u = np.minimum(t - s, bound)
-    return np.subtract(t, np.maximum(u, minus_bound, out=u), out=out)  # the same operations, in place
+    return projection_residual(t, s, bound, minus_bound, out)   # the ball of radius b, k = 1 (rollqp.friction.projection)
 
 
 @dataclass

@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import InputError
 from ..friction import Coulomb
 from ..histories import Constant, History, parse_history
-from ..influence import DEFAULT_MODEL
+from ..influence import DEFAULT_MODEL, get_model
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
 from .checks import MAX_FRICTION, check_scene_name, check_units
@@ -164,7 +164,7 @@ def _contact(c: Contact3D) -> Contact3D:
                 lambda x: 0 <= x <= MAX_FRICTION)
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-    return Contact3D(Coulomb.checked(mu), 3, choice("contact.model", c.model, (DEFAULT_MODEL,)))
+    return Contact3D(Coulomb.checked(mu), 3, get_model(c.model, "contact.model", dimension=3).name)
 
 
 def _history(v, key):
