@@ -222,7 +222,7 @@ def test_newton_reports_failure_with_the_residual(contact, pressure):
 def test_scales_are_hertz():
     c = elliptic()
     e = c.ellipse
-    assert c.scales == Scales(length=np.sqrt(e.a * e.b), stress=e.p0, modulus=STEEL.Estar)
+    assert c.scales == Scales(length=np.sqrt(e.a * e.b), stress=e.p0, modulus=STEEL.Estar, dimension=3)
 
 
 def test_the_2d_normal_machinery_solves_the_3d_normal_step(contact, pressure):

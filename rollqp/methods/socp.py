@@ -212,13 +212,13 @@ def _solution(problem, form, x, y, name, info):
         p = np.zeros(problem.n)
         p[form.elements] = np.maximum(np.asarray(x), 0.0) * sc.stress
         delta = problem.delta if problem.delta is not None else -float(unknowns[0]) * sc.displacement
-        return problem.solution(p, delta, method=name, iterations=info.get("iterations", 0), info=info)
+        return problem.solution(p, delta, method=name, iterations=info.get("iterations", 0), extras=info)
     nv = form.elements.size
     t = np.zeros((2, problem.n))
     t[:, form.elements] = np.asarray(x).reshape(2, nv) * sc.stress
     crp = dict(zip(form.rows, unknowns * sc.slip))
     return problem.solution(t, crp.get("Fx"), crp.get("Fy"), method=name,
-                            iterations=info.get("iterations", 0), info=info)
+                            iterations=info.get("iterations", 0), extras=info)
 
 
 def _clarabel_settings(tolerance, max_iterations):

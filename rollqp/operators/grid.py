@@ -75,7 +75,7 @@ class Contact:
         self.grid, self.materials, self.mu = grid, materials, as_law(mu).mu
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
-        self.scales = Scales.hertz(self.ellipse)
+        self.scales = Scales.ellipse(self.ellipse)
         self.ops = get_model(model, "contact.model", dimension=3).build(grid, materials)
         self.x, self.y = grid.centres()
         h = np.asarray(self.profile(self.x, self.y), dtype=float)

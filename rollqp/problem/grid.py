@@ -36,6 +36,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..friction.projection import project
+from .scales import Scales
+from .solution import Residuals, StepSolution
 from ..validate import positive as _positive, scalar
 
 __all__ = ["Scales", "Residuals", "StepSolution", "NormalStep", "TangentialStep", "disc_projection",
@@ -43,84 +45,6 @@ __all__ = ["Scales", "Residuals", "StepSolution", "NormalStep", "TangentialStep"
 
 #: Element states (result files): 0 separation, 1 stick, 2 slip.
 SEPARATION, STICK, SLIP = 0, 1, 2
-
-
-@dataclass(frozen=True)
-class Scales:
-    """Units of the nondimensional form: ``length`` (``c = √(ab)``), ``stress`` (``p0``),
-    ``modulus`` (``E*``); all 1 leaves a problem in its own units."""
-
-    length: float = 1.0
-    stress: float = 1.0
-    modulus: float = 1.0
-
-    def __post_init__(self):
-        for name in ("length", "stress", "modulus"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise InputError(f"scales.{name}", f"must be a finite number > 0, got {v!r}")
-
-    @classmethod
-    def hertz(cls, ellipse) -> "Scales":
-        """From a :class:`~rollqp.three.hertz.HertzEllipse`: ``c = √(ab)``, ``p0``, ``E*``."""
-        return cls(length=ellipse.c, stress=ellipse.p0, modulus=ellipse.Estar)
-
-    @property
-    def displacement(self) -> float:
-        """``u0 = c p0/E*``: gaps, displacements, approach."""
-        return self.length * self.stress / self.modulus
-
-    @property
-    def slip(self) -> float:
-        """``p0/E*``: slips and creepages (spin: ``p0/(E* c)``)."""
-        return self.stress / self.modulus
-
-    @property
-    def force(self) -> float:
-        """``p0 c²``: forces."""
-        return self.stress * self.length ** 2
-
-
-@dataclass(frozen=True)
-class Residuals:
-    """rollqp's nondimensional residuals of a step solution (max-norms, eq. 3D.27)."""
-
-    signorini: float = 0.0
-    friction: float = 0.0
-    load_normal: float = 0.0
-    load_x: float = 0.0
-    load_y: float = 0.0
-
-    @property
-    def max(self) -> float:
-        """The largest, NaN if any is NaN."""
-        v = (self.signorini, self.friction, self.load_normal, self.load_x, self.load_y)
-        return float("nan") if any(math.isnan(x) for x in v) else max(v)
-
-
-@dataclass(frozen=True)
-class StepSolution:
-    """A solution of a normal (``p, g, delta``) or tangential (``t, s, xi, eta``) step.
-
-    ``t`` and ``s`` have shape ``(2, n)`` (x and y components), ``p`` and ``g`` ``(n,)``;
-    ``residuals`` are rollqp's (:class:`Residuals`), ``residual`` their maximum.
-    """
-
-    residuals: Residuals
-    p: np.ndarray | None = None
-    g: np.ndarray | None = None
-    delta: float | None = None
-    t: np.ndarray | None = None
-    s: np.ndarray | None = None
-    xi: float | None = None
-    eta: float | None = None
-    method: str = ""
-    iterations: int = 0
-    info: dict = field(default_factory=dict)
-
-    @property
-    def residual(self) -> float:
-        return self.residuals.max
 
 
 def disc_projection(z: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -179,7 +103,7 @@ class NormalStep:
     FN: float | None = None
     delta: float | None = None
     offset: np.ndarray | None = None
-    scales: Scales = field(default_factory=Scales)
+    scales: Scales = field(default_factory=lambda: Scales(dimension=3))
     kind = "normal"
 
     def __post_init__(self):
@@ -262,7 +186,7 @@ class TangentialStep:
     Fy: float | None = None
     eta: float | None = None
     phi: float = 0.0
-    scales: Scales = field(default_factory=Scales)
+    scales: Scales = field(default_factory=lambda: Scales(dimension=3))
     kind = "tangential"
 
     def __post_init__(self):
@@ -322,7 +246,7 @@ class TangentialStep:
         fric = float(np.max(np.hypot(r[0], r[1])))
         lx = 0.0 if self.Fx is None else abs(self.area * float(np.sum(t[0])) - self.Fx) / sc.force
         ly = 0.0 if self.Fy is None else abs(self.area * float(np.sum(t[1])) - self.Fy) / sc.force
-        return Residuals(friction=fric, load_x=lx, load_y=ly)
+        return Residuals(friction=fric, load_tangential=lx, load_lateral=ly)
 
     def solution(self, t, xi=None, eta=None, Bt=None, **meta) -> StepSolution:
         """``(t, ξ, η)`` with its slip and rollqp's residuals."""

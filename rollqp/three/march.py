@@ -115,7 +115,7 @@ def _frictionless(contact, kind, nsol, loads, previous, dq, direction):
     free = Loads(xi=0.0 if loads.xi is None else loads.xi, eta=0.0 if loads.eta is None else loads.eta,
                  phi=loads.phi)
     prob = contact.tangential_step(kind, nsol.p, free, previous, dq, direction)
-    return prob.solution(np.zeros((2, contact.grid.n)), method="frictionless", info={"status": "frictionless"})
+    return prob.solution(np.zeros((2, contact.grid.n)), method="frictionless", extras={"status": "frictionless"})
 
 
 def _warm_of(rec):

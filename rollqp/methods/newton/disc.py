@@ -204,7 +204,7 @@ def _solve_normal(method, problem, warm):
     p = np.maximum(x[:n], 0.0) * sc.stress
     Ap = (A @ p)
     return problem.solution(p, x[n] * sc.displacement, Ap=Ap, method=method.name,
-                            iterations=info["directions"], info=info)
+                            iterations=info["directions"], extras=info)
 
 
 def _normal_direction(method, A, s, x, Kx, phi, r, hh, ah, free_delta):
@@ -276,7 +276,7 @@ def _solve_tangential(method, problem, warm):
     n, B = problem.n, problem.B
     V = np.flatnonzero(bh > 0)
     if V.size == 0:   # no contact: no traction (the sliding limit check rejects a nonzero force)
-        return problem.solution(np.zeros((2, n)), 0.0, 0.0, method=method.name, info={"contact": 0})
+        return problem.solution(np.zeros((2, n)), 0.0, 0.0, method=method.name, extras={"contact": 0})
     diag = k * B.diagonal()
     r = method.r if method.r is not None else 1.0 / float(np.mean(np.concatenate([diag[V], diag[n + V]])))
     if warm is not None and warm.t is not None and np.shape(warm.t) == (2, n):
@@ -292,7 +292,7 @@ def _solve_tangential(method, problem, warm):
     t[:, V] = x[:2 * V.size].reshape(2, V.size) * sc.stress
     crp = {j: x[2 * V.size + i] * sc.slip for i, j in enumerate(free)}
     sol = problem.solution(t, crp.get(0), crp.get(1), method=method.name, iterations=info["directions"],
-                           info={**info, "contact": int(V.size)})
+                           extras={**info, "contact": int(V.size)})
     # ‖Φ‖∞ ≤ tol·min(1, r) bounds the residual on the same products; the fresh FFT product of
     # problem.solution can differ by round-off times the condition: 100× is the 2D QPs' residual_limit
     if not sol.residual <= 100 * method.tolerance:
