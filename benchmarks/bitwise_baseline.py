@@ -52,7 +52,7 @@ SHORTEN = {
     "cattaneo-3d": {"discretization.elements": [16, 16], "discretization.distance": 2.0},
     "kalker-circular": {"discretization.elements": [20, 20]},
     "kalker-elliptic": {"discretization.elements": [12, 24]},
-    "ball-in-groove": {"discretization.elements": [10, 30]},
+    "ball-in-groove": {"discretization.elements": [14, 42]},
     "quartic-roller": {"discretization.elements": [12, 24]},
 }
 #: Slow methods run on these scenes only (first-order solvers and the optional QP backends on
