@@ -63,8 +63,8 @@ class LinearFriction:
     def largest(self) -> float:
         return self.mu + abs(self.slope) * self.reach
 
-    def coefficient(self, x_hat, q_hat, direction):
-        return self.mu + self.slope * np.asarray(x_hat, dtype=float)
+    def coefficient(self, points, q_hat, direction):
+        return self.mu + self.slope * np.asarray(points, dtype=float)[0]
 
     def check_strip(self, half_width_hat, q_end_hat, direction):
         """It varies everywhere: it meets every strip."""

@@ -57,7 +57,9 @@ class FrictionLaw(Protocol):
         Its name, the table's ``law`` key.
     kind : {"constant", "spatial", "slip"}
         ``"constant"``: ``mu``, one number (the step problems' fast path). ``"spatial"``: also
-        ``coefficient(x_hat, q_hat, direction) -> (n,) array`` (``μ`` at the nodes, ``a_H`` units) and
+        ``coefficient(points, q_hat, direction) -> (n,) array`` (``μ`` at the ``points`` of the
+        discretization, shape ``(d, n)``: ``x̂`` on a strip, ``(x̂, ŷ)`` on a grid, in the contact's length
+        unit — ``a_H`` on a strip, ``c = √(ab)`` on a grid) and
         ``check_strip(half_width_hat, q_end_hat, direction)`` (the scene's check that it meets the
         strip). ``"slip"``: also ``steady(v) -> (μ, dμ/dv)`` of the slip velocity, ``rolling_speed``,
         ``memory`` and ``weight(dq_hat)`` (:class:`~.bound.SlipBound`), and for the selection of a step's

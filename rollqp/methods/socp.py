@@ -148,7 +148,7 @@ class ConicMethod:
         ref = active_set_refine(problem, sol)
         if ref is not None and ref.residual < sol.residual:
             info = {**sol.info, **raw, "refined": True, "refine_iterations": ref.iterations}
-            return type(sol)(**{**ref.__dict__, "method": self.name, "iterations": sol.iterations, "info": info})
+            return type(sol)(**{**ref.__dict__, "method": self.name, "iterations": sol.iterations, "extras": info})
         sol.info.update(raw, refined=False)
         return sol
 

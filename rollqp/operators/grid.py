@@ -31,13 +31,15 @@ __all__ = ["Contact", "Loads"]
 @dataclass(frozen=True)
 class Loads:
     """The tangential loading of a step: ``Fx`` or ``xi``, ``Fy`` or ``eta`` (exactly one of each
-    pair), and the spin ``phi`` (1/length). Forces on body A, creepages of A relative to B."""
+    pair), and the spin ``phi`` (1/length). Forces on body A, creepages of A relative to B; ``q`` the
+    rolled distance of the step (length units: where a friction law along the surface is read)."""
 
     Fx: float | None = None
     xi: float | None = None
     Fy: float | None = None
     eta: float | None = None
     phi: float = 0.0
+    q: float = 0.0
 
 
 class Contact:
@@ -51,8 +53,10 @@ class Contact:
         ``(A, B)`` of eq. 3D.1 (for the Hertz ellipse and the default profile).
     FN : float
         The nominal normal force: the Hertz ellipse and the scales.
-    mu : float
-        Coulomb's coefficient of friction (``>= 0``).
+    mu : float or FrictionLaw
+        Coulomb's coefficient of friction (``>= 0``), or a friction law along the surface
+        (:class:`rollqp.friction.FrictionLaw` of kind ``"constant"`` or ``"spatial"``: ``μ`` at the grid's
+        points, read at each step's rolled distance, :meth:`coefficient`). ``mu`` is then its reference.
     profile : callable, optional
         ``h(x, y)``, the undeformed distance; default ``A x² + B y²`` (the seam for
         non-Hertzian profiles).
@@ -71,8 +75,13 @@ class Contact:
 
     def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None,
                  model: str = DEFAULT_MODEL):
-        # Coulomb's constant μ only (no laws in 3D yet): a scene's law as it is, a number checked once here
-        self.grid, self.materials, self.mu = grid, materials, as_law(mu).mu
+        # a scene's law as it is, a number checked once here (as_law)
+        law = as_law(mu)
+        if law.kind not in ("constant", "spatial"):
+            raise InputError("contact.friction", f"a 3D contact takes a law of kind 'constant' or 'spatial' (μ at the "
+                                                 f"grid's points); law {law.law!r} is of kind {law.kind!r}")
+        self.law = law
+        self.grid, self.materials, self.mu = grid, materials, law.mu if law.kind == "constant" else float(law.reference)
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
         self.scales = Scales.ellipse(self.ellipse)
@@ -130,9 +139,26 @@ class Contact:
                     c = c - (ops.Atn if off == 0 else ops.shifted("tn", off)) @ pp
         else:
             raise InputError("kind", f"must be 'shift', 'rolling' or 'steady', got {kind!r}")
-        bound = self.mu * np.maximum(p, 0.0)
+        bound = self.bound(p, loads.q, direction)
         return TangentialStep(B, g.area, bound, self.x, self.y, c.reshape(2, g.n), dq, Fx=loads.Fx, xi=loads.xi,
                               Fy=loads.Fy, eta=loads.eta, phi=loads.phi, scales=self.scales)
+
+    def coefficient(self, q: float = 0.0, direction: int = -1):
+        """``μ`` at the grid's points at the rolled distance ``q``: the number ``mu`` for a constant law, else
+        the law's ``coefficient`` at the element centres ``(x, y)/a`` (``a`` the Hertz semi-axis along x,
+        the unit of the scene's distances) and ``q/a`` (:class:`rollqp.friction.FrictionLaw`)."""
+        if self.law.kind == "constant":
+            return self.mu
+        a = self.ellipse.a
+        mu = np.asarray(self.law.coefficient(np.stack([self.x, self.y]) / a, float(q) / a, direction), dtype=float)
+        if mu.shape != (self.grid.n,) or not np.all(np.isfinite(mu) & (mu >= 0)):
+            raise InputError("contact.friction", f"law {self.law.law!r} must give a finite μ >= 0 at each of the "
+                                                 f"{self.grid.n} elements, got shape {mu.shape}")
+        return mu
+
+    def bound(self, p, q: float = 0.0, direction: int = -1) -> np.ndarray:
+        """The traction bound ``μ p⁺`` of the pressure ``p`` at the rolled distance ``q`` (eq. 3D.18)."""
+        return self.coefficient(q, direction) * np.maximum(p, 0.0)
 
     def hertz_start(self, FN: float):
         """The Hertz pressure and approach of ``FN`` as a start for an iterative normal solve: the

@@ -37,13 +37,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError
-from ..friction import Coulomb
+from ..friction import Coulomb, FrictionLaw, parse_friction
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL, get_model
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
 from .checks import MAX_FRICTION, check_scene_name, check_units
 from .core import SceneBase
+from .plain import plain
 from ..validate import choice, integer, number, string, suggestion
 from ..operators.grid import Loads
 from ..profiles.surface import Body, curvatures
@@ -92,7 +93,8 @@ class Contact3D:
 
     @property
     def mu(self) -> float:
-        return float(self.friction)
+        """Coulomb's coefficient, or a law's reference ``μ`` (``load.tangential = Fx/(μ FN)``)."""
+        return float(self.friction.reference)
 
 
 @dataclass(frozen=True)
@@ -157,9 +159,15 @@ def _body(key, b: Body3D) -> Body3D:
 
 
 def _contact(c: Contact3D) -> Contact3D:
-    if isinstance(c.friction, dict):
-        raise InputError("contact.friction", "a 3D scene takes Coulomb's coefficient (a number > 0); friction laws "
-                                             "(docs/friction.md) are two-dimensional")
+    if isinstance(c.friction, dict) or isinstance(c.friction, FrictionLaw) and not isinstance(c.friction, float):
+        law = parse_friction(c.friction)   # the law's own checks, once
+        if law.kind == "slip":
+            raise InputError("contact.friction.law", f"a 3D scene takes Coulomb's coefficient or a law along the "
+                                                     f"surface (kind 'constant' or 'spatial'); {law.law!r} depends on "
+                                                     "the slip velocity, which only 2D scenes take")
+        if c.dimension != 3 or isinstance(c.dimension, bool):
+            raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
+        return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name)
     mu = number("contact.friction", c.friction, f"in [0, {MAX_FRICTION:g}] (Coulomb's coefficient; 0: frictionless)",
                 lambda x: 0 <= x <= MAX_FRICTION)
     if c.dimension != 3 or isinstance(c.dimension, bool):
@@ -368,7 +376,7 @@ class Scene3D(SceneBase):
         val = lambda h: None if h is None else float(h(s))  # noqa: E731
         Fx, Fy = val(ld.tangential), val(ld.lateral)
         return Loads(Fx=None if Fx is None else Fx * cap, xi=val(cr.longitudinal),
-                     Fy=None if Fy is None else Fy * cap, eta=val(cr.lateral), phi=float(cr.spin(s)))
+                     Fy=None if Fy is None else Fy * cap, eta=val(cr.lateral), phi=float(cr.spin(s)), q=float(q))
 
     # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
@@ -385,7 +393,7 @@ class Scene3D(SceneBase):
         return {"name": self.name, "description": self.description, **({"units": self.units} if self.units else {}),
                 "bodies": {k: {f: v for f, v in dataclasses.asdict(b).items() if v is not None}
                            for k, b in (("A", self.A), ("B", self.B))},
-                "contact": {"dimension": 3, "friction": self.contact.friction, "model": self.contact.model},
+                "contact": {"dimension": 3, "friction": plain(self.contact.friction), "model": self.contact.model},
                 "load": loads,
                 "discretization": {**disc, "step": d.step, "distance": d.distance},
                 "solver": solver}

@@ -135,14 +135,14 @@ def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_stat
                       info={"sweeps": sweeps, "normal": nsol.info, "tangential": tsol.info})
 
 
-def _states(contact, p, t, s):
+def _states(contact, p, t, s, q=0.0):
     """0 separation, 1 stick, 2 slip (:func:`~rollqp.problem.grid.element_states`). At ``μ = 0`` (bound
     zero) as in 2D (:func:`rollqp.problem.solution.classify`): an element in contact (``p > 0``) slips
     where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it."""
     if contact.mu == 0:
         moving = np.hypot(*(np.asarray(s, dtype=float).reshape(2, -1) / contact.scales.slip)) > 1e-7
         return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
-    return element_states(np.asarray(t), np.asarray(s), contact.mu * np.maximum(p, 0.0), contact.scales)
+    return element_states(np.asarray(t), np.asarray(s), contact.bound(p, q), contact.scales)
 
 
 def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, phi: float = 0.0, steps: int = 1):
@@ -207,7 +207,7 @@ def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure
     base = np.zeros((2, n)) if start is None else np.asarray(start.t, dtype=float)
     x, best, warm = base, None, None       # best: (change, x, G(x)) of the last accepted base point
     limit = int(np.ceil(MAX_MARCH_DISTANCE * contact.scales.length / dx))
-    bound = contact.mu * np.maximum(nsol.p, 0.0)
+    bound = contact.bound(nsol.p)
     for k in range(1, limit + 1):
         prob = contact.tangential_step("rolling", nsol.p, loads, (nsol.p, x), dx, direction)
         try:
@@ -310,6 +310,6 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                                       warm=warm, pressure=fixed)
         except SolverError as exc:
             raise exc.with_step(k) from None
-        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s))
+        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q))
         yield rec
         prev, warm = rec, (ns, ts)

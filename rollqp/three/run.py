@@ -48,7 +48,7 @@ def prepare(scene, method=None):
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
-    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu,
+    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
                       profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
         contact.move = moving_profile(contact, scene.shape, scene.load.direction)
