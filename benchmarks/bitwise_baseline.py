@@ -61,7 +61,7 @@ SLOW = {"socp-scs": ("kalker-circular",)}
 #: Arrays holding wall-clock times: reported, never part of the verdict.
 VOLATILE = ("step_time", "time", "wall_time", "setup_time", "solve_time")
 #: meta entries that hold times or versions.
-META_VOLATILE = ("time", "elapsed", "version", "versions", "created", "started", "finished", "host", "wall")
+META_VOLATILE = ("time", "elapsed", "seconds", "version", "versions", "created", "started", "finished", "host", "wall")
 
 
 def _scene(name: str):
