@@ -77,11 +77,6 @@ class Coulomb(float):
             raise InputError(f"{KEY}.law", f"must be 'coulomb' for a Coulomb law, got {law!r}")
         return super().__new__(cls, _mu("mu", mu))
 
-    @classmethod
-    def checked(cls, mu: float) -> "Coulomb":
-        """The law of a coefficient a scene has checked already (its own range): not checked again."""
-        return float.__new__(cls, mu)
-
     def __reduce__(self):
         return Coulomb, (float(self),)
 

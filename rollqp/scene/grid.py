@@ -37,12 +37,12 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError
-from ..friction import Coulomb, FrictionLaw, parse_friction
+from ..friction import parse_friction
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL, get_model
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
-from .checks import MAX_FRICTION, check_scene_name, check_units
+from .checks import check_scene_name, check_units
 from .core import SceneBase
 from .plain import plain
 from ..validate import choice, integer, number, string, suggestion
@@ -159,20 +159,14 @@ def _body(key, b: Body3D) -> Body3D:
 
 
 def _contact(c: Contact3D) -> Contact3D:
-    if isinstance(c.friction, dict) or isinstance(c.friction, FrictionLaw) and not isinstance(c.friction, float):
-        law = parse_friction(c.friction)   # the law's own checks, once
-        if law.kind == "slip":
-            raise InputError("contact.friction.law", f"a 3D scene takes Coulomb's coefficient or a law along the "
-                                                     f"surface (kind 'constant' or 'spatial'); {law.law!r} depends on "
-                                                     "the slip velocity, which only 2D scenes take")
-        if c.dimension != 3 or isinstance(c.dimension, bool):
-            raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-        return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name)
-    mu = number("contact.friction", c.friction, f"in [0, {MAX_FRICTION:g}] (Coulomb's coefficient; 0: frictionless)",
-                lambda x: 0 <= x <= MAX_FRICTION)
+    law = parse_friction(c.friction)   # a number is Coulomb's coefficient; a table a law: checked once, here
+    if law.kind == "slip":
+        raise InputError("contact.friction.law", f"a 3D scene takes Coulomb's coefficient or a law along the "
+                                                 f"surface (kind 'constant' or 'spatial'); {law.law!r} depends on "
+                                                 "the slip velocity, which only 2D scenes take")
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-    return Contact3D(Coulomb.checked(mu), 3, get_model(c.model, "contact.model", dimension=3).name)
+    return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name)
 
 
 def _history(v, key):
