@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 
 from .fields import FORCE, STRESS, Field, register
+from .friction import largest
+from .errors import InputError
 
 __all__ = ["friction_power", "dissipation", "friction_work", "step_length", "elastic_energy", "load_work", "balance",
            "steady_identity", "power"]
@@ -132,7 +134,6 @@ def load_work(rows) -> np.ndarray:
 
 def _mu(scene) -> bool:
     """Friction somewhere (a Coulomb μ > 0 or a law of :mod:`rollqp.friction` that is not zero)."""
-    from .friction import largest
     return largest(scene.contact.friction) > 0
 
 
@@ -174,7 +175,6 @@ def steady_identity(res: dict, k: int, direction: int) -> float:
 def power(res: dict, speed: float) -> np.ndarray:
     """Frictional power per unit axial length of each state at the rolling speed ``|V|`` (length/time):
     ``D·|V|`` (force·length/time per length); the density is ``friction_power·|V|``."""
-    from .errors import InputError
     if not (isinstance(speed, (int, float, np.floating)) and np.isfinite(speed) and speed >= 0):
         raise InputError("speed", f"must be a finite number >= 0 (|V|, length/time), got {speed!r}")
     if "dissipation" not in res:

@@ -39,6 +39,7 @@ from typing import Protocol, runtime_checkable
 from ..errors import InputError
 from ..validate import suggestion
 from .laws import FRAMES, MAX_FRICTION, VELOCITY_FORMS, Coulomb, Patch, SlipVelocity, Table
+from ..validate import number
 
 __all__ = ["LAWS", "FrictionLaw", "register", "parse_friction", "as_law", "Coulomb", "Patch", "Table",
            "SlipVelocity", "MAX_FRICTION", "FRAMES", "VELOCITY_FORMS", "law_kind", "reference", "largest"]
@@ -126,7 +127,6 @@ def parse_friction(value) -> FrictionLaw:
     if isinstance(value, FrictionLaw) and dataclasses.is_dataclass(value):
         value = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
     if not isinstance(value, dict):
-        from ..validate import number
         return Coulomb(number(KEY, value, f">= 0 (and <= {MAX_FRICTION:g}), or a table [contact.friction] with law = "
                                           f"{', '.join(map(repr, LAWS))}", lambda x: 0 <= x <= MAX_FRICTION))
     name = value.get("law")

@@ -12,6 +12,9 @@ from ..errors import InputError
 from .grid import ContactOperators
 from .halfspace import halfspace_influence
 from .model import Model
+from .halfspace import undeformed_gap
+from .toeplitz import halfspace_operators
+from .toeplitz import positive_definite_threshold
 
 __all__ = ["HALFSPACE", "BEM", "MIN_BEM_ELEMENT_RATIO"]
 
@@ -29,8 +32,6 @@ def halfspace_operators_of(scene, strip):
     (:func:`~rollqp.influence.toeplitz.positive_definite_threshold`), else an
     :class:`InputError` on ``contact.reference_distance`` as on the dense path.
     """
-    from .halfspace import undeformed_gap
-    from .toeplitz import halfspace_operators, positive_definite_threshold
     t0 = time.perf_counter()
     coupling = scene.coupling_level
     d_ref = scene.reference_distance_value

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
+from ..closedforms import hertz_half_width
+from ..closedforms import hertz_peak_pressure
 
 __all__ = ["Scales"]
 
@@ -50,7 +52,6 @@ class Scales:
     @classmethod
     def hertz(cls, P: float, R: float, Estar: float) -> "Scales":
         """Hertz half-width ``a`` and peak pressure ``p0`` for load ``P`` (docs/formulation.md §12)."""
-        from ..closedforms import hertz_half_width, hertz_peak_pressure
         a = hertz_half_width(P, R, Estar)
         return cls(length=a, stress=hertz_peak_pressure(P, a), modulus=float(Estar))
 

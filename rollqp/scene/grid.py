@@ -52,6 +52,8 @@ from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
 from ..three.hertz import hertz
 from ..materials import Materials
 from ..three.patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
+from ..methods import REFERENCE_METHOD
+from ..methods import scene_method_3d
 
 __all__ = ["Scene3D", "Body3D", "Contact3D", "Creepage3D", "Load3D", "Discretization3D", "Solver3D",
            "scene_from_dict", "MAX_STEPS", "MAX_RESULT_BYTES"]
@@ -311,7 +313,6 @@ class Scene3D(SceneBase):
         None for two paraboloids."""
         if self.shape.hertzian:
             return None
-        from ..methods import REFERENCE_METHOD, scene_method_3d
         A, B = self.shape.curvatures()
         guess = (A, B) if A > 0 and B > 0 else None
         return computed_patch(self.shape.at(0.0), self.grid, self.materials, self.load.normal,

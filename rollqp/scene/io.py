@@ -27,6 +27,16 @@ from .checks import safe_name
 from .core import Scene, SceneBase
 from .core import scene_from_dict as scene_from_dict_2d
 from .plain import part_dict, plain, scene_to_dict, scene_to_toml  # noqa: F401 - re-exported
+from .schema import Body
+from .schema import Contact
+from .schema import Discretization
+from .schema import Load
+from .schema import SolverSettings
+from .grid import Body3D
+from .grid import Contact3D
+from .grid import Discretization3D
+from .grid import Load3D
+from .grid import Solver3D
 
 __all__ = ["load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes", "scene_to_dict", "scene_to_toml"]
 
@@ -73,11 +83,9 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
 def _table_keys(dimension: int) -> dict:
     """``{table: key names}`` of the scene tables of ``dimension`` (their dataclass fields)."""
     if dimension == 2:
-        from .schema import Body, Contact, Discretization, Load, SolverSettings
         classes = {"bodies": Body, "contact": Contact, "load": Load, "discretization": Discretization,
                    "solver": SolverSettings}
     else:
-        from .grid import Body3D, Contact3D, Discretization3D, Load3D, Solver3D
         classes = {"bodies": Body3D, "contact": Contact3D, "load": Load3D, "discretization": Discretization3D,
                    "solver": Solver3D}
     return {t: {f.name for f in dataclasses.fields(c)} for t, c in classes.items()}
