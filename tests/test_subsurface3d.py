@@ -178,3 +178,49 @@ def test_bad_input_names_the_argument():
         assert err.value.key == key
     assert parse_plane(" x = 2.5") == ("x", 2.5) and parse_line("y=1,x=-2") == (-2.0, 1.0)
     assert COMPONENTS == ("sxx", "syy", "szz", "sxy", "sxz", "syz")
+
+
+# ------------------------------------------------------------------------------ the command
+@pytest.fixture(scope="module")
+def result3d(tmp_path_factory):
+    from rollqp import load_scene
+    from rollqp.three.run import run
+    scene = load_scene("cattaneo-3d").replace(**{"discretization.elements": [12, 12], "discretization.distance": 1.0,
+                                                 "name": "cattaneo-3d-coarse"})
+    path = tmp_path_factory.mktemp("s3") / "r.npz"
+    run(scene).save(path)
+    return path
+
+
+def test_command_on_a_3d_result(result3d, tmp_path, capsys):
+    """``rollqp stresses R.npz --step K`` with a plane, a line and depths: the stress file holds the section's
+    points and every quantity, equal to the API's; the figure is written; the peaks are printed."""
+    from rollqp import cli
+    from rollqp.result import load_result
+    from rollqp.subsurface3d import stresses3d
+    out, fig = tmp_path / "s.npz", tmp_path / "s.png"
+    assert cli.main(["stresses", str(result3d), "--step", "-1", "--plane", "x=0.02", "--depths", "0.05,0.1,0.3",
+                     "--out", str(out), "--plot", str(fig)]) == 0
+    text = capsys.readouterr().out
+    assert "peak von Mises" in text and "plane x = 0.02" in text
+    assert fig.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    with np.load(out, allow_pickle=False) as f:
+        got = {k: f[k] for k in f.files}
+    sf = stresses3d(load_result(result3d), -1, plane=("x", 0.02), depths=[0.05, 0.1, 0.3])
+    assert got["x"].shape == got["sxx"].shape == (3, 12) and np.all(got["x"] == 0.02)
+    for k in COMPONENTS + ("von_mises", "s1", "s3"):
+        np.testing.assert_array_equal(got[k], sf[k])
+    assert got["max_von_mises"][0] == sf.values["von_mises"].max()
+    assert cli.main(["stresses", str(result3d), "--step", "0", "--line", "x=0,y=0", "--plot", str(fig)]) == 0
+
+
+@pytest.mark.parametrize("args, key", [(["--grid", "3,4"], "--grid"), (["--plane", "z=1"], "--plane"),
+                                       (["--line", "x=1"], "--line"), (["--depths", "0.1,0"], "--depths"),
+                                       (["--step", "99"], "--step"),
+                                       (["--plane", "y=0", "--line", "x=0,y=0"], "--line")])
+def test_command_refuses_bad_3d_input_in_one_line(result3d, args, key, capsys):
+    from rollqp import cli
+    argv = ["stresses", str(result3d)] + (["--step", "1"] if "--step" not in args else []) + args
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"rollqp: error: {key}:"), err
