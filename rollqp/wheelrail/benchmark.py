@@ -53,7 +53,8 @@ class Row:
 
 def table(scene, cases=None, sides=("left", "right"), progress=None):
     """Run the benchmark positions ``cases`` (1-based; default all 21) of the wheel–rail ``scene`` (its
-    profiles, materials, friction, load and grid) for ``sides``: a list of :class:`Row`."""
+    profiles, materials, friction, load and grid) for ``sides``: a list of :class:`Row` (``progress``: called
+    with the rows of each position and wheel as they are done)."""
     from .run import solve_scene
     cases = list(range(1, len(POSITIONS) + 1)) if cases is None else list(cases)
     for c in cases:
@@ -78,7 +79,7 @@ def table(scene, cases=None, sides=("left", "right"), progress=None):
                         "FN": p.FN, "FX": p.Fx, "FS": p.Fs, "MN": p.Mn, "APPROACH": p.approach, "PMAX": p.pmax,
                         "AREA": p.area}, elapsed))
             if progress is not None:
-                progress(c, side, elapsed)
+                progress([r for r in rows if r.case == c and r.wheel == side])
     return rows
 
 

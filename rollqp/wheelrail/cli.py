@@ -44,6 +44,7 @@ def add_parser(sub) -> None:
     t.add_argument("--sides", default="left,right", help="left, right or left,right (default)")
     t.add_argument("--reference", action="append", metavar="REF_OUT",
                    help="CONTACT's reference output(s) to compare with (its .ref_out of the left and/or right wheel)")
+    t.add_argument("--element-size", type=float, help="the elements' size dx = ds (mm; default the scene's)")
     t.add_argument("--out", help="write the rows as JSON to this file")
 
 
@@ -63,6 +64,11 @@ def cmd_table(args) -> int:
     scene = load_scene(args.scene)
     if getattr(scene, "family", None) != "wheel-rail":
         raise InputError("SCENE", f"{scene.name!r} is not a wheel-rail scene ([contact] kind = \"wheel-rail\")")
+    if args.element_size is not None:
+        try:
+            scene = scene.replace(**{"discretization.element_size": args.element_size})
+        except InputError as err:
+            raise InputError("--element-size", str(err).split(": ", 1)[-1]) from None
     sides = tuple(s.strip() for s in args.sides.split(",") if s.strip())
     if not sides or any(s not in ("left", "right") for s in sides):
         raise InputError("--sides", f"must be left, right or left,right, got {args.sides!r}")
@@ -73,20 +79,23 @@ def cmd_table(args) -> int:
     load = scene.data["wheelset"]["load"] or 1.0
     print(f"{'case':>4} {'wheel':>5} {'p':>1} {'y_rail':>8} {'delta':>8} {'FN':>8} {'Fx':>8} {'Fs':>8} "
           f"{'xi':>10} {'eta':>10} {'phi':>10} {'s':>6}" + ("   d_y_rail  dFN/Fz  dFx/Fz  dFs/Fz" if refs else ""))
-    rows = table(scene, _cases(args.cases), sides)
     out = []
-    for r in rows:
-        v = r.values
-        line = (f"{r.case:>4} {r.wheel:>5} {r.patch:>1} {v['YCP_R']:8.3f} {v['DELTCP']:8.4f} {v['FN']:8.1f} "
-                f"{v['FX']:8.1f} {v['FS']:8.1f} {v['CKSI']:10.3e} {v['CETA']:10.3e} {v['CPHI']:10.3e} {r.time:6.2f}")
-        ref = refs.get((r.wheel, r.case))
-        if ref and len(ref["patches"]) >= r.patch:
-            p = ref["patches"][r.patch - 1]
-            line += (f"   {v['YCP_R'] - p['YCP_R']:+8.3f}  {(v['FN'] - p['FN']) / load:+6.2%}  "
-                     f"{(v['FX'] - p['FX']) / load:+6.2%}  {(v['FS'] - p['FS']) / load:+6.2%}")
-        print(line, flush=True)
-        out.append({"case": r.case, "wheel": r.wheel, "patch": r.patch, "time": r.time,
-                    **{k: float(x) for k, x in v.items()}})
+
+    def show(rows):
+        for r in rows:
+            v = r.values
+            line = (f"{r.case:>4} {r.wheel:>5} {r.patch:>1} {v['YCP_R']:8.3f} {v['DELTCP']:8.4f} {v['FN']:8.1f} "
+                    f"{v['FX']:8.1f} {v['FS']:8.1f} {v['CKSI']:10.3e} {v['CETA']:10.3e} {v['CPHI']:10.3e} {r.time:6.2f}")
+            ref = refs.get((r.wheel, r.case))
+            if ref and len(ref["patches"]) >= r.patch:
+                p = ref["patches"][r.patch - 1]
+                line += (f"   {v['YCP_R'] - p['YCP_R']:+8.3f}  {(v['FN'] - p['FN']) / load:+6.2%}  "
+                         f"{(v['FX'] - p['FX']) / load:+6.2%}  {(v['FS'] - p['FS']) / load:+6.2%}")
+            print(line, flush=True)
+            out.append({"case": r.case, "wheel": r.wheel, "patch": r.patch, "time": r.time,
+                        **{k: float(x) for k, x in v.items()}})
+
+    table(scene, _cases(args.cases), sides, progress=show)
     if args.out:
         from ..atomic import written
         with written(args.out, suffix=".json") as (fh, _):

@@ -180,7 +180,8 @@ def figure(res: dict, scene, path) -> None:
 def crossval(scene, methods=None, tolerance: float = 1e-10):
     """Every patch's tangential step solved again by ``methods`` (default ``socp-clarabel``), posed from the
     run's steady state (one rolling step of ``Δq = dx`` from it, whose answer is that state again) and
-    compared with Newton's: ``[(wheel, patch, method, |dp|/p0, |dt|/(μ p0), residual, seconds)]``."""
+    compared with Newton's: ``[(wheel, patch, method, |dp|/p0, |dt|/(μ p0), residual, seconds, raw |dt|)]``
+    (raw: the conic solver's own answer before rollqp's active-set refinement, None without one)."""
     from ..methods import get_method
     methods = list(methods or ["socp-clarabel"])
     wheels = solve_scene(scene)
@@ -199,16 +200,20 @@ def crossval(scene, methods=None, tolerance: float = 1e-10):
                 nsol, tsol, _ = coupled_step(c, m, rec.FN, "rolling", loads, (rec.p, rec.t), c.grid.dx, -1)
                 dp = float(np.max(np.abs(nsol.p - rec.p))) / sc.stress
                 dt = float(np.max(np.abs(tsol.t - rec.t))) / (c.mu * sc.stress)
-                rows.append((w.side, k, name, dp, dt, max(nsol.residual, tsol.residual), time.perf_counter() - t0))
+                rt = tsol.info.get("raw")
+                raw = None if rt is None else float(np.max(np.abs(rt["t"] - rec.t))) / (c.mu * sc.stress)
+                rows.append((w.side, k, name, dp, dt, max(nsol.residual, tsol.residual), time.perf_counter() - t0,
+                             raw))
     return rows
 
 
 def crossval_report(rows, tolerance) -> tuple[str, bool]:
     ok = all(max(r[3], r[4]) <= AGREEMENT for r in rows)
     lines = [f"wheel-rail cross-check: every patch's steady tangential step solved again (tolerance {tolerance:g})"]
-    for side, k, name, dp, dt, res, sec in rows:
+    for side, k, name, dp, dt, res, sec, raw in rows:
         verdict = "agree" if max(dp, dt) <= AGREEMENT else f"DISAGREE (beyond {AGREEMENT:g})"
-        lines.append(f"  {side} patch {k}, {name}: {verdict}: max |dp| {dp:.1e} p0, |dt| {dt:.1e} mu p0; residual "
-                     f"{res:.1e}; {sec:.2f} s")
+        rawtext = "" if raw is None else f" (the solver's own answer before the active-set refinement: |dt| {raw:.1e})"
+        lines.append(f"  {side} patch {k}, {name}: {verdict}: max |dp| {dp:.1e} p0, |dt| {dt:.1e} mu p0{rawtext}; "
+                     f"residual {res:.1e}; {sec:.2f} s")
     return "\n".join(lines), ok
 

@@ -75,7 +75,7 @@ class PatchResult:
     Fx: float
     Fs: float
     Mn: float
-    approach: float
+    approach: float               # the rigid approach: the largest overlap of the undeformed surfaces along e_n
     area: float
     pmax: float
     x: np.ndarray
@@ -277,7 +277,7 @@ def _tangential(wheelset, st, patch, contact, nsol, method, side, track, dz):
     Fx, Fs, Mn = contact.moments(rec.t)
     elapsed = time.perf_counter() - t0
     return PatchResult(side, patch.origin.copy(), patch.angle, float(yr), float(zr), wp, (xi, eta, phi), FN, Fx, Fs,
-                       Mn, float(nsol.delta), g.area * float(np.count_nonzero(nsol.p > 0)), float(np.max(nsol.p)),
+                       Mn, patch.overlap + float(nsol.delta), g.area * float(np.count_nonzero(nsol.p > 0)), float(np.max(nsol.p)),
                        g.x, g.y, nsol.p, rec.t, rec.state, float(rec.residual), int(rec.iterations), elapsed, contact,
                        rec)
 

@@ -21,10 +21,11 @@ The velocity of a wheel material point ``p`` relative to the frame moving with t
 forward speed ``V``: ``v = (0, v_y, v_z) + ω × (p − C)``, with ``ω = φ̇ e_x + ψ̇ R_x(φ) e_z + Ω R e_y``
 (``Ω`` the angular velocity about the axle, negative when rolling forward). The rail's material moves
 at ``(−V, 0, 0)``. The creepages of a patch with axes ``(e_x, e_s, e_n)`` are the rigid slip of the
-rail (body A, CONTACT's body 1) relative to the wheel over ``V`` (WR.3):
+rail (body A, CONTACT's body 1) relative to the wheel over the rolling speed ``V_r = |½(v_A + v_B)|``
+in the contact plane (the mean speed of the two surfaces through the contact, CONTACT's VELOC) (WR.3):
 
 .. math::
-    ξ = (v_A − v_B)·e_x / V,\quad η = (v_A − v_B)·e_s / V,\quad φ = −ω·e_n / V .
+    ξ = (v_A − v_B)·e_x / V_r,\quad η = (v_A − v_B)·e_s / V_r,\quad φ = −ω·e_n / V_r .
 """
 from __future__ import annotations
 
@@ -173,4 +174,13 @@ class Wheelset:
         vB = np.array([0.0, state.vy, state.vz]) + np.cross(om, np.asarray(W) - self.centre(state))
         vA = np.array([-state.speed, 0.0, 0.0])
         rel = vA - vB
-        return (float(rel @ ex) / state.speed, float(rel @ es) / state.speed, float(-(om @ en)) / state.speed)
+        mean = 0.5 * (vA + vB)
+        V = math.hypot(float(mean @ ex), float(mean @ es))        # the rolling speed in the contact plane
+        return float(rel @ ex) / V, float(rel @ es) / V, float(-(om @ en)) / V
+
+    def rolling_speed(self, state: State, W, ex, es) -> float:
+        """``|½(v_A + v_B)|`` in the contact plane: the speed the creepages are relative to (WR.3)."""
+        om = self.angular_velocity(state)
+        vB = np.array([0.0, state.vy, state.vz]) + np.cross(om, np.asarray(W) - self.centre(state))
+        mean = 0.5 * (np.array([-state.speed, 0.0, 0.0]) + vB)
+        return math.hypot(float(mean @ ex), float(mean @ es))
