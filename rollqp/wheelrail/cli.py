@@ -25,7 +25,7 @@ def _check(kept, scene) -> str:  # pragma: no cover - no steps are kept
 def _crossval(scene, step, methods) -> int:
     if step not in (None, 0):
         raise InputError("--step", f"a wheel-rail scene is one state (step 0), got {step!r}")
-    rows = crossval(scene, methods or ["socp-clarabel"], tolerance=scene.solver.tolerance)
+    rows = crossval(scene, methods, tolerance=scene.solver.tolerance)
     text, ok = crossval_report(rows, scene.solver.tolerance)
     print(text)
     return 0 if ok else 1

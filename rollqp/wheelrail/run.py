@@ -60,7 +60,8 @@ class WheelRailResult:
         self.scene, self.wheels, self.method, self.wall = scene, wheels, method, wall
 
     def arrays(self) -> dict:
-        from .. import __version__
+        from ..three.run import _versions
+        from ..version import __version__
         P = [p for w in self.wheels for p in w.patches]
         a = {"patch_wheel": np.array([0 if p.wheel == "left" else 1 for p in P], dtype=np.int64)}
         for key, attr in (("patch_FN", "FN"), ("patch_Fx", "Fx"), ("patch_Fy", "Fs"), ("patch_Mz", "Mn"),
@@ -83,7 +84,7 @@ class WheelRailResult:
             a[f"patch{k}_px"], a[f"patch{k}_py"] = g.field(p.t[0]), g.field(p.t[1])
             a[f"patch{k}_state"] = g.field(p.state).astype(np.int8)
         a["meta"] = np.array(json.dumps({"scene": self.scene.to_dict(), "method": self.method, "kind": "wheel-rail",
-                                         "version": __version__, "wall": self.wall}))
+                                         "rollqp": __version__, "versions": dict(_versions()), "wall": self.wall}))
         return a
 
     def save(self, out) -> None:
@@ -178,12 +179,12 @@ def figure(res: dict, scene, path) -> None:
 
 
 def crossval(scene, methods=None, tolerance: float = 1e-10):
-    """Every patch's tangential step solved again by ``methods`` (default ``socp-clarabel``), posed from the
+    """Every patch's tangential step solved again by ``methods`` (default: the installed conic methods, :func:`default_crossval_methods`), posed from the
     run's steady state (one rolling step of ``Δq = dx`` from it, whose answer is that state again) and
-    compared with Newton's: ``[(wheel, patch, method, |dp|/p0, |dt|/(μ p0), residual, seconds, raw |dt|)]``
+    compared with the run's: ``[(wheel, patch, method, |dp|/p0, |dt|/(μ p0), residual, seconds, raw |dt|)]``
     (raw: the conic solver's own answer before rollqp's active-set refinement, None without one)."""
     from ..methods import get_method
-    methods = list(methods or ["socp-clarabel"])
+    methods = list(methods or default_crossval_methods(scene))
     wheels = solve_scene(scene)
     rows = []
     for w in wheels:
@@ -205,6 +206,13 @@ def crossval(scene, methods=None, tolerance: float = 1e-10):
                 rows.append((w.side, k, name, dp, dt, max(nsol.residual, tsol.residual), time.perf_counter() - t0,
                              raw))
     return rows
+
+
+def default_crossval_methods(scene) -> list:
+    """The installed conic methods of ``rollqp crossval`` other than the scene's own."""
+    from ..methods import CROSSVAL_METHODS_3D, available_methods
+    installed = set(available_methods(3))
+    return [m for m in CROSSVAL_METHODS_3D if m in installed and m != scene.solver.method]
 
 
 def crossval_report(rows, tolerance) -> tuple[str, bool]:

@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ..errors import InputError
+from ..methods import DEFAULT_METHOD, require_3d
 from ..scene.core import SceneBase
 from ..validate import suggestion
 
@@ -62,7 +63,7 @@ KEYS = {
                  "wheel_E": None, "wheel_nu": None, "rail_E": None, "rail_nu": None},
     "track": {"gauge": 1435.0, "gauge_height": 14.0, "cant": 0.0},
     "discretization": {"element_size": REQUIRED, "combine": 4.0, "separate_angle": math.pi / 2},
-    "solver": {"method": "newton", "tolerance": 1e-10},
+    "solver": {"method": DEFAULT_METHOD, "tolerance": 1e-10},
 }
 TOP = {"name": None, "description": "", "units": "N-mm"}
 SIDES = ("left", "right", "both")
@@ -172,40 +173,13 @@ class WheelRailScene(SceneBase):
         return (e, e) if isinstance(e, float) else tuple(e)
 
 
-def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene") -> WheelRailScene:
-    """Validate a wheel–rail scene's nested dict (module docstring); every error names its key."""
-    if not isinstance(d, dict):
-        raise InputError("scene", "must be a table")
-    out = {}
-    for k, v in d.items():
-        if k not in TOP and k not in KEYS:
-            raise InputError(k, f"unknown key of a wheel-rail scene{suggestion(k, [*TOP, *KEYS])}; tables: "
-                                f"{', '.join(KEYS)}")
-    for k, default in TOP.items():
-        out[k] = d.get(k, default)
-    out["name"] = str(out["name"] or default_name)
-    for k in ("name", "description", "units"):
-        if not isinstance(out[k], str):
-            raise InputError(k, f"must be a string, got {out[k]!r}")
-    for table, keys in KEYS.items():
-        given = d.get(table, {})
-        if not isinstance(given, dict):
-            raise InputError(table, "must be a table")
-        for k in given:
-            if k not in keys:
-                raise InputError(f"{table}.{k}", f"unknown key{suggestion(k, keys)}; keys of [{table}]: "
-                                                 f"{', '.join(keys)}")
-        t = {}
-        for k, default in keys.items():
-            if k not in given and default is REQUIRED:
-                raise InputError(f"{table}.{k}", "is required in a wheel-rail scene")
-            t[k] = given.get(k, default)
-        out[table] = t
-    c = out["contact"]
+def _check_contact(c):
     if c["dimension"] != 3 or c["kind"] != "wheel-rail":
         raise InputError("contact.kind", "a wheel-rail scene has dimension = 3 and kind = \"wheel-rail\"")
     c["friction"] = _real("contact.friction", c["friction"], lo=0.0, hi=10.0)
-    w = out["wheelset"]
+
+
+def _check_wheelset(w):
     for k in ("wheel_profile", "rail_profile"):
         if not isinstance(w[k], str) or not w[k]:
             raise InputError(f"wheelset.{k}", f"must be a file name, got {w[k]!r}")
@@ -237,6 +211,9 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     for k in ("nu", "wheel_nu", "rail_nu"):
         if w[k] is not None:
             w[k] = _real(f"wheelset.{k}", w[k], lo=-0.99, hi=0.5)
+
+
+def _check_rest(out):
     t = out["track"]
     t["gauge"] = _real("track.gauge", t["gauge"], positive=True)
     t["gauge_height"] = _real("track.gauge_height", t["gauge_height"], positive=True)
@@ -253,10 +230,43 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     disc["separate_angle"] = _real("discretization.separate_angle", disc["separate_angle"], lo=0.0, hi=math.pi)
     s = out["solver"]
     s["tolerance"] = _real("solver.tolerance", s["tolerance"], lo=1e-14, hi=1e-3)
-    from ..methods import require_3d
     if not isinstance(s["method"], str):
         raise InputError("solver.method", f"must be a method name, got {s['method']!r}")
     require_3d(s["method"], "solver.method")
+
+
+def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene") -> WheelRailScene:
+    """Validate a wheel–rail scene's nested dict (module docstring); every error names its key."""
+    if not isinstance(d, dict):
+        raise InputError("scene", "must be a table")
+    out = {}
+    for k, v in d.items():
+        if k not in TOP and k not in KEYS:
+            raise InputError(k, f"unknown key of a wheel-rail scene{suggestion(k, [*TOP, *KEYS])}; tables: "
+                                f"{', '.join(KEYS)}")
+    for k, default in TOP.items():
+        out[k] = d.get(k, default)
+    out["name"] = str(out["name"] or default_name)
+    for k in ("name", "description", "units"):
+        if not isinstance(out[k], str):
+            raise InputError(k, f"must be a string, got {out[k]!r}")
+    for table, keys in KEYS.items():
+        given = d.get(table, {})
+        if not isinstance(given, dict):
+            raise InputError(table, "must be a table")
+        for k in given:
+            if k not in keys:
+                raise InputError(f"{table}.{k}", f"unknown key{suggestion(k, keys)}; keys of [{table}]: "
+                                                 f"{', '.join(keys)}")
+        t = {}
+        for k, default in keys.items():
+            if k not in given and default is REQUIRED:
+                raise InputError(f"{table}.{k}", "is required in a wheel-rail scene")
+            t[k] = given.get(k, default)
+        out[table] = t
+    _check_contact(out["contact"])
+    _check_wheelset(out["wheelset"])
+    _check_rest(out)
     scene = WheelRailScene(out, source=str(source))
     scene.materials()           # E and nu given
     return scene
