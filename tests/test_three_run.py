@@ -173,12 +173,8 @@ def test_crossval_step_out_of_range_is_one_line():
         crossval(coarse("kalker-elliptic"), methods=["qp-osqp"])
 
 
-def test_spot_steps_fit_the_budget():
-    assert spot_steps(10) == [0, 5, 10]
-    assert spot_steps(10, 100) == [0, 5, 10]            # 100 contact elements: well inside the budget
-    assert spot_steps(10, 100, budget=0.0) == []
-    one = spot_steps(10, 812, budget=6.0)               # one conic step on 812 elements: ~5 s
-    assert one == [10]
+def test_spot_steps_are_the_first_middle_and_last():
+    assert spot_steps(10) == [0, 5, 10] and spot_steps(0) == [0]
 
 
 # ------------------------------------------------------------------------------- command line
@@ -222,7 +218,7 @@ def test_cli_refuses_osqp_on_a_3d_scene(tmp_path, capsys, monkeypatch):
 
 # ------------------------------------------------------------------------------- the built-ins
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["kalker-circular", "kalker-elliptic", "cattaneo-3d"])
+@pytest.mark.parametrize("name", ["kalker-circular", "kalker-elliptic", "cattaneo-3d", "ball-in-groove"])
 def test_builtin_3d_scene_runs_and_crossvalidates(name, tmp_path):
     """The built-in scene at its own grid: run with Newton (seconds), its figure, and every step
     solved again by the SOCP backends (the conic solves take minutes on the 40 × 40 grid)."""

@@ -35,7 +35,7 @@ def _field_panel(ax, res, e, mu, k):
     ax.plot(np.cos(th), e.b / e.a * np.sin(th), "k-", lw=0.8)
     step = max(1, int(np.ceil(max(x.size, y.size) / ARROWS)))
     sl = (slice(None, None, step), slice(None, None, step))
-    q = mu * e.p0
+    q = (mu or 1.0) * e.p0
     tx, ty, st = res["px"][k][sl] / q, res["py"][k][sl] / q, state[sl]
     big = float(np.max(np.hypot(tx, ty), initial=0.0))
     spacing = step * float(min(np.diff(x[:2])[0] if x.size > 1 else 1, np.diff(y[:2])[0] if y.size > 1 else 1))
@@ -86,7 +86,7 @@ def _history_panel(ax, res, e, mu, FN, braked):
 def _centre_line_panel(ax, res, e, mu):
     j0 = int(np.argmin(np.abs(res["y"])))
     x = res["x"] / e.a
-    q = mu * e.p0
+    q = (mu or 1.0) * e.p0
     st = res["state"][-1][j0]
     tx, ty = res["px"][-1][j0] / q, res["py"][-1][j0] / q
     big = float(np.max(np.abs(np.concatenate([tx, ty])), initial=0.0))
@@ -123,7 +123,7 @@ def three_figure(res, scene=None, path: str | None = None, title: str | None = N
     xi, eta, phi = (float(v) for v in res["creepage"][-1])
     method = meta(res).get("method", "")
     fig.suptitle(title or (f"{scene.name}: {scene.description}\n[a/b = {e.a / e.b:.3g}, mu = {mu:g}, "
-                           f"xi = {xi:.3g}, eta = {eta:.3g}, phi = {phi:.3g}, Fx = {float(res['Fx'][-1]) / (mu * FN):.3f} "
-                           f"mu FN, Fy = {float(res['Fy'][-1]) / (mu * FN):.3f} mu FN" + (f", {method}]" if method else "]")),
+                           f"xi = {xi:.3g}, eta = {eta:.3g}, phi = {phi:.3g}, Fx = {float(res['Fx'][-1]) / ((mu or 1.0) * FN):.3f} "
+                           f"mu FN, Fy = {float(res['Fy'][-1]) / ((mu or 1.0) * FN):.3f} mu FN" + (f", {method}]" if method else "]")),
                  fontsize=9)
     return finish(fig, path)

@@ -256,7 +256,7 @@ def _raw_distance(meta: dict, rec: StepRecord, contact) -> bool:
     if rp is not None:
         row["dp"] = max(row["dp"], float(np.max(np.abs(rp["p"] - rec.p))) / sc.stress)
     if rt is not None:
-        row["dt"] = max(row["dt"], float(np.max(np.abs(rt["t"] - rec.t))) / (contact.mu * sc.stress))
+        row["dt"] = max(row["dt"], float(np.max(np.abs(rt["t"] - rec.t))) / ((contact.mu or 1.0) * sc.stress))
     row["steps"] += 1
     return True
 

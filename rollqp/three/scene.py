@@ -5,7 +5,7 @@ table here) describes two bodies with principal radii in x (rolling) and y (late
 normal force and rolling in x with creepages or tangential forces::
 
     name, description, units
-    [bodies.A] [bodies.B]   radius, radius_y (> 0 or inf), E, nu
+    [bodies.A] [bodies.B]   radius, radius_y (> 0 convex, < 0 concave, or inf), E, nu
     [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace")
     [load]                  normal (FN), tangential (Fx/(μFN)), lateral (Fy/(μFN)),
                             creepage = { longitudinal = ξ, lateral = η, spin = φ },
@@ -19,8 +19,8 @@ the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a
 (:mod:`rollqp.histories`), ``a`` the Hertz semi-axis along x.
 
 Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
-allowed range: radii ``> 0`` (or ``inf``), a concentrated contact (not both bodies straight in one
-direction), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
+allowed range: radii nonzero (``< 0`` concave, ``inf`` straight), a concentrated contact (the summed
+curvature positive in both directions, eq. 3D.1), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
 element aspect ratio ``dx/dy`` in :data:`rollqp.three.grid.ASPECT_RANGE`, the forces below the sliding
 limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
@@ -52,6 +52,11 @@ from .materials import Materials
 __all__ = ["Scene3D", "Body3D", "Contact3D", "Creepage3D", "Load3D", "Discretization3D", "Solver3D",
            "scene_from_dict", "MAX_STEPS", "MAX_RESULT_BYTES"]
 
+#: Largest magnitude of a prescribed creepage ξ, η, and of the spin's rigid slip ``φ·max(a, b)`` at the
+#: contact's edge. A creepage is a slip velocity over the rolling speed: at 1 the bodies slide as fast as
+#: they roll, two decades beyond the onset of full sliding of any contact the half-space model holds
+#: (about ``3μ a/R``, ``a/R`` small); a larger value is a typing error, not a rolling contact.
+MAX_CREEPAGE = 1.0
 #: Largest number of rolling steps of a 3D scene.
 MAX_STEPS = 100_000
 #: Largest result a 3D scene may ask for (bytes: six fields of 8 bytes per element and state).
@@ -62,8 +67,8 @@ STARTS = ("braked", "rolling")
 # =========================================================================== parts
 @dataclass(frozen=True)
 class Body3D:
-    """One body: principal radii ``radius`` (x–z plane) and ``radius_y`` (y–z plane), ``> 0`` or
-    ``inf`` (a straight generator; both ``inf``: a plane); Young's modulus ``E > 0``, Poisson's ratio
+    """One body: principal radii ``radius`` (x–z plane) and ``radius_y`` (y–z plane), ``> 0`` (convex),
+    ``< 0`` (concave: a groove) or ``inf`` (a straight generator; both ``inf``: a plane); Young's modulus ``E > 0``, Poisson's ratio
     ``nu`` in (−1, 0.5)."""
 
     radius: float
@@ -135,8 +140,9 @@ class Solver3D:
 
 # =========================================================================== part checks
 def _radius(key, v) -> float:
-    if not (isinstance(v, (int, float)) and not isinstance(v, bool)) or math.isnan(v) or v <= 0:
-        raise InputError(key, f"must be a number > 0 (or inf for a straight generator), got {v!r}")
+    if not (isinstance(v, (int, float)) and not isinstance(v, bool)) or math.isnan(v) or v == 0:
+        raise InputError(key, f"must be a nonzero number (> 0 convex, < 0 concave, inf for a straight generator), "
+                              f"got {v!r}")
     return float(v)
 
 
@@ -150,8 +156,8 @@ def _contact(c: Contact3D) -> Contact3D:
     if isinstance(c.friction, dict):
         raise InputError("contact.friction", "a 3D scene takes Coulomb's coefficient (a number > 0); friction laws "
                                              "(docs/friction.md) are two-dimensional")
-    mu = number("contact.friction", c.friction, f"in (0, {MAX_FRICTION:g}] (Coulomb's coefficient)",
-                lambda x: 0 < x <= MAX_FRICTION)
+    mu = number("contact.friction", c.friction, f"in [0, {MAX_FRICTION:g}] (Coulomb's coefficient; 0: frictionless)",
+                lambda x: 0 <= x <= MAX_FRICTION)
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
     return Contact3D(mu, 3, choice("contact.model", c.model, (DEFAULT_MODEL,)))
@@ -228,10 +234,10 @@ class Scene3D(SceneBase):
     >>> s = load_scene("kalker-circular")
     >>> s.dimension, s.grid.nx, s.grid.ny, round(s.ellipse.a, 4), s.n_steps
     (3, 40, 40, 0.5857, 64)
-    >>> s.replace(**{"bodies.A.radius": -1.0})
+    >>> s.replace(**{"bodies.A.radius": 0.0})
     Traceback (most recent call last):
     ...
-    rollqp.errors.InputError: bodies.A.radius: must be a number > 0 (or inf for a straight generator), got -1.0
+    rollqp.errors.InputError: bodies.A.radius: must be a nonzero number (> 0 convex, < 0 concave, inf for a straight generator), got 0.0
     """
 
     name: str
@@ -384,13 +390,16 @@ def _check_whole(scene) -> None:
     _check_grid(scene)
     _check_work(scene)
     _check_sliding_limit(scene)
+    _check_creepages(scene)
 
 
 def _check_ellipse(scene) -> None:
     try:
         e = scene.ellipse
     except InputError as err:
-        key = "bodies.A.radius" if err.key in ("A", "bodies.A.radius") else "bodies.A.radius_y"
+        if err.key.startswith("bodies."):
+            raise
+        key = "bodies.A.radius" if err.key == "A" else "bodies.A.radius_y"
         raise InputError(key, str(err).split(": ", 1)[-1]) from None
     if not all(math.isfinite(v) and v > 0 for v in (e.a, e.b, e.p0, e.delta)):
         raise InputError("load.normal", f"the Hertz ellipse of FN = {scene.load.normal!r} with these radii and moduli "
@@ -443,10 +452,35 @@ def _check_sliding_limit(scene) -> None:
     fy = ld.lateral(s) if ld.lateral is not None else 0.0
     r = np.hypot(fx, fy) * np.ones_like(s)
     k = int(np.argmax(r))
+    if scene.mu == 0 and r[k] != 0:   # as in 2D (rollqp.scene.checks.check_tangential)
+        key = "load.tangential" if ld.tangential is not None else "load.lateral"
+        raise InputError(key, f"must be 0 when contact.friction = 0 (a force over mu FN, and |(Fx, Fy)| <= mu FN = 0), "
+                              f"got |(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a; prescribe creepages instead")
     if not r[k] < 1:
         key = "load.tangential" if ld.tangential is not None else "load.lateral"
         raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a must be < 1: a stick solution "
                               "exists only below the sliding limit (prescribe creepages for gross sliding)")
+
+
+def _check_creepages(scene) -> None:
+    """Prescribed creepages: ``|ξ|, |η| <= MAX_CREEPAGE`` and ``|φ|·max(a, b) <= MAX_CREEPAGE`` at every step
+    (and the histories' breakpoints)."""
+    cr, e = scene.load.creepage, scene.ellipse
+    s_end = float(scene.q_steps[-1]) / e.a
+    arm = max(e.a, e.b)
+    for h, key, scale, what in ((cr.longitudinal, "longitudinal", 1.0, "|xi|"), (cr.lateral, "lateral", 1.0, "|eta|"),
+                                (cr.spin, "spin", arm, "|phi|·max(a, b)")):
+        if h is None:
+            continue
+        s = np.union1d(scene.q_steps / e.a, h.critical_points(s_end))
+        v = np.abs(h(s) * np.ones_like(s)) * scale
+        k = int(np.argmax(v))
+        if not v[k] <= MAX_CREEPAGE:
+            here = f" (here |phi| <= {MAX_CREEPAGE / arm:.4g} per length unit)" if key == "spin" else ""
+            raise InputError(f"load.creepage.{key}", f"{what} = {v[k]:.4g} at q = {s[k]:.4g} a must be <= "
+                                                     f"{MAX_CREEPAGE:g}{here}: a creepage is a slip velocity over the "
+                                                     f"rolling speed, and full sliding sets in near 3 mu a/R (a few 1e-3 "
+                                                     f"for steel wheels on rails): larger is a typing error")
 
 
 # =========================================================================== from a dict
