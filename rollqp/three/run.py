@@ -32,6 +32,7 @@ from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
 from .contact import Contact
+from .patch import moving_profile
 from .march import StepRecord, static_shift, steady, transient
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "GRID"]
@@ -51,7 +52,10 @@ def prepare(scene, method=None):
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
-    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu)
+    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu,
+                      profile=None if scene.shape.hertzian else scene.shape.at(0.0))
+    if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
+        contact.move = moving_profile(contact, scene.shape, scene.load.direction)
     meth.setup(contact)
     return scene, meth, contact
 
