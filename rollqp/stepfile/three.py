@@ -113,7 +113,7 @@ class StepFile3D:
     ref_xi: float
     ref_eta: float
     ref_residual: float
-    ref_method: str = "newton"
+    ref_method: str = ""
     scene: dict = field(default_factory=dict)
 
     @property
