@@ -104,7 +104,8 @@ def _parser():
     e.add_argument("--method", choices=METHOD_NAMES, help="method that marches to step K (default newton)")
     c = sub.add_parser("check-step", help="check a candidate solution of an exported step")
     c.add_argument("step_file", metavar="STEP.npz")
-    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi")
+    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi "
+                   "(3D: p (n,) and t (2, n) on the grid, optional delta, xi, eta)")
     c.add_argument("--tol", type=float, default=None, help="pass/fail limit on each nondimensional residual "
                    "(default 1e-6: see docs/stepfiles.md)")
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
@@ -260,7 +261,7 @@ class Family:
     scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
     ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
     ``rollqp crossval``'s report and returns the exit code; ``check(kept, scene, budget)`` takes a time budget
-    in seconds (None: none).
+    in seconds (None: none); ``export_step(scene, k, method)`` the step file of step ``k``.
     """
 
     run: Callable
@@ -272,6 +273,7 @@ class Family:
     stresses: Callable | None
     commands: frozenset
     crossval: Callable
+    export_step: Callable | None = None
     #: ``refuse(scene, allow_long)``: raise an InputError, before any work, for a run that cannot finish in
     #: reasonable time or memory (3D conic runs: :func:`rollqp.three.advice.refusal`).
     refuse: Callable = lambda scene, allow_long: None
@@ -282,8 +284,10 @@ def _family_2d() -> Family:
     from .plot import plot_result
     from .report import summary
     from .subsurface import stress_history
+    from .stepfile import export_step
     return Family(run, summary, plot_result, _advise, _spot_steps, _spot_lines, stress_history,
-                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d)
+                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d,
+                  export_step=export_step)
 
 
 def _family_3d() -> Family:
@@ -296,8 +300,9 @@ def _family_3d() -> Family:
         for note in notes(scene):
             print(f"rollqp: {note}", file=sys.stderr, flush=True)
 
-    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
-                  _crossval_3d, refusal)
+    from .stepfile.three import export_step_3d
+    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval", "export-step"}),
+                  _crossval_3d, refuse=refusal, export_step=export_step_3d)
 
 
 def _family_wheel_rail() -> Family:
@@ -529,22 +534,25 @@ def cmd_show(args) -> int:
 
 def cmd_export_step(args) -> int:
     from .scene import load_scene
-    from .stepfile import export_step
     from .result import check_output
     scene = load_scene(args.scene)
     _takes(scene, "export-step")
     out = check_output(args.out or default_output(scene.name, f"-step{args.step}.npz"), "step file")
-    step = export_step(scene, args.step, method=args.method)
+    step = family(scene).export_step(scene, args.step, method=args.method)
     for path in step.save(out):
         print(f"wrote {path}")
     return 0
 
 
 def cmd_check_step(args) -> int:
-    from .stepfile import DEFAULT_TOL, StepFile, check_step, load_solution
-    step = StepFile.load(args.step_file, arg="STEP.npz")
-    sol = load_solution(args.solution, step.n, arg="SOLUTION.npz")
-    rep = check_step(step, sol, tol=DEFAULT_TOL if args.tol is None else args.tol)
+    from .stepfile import DEFAULT_TOL, check_step, load_solution, load_step
+    from .stepfile.three import StepFile3D, check_step_3d, load_solution_3d
+    step = load_step(args.step_file, arg="STEP.npz")       # either dimension's, by its format key
+    tol = DEFAULT_TOL if args.tol is None else args.tol
+    if isinstance(step, StepFile3D):
+        rep = check_step_3d(step, load_solution_3d(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
+    else:
+        rep = check_step(step, load_solution(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
     print(rep)
     if rep.passed:
         return 0
