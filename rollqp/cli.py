@@ -88,9 +88,11 @@ def _parser():
     r.add_argument("--stresses", action="store_true", help="report the peak subsurface von Mises and tau1 over "
                    "the run, with place and state (docs/stresses.md)")
     r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
-                   help="solve three steps again with qp-clarabel and qp-osqp (3D: qp-clarabel, or newton for a "
+                   help="solve three steps again with qp-clarabel and qp-osqp (3D: socp-clarabel, or newton for a "
                         "conic run) and show the differences (default: on for strips of at most 400 nodes run by "
-                        "a method other than those; 3D: the steps that fit about 12 s)")
+                        "a method other than those; 3D: the steps that fit the run's own time plus 3 s)")
+    r.add_argument("--allow-long", dest="allow_long", action="store_true",
+                   help="start a 3D conic run even when its estimate is above an hour (refused otherwise)")
     sub.add_parser("scenes", help="list the built-in scenes")
     s = sub.add_parser("show", help="print a scene's TOML with defaults filled in")
     s.add_argument("scene")
@@ -256,7 +258,8 @@ class Family:
     the notes before a run; ``spot(args, scene)`` → ``(kept, observe)`` of the cross-check and ``check(kept,
     scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
     ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
-    ``rollqp crossval``'s report and returns the exit code.
+    ``rollqp crossval``'s report and returns the exit code; ``check(kept, scene, budget)`` takes a time budget
+    in seconds (None: none).
     """
 
     run: Callable
@@ -268,6 +271,9 @@ class Family:
     stresses: Callable | None
     commands: frozenset
     crossval: Callable
+    #: ``refuse(scene, allow_long)``: raise an InputError, before any work, for a run that cannot finish in
+    #: reasonable time or memory (3D conic runs: :func:`rollqp.three.advice.refusal`).
+    refuse: Callable = lambda scene, allow_long: None
 
 
 def _family_2d() -> Family:
@@ -281,7 +287,7 @@ def _family_2d() -> Family:
 
 def _family_3d() -> Family:
     from .plot.three import three_figure
-    from .three.advice import notes
+    from .three.advice import notes, refusal
     from .three.report import summary
     from .three.run import run
 
@@ -290,7 +296,7 @@ def _family_3d() -> Family:
             print(f"rollqp: {note}", file=sys.stderr, flush=True)
 
     return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
-                  _crossval_3d)
+                  _crossval_3d, refusal)
 
 
 #: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
@@ -339,6 +345,7 @@ def cmd_run(args) -> int:
         from .errors import InputError
         raise InputError("--stresses", f"the subsurface stresses are computed for 2D scenes only; {scene.name!r} is "
                                        f"{scene.dimension}D")
+    fam.refuse(scene, getattr(args, "allow_long", False))
     _give_back_freed_memory()
     if source is not None and source.journal is None and source.last == scene.n_steps:
         print(f"rollqp: {args.resume} is complete ({scene.n_steps} rolling steps): nothing to resume",
@@ -385,7 +392,8 @@ def cmd_run(args) -> int:
         print(fam.summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
         if keep:
             t1 = time.perf_counter()
-            head, *failures = fam.check(keep, scene).splitlines()
+            from .three.crosscheck import SLACK  # the default: at most the run's own time plus SLACK seconds
+            head, *failures = fam.check(keep, scene, None if args.cross_check else wall + SLACK).splitlines()
             print(f"  cross-check   {head} ({time.perf_counter() - t1:.2f} s)")
             for line in failures:  # each in full, on a line of its own
                 print(f"                {line}")
@@ -393,23 +401,21 @@ def cmd_run(args) -> int:
     return 0
 
 
-def _spot_lines(keep, scene) -> str:
-    """The 2D cross-check (:func:`rollqp.crossval.spot_check` of the kept step files)."""
+def _spot_lines(keep, scene, budget=None) -> str:
+    """The 2D cross-check (:func:`rollqp.crossval.spot_check` of the kept step files; strips of at most
+    :data:`~rollqp.crossval.SPOT_MAX_NODES` nodes, no time budget)."""
     from .crossval import spot_check
     return str(spot_check(list(keep.values())))
 
 
 def _spot_3d(args, scene):
-    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check — by
-    default as many as fit :data:`~rollqp.three.crosscheck.SPOT_BUDGET` (the last first), all three with
-    ``--cross-check``."""
+    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check (by default
+    solved again as far as the run's own time plus :data:`~rollqp.three.crosscheck.SLACK` allows, the last
+    first; all three with ``--cross-check``)."""
     from .three.crosscheck import SpotObserver, spot_steps
     if args.quiet or args.cross_check is False:
         return {}, None
-    steps = spot_steps(scene.n_steps, None if args.cross_check else scene.contact_elements())
-    if not steps:
-        return {}, None
-    observer = SpotObserver(steps)
+    observer = SpotObserver(spot_steps(scene.n_steps))
     return observer, observer
 
 
@@ -430,9 +436,9 @@ def _crossval_3d(scene, step, methods) -> int:
     return 0 if check.agrees() else 1
 
 
-def _check_3d(observer, scene) -> str:
+def _check_3d(observer, scene, budget=None) -> str:
     from .three.crosscheck import cross_check
-    return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance))
+    return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance, budget=budget))
 
 
 #: A run's remaining time above which ``rollqp run`` prints its estimate after the first steps (seconds).

@@ -165,12 +165,8 @@ def test_crossval_step_out_of_range_is_one_line():
         crossval(coarse("kalker-elliptic"), methods=["qp-osqp"])
 
 
-def test_spot_steps_fit_the_budget():
-    assert spot_steps(10) == [0, 5, 10]
-    assert spot_steps(10, 100) == [0, 5, 10]            # 100 contact elements: well inside the budget
-    assert spot_steps(10, 100, budget=0.0) == []
-    one = spot_steps(10, 812, budget=6.0)               # one conic step on 812 elements: ~5 s
-    assert one == [10]
+def test_spot_steps_are_the_first_middle_and_last():
+    assert spot_steps(10) == [0, 5, 10] and spot_steps(0) == [0]
 
 
 # ------------------------------------------------------------------------------- command line

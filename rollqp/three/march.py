@@ -296,12 +296,15 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
     yield start
     prev, warm = start, (_warm_of(start) if start.phase == "resumed" else None)
     fixed = None
-    if not contact.ops.coupled:
+    move = getattr(contact, "move", None)       # a profile feature rolls through: a normal step every step
+    if not contact.ops.coupled and move is None:
         fixed = normal(contact, method, FN, warm=None)
     for k in range(int(first), int(steps) + 1):
         t0 = time.perf_counter()
         q = k * dq
         ld = load_at(q)
+        if move is not None:
+            move(q)
         try:
             ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, (prev.p, prev.t), dq, direction,
                                       warm=warm, pressure=fixed)

@@ -26,6 +26,7 @@ from ..errors import InputError, SolverError
 from ..scene import load_scene
 from ..scene.core import SceneBase
 from .contact import Contact
+from .patch import moving_profile
 from .march import StepRecord, static_shift, steady, transient
 from .result import Result3D
 
@@ -47,7 +48,10 @@ def prepare(scene, method=None):
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
-    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu)
+    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu,
+                      profile=None if scene.shape.hertzian else scene.shape.at(0.0))
+    if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
+        contact.move = moving_profile(contact, scene.shape, scene.load.direction)
     meth.setup(contact)
     return scene, meth, contact
 

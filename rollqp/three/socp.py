@@ -35,6 +35,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError, MissingBackendError, SolverError
 from ..methods.base import Capabilities, check_options
+from ..threads import threads
 from .forms import normal_form, tangential_form
 from .refine import active_set_refine
 
@@ -64,6 +65,8 @@ class ConicMethod:
 
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "conic"
+    #: ``time.perf_counter()`` at which Clarabel stops its iterations (a cross-check's time budget); None: none.
+    deadline = None
     capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimension=3, traction_components=2,
                                 friction_set="disc")
 
@@ -226,7 +229,8 @@ def _clarabel_settings(tolerance, max_iterations):
     # stops "AlmostSolved" at a residual of 3e-4 on a 30 × 30 rolling step (540 cones), at 1e-13 it
     # reaches 9e-9 "Solved" (measured; the active-set refinement takes either to round-off)
     gap = max(1e-4 * tolerance, 1e-13)
-    values = dict(verbose=False, presolve_enable=False, tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=gap,
+    # max_threads: faer's own pool (0 = every core) at rollqp's BLAS threads (rollqp.threads)
+    values = dict(max_threads=threads(), verbose=False, presolve_enable=False, tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=gap,
                   tol_ktratio=min(1e-6, gap), iterative_refinement_reltol=1e-14,
                   iterative_refinement_abstol=1e-14, iterative_refinement_max_iter=20,
                   max_iter=int(max_iterations or 200))
@@ -277,8 +281,15 @@ class ClarabelMethod(ConicMethod):
         else:
             solver = entry[1]
             solver.update(q=q, b=b)
+        deadline = self.deadline
+        if deadline is not None:  # a time budget (the run's cross-check): stop at its end
+            solver.set_termination_callback(lambda info: time.perf_counter() > deadline)
+        else:
+            solver.unset_termination_callback()
         sol = solver.solve()
         status = str(sol.status)
+        if deadline is not None and time.perf_counter() > deadline and status not in ("Solved", "AlmostSolved"):
+            raise SolverError("stopped at the end of its time budget", method=self.name, status="budget")
         if status not in ("Solved", "AlmostSolved"):
             raise SolverError("Clarabel did not solve the step", method=self.name, status=status)
         k = form.a.shape[0]
