@@ -35,6 +35,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import RollqpError
+from ..methods import REFERENCE_METHOD
 from ..units import unit_names
 from ..three.closedforms import cattaneo_stick_radius, cattaneo_traction, kalker_linear
 from ..three.report import LINEAR_SLIP_FRACTION, stick_fraction
@@ -117,11 +118,12 @@ def _linear_forces(scene, creepage):
 
 
 def _steady_reference(scene, res):
-    """The steady state of the final loads, solved directly (Newton), or None if it cannot be posed."""
+    """The steady state of the final loads, solved directly (the reference method, Newton), or None if it
+    cannot be posed."""
     from ..three.run import run
     last = float(res["q"][-1]) / scene.ellipse.a
     ld = scene.load
-    changes = {"load.start": "rolling", "discretization.distance": 0.0, "solver.method": "newton",
+    changes = {"load.start": "rolling", "discretization.distance": 0.0, "solver.method": REFERENCE_METHOD,
                "name": f"{scene.name}-steady"}
     for key, h in (("load.tangential", ld.tangential), ("load.lateral", ld.lateral),
                    ("load.creepage.longitudinal", ld.creepage.longitudinal),
