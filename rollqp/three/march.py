@@ -294,7 +294,9 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                            FN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, nsol.delta, nsol.iterations, 0.0, nsol.residual,
                            {"normal": nsol.info})
     yield start
-    prev, warm = start, (_warm_of(start) if start.phase == "resumed" else None)
+    # the step after a rolling step sets out from it; the first rolling step from nothing (as a run that never
+    # stopped does, whatever the start: a resumed run repeats the same computations)
+    prev, warm = start, (_warm_of(start) if start.k >= 1 else None)
     fixed = None
     move = getattr(contact, "move", None)       # a profile feature rolls through: a normal step every step
     if not contact.ops.coupled and move is None:
