@@ -114,6 +114,7 @@ def _parser():
     x.add_argument("--step", type=int, default=None, help="step K (default 1; a 3D scene: every step of its run)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
     _stresses_parser(sub)
+    _wheelrail_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
                        "(docs/performance.md; 'rollqp bench --help' for the options)")
     b.add_argument("bench_args", nargs=argparse.REMAINDER)
@@ -309,13 +310,19 @@ def _family_3d() -> Family:
                   _crossval_3d, refuse=refusal, export_step=export_step_3d, sweep=_sweep_3d, creep_curve=_creep_3d)
 
 
-#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
-FAMILIES = {2: _family_2d, 3: _family_3d}
+def _family_wheel_rail() -> Family:
+    from .wheelrail.cli import family_record
+    return family_record(Family)
+
+
+#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy); a scene whose
+#: ``family`` names another record (a wheel on its rail) uses that one.
+FAMILIES = {2: _family_2d, 3: _family_3d, "wheel-rail": _family_wheel_rail}
 
 
 def family(scene) -> Family:
-    """The :class:`Family` of ``scene``'s dimension."""
-    return FAMILIES[scene.dimension]()
+    """The :class:`Family` of ``scene``'s dimension (or of its ``family``)."""
+    return FAMILIES[getattr(scene, "family", scene.dimension)]()
 
 
 def _takes(scene, command: str) -> None:
@@ -755,7 +762,7 @@ def main(argv=None) -> int:
             return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
                     "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
                     "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
-                    "stresses": cmd_stresses}[args.command](args)
+                    "stresses": cmd_stresses, "wheelrail-table": cmd_wheelrail_table}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
@@ -772,6 +779,17 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("rollqp: interrupted", file=sys.stderr)
         return 130
+
+
+# ----------------------------------------------------------------------------- wheel on rail
+def _wheelrail_parser(sub):
+    from .wheelrail.cli import add_parser
+    add_parser(sub)
+
+
+def cmd_wheelrail_table(args) -> int:
+    from .wheelrail.cli import cmd_table
+    return cmd_table(args)
 
 
 # ----------------------------------------------------------------------------- stresses
