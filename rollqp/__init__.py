@@ -20,7 +20,11 @@ open_result                              a result file as an xarray Dataset (ext
 closedforms                              Hertz, Cattaneo, Carter, creep law, McEwen
 stresses                                 subsurface stresses of a state (rollqp.subsurface)
 """
-from .version import __version__  # noqa: F401
+from . import threads as _threads
+
+_threads.pin_environment()  # before numpy and scipy load: their BLAS pools start at $ROLLQP_THREADS (rollqp.threads)
+
+from .version import __version__  # noqa: E402,F401
 
 from . import closedforms
 from .errors import InputError, MissingBackendError, RollqpError, SolverError
@@ -56,10 +60,11 @@ def run(scene, method=None, progress=None, resume=None, observe=None, **options)
     ((40, 40), 1000)
     """
     scene = _scene(scene)
-    if scene.dimension == 3:
-        from .three.run import run as run_3d
-        return run_3d(scene, method, progress, resume, observe, **options)
-    return _march.run(scene, method, progress, resume, observe, **options)
+    with _threads.limited():  # every BLAS pool at $ROLLQP_THREADS (default 1) for the run (rollqp.threads)
+        if scene.dimension == 3:
+            from .three.run import run as run_3d
+            return run_3d(scene, method, progress, resume, observe, **options)
+        return _march.run(scene, method, progress, resume, observe, **options)
 
 
 def march(scene, method=None, **options):

@@ -10,6 +10,7 @@
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
+    rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
     rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
                     (3D: [--plane y=Y | --plane x=X | --line x=X,y=Y] [--depths Z1,Z2,...])
 
@@ -18,8 +19,9 @@ that did not converge (the completed steps are written to the result file first)
 result that could not be written (a full disk: the completed steps stay in the journal, and
 ``run --resume`` continues once there is room).
 ``check-step`` exits 1 when the candidate fails, with one line per failed condition.
-BLAS threads are pinned to one: numpy's and scipy's wheels each bundle OpenBLAS, and two
-pools competing for 2 cores can make a dense solve 100× slower.
+BLAS threads are pinned to ``$ROLLQP_THREADS`` (default one) before numpy and scipy load
+(:mod:`rollqp.threads`): their wheels each bundle OpenBLAS, and two pools competing for 2 cores
+made a 3D run 3× slower.
 """
 from __future__ import annotations
 
@@ -88,9 +90,11 @@ def _parser():
     r.add_argument("--stresses", action="store_true", help="report the peak subsurface von Mises and tau1 over "
                    "the run, with place and state (docs/stresses.md)")
     r.add_argument("--cross-check", dest="cross_check", action=argparse.BooleanOptionalAction, default=None,
-                   help="solve three steps again with qp-clarabel and qp-osqp (3D: qp-clarabel, or newton for a "
+                   help="solve three steps again with qp-clarabel and qp-osqp (3D: socp-clarabel, or newton for a "
                         "conic run) and show the differences (default: on for strips of at most 400 nodes run by "
-                        "a method other than those; 3D: the steps that fit about 12 s)")
+                        "a method other than those; 3D: the steps that fit the run's own time plus 3 s)")
+    r.add_argument("--allow-long", dest="allow_long", action="store_true",
+                   help="start a 3D conic run even when its estimate is above an hour (refused otherwise)")
     sub.add_parser("scenes", help="list the built-in scenes")
     s = sub.add_parser("show", help="print a scene's TOML with defaults filled in")
     s.add_argument("scene")
@@ -102,7 +106,8 @@ def _parser():
     e.add_argument("--method", choices=METHOD_NAMES, help="method that marches to step K (default newton)")
     c = sub.add_parser("check-step", help="check a candidate solution of an exported step")
     c.add_argument("step_file", metavar="STEP.npz")
-    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi")
+    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi "
+                   "(3D: p (n,) and t (2, n) on the grid, optional delta, xi, eta)")
     c.add_argument("--tol", type=float, default=None, help="pass/fail limit on each nondimensional residual "
                    "(default 1e-6: see docs/stepfiles.md)")
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
@@ -110,6 +115,7 @@ def _parser():
     x.add_argument("--step", type=int, default=None, help="step K (default 1; a 3D scene: every step of its run)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
     _stresses_parser(sub)
+    _wheelrail_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
                        "(docs/performance.md; 'rollqp bench --help' for the options)")
     b.add_argument("bench_args", nargs=argparse.REMAINDER)
@@ -256,7 +262,9 @@ class Family:
     the notes before a run; ``spot(args, scene)`` → ``(kept, observe)`` of the cross-check and ``check(kept,
     scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
     ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
-    ``rollqp crossval``'s report and returns the exit code.
+    ``rollqp crossval``'s report and returns the exit code; ``check(kept, scene, budget)`` takes a time budget
+    in seconds (None: none); ``export_step(scene, k, method)`` the step file of step ``k``; ``sweep(scene, args)``
+    and ``creep_curve(scene, args)`` run those commands and return the exit code.
     """
 
     run: Callable
@@ -268,6 +276,12 @@ class Family:
     stresses: Callable | None
     commands: frozenset
     crossval: Callable
+    export_step: Callable | None = None
+    sweep: Callable | None = None
+    creep_curve: Callable | None = None
+    #: ``refuse(scene, allow_long)``: raise an InputError, before any work, for a run that cannot finish in
+    #: reasonable time or memory (3D conic runs: :func:`rollqp.three.advice.refusal`).
+    refuse: Callable = lambda scene, allow_long: None
 
 
 def _family_2d() -> Family:
@@ -275,13 +289,15 @@ def _family_2d() -> Family:
     from .plot import plot_result
     from .report import summary
     from .subsurface import stress_history
+    from .stepfile import export_step
     return Family(run, summary, plot_result, _advise, _spot_steps, _spot_lines, stress_history,
-                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d)
+                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d,
+                  export_step=export_step, sweep=_sweep_2d, creep_curve=_creep_2d)
 
 
 def _family_3d() -> Family:
     from .plot.three import three_figure
-    from .three.advice import notes
+    from .three.advice import notes, refusal
     from .three.report import summary
     from .three.run import run
 
@@ -289,17 +305,25 @@ def _family_3d() -> Family:
         for note in notes(scene):
             print(f"rollqp: {note}", file=sys.stderr, flush=True)
 
-    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
-                  _crossval_3d)
+    from .stepfile.three import export_step_3d
+    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval", "export-step", "sweep",
+                                                                                       "creep-curve"}),
+                  _crossval_3d, refuse=refusal, export_step=export_step_3d, sweep=_sweep_3d, creep_curve=_creep_3d)
 
 
-#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
-FAMILIES = {2: _family_2d, 3: _family_3d}
+def _family_wheel_rail() -> Family:
+    from .wheelrail.cli import family_record
+    return family_record(Family)
+
+
+#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy); a scene whose
+#: ``family`` names another record (a wheel on its rail) uses that one.
+FAMILIES = {2: _family_2d, 3: _family_3d, "wheel-rail": _family_wheel_rail}
 
 
 def family(scene) -> Family:
-    """The :class:`Family` of ``scene``'s dimension."""
-    return FAMILIES[scene.dimension]()
+    """The :class:`Family` of ``scene``'s dimension (or of its ``family``)."""
+    return FAMILIES[getattr(scene, "family", scene.dimension)]()
 
 
 def _takes(scene, command: str) -> None:
@@ -339,6 +363,7 @@ def cmd_run(args) -> int:
         from .errors import InputError
         raise InputError("--stresses", f"the subsurface stresses are computed for 2D scenes only; {scene.name!r} is "
                                        f"{scene.dimension}D")
+    fam.refuse(scene, getattr(args, "allow_long", False))
     _give_back_freed_memory()
     if source is not None and source.journal is None and source.last == scene.n_steps:
         print(f"rollqp: {args.resume} is complete ({scene.n_steps} rolling steps): nothing to resume",
@@ -385,7 +410,8 @@ def cmd_run(args) -> int:
         print(fam.summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
         if keep:
             t1 = time.perf_counter()
-            head, *failures = fam.check(keep, scene).splitlines()
+            from .three.crosscheck import SLACK  # the default: at most the run's own time plus SLACK seconds
+            head, *failures = fam.check(keep, scene, None if args.cross_check else wall + SLACK).splitlines()
             print(f"  cross-check   {head} ({time.perf_counter() - t1:.2f} s)")
             for line in failures:  # each in full, on a line of its own
                 print(f"                {line}")
@@ -393,23 +419,21 @@ def cmd_run(args) -> int:
     return 0
 
 
-def _spot_lines(keep, scene) -> str:
-    """The 2D cross-check (:func:`rollqp.crossval.spot_check` of the kept step files)."""
+def _spot_lines(keep, scene, budget=None) -> str:
+    """The 2D cross-check (:func:`rollqp.crossval.spot_check` of the kept step files; strips of at most
+    :data:`~rollqp.crossval.SPOT_MAX_NODES` nodes, no time budget)."""
     from .crossval import spot_check
     return str(spot_check(list(keep.values())))
 
 
 def _spot_3d(args, scene):
-    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check — by
-    default as many as fit :data:`~rollqp.three.crosscheck.SPOT_BUDGET` (the last first), all three with
-    ``--cross-check``."""
+    """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check (by default
+    solved again as far as the run's own time plus :data:`~rollqp.three.crosscheck.SLACK` allows, the last
+    first; all three with ``--cross-check``)."""
     from .three.crosscheck import SpotObserver, spot_steps
     if args.quiet or args.cross_check is False:
         return {}, None
-    steps = spot_steps(scene.n_steps, None if args.cross_check else scene.contact_elements())
-    if not steps:
-        return {}, None
-    observer = SpotObserver(steps)
+    observer = SpotObserver(spot_steps(scene.n_steps))
     return observer, observer
 
 
@@ -430,9 +454,9 @@ def _crossval_3d(scene, step, methods) -> int:
     return 0 if check.agrees() else 1
 
 
-def _check_3d(observer, scene) -> str:
+def _check_3d(observer, scene, budget=None) -> str:
     from .three.crosscheck import cross_check
-    return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance))
+    return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance, budget=budget))
 
 
 #: A run's remaining time above which ``rollqp run`` prints its estimate after the first steps (seconds).
@@ -500,11 +524,11 @@ def _spot_steps(args, scene):
 
 
 def cmd_scenes(args) -> int:
-    from .scene import builtin_scenes
+    from .scene import builtin_scenes, load_scene
     names = builtin_scenes()
     w = max(map(len, names))
-    for k, v in names.items():
-        print(f"{k:<{w}}  {v}")
+    for k, v in names.items():      # every scene tagged by its dimension, the same way
+        print(f"{k:<{w}}  {load_scene(k).dimension}D  {v}")
     return 0
 
 
@@ -516,22 +540,25 @@ def cmd_show(args) -> int:
 
 def cmd_export_step(args) -> int:
     from .scene import load_scene
-    from .stepfile import export_step
     from .result import check_output
     scene = load_scene(args.scene)
     _takes(scene, "export-step")
     out = check_output(args.out or default_output(scene.name, f"-step{args.step}.npz"), "step file")
-    step = export_step(scene, args.step, method=args.method)
+    step = family(scene).export_step(scene, args.step, method=args.method)
     for path in step.save(out):
         print(f"wrote {path}")
     return 0
 
 
 def cmd_check_step(args) -> int:
-    from .stepfile import DEFAULT_TOL, StepFile, check_step, load_solution
-    step = StepFile.load(args.step_file, arg="STEP.npz")
-    sol = load_solution(args.solution, step.n, arg="SOLUTION.npz")
-    rep = check_step(step, sol, tol=DEFAULT_TOL if args.tol is None else args.tol)
+    from .stepfile import DEFAULT_TOL, check_step, load_solution, load_step
+    from .stepfile.three import StepFile3D, check_step_3d, load_solution_3d
+    step = load_step(args.step_file, arg="STEP.npz")       # either dimension's, by its format key
+    tol = DEFAULT_TOL if args.tol is None else args.tol
+    if isinstance(step, StepFile3D):
+        rep = check_step_3d(step, load_solution_3d(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
+    else:
+        rep = check_step(step, load_solution(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
     print(rep)
     if rep.passed:
         return 0
@@ -596,9 +623,12 @@ def _sweep_parsers(sub):
     c = sub.add_parser("creep-curve", help="the steady creep curve Q/(mu P) against the creepage, on dask, "
                        "with Carter's law or the Bentall-Johnson limit (docs/sweeps.md)")
     c.add_argument("scene", help="the base scene: a TOML file or a built-in scene")
-    c.add_argument("--ratios", default="0.05:0.95:19", help="load ratios Q/(mu P): a,b,c or start:stop:count "
+    c.add_argument("--ratios", default=None, help="2D: load ratios Q/(mu P): a,b,c or start:stop:count "
                    "(default 0.05:0.95:19)")
-    c.add_argument("--friction", help="friction coefficients mu (default: the scene's)")
+    c.add_argument("--friction", help="2D: friction coefficients mu (default: the scene's)")
+    c.add_argument("--creepage", help="3D: the creepage swept: longitudinal | lateral | spin (default longitudinal)")
+    c.add_argument("--values", help="3D: its values, a,b,c or start:stop:count (default 1e-4:2e-3:12; spin in "
+                   "1/length)")
     c.add_argument("--plot", help="draw the creep-force figure to this file")
     c.add_argument("--out", help="the zarr store (default <scene name>-creep.zarr)")
     _cluster_options(c)
@@ -648,9 +678,42 @@ def _sweep_exit(summary) -> int:
 
 def cmd_sweep(args) -> int:
     from .scene import load_scene
-    from .sweep import sweep
     scene = load_scene(args.scene)
     _takes(scene, "sweep")
+    return family(scene).sweep(scene, args)
+
+
+def _sweep_3d(scene, args) -> int:
+    from .sweep.three import sweep_3d
+    out = args.out or default_output(scene.name, "-sweep.zarr")
+    _, summary = sweep_3d(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    if not args.quiet:
+        print(f"rollqp sweep of {scene.name} (3D): {out}")
+        print(summary.table())
+    return _sweep_exit(summary)
+
+
+def _creep_3d(scene, args) -> int:
+    from .errors import InputError
+    from .sweep.three import creep_curve_3d
+    if args.ratios is not None or args.friction is not None:
+        raise InputError("--ratios" if args.ratios is not None else "--friction",
+                         "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
+    out = args.out or default_output(scene.name, "-creep.zarr")
+    _check_plot(args.plot)
+    curve = creep_curve_3d(scene, args.creepage or "longitudinal", args.values or "1e-4:2e-3:12", out,
+                           scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    if args.plot:
+        curve.plot(args.plot)
+    if not args.quiet:
+        print(curve.table())
+        print(curve.summary.table())
+        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
+    return _sweep_exit(curve.summary)
+
+
+def _sweep_2d(scene, args) -> int:
+    from .sweep import sweep
     out = args.out or default_output(scene.name, "-sweep.zarr")
     summary = _sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
                                            quiet=args.quiet))
@@ -662,9 +725,18 @@ def cmd_sweep(args) -> int:
 
 def cmd_creep_curve(args) -> int:
     from .scene import load_scene
-    from .sweep.creep import creep_curve
     scene = load_scene(args.scene)
     _takes(scene, "creep-curve")
+    return family(scene).creep_curve(scene, args)
+
+
+def _creep_2d(scene, args) -> int:
+    from .errors import InputError
+    from .sweep.creep import creep_curve
+    if args.creepage is not None or args.values is not None:
+        raise InputError("--creepage" if args.creepage is not None else "--values",
+                         "a 2D creep curve prescribes the load ratios: --ratios (and --friction)")
+    args.ratios = "0.05:0.95:19" if args.ratios is None else args.ratios
     out = args.out or default_output(scene.name, "-creep.zarr")
     _check_plot(args.plot)
     curve = _sweep_signals(lambda: creep_curve(scene, args.ratios, args.friction, out, scheduler=args.scheduler,
@@ -685,16 +757,13 @@ def main(argv=None) -> int:
     else:
         args = _parser().parse_args(argv)
     from .errors import InputError, RollqpError, SolverError
+    from .threads import limited
     try:
-        from threadpoolctl import threadpool_limits
-        limiter = threadpool_limits(limits=int(os.environ.get("ROLLQP_THREADS", "1")))
-    except ImportError:  # pragma: no cover - threadpoolctl is a dependency
-        limiter = None
-    try:
-        return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
-                "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
-                "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
-                "stresses": cmd_stresses}[args.command](args)
+        with limited():  # every BLAS pool at $ROLLQP_THREADS (default 1), scipy's included (rollqp.threads)
+            return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
+                    "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
+                    "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
+                    "stresses": cmd_stresses, "wheelrail-table": cmd_wheelrail_table}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
@@ -711,9 +780,17 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("rollqp: interrupted", file=sys.stderr)
         return 130
-    finally:
-        if limiter is not None:
-            limiter.unregister() if hasattr(limiter, "unregister") else None
+
+
+# ----------------------------------------------------------------------------- wheel on rail
+def _wheelrail_parser(sub):
+    from .wheelrail.cli import add_parser
+    add_parser(sub)
+
+
+def cmd_wheelrail_table(args) -> int:
+    from .wheelrail.cli import cmd_table
+    return cmd_table(args)
 
 
 # ----------------------------------------------------------------------------- stresses

@@ -353,6 +353,15 @@ def source3d(result) -> tuple[dict, object]:
     return arrays, load_scene(meta["scene"])
 
 
+def _scale(arrays) -> float:
+    """The Hertz semi-axis ``a`` of the result (the default depths' scale), checked."""
+    a = float(np.asarray(arrays.get("a", np.nan), dtype=float).reshape(-1)[0]) if np.size(arrays.get("a", [])) == 1 \
+        else float("nan")
+    if not (np.isfinite(a) and a > 0):
+        raise InputError("result", f"key 'a' must be a number > 0 (the Hertz semi-axis), got {a!r}")
+    return a
+
+
 def _body_nu(scene, body: str):
     if body not in ("A", "B"):
         raise InputError("body", f"must be 'A' or 'B', got {body!r}")
@@ -382,7 +391,7 @@ def stresses3d(result, step: int, plane=None, line=None, depths=None, body: str 
     grid = result_grid(arrays, scene)
     k = _state(arrays, step)
     nu, sign = _body_nu(scene, body)
-    sec = section(grid, float(np.asarray(arrays.get("a", grid.dx * grid.nx / 2.5))), plane, line, depths, along)
+    sec = section(grid, _scale(arrays), plane, line, depths, along)
     pts = sec.points()
     s = stress_components(grid, *pts, arrays["pn"][k], sign * np.asarray(arrays["px"][k]),
                           sign * np.asarray(arrays["py"][k]), nu)
@@ -409,7 +418,7 @@ def stress_history3d(result, plane=None, line=None, depths=None, body: str = "A"
     K1 = len(arrays["q"])
     ks = np.arange(K1) if steps is None else np.array([_state(arrays, s) for s in steps], dtype=int)
     nu, sign = _body_nu(scene, body)
-    sec = section(grid, float(np.asarray(arrays.get("a", grid.dx * grid.nx / 2.5))), plane, line, depths)
+    sec = section(grid, _scale(arrays), plane, line, depths)
     pts = sec.points()
     peaks = {n: np.zeros((ks.size, 4)) for n in PEAKS}
     per = max(1, (1 << 22) // max(1, pts[0].size * 6))

@@ -70,7 +70,7 @@ def test_curvatures_of_bodies():
     assert QuadraticProfile(a, b)(np.array([1.0]), np.array([2.0]))[0] == pytest.approx(a + 4 * b)
 
 
-@pytest.mark.parametrize("radius, key", [(0.0, "bodies.A.radius"), (-3.0, "bodies.A.radius"),
+@pytest.mark.parametrize("radius, key", [(0.0, "bodies.A.radius"), (-0.0, "bodies.A.radius"),
                                          (float("nan"), "bodies.A.radius"), ("x", "bodies.A.radius")])
 def test_bad_radius_names_the_key(radius, key):
     with pytest.raises(InputError, match=key.replace(".", r"\.")):

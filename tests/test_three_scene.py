@@ -12,7 +12,7 @@ from rollqp.errors import InputError
 from rollqp.methods import available_methods, capabilities, cone_methods, get_method, method_class
 from rollqp.scene import scene_from_dict, scene_from_toml
 
-BUILTIN_3D = ("kalker-circular", "kalker-elliptic", "cattaneo-3d")
+BUILTIN_3D = ("kalker-circular", "kalker-elliptic", "cattaneo-3d", "ball-in-groove")
 
 
 def _base():
@@ -74,7 +74,7 @@ def test_builtin_3d_round_trip_through_toml(name):
 # ------------------------------------------------------------------------------------ bad input
 BAD = [
     ("radius zero", lambda d: d["bodies"]["A"].update(radius=0.0), "bodies.A.radius:", "> 0"),
-    ("radius_y negative", lambda d: d["bodies"]["B"].update(radius_y=-2.0), "bodies.B.radius_y:", "> 0"),
+    ("radius_y concave, more curved", lambda d: d["bodies"]["B"].update(radius_y=-2.0), "bodies.B.radius_y:", "> 0"),
     ("radius text", lambda d: d["bodies"]["A"].update(radius="big"), "bodies.A.radius:", "> 0"),
     ("both straight in x", lambda d: d["bodies"]["A"].update(radius=math.inf), "bodies.A.radius:", "concentrated"),
     ("zone below the ellipse", lambda d: d["discretization"].update(zone=[1.0, 1.25]), "discretization.zone",
@@ -102,8 +102,8 @@ BAD = [
     ("step too long", lambda d: d["discretization"].update(step=20.0), "discretization.step:", "(0, 8]"),
     ("2D key in 3D", lambda d: d["discretization"].update(element="linear"), "discretization.element:",
      "a key of 2D scenes"),
-    ("2D profile in 3D", lambda d: d["bodies"]["A"].update(profile={"kind": "dent"}), "bodies.A.profile:",
-     "a key of 2D scenes"),
+    ("2D profile kind in 3D", lambda d: d["bodies"]["A"].update(profile={"kind": "dent"}), "bodies.A.profile.kind:",
+     "in a 3D scene"),
 ]
 
 

@@ -105,7 +105,7 @@ CROSS_CHECK_METHODS = ("qp-clarabel", "qp-osqp")
 STEP_METHOD = "qp-clarabel"
 #: The methods a 3D run is cross-checked with (:func:`rollqp.three.crosscheck.cross_check`): the conic
 #: route (Clarabel, core dependency) and Newton; the one that ran the scene is left out.
-CROSS_CHECK_METHODS_3D = ("qp-clarabel", "newton")
+CROSS_CHECK_METHODS_3D = ("socp-clarabel", "newton")
 #: The methods ``rollqp crossval`` solves every step of a 3D scene with (those installed): rollqp's Newton
 #: method and the SOCP backends (Clarabel natively, cvxpy's statement solved by Clarabel).
 CROSSVAL_METHODS_3D = ("newton", "socp-clarabel", "socp-cvxpy")

@@ -39,6 +39,7 @@ import time
 from dataclasses import dataclass, field
 
 from ..errors import InputError
+from ..threads import limited
 
 __all__ = ["connect", "check_scheduler", "close_client", "InProcess", "compute_point", "compute_points", "run_sweep", "iter_jobs",
            "map_jobs", "Summary", "Progress", "CONNECT_TIMEOUT", "HANDSHAKE_BYTES"]
@@ -290,8 +291,7 @@ def compute_point(scene) -> dict:
     """Run one scene (a :class:`~rollqp.scene.Scene` or its dict) on a worker: ``{"arrays", "time",
     "cpu", "worker"}`` (wall and CPU seconds of the worker's process), or ``{"error", "time", "cpu",
     "worker"}`` with its one-line error."""
-    from threadpoolctl import threadpool_limits
-    with threadpool_limits(limits=1):
+    with limited(1):  # scipy's BLAS loaded first, so that its pool is limited too (rollqp.threads)
         return _run_point(scene)
 
 
@@ -359,9 +359,8 @@ def _compute_points(base, points) -> list:
     except Exception as err:  # validated on the client: a worker of another rollqp version?
         msg = f"{type(err).__name__}: {err}".splitlines()[0]
         return [{"error": msg, "time": time.perf_counter() - t0} for _ in points]
-    from threadpoolctl import threadpool_limits
     out = []
-    with threadpool_limits(limits=1):  # once for the task (a few hundred microseconds each time)
+    with limited(1):  # once for the task, scipy's BLAS loaded first (rollqp.threads) (a few hundred microseconds each time)
         for _, changes in points:
             t1 = time.perf_counter()
             try:

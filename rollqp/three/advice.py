@@ -1,40 +1,88 @@
-"""What ``rollqp run`` says before a 3D run that will take long: the conic route's cost, estimated from
-the scene alone (the 3D counterpart of :mod:`rollqp.advice`).
+"""What ``rollqp run`` says before a 3D run that will take long, and what it refuses: the conic route's
+cost estimated from the scene and from this machine's speed (the 3D counterpart of :mod:`rollqp.advice`).
 
 Newton's 3D steps take a fraction of a second on the built-in grids (docs/performance.md). A conic
-method (``qp-clarabel``, ``qp-cvxpy``, ``socp-*``) poses each step as an SOCP with a dense Hessian
-of the contact elements, whose factorization grows like their cube: :func:`conic_step_seconds`
-estimates one step from a measured reference, and a rolling start multiplies it by the steps of the
-march to the steady state (:func:`rollqp.three.march.steady`). A note is printed when the estimate is
-above :data:`NOTE_SECONDS`, naming what runs faster.
+method (``qp-clarabel``, ``qp-cvxpy``, ``socp-*``) poses each step as an SOCP whose Hessian is the
+influence matrix of the contact area, dense: ``2m`` unknowns for ``m`` elements in contact.
+
+**The cost model** (:func:`conic_step_seconds`): one conic step (the normal QP and the tangential SOCP,
+Clarabel, with the active-set refinement) in units of a yardstick timed in the same process — a dense
+Cholesky factorization of order 600 (:func:`yardstick`, a few milliseconds), so that the estimate follows
+the machine and its load —
+
+.. math:: t \\approx y\\,(\\alpha x^2 + \\beta x^3), \\qquad x = 2m/600,
+
+with ``α`` (forming the dense Hessian, Clarabel's assembly of its KKT system, the refinement: the
+``x²`` terms dominate up to a few thousand elements) fitted to conic steps on circles of 132 … 812 contact
+elements, and ``β`` the interior point's factorizations (about 20 of order ``2m``; :data:`QUADRATIC`,
+:data:`CUBIC`; benchmarks/three_speed.py ``--only conic-model`` measures the model against real steps).
+
+A rolling start by a method that cannot solve the steady problem marches to it (:data:`MARCH_LENGTHS`
+contact lengths of ``dx`` steps). :func:`notes` prints the estimate when it exceeds :data:`NOTE_SECONDS`;
+:func:`refusal` refuses before any work a run whose estimate exceeds :data:`REFUSE_SECONDS`, or whose
+dense Hessian would not fit :data:`~rollqp.three.operator.DENSE_MAX`, naming what runs instead.
 """
 from __future__ import annotations
 
+import time
+
+import numpy as np
+
 from ..advice import duration
+from ..errors import InputError
+from .operator import DENSE_MAX
 
-__all__ = ["notes", "conic_step_seconds", "NOTE_SECONDS", "REFERENCE_CONTACT", "REFERENCE_SECONDS"]
+__all__ = ["notes", "refusal", "conic_step_seconds", "conic_run", "yardstick", "NOTE_SECONDS", "REFUSE_SECONDS",
+           "QUADRATIC", "CUBIC", "MARCH_LENGTHS"]
 
-#: One Clarabel step (QP + SOCP and the active-set refinement) on 812 contact elements (the 40 × 40
-#: kalker-circular grid) took 5.3 s here (benchmarks/three_speed.py, load average 7 on 2 cores).
-REFERENCE_CONTACT, REFERENCE_SECONDS = 812, 5.3
+#: Order of the yardstick's dense Cholesky factorization (:func:`yardstick`).
+YARDSTICK_ORDER = 600
+#: The cost model's coefficients in yardsticks (module docstring): fitted to Clarabel steps on circles of
+#: 132, 300, 524 and 812 contact elements (t/y = 125, 536, 1607, 3382 at x = 0.44, 1.0, 1.75, 2.71; the
+#: quadratic term alone fits them within 25 %); the cubic one is about 20 factorizations of order 2m.
+QUADRATIC, CUBIC = 500.0, 20.0
 #: Estimated run time above which the note is printed (seconds).
 NOTE_SECONDS = 60.0
-#: Conic steps of the march to a steady state, per contact length 2a/dx rolled (measured: the
-#: accelerated march of docs/validation3d.md §9 takes about one contact length).
-MARCH_LENGTHS = 1.0
+#: Estimated run time above which ``rollqp run`` refuses to start (one hour), unless told ``--allow-long``.
+REFUSE_SECONDS = 3600.0
+#: Conic steps of the march to a steady state, per contact length ``2a/dx`` rolled: measured 4.6 with a
+#: slip area (88 steps on the 24 × 24 circle, ξ = 1e-3, docs/performance.md); with everything sticking
+#: two steps reach it (the estimate is then pessimistic).
+MARCH_LENGTHS = 4.6
+
+_YARDSTICK = []
 
 
-def conic_step_seconds(contact_elements: int) -> float:
-    """The estimated wall time of one conic step on ``contact_elements`` (cube law from the reference)."""
-    return REFERENCE_SECONDS * (max(contact_elements, 1) / REFERENCE_CONTACT) ** 3
+def yardstick() -> float:
+    """Seconds of one dense Cholesky factorization of order :data:`YARDSTICK_ORDER` on this machine now
+    (LAPACK's ``dpotrf`` in place, the best of eight after one to warm up; measured once per process, 25–200 ms)."""
+    if not _YARDSTICK:
+        from scipy.linalg import lapack
+        rng = np.random.default_rng(0)
+        a = rng.standard_normal((YARDSTICK_ORDER, YARDSTICK_ORDER))
+        a = np.asfortranarray(a @ a.T + YARDSTICK_ORDER * np.eye(YARDSTICK_ORDER))
+        work = np.empty_like(a, order="F")
+        best = np.inf
+        for k in range(9):  # in place (no allocation: the command line maps every array above 1 MiB afresh)
+            np.copyto(work, a)
+            t0 = time.perf_counter()
+            lapack.dpotrf(work, lower=1, overwrite_a=1)
+            if k:  # the first call pays for cold caches; then the best of eight (a loaded machine varies 3x)
+                best = min(best, time.perf_counter() - t0)
+        _YARDSTICK.append(best)
+    return _YARDSTICK[0]
 
 
-def notes(scene) -> list[str]:
-    """One line before a 3D run with a conic method whose estimated time exceeds :data:`NOTE_SECONDS`."""
+def conic_step_seconds(contact_elements: int, y: float | None = None) -> float:
+    """The estimated wall time of one conic step on ``contact_elements`` (module docstring)."""
+    x = 2.0 * max(int(contact_elements), 1) / YARDSTICK_ORDER
+    return (yardstick() if y is None else y) * (QUADRATIC * x * x + CUBIC * x ** 3)
+
+
+def conic_run(scene) -> tuple:
+    """``(steps, seconds a step, seconds in all)`` of ``scene`` run by a conic method (estimate)."""
     from ..methods import capabilities
     caps = capabilities(scene.solver.method, 3)
-    if caps.matrix_free:
-        return []
     n = scene.contact_elements()
     per = conic_step_seconds(n)
     steps = scene.n_steps
@@ -42,10 +90,47 @@ def notes(scene) -> list[str]:
         steps += int(MARCH_LENGTHS * 2 * scene.ellipse.a / scene.grid.dx) + 1
     else:
         steps += scene.load.start_steps if scene.load.start == "braked" else 1
-    total = per * steps
+    return steps, per, per * steps
+
+
+def _conic(scene) -> bool:
+    """Whether the scene's method needs the dense matrices (the conic backends; Newton works with FFT products)."""
+    from ..methods import capabilities
+    return not capabilities(scene.solver.method, 3).matrix_free
+
+
+def notes(scene) -> list[str]:
+    """One line before a 3D run with a conic method whose estimated time exceeds :data:`NOTE_SECONDS`."""
+    if not _conic(scene):
+        return []
+    n = scene.contact_elements()
+    steps, per, total = conic_run(scene)
     if total <= NOTE_SECONDS:
         return []
-    return [f"{scene.solver.method} on {n} contact elements: about {duration(per)} a step (an SOCP with a dense "
-            f"Hessian, growing like the cube of the contact), {steps} steps: about {duration(total)} in all "
-            "(estimate); solver.method = 'newton' solves the same steps in a fraction of that, and the run's "
-            "cross-check solves a few of them by the conic route"]
+    march = " (the march to the steady state included)" if scene.load.start == "rolling" else ""
+    return [f"{scene.solver.method} on about {n} contact elements: about {duration(per)} a step, {steps} steps"
+            f"{march}: about {duration(total)} in all (estimate from this "
+            "machine's speed now); --method newton solves the same steps in seconds"]
+
+
+def refusal(scene, allow_long: bool = False) -> None:
+    """Refuse, before any work, a conic run that cannot finish in reasonable time or memory (one
+    :class:`~rollqp.errors.InputError` naming ``--method newton`` and a coarser grid); ``allow_long``
+    lets a run above :data:`REFUSE_SECONDS` start (never one whose dense matrix does not fit)."""
+    if not _conic(scene):
+        return
+    n = scene.contact_elements()
+    g = scene.grid
+    entries = (2 * n) ** 2
+    coarser = f"a coarser grid (discretization.elements, now {g.nx} × {g.ny})"
+    if entries > DENSE_MAX:
+        raise InputError("solver.method", f"{scene.solver.method} needs the influence matrix of the contact area "
+                                          f"as a dense matrix: {entries:,} entries ({entries * 8 / 1e9:.1f} GB) "
+                                          f"for about {n} contact elements, above the limit of {DENSE_MAX:,}; use "
+                                          f"--method newton (FFT products, no matrix) or {coarser}")
+    steps, per, total = conic_run(scene)
+    if total > REFUSE_SECONDS and not allow_long:
+        raise InputError("solver.method", f"{scene.solver.method} would take about {duration(total)} ({steps} "
+                                          f"steps of about {duration(per)} on about {n} contact elements, "
+                                          f"estimated from this machine's speed now); use --method newton "
+                                          f"(seconds) or {coarser}, or --allow-long to run it anyway")

@@ -25,13 +25,13 @@ import numpy as np
 from ..errors import RollqpError
 from .march import coupled_step
 
-__all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SPOT_BUDGET", "AGREEMENT"]
+__all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
 
-#: Wall time the default cross-check of ``rollqp run`` may take (seconds, estimated from the scene by
-#: :func:`rollqp.three.advice.conic_step_seconds`: one Clarabel SOCP has twice as many variables as the
-#: contact has elements and a dense Hessian, its cost grows like their cube — 0.35 s at 300 contact
-#: elements, 5.3 s at 812 measured here). ``--cross-check`` forces the three steps whatever they cost.
-SPOT_BUDGET = 12.0
+#: The default cross-check of ``rollqp run`` may take the run's own wall time plus this many seconds: a
+#: conic step whose estimated cost (:func:`rollqp.three.advice.conic_step_seconds`) does not fit is not
+#: started, and one still running at the end is stopped. ``--cross-check`` solves the three steps whatever
+#: they cost.
+SLACK = 3.0
 #: The refined answers of two routes that solve the same step to rollqp's residual 1e-10 agree to about
 #: that times the conditioning of the stick block (measured ≤ 5e-11 μp0, docs/validation3d.md §6); a
 #: different stick/slip partition would differ by 1e-3 or more. Differences above this are reported as
@@ -39,17 +39,10 @@ SPOT_BUDGET = 12.0
 AGREEMENT = 1e-7
 
 
-def spot_steps(K: int, contact_elements: int | None = None, budget: float | None = None) -> list[int]:
-    """The steps a run of ``K`` rolling steps keeps for its cross-check: 0, K/2, K — or, with
-    ``contact_elements`` and a ``budget`` (default :data:`SPOT_BUDGET`), as many of them as fit the
-    budget at the estimated cost of one conic step, the last state first (the one the summary
-    reports); ``[]`` if not even one fits."""
-    steps = sorted({0, K // 2, K})
-    if contact_elements is None:
-        return steps
-    from .advice import conic_step_seconds
-    fit = int((SPOT_BUDGET if budget is None else budget) // conic_step_seconds(contact_elements))
-    return sorted(steps[::-1][:max(fit, 0)])
+def spot_steps(K: int) -> list[int]:
+    """The steps a run of ``K`` rolling steps keeps for its cross-check: 0, K/2, K (which of them are solved
+    again within a time budget is :func:`cross_check`'s choice, the last first)."""
+    return sorted({0, K // 2, K})
 
 
 class SpotObserver:
@@ -82,6 +75,13 @@ class CrossCheck:
     #: ``(method, step) -> differences`` of each step (:meth:`table`).
     per_step: dict = field(default_factory=dict)
     ran: str = ""
+    #: The time budget it ran under (seconds; None: none), and per method the steps it left out for it.
+    budget: float | None = None
+    skipped: dict = field(default_factory=dict)
+    #: The estimated time of the step left out first (seconds).
+    estimate: float | None = None
+    #: ``(method, step) -> earlier step`` posed from the same data, whose solution it shares.
+    same: dict = field(default_factory=dict)
 
     def table(self) -> str:
         """One line per step and method: the differences from the run's solution and rollqp's residual."""
@@ -91,15 +91,23 @@ class CrossCheck:
                  "before it, at its loads", head]
         for (m, k), d in sorted(self.per_step.items(), key=lambda kv: (kv[0][1], kv[0][0])):
             raw = (f"{d['dp_raw']:9.1e} {d['dt_raw']:9.1e}" if "dp_raw" in d else f"{'-':>9} {'-':>9}")
+            same = f"  (the data of step {self.same[m, k]}: its solution)" if (m, k) in self.same else ""
             lines.append(f"{k:>5}  {m:<14} {d['dp']:10.1e} {d['dt']:13.1e} {d['dcreep']:9.1e} {d['residual']:9.1e} "
-                         f"{raw}")
+                         f"{raw}{same}")
         return "\n".join(lines)
 
     def agrees(self) -> bool:
         return all("error" not in r and max(r["dp"], r["dt"]) <= AGREEMENT for r in self.rows.values())
 
     def __str__(self) -> str:
-        head = f"{', '.join(self.rows)} on steps {', '.join(map(str, self.steps))}"
+        if not self.rows:
+            return self._nothing()
+        st = self.steps
+        shown = f"{st[0]}–{st[-1]}" if len(st) > 3 and st == list(range(st[0], st[-1] + 1)) else ", ".join(map(str, st))
+        head = f"{', '.join(self.rows)} on steps {shown}"
+        same = {k for (_, k) in self.same}
+        if same:
+            head += f" ({len(same)} of them posed from the same data as an earlier step: solved once)"
         if self.steady:
             head += " (state 0 steady: one rolling step of dx from it must return it)"
         lines = [head]
@@ -112,7 +120,19 @@ class CrossCheck:
                    if r.get("raw") else "")
             lines.append(f"{m}: {verdict}: max |dp| {r['dp']:.1e} p0, |dt| {r['dt']:.1e} mu p0, |d creepage| "
                          f"{r['dcreep']:.1e} p0/E*{raw}; residual {r['residual']:.1e}; {r['time']:.2f} s")
+        for m, ks in self.skipped.items():
+            lines.append(f"{m}: step{'s' if len(ks) > 1 else ''} {', '.join(map(str, sorted(ks)))} left out: beyond "
+                         f"the budget of {self.budget:.1f} s (the run's own time plus {SLACK:g} s; --cross-check "
+                         "solves every kept step)")
         return "\n".join(lines)
+
+    def _nothing(self) -> str:
+        if self.skipped:
+            m, ks = next(iter(self.skipped.items()))
+            return (f"skipped: one {m} step takes about {self.estimate:.0f} s (estimate), beyond the budget of "
+                    f"{self.budget:.1f} s (the run's own time plus {SLACK:g} s); --cross-check solves steps {', '.join(map(str, sorted(ks)))} again, "
+                    "rollqp crossval every step")
+        return "nothing to check"
 
 
 def _pose(scene, contact, rec, before):
@@ -126,44 +146,86 @@ def _pose(scene, contact, rec, before):
 
 def _compare(row, contact, rec, nsol, tsol) -> dict:
     sc, mu = contact.scales, contact.mu
-    d = {"dp": np.max(np.abs(nsol.p - rec.p)) / sc.stress, "dt": np.max(np.abs(tsol.t - rec.t)) / (mu * sc.stress),
+    d = {"dp": np.max(np.abs(nsol.p - rec.p)) / sc.stress, "dt": np.max(np.abs(tsol.t - rec.t)) / ((mu or 1.0) * sc.stress),
          "dcreep": max(abs(tsol.xi - rec.xi), abs(tsol.eta - rec.eta)) / sc.slip,
          "residual": max(nsol.residual, tsol.residual)}
     rp, rt = nsol.info.get("raw"), tsol.info.get("raw")
     if rp is not None or rt is not None:
         row["raw"] = True
         d["dp_raw"] = np.max(np.abs((rp or {"p": nsol.p})["p"] - rec.p)) / sc.stress
-        d["dt_raw"] = np.max(np.abs((rt or {"t": tsol.t})["t"] - rec.t)) / (mu * sc.stress)
+        d["dt_raw"] = np.max(np.abs((rt or {"t": tsol.t})["t"] - rec.t)) / ((mu or 1.0) * sc.stress)
     for k, v in d.items():
         row[k] = max(row.get(k, 0.0), float(v))
     return {k: float(v) for k, v in d.items()}
 
 
-def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance: float = 1e-10) -> CrossCheck:
+def _key(kind, loads, previous, dq) -> tuple:
+    """The data a step is posed from, as bytes: two steps with equal keys are the same problem."""
+    prev = b"" if previous is None else np.asarray(previous[0]).tobytes() + np.asarray(previous[1]).tobytes()
+    return kind, repr(loads), None if dq is None else float(dq), prev
+
+
+def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance: float = 1e-10,
+                budget: float | None = None) -> CrossCheck:
     """Solve the kept steps of a run (``observer``) again with ``methods`` (default: the registry's
-    :data:`~rollqp.methods.CROSS_CHECK_METHODS_3D` without ``ran``) and compare (module docstring)."""
-    from ..methods import CROSS_CHECK_METHODS_3D, get_method, method_class
+    :data:`~rollqp.methods.CROSS_CHECK_METHODS_3D` without ``ran``) and compare (module docstring).
+
+    A step posed from exactly the same data as one solved before (the same state before it, bit for bit,
+    the same loads and ``Δq``: the rolling steps that reproduce a steady state) is not solved again: its
+    solution is that step's, compared with the run's own solution of it (``CrossCheck.same``).
+
+    ``budget`` (seconds; None: none) bounds the wall time: the steps are taken the last first, a step
+    whose estimated conic cost (:func:`rollqp.three.advice.conic_step_seconds`) does not fit what is left
+    is not started, and a conic solve still running at the end is stopped (``CrossCheck.skipped``)."""
+    from ..methods import CROSS_CHECK_METHODS_3D, capabilities, get_method, method_class
+    from .advice import conic_step_seconds
     if methods is None:      # the other route: not the class that ran (socp-clarabel and qp-clarabel are one)
         methods = [m for m in CROSS_CHECK_METHODS_3D if method_class(m, 3) is not method_class(ran, 3)]
     names = [m for m in methods if m != ran]
     contact, kept = observer.contact, observer.kept
-    out = CrossCheck(sorted(kept), steady=any(rec.phase == "steady" for rec, _ in kept.values()), ran=ran)
+    t_start = time.perf_counter()
+    deadline = None if budget is None else t_start + budget
+    order = sorted(kept, reverse=budget is not None)
+    out = CrossCheck(sorted(kept), steady=any(rec.phase == "steady" for rec, _ in kept.values()), ran=ran,
+                     budget=budget)
     for name in names:
-        row, k = {}, None
+        row, k, done, measured = {}, None, {}, None
         t0 = time.perf_counter()
         try:
             method = get_method(name, 3, tolerance=tolerance)
+            conic = not capabilities(name, 3).matrix_free
+            if deadline is not None and conic:
+                method.deadline = deadline
             method.setup(contact)
-            for k in sorted(kept):
+            for k in order:
                 rec, before = kept[k]
                 kind, loads, previous, dq = _pose(scene, contact, rec, before)
-                nsol, tsol, _ = coupled_step(contact, method, scene.load.normal, kind, loads, previous, dq,
-                                             scene.load.direction)
-                out.per_step[name, k] = _compare(row, contact, rec, nsol, tsol)
+                key = _key(kind, loads, previous, dq)
+                if key not in done:
+                    m = max(int(np.sum(rec.p > 0)), 1)
+                    # the estimate: the model's before the first conic step, then that step's own time
+                    est = conic_step_seconds(m) if measured is None else measured[0] * (m / measured[1]) ** 2
+                    if deadline is not None and conic and time.perf_counter() + est > deadline:
+                        out.skipped.setdefault(name, []).append(k)
+                        out.estimate = max(out.estimate or 0.0, est)
+                        continue
+                    t1 = time.perf_counter()
+                    nsol, tsol, _ = coupled_step(contact, method, scene.load.normal, kind, loads, previous, dq,
+                                                 scene.load.direction)
+                    measured = (time.perf_counter() - t1, m)
+                    done[key] = (k, nsol, tsol)
+                else:
+                    out.same[name, k] = done[key][0]
+                out.per_step[name, k] = _compare(row, contact, rec, *done[key][1:])
         except RollqpError as err:
-            row = {"error": f"step {k}: {err}" if k is not None else str(err)}
+            if getattr(err, "status", None) == "budget":
+                out.skipped.setdefault(name, []).append(k)
+            else:
+                row = {"error": f"step {k}: {err}" if k is not None else str(err)}
         row["time"] = time.perf_counter() - t0
-        out.rows[name] = row
+        if "dp" in row or "error" in row:
+            out.rows[name] = row
+    out.steps = sorted({k for (_, k) in out.per_step})
     return out
 
 

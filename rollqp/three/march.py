@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from .contact import Loads
-from .problem import disc_projection, element_states
+from .problem import SEPARATION, SLIP, STICK, disc_projection, element_states
 
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
@@ -86,6 +86,9 @@ def coupled_step(contact, method, FN, kind, loads, previous=None, dq=None, direc
     sweeps)``.
     """
     wn, wt = warm if warm is not None else (None, None)
+    if contact.mu == 0:                 # frictionless: t = 0, the normal half alone (its shear is zero)
+        nsol = pressure if pressure is not None else normal(contact, method, FN, warm=wn)
+        return nsol, _frictionless(contact, kind, nsol, loads, previous, dq, direction), 1
     if not contact.ops.coupled:
         nsol = pressure if pressure is not None else normal(contact, method, FN, warm=wn)
         tsol = method.solve(contact.tangential_step(kind, nsol.p, loads, previous, dq, direction), wt)
@@ -102,6 +105,17 @@ def coupled_step(contact, method, FN, kind, loads, previous=None, dq=None, direc
             return nsol, tsol, sweep
     raise SolverError("the normal–tangential alternation did not converge", method=method.name,
                       iterations=MAX_SWEEPS, residual=max(nres, tsol.residual))
+
+
+def _frictionless(contact, kind, nsol, loads, previous, dq, direction):
+    """The tangential half at ``μ = 0``, as the 2D march's (:mod:`rollqp.march`): ``t = 0`` — the bound
+    ``μp`` is zero on every element, so every element in contact slips freely and nothing is solved
+    (a prescribed force is 0: ``load.tangential`` is then 0 by the scene's check). The creepages are
+    not determined by the contact: the prescribed ones, else 0; the slip follows from them."""
+    free = Loads(xi=0.0 if loads.xi is None else loads.xi, eta=0.0 if loads.eta is None else loads.eta,
+                 phi=loads.phi)
+    prob = contact.tangential_step(kind, nsol.p, free, previous, dq, direction)
+    return prob.solution(np.zeros((2, contact.grid.n)), method="frictionless", info={"status": "frictionless"})
 
 
 def _warm_of(rec):
@@ -122,7 +136,12 @@ def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_stat
 
 
 def _states(contact, p, t, s):
-    """0 separation, 1 stick, 2 slip (:func:`~rollqp.three.problem.element_states`)."""
+    """0 separation, 1 stick, 2 slip (:func:`~rollqp.three.problem.element_states`). At ``μ = 0`` (bound
+    zero) as in 2D (:func:`rollqp.problem.solution.classify`): an element in contact (``p > 0``) slips
+    where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it."""
+    if contact.mu == 0:
+        moving = np.hypot(*(np.asarray(s, dtype=float).reshape(2, -1) / contact.scales.slip)) > 1e-7
+        return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
     return element_states(np.asarray(t), np.asarray(s), contact.mu * np.maximum(p, 0.0), contact.scales)
 
 
@@ -158,12 +177,12 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
 
     ``accelerate``: ``"chord"`` (similar bodies; default) Newton's method on the march map
-    (:mod:`rollqp.three.chord`, eq. 3D.29), every iterate evaluated by the method; ``"anderson"`` the
+    (:mod:`rollqp.three.chord`, eq. 3D.24), every iterate evaluated by the method; ``"anderson"`` the
     march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
     0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
     bodies; solved here if ``None``)."""
     t0 = time.perf_counter()
-    if "steady" in method.capabilities.solves:
+    if "steady" in method.capabilities.solves or contact.mu == 0:
         warm = (start, start) if start is not None else None
         nsol, tsol, sw = coupled_step(contact, method, FN, "steady", loads, direction=direction, warm=warm,
                                       pressure=pressure)
@@ -275,14 +294,19 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                            FN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, nsol.delta, nsol.iterations, 0.0, nsol.residual,
                            {"normal": nsol.info})
     yield start
-    prev, warm = start, (_warm_of(start) if start.phase == "resumed" else None)
+    # the step after a rolling step sets out from it; the first rolling step from nothing (as a run that never
+    # stopped does, whatever the start: a resumed run repeats the same computations)
+    prev, warm = start, (_warm_of(start) if start.k >= 1 else None)
     fixed = None
-    if not contact.ops.coupled:
+    move = getattr(contact, "move", None)       # a profile feature rolls through: a normal step every step
+    if not contact.ops.coupled and move is None:
         fixed = normal(contact, method, FN, warm=None)
     for k in range(int(first), int(steps) + 1):
         t0 = time.perf_counter()
         q = k * dq
         ld = load_at(q)
+        if move is not None:
+            move(q)
         try:
             ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, (prev.p, prev.t), dq, direction,
                                       warm=warm, pressure=fixed)

@@ -20,6 +20,7 @@ import json
 
 import numpy as np
 
+from ..report import time_row
 from ..units import unit_names
 from .closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
 from .post import hertz_field_errors
@@ -52,6 +53,11 @@ def stick_fraction(state) -> tuple[int, int, int]:
 def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
     """``(name, text)`` for every comparison that applies (module docstring)."""
     e = scene.ellipse
+    if not scene.shape.hertzian:       # a profile: no closed form; a, b, p0 are the scales (docs/scenes.md)
+        on = np.asarray(res["pn"][0]) > 0
+        area = float(on.sum()) * float(np.diff(res["x"][:2])[0]) * float(np.diff(res["y"][:2])[0])
+        return [("contact (start)", f"area {area:.5g} (the normal step's; the Hertz ellipse of a, b would be "
+                                    f"{np.pi * e.a * e.b:.5g}); no closed form for a non-Hertzian profile")]
     X, Y = np.meshgrid(res["x"], res["y"])
     h = hertz_field_errors(X, Y, res["pn"][0], float(res["approach"][0]), e)
     rows = [("error: hertz", f"a {100 * h['a']:+.3f} %, b {100 * h['b']:+.3f} %, p0 {100 * h['p0']:+.3f} %, "
@@ -64,9 +70,11 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
 
 
 def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
-    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.7)."""
+    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.6–3D.7)."""
     e, m, mu = scene.ellipse, scene.materials, scene.mu
     FN, Fx = float(res["FN"][0]), float(res["Fx"][0])
+    if mu == 0:
+        return []
     r = abs(Fx) / (mu * FN)
     loads = scene.loads_at(0.0)
     if abs(e.a / e.b - 1) > 1e-9 or m.K != 0 or loads.Fy != 0 or loads.phi != 0 or not 0 < r < 1:
@@ -82,6 +90,8 @@ def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
 
 def _kalker_rows(res, scene) -> list[tuple[str, str]]:
     e, m = scene.ellipse, scene.materials
+    if scene.mu == 0:
+        return [("error: kalker", "not compared (mu = 0: no stick, no creep force)")]
     C = kalker_linear(e.a / e.b, m.nu)
     n, _, slip = stick_fraction(res["state"][0])
     if C is None or m.K != 0:
@@ -113,11 +123,18 @@ def _kalker_rows(res, scene) -> list[tuple[str, str]]:
     return [("error: kalker", "; ".join(out) + " " + note)]
 
 
+def _of_cap(F: float, cap: float) -> str:
+    """`` (+0.30000 mu FN)``, or nothing when ``μ = 0``."""
+    return f" ({F / cap:+.5f} mu FN)" if cap > 0 else ""
+
+
 def _grid_row(res, scene, u) -> str:
     nx, ny = res["x"].size, res["y"].size
     dx, dy = float(np.diff(res["x"][:2])[0]), float(np.diff(res["y"][:2])[0])
-    zx, zy = scene.discretization.zone
-    return (f"{nx} x {ny} elements ({nx * ny}), dx = {dx:.4g}, dy = {dy:.4g} {u.length}, zone ±{zx:g} a × ±{zy:g} b")
+    d = scene.discretization
+    where = (f"zone ±{d.zone[0]:g} a × ±{d.zone[1]:g} b" if d.zone is not None else
+             f"extent [{d.extent[0][0]:g}, {d.extent[0][1]:g}] × [{d.extent[1][0]:g}, {d.extent[1][1]:g}] {u.length}")
+    return f"{nx} x {ny} elements ({nx * ny}), dx = {dx:.4g}, dy = {dy:.4g} {u.length}, {where}"
 
 
 def _steps_row(res, scene, u) -> str:
@@ -133,7 +150,7 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
     force, moment = _force_units(u)
     e, mu = scene.ellipse, scene.mu
     ran = _meta(res).get("method") or method
-    it, st = np.asarray(res["iterations"]), np.asarray(res["step_time"], dtype=float)
+    it = np.asarray(res["iterations"])
     n, stick, slip = stick_fraction(res["state"][-1])
     xi, eta, phi = (float(v) for v in res["creepage"][-1])
     FN, Fx, Fy, Mz = (float(res[k][-1]) for k in ("FN", "Fx", "Fy", "Mz"))
@@ -144,13 +161,14 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
                       f"{u.stress}, E* = {e.Estar:.5g} {u.stress}, FN = {scene.load.normal:.6g} {force}"),
             ("steps", _steps_row(res, scene, u)),
             ("iterations", f"{int(it.sum())} in all ({int(it[0])} for the starting state)"),
-            ("wall time", f"{wall:.3f} s ({float(st.sum()):.3f} s stepping)"),
+            ("wall time", time_row(res, wall)),
             ("max residual", f"{float(np.max(res['residual'])):.2e} (nondimensional, docs/theory3d.md §10)"),
-            ("forces (end)", f"FN = {FN:.6g} {force}, Fx = {Fx:.6g} {force} ({Fx / (mu * FN):+.5f} mu FN), "
-                             f"Fy = {Fy:.6g} {force} ({Fy / (mu * FN):+.5f} mu FN), Mz = {Mz:.6g} {moment}"),
+            ("forces (end)", f"FN = {FN:.6g} {force}, Fx = {Fx:.6g} {force}{_of_cap(Fx, mu * FN)}, "
+                             f"Fy = {Fy:.6g} {force}{_of_cap(Fy, mu * FN)}, Mz = {Mz:.6g} {moment}"),
             ("creepages (end)", f"xi = {xi:.6g}, eta = {eta:.6g}, phi = {phi:.6g} 1/{u.length}"),
             ("stick area (end)", f"{100 * stick / max(n, 1):.1f} % of the {n} contact elements ({stick} stick, "
-                                 f"{slip} slip)")]
+                                 f"{slip} slip)" + (": frictionless (mu = 0): t = 0, the creepages as prescribed (else "
+                                                    "0), an element slips wherever they move it" if mu == 0 else ""))]
     note = _meta(res).get("rolling_start")
     if note:
         rows.append(("starting state", note))

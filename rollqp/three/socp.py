@@ -1,9 +1,9 @@
 r"""The 3D steps on external conic solvers: Clarabel natively, OSQP (normal step only), cvxpy
 (docs/theory3d.md §5–6).
 
-Each backend poses the normal step as the QP of eq. 3D.20 and the tangential step as the SOCP
-of eq. 3D.21 (:mod:`rollqp.three.forms`), maps the answer back (pressures, tractions, and the
-load rows' multipliers as the approach and the creepages, eq. 3D.22) and evaluates it with
+Each backend poses the normal step as the QP of eq. 3D.22 and the tangential step as the SOCP
+of eq. 3D.20 (:mod:`rollqp.three.forms`), maps the answer back (pressures, tractions, and the
+load rows' multipliers as the approach and the creepages, eq. 3D.21) and evaluates it with
 rollqp's own residuals on the step problem. On top of the solver:
 
 * **tolerances** from the requested residual, never the solvers' defaults (Clarabel's defaults
@@ -15,7 +15,7 @@ rollqp's own residuals on the step problem. On top of the solver:
 * **active-set refinement** (:mod:`rollqp.three.refine`): an interior point method ends with every
   complementary pair small but not zero, so elements at the edge of the contact or of the stick area
   are off by about ``√gap``. The answer is refined by the conic program's own KKT system on the
-  active set the solver identified (eq. 3D.28: Newton iterations on smooth equations, the active set
+  active set the solver identified (eq. 3D.23: Newton iterations on smooth equations, the active set
   held fixed — OSQP's polish carried to the cone, as the 2D QPs' ``active_set_refine``) and kept only
   if rollqp's residual drops; ``info["raw"]`` keeps the solver's own answer and ``info["raw_residual"]``
   its residual, so that its distance from any other method stays visible;
@@ -35,6 +35,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError, MissingBackendError, SolverError
 from ..methods.base import Capabilities, check_options
+from ..threads import threads
 from .forms import normal_form, tangential_form
 from .refine import active_set_refine
 
@@ -64,6 +65,8 @@ class ConicMethod:
 
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "conic"
+    #: ``time.perf_counter()`` at which Clarabel stops its iterations (a cross-check's time budget); None: none.
+    deadline = None
     capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimension=3, traction_components=2,
                                 friction_set="disc")
 
@@ -89,7 +92,7 @@ class ConicMethod:
         self._solvers = {}
 
     def solve(self, problem, warm=None):
-        """Solve a normal or tangential step (eq. 3D.20/3D.21); rollqp's residuals decide."""
+        """Solve a normal or tangential step (eq. 3D.22/3D.20); rollqp's residuals decide."""
         if problem.kind not in self.capabilities.solves:
             from ..methods import cone_methods
             raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step "
@@ -203,7 +206,7 @@ def raw_solution(problem, solution):
 
 
 def _solution(problem, form, x, y, name, info):
-    """Map a solver's ``(x, y)`` back to the step's unknowns (eq. 3D.22) and evaluate it."""
+    """Map a solver's ``(x, y)`` back to the step's unknowns (eq. 3D.21) and evaluate it."""
     sc = problem.scales
     unknowns = form.multipliers_to_unknowns(y)
     if form.kind == "normal":
@@ -226,7 +229,8 @@ def _clarabel_settings(tolerance, max_iterations):
     # stops "AlmostSolved" at a residual of 3e-4 on a 30 × 30 rolling step (540 cones), at 1e-13 it
     # reaches 9e-9 "Solved" (measured; the active-set refinement takes either to round-off)
     gap = max(1e-4 * tolerance, 1e-13)
-    values = dict(verbose=False, presolve_enable=False, tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=gap,
+    # max_threads: faer's own pool (0 = every core) at rollqp's BLAS threads (rollqp.threads)
+    values = dict(max_threads=threads(), verbose=False, presolve_enable=False, tol_gap_abs=gap, tol_gap_rel=gap, tol_feas=gap,
                   tol_ktratio=min(1e-6, gap), iterative_refinement_reltol=1e-14,
                   iterative_refinement_abstol=1e-14, iterative_refinement_max_iter=20,
                   max_iter=int(max_iterations or 200))
@@ -261,7 +265,7 @@ def _constraint_rows(form):
 
 
 class ClarabelMethod(ConicMethod):
-    """Clarabel (interior point, native cones): the QP of eq. 3D.20 and the SOCP of eq. 3D.21."""
+    """Clarabel (interior point, native cones): the QP of eq. 3D.22 and the SOCP of eq. 3D.20."""
 
     name = "clarabel"
 
@@ -277,8 +281,15 @@ class ClarabelMethod(ConicMethod):
         else:
             solver = entry[1]
             solver.update(q=q, b=b)
+        deadline = self.deadline
+        if deadline is not None:  # a time budget (the run's cross-check): stop at its end
+            solver.set_termination_callback(lambda info: time.perf_counter() > deadline)
+        else:
+            solver.unset_termination_callback()
         sol = solver.solve()
         status = str(sol.status)
+        if deadline is not None and time.perf_counter() > deadline and status not in ("Solved", "AlmostSolved"):
+            raise SolverError("stopped at the end of its time budget", method=self.name, status="budget")
         if status not in ("Solved", "AlmostSolved"):
             raise SolverError("Clarabel did not solve the step", method=self.name, status=status)
         k = form.a.shape[0]
@@ -286,7 +297,7 @@ class ClarabelMethod(ConicMethod):
 
 
 class OsqpMethod(ConicMethod):
-    """OSQP (ADMM, polished) on the normal QP of eq. 3D.20; a tangential step is an InputError."""
+    """OSQP (ADMM, polished) on the normal QP of eq. 3D.22; a tangential step is an InputError."""
 
     name = "osqp"
     #: No cones: the friction disc cannot be posed, so it solves the normal QP only.
@@ -322,7 +333,7 @@ class OsqpMethod(ConicMethod):
 
 
 class CvxpyMethod(ConicMethod):
-    """cvxpy's textbook statement of eq. 3D.20/3D.21 (DPP parameters), on ``solver`` (``"CLARABEL"``
+    """cvxpy's textbook statement of eq. 3D.22/3D.20 (DPP parameters), on ``solver`` (``"CLARABEL"``
     or ``"SCS"``)."""
 
     name = "cvxpy"

@@ -1,0 +1,102 @@
+"""What a 3D run costs and what it says about it: the conic cost model, the refusal before any work, the
+cross-check's time budget and its reuse of identical steps (rollqp.three.advice, rollqp.three.crosscheck).
+No test times anything: the budget tests use a budget of zero or a deadline already past."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rollqp import cli, load_scene
+from rollqp.errors import InputError
+from rollqp.three import advice
+from rollqp.three.crosscheck import SpotObserver, cross_check, crossval
+from rollqp.three.run import run
+
+
+def coarse(name, **changes):
+    s = load_scene(name)
+    nx, ny = s.discretization.elements
+    k = 12 / min(nx, ny)
+    base = {"discretization.elements": [round(nx * k), round(ny * k)], "discretization.zone": [1.3, 1.3]}
+    return s.replace(**{**base, **changes})
+
+
+def test_the_cost_model_grows_with_the_contact_and_follows_the_yardstick():
+    y = 0.003
+    t = [advice.conic_step_seconds(m, y) for m in (100, 300, 812, 5000)]
+    assert all(b > a for a, b in zip(t, t[1:]))
+    assert advice.conic_step_seconds(812, 2 * y) == pytest.approx(2 * t[2])
+    # between the quadratic (assembly) and the cubic (factorizations) law
+    assert (812 / 300) ** 2 < t[2] / t[1] < (812 / 300) ** 3
+    assert advice.yardstick() > 0
+
+
+def test_a_conic_run_whose_dense_matrix_does_not_fit_is_refused_before_any_work():
+    scene = load_scene("kalker-circular", {"solver.method": "socp-clarabel", "discretization.elements": [200, 200]})
+    with pytest.raises(InputError, match=r"^solver.method: .*--method newton.*coarser grid") as err:
+        advice.refusal(scene, allow_long=True)          # memory: not even --allow-long
+    assert "\n" not in str(err.value) and "Ann" not in str(err.value) and "use the FFT product" not in str(err.value)
+
+
+def test_a_conic_run_estimated_above_an_hour_is_refused_unless_allowed(monkeypatch):
+    scene = load_scene("kalker-circular", {"solver.method": "socp-clarabel"})
+    monkeypatch.setattr(advice, "_YARDSTICK", [1.0])    # a machine where a 600-order Cholesky takes 1 s
+    steps, per, total = advice.conic_run(scene)
+    assert total > advice.REFUSE_SECONDS and steps > scene.n_steps  # the march to the steady state counted
+    with pytest.raises(InputError, match=r"would take about .* h .*--method newton.*--allow-long"):
+        advice.refusal(scene)
+    advice.refusal(scene, allow_long=True)
+    assert advice.notes(scene) and "about" in advice.notes(scene)[0]
+    monkeypatch.setattr(advice, "_YARDSTICK", [1e-6])   # a fast machine: no note, no refusal
+    advice.refusal(scene)
+    assert advice.notes(scene) == []
+    assert advice.notes(load_scene("kalker-circular")) == []   # Newton: nothing to say
+
+
+def test_the_command_refuses_in_one_line(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    path = tmp_path / "big.toml"
+    path.write_text(load_scene("kalker-circular", {"discretization.elements": [200, 200]}).to_toml(), encoding="utf-8")
+    code = cli.main(["run", str(path), "--method", "socp-clarabel", "--quiet"])
+    err = capsys.readouterr().err
+    assert code == cli.EXIT_INPUT and err.count("\n") == 1 and "--method newton" in err, err
+    assert not (tmp_path / "big.npz").exists() and not list(tmp_path.glob("*.journal"))
+
+
+@pytest.fixture(scope="module")
+def kept():
+    scene = coarse("kalker-circular", **{"discretization.distance": 1.0})
+    obs = SpotObserver(range(scene.n_steps + 1))
+    run(scene, observe=obs)
+    return scene, obs
+
+
+def test_a_budget_of_zero_solves_nothing_and_says_so(kept):
+    scene, obs = kept
+    check = cross_check(scene, obs, "newton", budget=0.0)
+    assert check.rows == {} and sorted(check.skipped["socp-clarabel"]) == sorted(obs.kept)
+    text = str(check)
+    assert text.startswith("skipped: one socp-clarabel step takes about") and "--cross-check" in text
+
+
+def test_identical_steps_are_solved_once_and_compared_each(kept):
+    scene, obs = kept
+    check = cross_check(scene, obs, "newton", methods=["socp-clarabel"])
+    K = scene.n_steps
+    assert check.agrees() and check.steps == list(range(K + 1))
+    # the rolling steps from the second on start from the same state, bit for bit (steady state reproduced)
+    arrays = [obs.kept[k][0] for k in range(1, K + 1)]
+    assert all(np.array_equal(a.t, arrays[0].t) for a in arrays)
+    same = {k for (_, k) in check.same}
+    # step 1 (Δq = dx from the steady state 0) is the steady check of step 0; steps 3…K start from states
+    # 2…K-1, which are state 1 bit for bit, as step 2 does
+    assert scene.dq == pytest.approx(obs.contact.grid.dx) and same == {1, *range(3, K + 1)}, same
+    for k in same:                                       # each compared with the run's own solution of it
+        assert ("socp-clarabel", k) in check.per_step
+    assert "solved once" in str(check)
+
+
+def test_crossval_step_choice_still_checks(kept):
+    scene, _ = kept
+    check = crossval(scene, step=1, methods=["socp-clarabel"])
+    assert check.agrees() and check.steps == [1]
