@@ -93,16 +93,27 @@ def kernels(rectangle: bool):
     return exprs, (X, Y, Z, nu)
 
 
-def source(name: str, rectangle: bool) -> str:
+def source(name: str, rectangle: bool, per: int = 60) -> str:
+    """The kernels as Python source: the common subexpressions ``x[i]`` computed by functions of ``per`` lines
+    each (one screen), then ``name(X, Y, z, nu)`` returning the 18 kernels."""
+    import re
     exprs, _ = kernels(rectangle)
     reps, red = sp.cse(exprs, optimizations="basic")
     pr = NumPyPrinter({"fully_qualified_modules": False})
-    lines = [f"def {name}(X, Y, z, nu):"]
-    lines += [f"    {s} = {pr.doprint(e)}" for s, e in reps]
-    lines.append("    return (" + ",\n            ".join(pr.doprint(e) for e in red) + ")")
-    return "\n".join(lines) + "\n"
+
+    def code(e):
+        return re.sub(r"\bx(\d+)\b", r"x[\1]", pr.doprint(e))
+    lines = [f"    x[{str(s)[1:]}] = {code(e)}" for s, e in reps]
+    parts = []
+    for k in range(0, len(lines), per):
+        parts.append(f"def {name}_{k // per}(X, Y, z, nu, x):\n" + "\n".join(lines[k:k + per]) + "\n")
+    body = [f"def {name}(X, Y, z, nu):", f"    x = [None] * {len(reps)}"]
+    body += [f"    {name}_{k}(X, Y, z, nu, x)" for k in range(len(parts))]
+    body.append("    return (" + ",\n            ".join(code(e) for e in red) + ")")
+    return "\n\n".join(parts) + "\n\n" + "\n".join(body) + "\n"
 
 
 if __name__ == "__main__":
     print(source("_corner_kernels", True))
+    print()
     print(source("_point_kernels", False))
