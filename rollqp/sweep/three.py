@@ -309,7 +309,8 @@ class CreepCurve3D:
         ax.plot(self.values, self.force / cap, "o-", ms=4, label=f"rollqp: {comp}/(μFN)")
         if k is not None:
             v = np.linspace(min(self.values.min(), 0.0), max(self.values.max(), 0.0), 200)
-            lin = np.clip(k * v / cap, -1.5, 1.5)
+            lin = k * v / cap
+            lin[np.abs(lin) > 1.2] = np.nan       # the line only where it is near the curve's range
             ax.plot(v, lin, "k:", lw=1, label="Kalker's linear theory")
         for y in (-1.0, 1.0):
             ax.axhline(y, color="0.5", lw=0.8, ls="--")
