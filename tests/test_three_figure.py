@@ -102,3 +102,15 @@ def test_braking_slips_on_the_lower_bound(runs):
 def test_she_saturation_has_the_linear_slope_and_saturates():
     u = np.array([1e-6, 3.0, 10.0])
     assert she_saturation(u)[0] == pytest.approx(1e-6, rel=1e-5) and she_saturation(u)[1:] == pytest.approx(1.0)
+
+
+def test_a_non_hertzian_patch_calls_its_ellipse_a_guide():
+    """A profile's contact is not elliptic: the ellipse of its equivalent curvatures, Hertz's pressure and
+    Kalker's coefficients of that ellipse are named as guides, not as its references."""
+    import matplotlib.pyplot as plt
+    scene = load_scene("quartic-roller").replace(**{"discretization.elements": [12, 24]})
+    fig = three_figure(run(scene).arrays(), scene)
+    labels = " | ".join(_labels(fig))
+    assert "ellipse of the equivalent curvatures (a guide)" in labels and "Hertz ellipse (3D.4)" not in labels
+    assert "equivalent ellipse's Kalker's linear theory" in labels and "a guide: the patch is not elliptic" in labels
+    plt.close(fig)

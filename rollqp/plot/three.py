@@ -192,10 +192,15 @@ def _field_panel(ax, res, scene, k, mu_p0, title):
            title=title)
     ax.set_xlim(x[0] - 0.5 * (x[1] - x[0]), x[-1] + 0.5 * (x[1] - x[0]))
     ax.set_ylim(y[0] - 0.5 * (y[1] - y[0]), y[-1] + 0.5 * (y[1] - y[0]))
-    return _field_handles()
+    return _field_handles(scene)
 
 
-def _field_handles():
+def _hertzian(scene) -> bool:
+    """Two paraboloids (eq. 3D.3); a profile's contact is not elliptic, its ellipse only a guide."""
+    return bool(getattr(getattr(scene, "shape", None), "hertzian", True))
+
+
+def _field_handles(scene):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
     arrow = dict(marker=r"$\rightarrow$", ls="none", ms=11)
@@ -203,7 +208,8 @@ def _field_handles():
              Patch(facecolor=STICK_AREA, edgecolor="0.6", lw=0.5),
              Line2D([], [], color="tab:blue", lw=0.6), Line2D([], [], color="k", lw=0.8)],
             ["$t$, element in stick", r"$t = -\mu p\, s/|s|$, element in slip", "stick area",
-             "$p/p_0$ = 0.2, 0.4, 0.6, 0.8", "Hertz ellipse (3D.4)"])
+             "$p/p_0$ = 0.2, 0.4, 0.6, 0.8",
+             "Hertz ellipse (3D.4)" if _hertzian(scene) else "ellipse of the equivalent curvatures (a guide)"])
 
 
 def _bounds(ax, x, bound, big):
@@ -278,8 +284,11 @@ def _pressure_panel(ax, res, scene):
     ax.plot(res["x"] / e.a, res["pn"][0][j0] / e.p0, "o", ms=3.2, color="tab:blue", label="$p/p_0$ along $x$ ($y = 0$)")
     ax.plot(res["y"] / e.b, res["pn"][0][:, i0] / e.p0, "s", ms=5, mfc="none", color="tab:green",
             label="$p/p_0$ along $y$ ($x = 0$), against $y/b$")
-    ax.plot(s, np.sqrt(1 - s * s), **{**REFERENCES["hertz"], "label": "Hertz (3D.4)"})
-    ax.set(xlabel="$x/a$, $y/b$", ylabel="$p/p_0$", title="pressure, state 0, against Hertz")
+    hz = _hertzian(scene)
+    ax.plot(s, np.sqrt(1 - s * s), **{**REFERENCES["hertz"], "label": "Hertz (3D.4)" if hz else
+                                      "Hertz of the equivalent curvatures (a guide: the patch is not elliptic)"})
+    ax.set(xlabel="$x/a$, $y/b$", ylabel="$p/p_0$",
+           title="pressure, state 0, against Hertz" if hz else "pressure of the patch, state 0")
     u = unit_names(getattr(scene, "units", ""))
     value_axis(ax, e.p0, f"$p$ [{u.stress}]")
 
@@ -305,7 +314,8 @@ def creep_force_panel(ax, res, scene, k=-1):
     u = float(np.hypot(*lin)) / (mu * FN)
     top = max(3.3, 1.15 * u) if u > 0.15 else 1.5 * max(u, 1e-300)
     s = np.linspace(0, top, 400)
-    ax.plot(s, s, **KALKER, label=f"Kalker's linear theory (3D.8): $C_{{11}}, C_{{22}}, C_{{23}}$ = "
+    ax.plot(s, s, **KALKER, label=("" if _hertzian(scene) else "equivalent ellipse's ")
+            + f"Kalker's linear theory (3D.8): $C_{{11}}, C_{{22}}, C_{{23}}$ = "
                                   f"{C[0]:.3g}, {C[1]:.3g}, {C[2]:.3g}")
     if top > 1:
         ax.axhline(1, **SATURATION, label=r"full sliding, $|F| = \mu F_N$")

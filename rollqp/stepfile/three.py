@@ -5,10 +5,10 @@ solution (docs/stepfiles.md, "Three dimensions").
 data on the grid (the dense influence operators ``A_nn``, the slip operator ``B`` of the step, the
 coupling operators ``A_nt``, ``A_tn``, the undeformed distance, the history vector, the loads and
 creepages, the scales), the state before it, rollqp's solution, and both halves as conic programs in
-rollqp's scaled variables (the QP of eq. 3D.20 and the SOCP of eq. 3D.21, each at rollqp's solution of
+rollqp's scaled variables (the QP of eq. 3D.22 and the SOCP of eq. 3D.20, each at rollqp's solution of
 the other half, with the skew part of a steady operator frozen there). :meth:`StepFile3D.save` writes
 the ``.npz`` without pickles and beside it Clarabel's JSON of both halves and a cvxpy script.
-:func:`check_step_3d` evaluates a candidate ``(p, t[, δ, ξ, η])`` with rollqp's residuals (eq. 3D.27),
+:func:`check_step_3d` evaluates a candidate ``(p, t[, δ, ξ, η])`` with rollqp's residuals (eq. 3D.29),
 element by element, and names the elements where a condition fails.
 
 The step problem (eq. 3D.14–3D.17) as stored::
@@ -496,8 +496,8 @@ def cvxpy_script_3d(step_name: str) -> str:
 
 _SCRIPT = r'''"""Rebuild and solve the 3D step in @SHOWN@ with cvxpy (written by rollqp export-step).
 
-Needs numpy and cvxpy. The normal half is the QP of eq. 3D.20, the tangential half the SOCP of
-eq. 3D.21 with one second-order cone per element, each at rollqp's solution of the other half and
+Needs numpy and cvxpy. The normal half is the QP of eq. 3D.22, the tangential half the SOCP of
+eq. 3D.20 with one second-order cone per element, each at rollqp's solution of the other half and
 with the skew part of a steady operator frozen there (q_frozen). The pressure and traction are
 written to the .npz that `rollqp check-step` reads (it fits the approach and the creepages):
 
@@ -529,7 +529,7 @@ def half(name):
     obj = 0.5 * cp.quad_form(x, cp.psd_wrap(d["H"])) + d["q_frozen"] @ x
     cp.Problem(cp.Minimize(obj), cons).solve(solver=cp.CLARABEL, tol_gap_abs=1e-12, tol_gap_rel=1e-12,
                                              tol_feas=1e-12)
-    # the load rows' multipliers are the unknowns (eq. 3D.22): -delta and the creepages, in rollqp's scales
+    # the load rows' multipliers are the unknowns (eq. 3D.21): -delta and the creepages, in rollqp's scales
     y = cons[0].dual_value * d["obj_scale"] / d["eq_scale"] if d["a"].shape[0] else np.zeros(0)
     return x.value, d["elements"].astype(int), np.atleast_1d(y)
 
