@@ -102,8 +102,8 @@ BAD = [
     ("step too long", lambda d: d["discretization"].update(step=20.0), "discretization.step:", "(0, 8]"),
     ("2D key in 3D", lambda d: d["discretization"].update(element="linear"), "discretization.element:",
      "a key of 2D scenes"),
-    ("2D profile in 3D", lambda d: d["bodies"]["A"].update(profile={"kind": "dent"}), "bodies.A.profile:",
-     "a key of 2D scenes"),
+    ("2D profile kind in 3D", lambda d: d["bodies"]["A"].update(profile={"kind": "dent"}), "bodies.A.profile.kind:",
+     "in a 3D scene"),
 ]
 
 

@@ -53,6 +53,11 @@ def stick_fraction(state) -> tuple[int, int, int]:
 def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
     """``(name, text)`` for every comparison that applies (module docstring)."""
     e = scene.ellipse
+    if not scene.shape.hertzian:       # a profile: no closed form; a, b, p0 are the scales (docs/scenes.md)
+        on = np.asarray(res["pn"][0]) > 0
+        area = float(on.sum()) * float(np.diff(res["x"][:2])[0]) * float(np.diff(res["y"][:2])[0])
+        return [("contact (start)", f"area {area:.5g} (the normal step's; the Hertz ellipse of a, b would be "
+                                    f"{np.pi * e.a * e.b:.5g}); no closed form for a non-Hertzian profile")]
     X, Y = np.meshgrid(res["x"], res["y"])
     h = hertz_field_errors(X, Y, res["pn"][0], float(res["approach"][0]), e)
     rows = [("error: hertz", f"a {100 * h['a']:+.3f} %, b {100 * h['b']:+.3f} %, p0 {100 * h['p0']:+.3f} %, "
@@ -65,7 +70,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
 
 
 def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
-    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.7)."""
+    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.6–3D.7)."""
     e, m, mu = scene.ellipse, scene.materials, scene.mu
     FN, Fx = float(res["FN"][0]), float(res["Fx"][0])
     if mu == 0:
@@ -126,8 +131,10 @@ def _of_cap(F: float, cap: float) -> str:
 def _grid_row(res, scene, u) -> str:
     nx, ny = res["x"].size, res["y"].size
     dx, dy = float(np.diff(res["x"][:2])[0]), float(np.diff(res["y"][:2])[0])
-    zx, zy = scene.discretization.zone
-    return (f"{nx} x {ny} elements ({nx * ny}), dx = {dx:.4g}, dy = {dy:.4g} {u.length}, zone ±{zx:g} a × ±{zy:g} b")
+    d = scene.discretization
+    where = (f"zone ±{d.zone[0]:g} a × ±{d.zone[1]:g} b" if d.zone is not None else
+             f"extent [{d.extent[0][0]:g}, {d.extent[0][1]:g}] × [{d.extent[1][0]:g}, {d.extent[1][1]:g}] {u.length}")
+    return f"{nx} x {ny} elements ({nx * ny}), dx = {dx:.4g}, dy = {dy:.4g} {u.length}, {where}"
 
 
 def _steps_row(res, scene, u) -> str:

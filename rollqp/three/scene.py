@@ -20,7 +20,7 @@ the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a
 
 Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
 allowed range: radii nonzero (``< 0`` concave, ``inf`` straight), a concentrated contact (the summed
-curvature positive in both directions, eq. 3D.1), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
+curvature positive in both directions, eq. 3D.3), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
 element aspect ratio ``dx/dy`` in :data:`rollqp.three.grid.ASPECT_RANGE`, the forces below the sliding
 limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
@@ -40,6 +40,7 @@ from ..errors import InputError
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL
 from ..methods import DEFAULT_METHOD, require_3d
+from ..profiles3d import Shape, parse_body
 from ..scene.checks import MAX_FRICTION, check_scene_name, check_units
 from ..scene.core import SceneBase
 from ..validate import choice, integer, number, string, suggestion
@@ -48,6 +49,7 @@ from .geometry import Body, curvatures
 from .grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
 from .hertz import hertz
 from .materials import Materials
+from .patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
 
 __all__ = ["Scene3D", "Body3D", "Contact3D", "Creepage3D", "Load3D", "Discretization3D", "Solver3D",
            "scene_from_dict", "MAX_STEPS", "MAX_RESULT_BYTES"]
@@ -69,12 +71,14 @@ STARTS = ("braked", "rolling")
 class Body3D:
     """One body: principal radii ``radius`` (x–z plane) and ``radius_y`` (y–z plane), ``> 0`` (convex),
     ``< 0`` (concave: a groove) or ``inf`` (a straight generator; both ``inf``: a plane); Young's modulus ``E > 0``, Poisson's ratio
-    ``nu`` in (−1, 0.5)."""
+    ``nu`` in (−1, 0.5); a ``profile`` over (x, y) (:mod:`rollqp.profiles3d`: it replaces ``radius_y``
+    or both radii)."""
 
-    radius: float
-    radius_y: float
-    E: float
-    nu: float
+    radius: float | None = None
+    radius_y: float | None = None
+    E: float = None
+    nu: float = None
+    profile: Any = None
 
 
 @dataclass(frozen=True)
@@ -118,13 +122,16 @@ class Load3D:
 
 @dataclass(frozen=True)
 class Discretization3D:
-    """``elements = (nx, ny)`` on the half-widths ``zone = (zx, zy)``·(a, b); rolling steps of
+    """``elements = (nx, ny)`` on the half-widths ``zone = (zx, zy)``·(a, b), or on ``extent = ((x0, x1),
+    (y0, y1))`` in length units (with ``elements`` or ``element_size = (dx, dy)``); rolling steps of
     ``step``·dx up to ``distance``·a."""
 
-    elements: tuple = (40, 40)
-    zone: tuple = (1.25, 1.25)
+    elements: tuple | None = None
+    zone: tuple | None = None
     step: float = 1.0
     distance: float = 4.0
+    extent: tuple | None = None
+    element_size: tuple | None = None
 
 
 @dataclass(frozen=True)
@@ -139,17 +146,13 @@ class Solver3D:
 
 
 # =========================================================================== part checks
-def _radius(key, v) -> float:
-    if not (isinstance(v, (int, float)) and not isinstance(v, bool)) or math.isnan(v) or v == 0:
-        raise InputError(key, f"must be a nonzero number (> 0 convex, < 0 concave, inf for a straight generator), "
-                              f"got {v!r}")
-    return float(v)
-
-
 def _body(key, b: Body3D) -> Body3D:
-    return Body3D(_radius(f"{key}.radius", b.radius), _radius(f"{key}.radius_y", b.radius_y),
-                  number(f"{key}.E", b.E, "> 0", lambda x: x > 0),
-                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5))
+    for k in ("E", "nu"):
+        if getattr(b, k) is None:
+            raise InputError(f"{key}.{k}", "missing required key")
+    shape = parse_body({k: getattr(b, k) for k in ("radius", "radius_y", "profile") if getattr(b, k) is not None}, key)
+    return Body3D(shape.rx, shape.ry, number(f"{key}.E", b.E, "> 0", lambda x: x > 0),
+                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict())
 
 
 def _contact(c: Contact3D) -> Contact3D:
@@ -196,17 +199,23 @@ def _pair(key, v, what, check) -> tuple:
 
 
 def _discretization(d: Discretization3D) -> Discretization3D:
-    elements = _pair("discretization.elements", d.elements, "integers >= 4",
-                     lambda k, v: integer(k, v, ">= 4 (and <= 10000)", lambda n: 4 <= n <= 10_000))
-    if elements[0] * elements[1] > MAX_ELEMENTS:
-        raise InputError("discretization.elements", f"nx·ny = {elements[0] * elements[1]} exceeds {MAX_ELEMENTS} elements")
-    zone = _pair("discretization.zone", d.zone, "half-widths / (a, b) > 1",
-                 lambda k, v: number(k, v, "> 1 (and <= 100): the grid covers the Hertz ellipse",
-                                     lambda x: 1 < x <= 100))
+    extent, size = grid_extent(d.extent, d.zone, d.element_size, d.elements)
+    elements = None
+    if size is None:
+        elements = _pair("discretization.elements", (40, 40) if d.elements is None else d.elements, "integers >= 4",
+                         lambda k, v: integer(k, v, ">= 4 (and <= 10000)", lambda n: 4 <= n <= 10_000))
+        if elements[0] * elements[1] > MAX_ELEMENTS:
+            raise InputError("discretization.elements", f"nx·ny = {elements[0] * elements[1]} exceeds {MAX_ELEMENTS} "
+                                                        "elements")
+    zone = None
+    if extent is None:
+        zone = _pair("discretization.zone", (1.25, 1.25) if d.zone is None else d.zone, "half-widths / (a, b) > 1",
+                     lambda k, v: number(k, v, "> 1 (and <= 100): the grid covers the Hertz ellipse",
+                                         lambda x: 1 < x <= 100))
     return Discretization3D(elements, zone,
                             number("discretization.step", d.step, "in (0, 8] (Δq/Δx)", lambda x: 0 < x <= 8),
                             number("discretization.distance", d.distance, "in [0, 1e6] (rolled distance / a)",
-                                   lambda x: 0 <= x <= 1e6))
+                                   lambda x: 0 <= x <= 1e6), extent, size)
 
 
 def _solver(s: Solver3D) -> Solver3D:
@@ -274,9 +283,36 @@ class Scene3D(SceneBase):
         return Materials.from_young(self.A.E, self.A.nu, self.B.E, self.B.nu)
 
     @functools.cached_property
+    def shape(self) -> Shape:
+        """The undeformed distance ``h(x, y, shift)`` of the two bodies (:mod:`rollqp.profiles3d`)."""
+        return Shape(*(parse_body({k: v for k, v in (("radius", b.radius), ("radius_y", b.radius_y),
+                                                      ("profile", b.profile)) if v is not None}, f"bodies.{name}")
+                       for name, b in (("A", self.A), ("B", self.B))))
+
+    @functools.cached_property
     def curvatures(self) -> tuple[float, float]:
-        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.1)."""
-        return curvatures(Body(self.A.radius, self.A.radius_y, "A"), Body(self.B.radius, self.B.radius_y, "B"))
+        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.3); with a profile, its curvatures at the origin where
+        both are positive, else the equivalent curvatures of the computed contact
+        (:func:`rollqp.three.patch.equivalent_curvatures`)."""
+        if self.shape.hertzian:
+            return curvatures(Body(self.A.radius, self.A.radius_y, "A"), Body(self.B.radius, self.B.radius_y, "B"))
+        A, B = self.shape.curvatures()
+        if A > 0 and B > 0:
+            return A, B
+        pt = self.patch
+        return equivalent_curvatures(pt.a, pt.b, self.materials.Estar, self.load.normal)
+
+    @functools.cached_property
+    def patch(self):
+        """The contact the normal step finds for the profile at the reference load (:mod:`rollqp.three.patch`),
+        None for two paraboloids."""
+        if self.shape.hertzian:
+            return None
+        from ..methods import REFERENCE_METHOD, scene_method_3d
+        A, B = self.shape.curvatures()
+        guess = (A, B) if A > 0 and B > 0 else None
+        return computed_patch(self.shape.at(0.0), self.grid, self.materials, self.load.normal,
+                              scene_method_3d(Solver3D(REFERENCE_METHOD, 1e-12)), guess)
 
     @functools.cached_property
     def ellipse(self):
@@ -286,9 +322,13 @@ class Scene3D(SceneBase):
 
     @functools.cached_property
     def grid(self) -> Grid:
-        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.three.grid.Grid.for_ellipse>`)."""
+        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.three.grid.Grid.for_ellipse>`),
+        or on ``extent`` (:func:`rollqp.three.patch.extent_grid`)."""
+        d = self.discretization
+        if d.extent is not None:
+            return extent_grid(d.extent, d.elements, d.element_size)
         e = self.ellipse
-        return Grid.for_ellipse(e.a, e.b, self.discretization.elements, self.discretization.zone)
+        return Grid.for_ellipse(e.a, e.b, d.elements, d.zone)
 
     @property
     def mu(self) -> float:
@@ -339,12 +379,14 @@ class Scene3D(SceneBase):
                  "start": ld.start, "direction": ld.direction, "start_steps": ld.start_steps}
         solver = {k.name: getattr(self.solver, k.name) for k in fields(self.solver)
                   if getattr(self.solver, k.name) is not None}
+        disc = {"elements": d.elements, "zone": d.zone, "extent": d.extent, "element_size": d.element_size}
+        disc = {k: [list(v) if isinstance(v, tuple) else v for v in val] for k, val in disc.items() if val is not None}
         return {"name": self.name, "description": self.description, **({"units": self.units} if self.units else {}),
-                "bodies": {k: dataclasses.asdict(b) for k, b in (("A", self.A), ("B", self.B))},
+                "bodies": {k: {f: v for f, v in dataclasses.asdict(b).items() if v is not None}
+                           for k, b in (("A", self.A), ("B", self.B))},
                 "contact": {"dimension": 3, "friction": self.contact.friction, "model": self.contact.model},
                 "load": loads,
-                "discretization": {"elements": list(d.elements), "zone": list(d.zone), "step": d.step,
-                                   "distance": d.distance},
+                "discretization": {**disc, "step": d.step, "distance": d.distance},
                 "solver": solver}
 
     def to_toml(self) -> str:
@@ -385,9 +427,26 @@ def _opt(key, v) -> dict:
 
 # =========================================================================== the scene as a whole
 def _check_whole(scene) -> None:
-    """The derived quantities, the grid against the ellipse, the work, the sliding limit (module docstring)."""
+    """The derived quantities, the grid against the ellipse (with a profile: against the computed contact),
+    the work, the sliding limit (module docstring)."""
+    if scene.discretization.extent is None and not scene.shape.hertzian:
+        A, B = scene.shape.curvatures()
+        if not (A > 0 and B > 0):
+            raise InputError("discretization.extent", f"required: the profile's curvature at the origin is not "
+                                                      f"positive (A = {A:.4g}, B = {B:.4g}), so there is no Hertz "
+                                                      "ellipse to scale discretization.zone by; give the grid in length "
+                                                      "units, extent = [[x0, x1], [y0, y1]]")
     _check_ellipse(scene)
-    _check_grid(scene)
+    if scene.discretization.extent is None:
+        _check_grid(scene)
+    elif scene.shape.hertzian and not scene.grid.covers(scene.ellipse.a, scene.ellipse.b):
+        raise InputError("discretization.extent", f"the grid must cover the Hertz ellipse (a = {scene.ellipse.a:.4g}, "
+                                                  f"b = {scene.ellipse.b:.4g}) with a row of elements to spare on each "
+                                                  "side; widen it")
+    if not scene.shape.hertzian:
+        scene.shape.check_cover(scene.grid, lambda k: f"bodies.{k}.profile")
+        check_patch(scene.patch, "discretization.extent" if scene.discretization.extent is not None
+                    else "discretization.zone")
     _check_work(scene)
     _check_sliding_limit(scene)
     _check_creepages(scene)
@@ -488,7 +547,7 @@ _TABLES = {"contact": Contact3D, "load": Load3D, "discretization": Discretizatio
 _TOP = ("name", "description", "units", "bodies", "contact", "load", "discretization", "solver")
 
 
-def _table(d: Any, key: str, cls: type) -> dict:
+def _table(d: Any, key: str, cls: type, also=()) -> dict:
     if not isinstance(d, dict):
         raise InputError(key, f"must be a table [{key}], got {d!r}")
     names = [f.name for f in fields(cls)]
@@ -497,7 +556,7 @@ def _table(d: Any, key: str, cls: type) -> dict:
             raise InputError(f"{key}.{k}", f"unknown key{suggestion(k, names)} (allowed in [{key}] of a 3D scene: "
                                            f"{', '.join(names)})")
     required = [f.name for f in fields(cls)
-                if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING]
+                if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING] + list(also)
     missing = [k for k in required if k not in d]
     if missing:
         raise InputError(f"{key}.{missing[0]}", f"missing required key ([{key}] needs {', '.join(required)})")
@@ -518,7 +577,7 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
     bodies = d["bodies"]
     if not isinstance(bodies, dict) or set(bodies) != {"A", "B"}:
         raise InputError("bodies", "must hold exactly the tables [bodies.A] and [bodies.B] (radius, radius_y, E, nu)")
-    A, B = (Body3D(**_table(bodies[k], f"bodies.{k}", Body3D)) for k in ("A", "B"))
+    A, B = (Body3D(**_table(bodies[k], f"bodies.{k}", Body3D, ("E", "nu"))) for k in ("A", "B"))
     parts = {k: _table(d.get(k, {}), k, cls) for k, cls in _TABLES.items()}
     if "creepage" in parts["load"]:
         cr = parts["load"]["creepage"]

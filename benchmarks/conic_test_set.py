@@ -1,0 +1,94 @@
+#!/usr/bin/env python3
+r"""rollqp's 3D steps as a test set for conic and friction-contact solvers (docs/conic-test-set.md).
+
+::
+
+    python benchmarks/conic_test_set.py [--out DIR] [--small] [--only CASES] [--run [--solver S] [--settings S]]
+    python benchmarks/conic_test_set.py --out DIR --summarize
+
+writes the set to ``DIR`` (default ``conic-test-set``)::
+
+    DIR/cbf/NAME.cbf          each tangential SOCP and normal QP in the Conic Benchmark Format (version 3)
+    DIR/data/NAME.npz         the same program's arrays (H, q, a, b, bound; rollqp.conicset.forms)
+    DIR/fclib/NAME.hdf5       each coupled static step as an FCLib local problem, its solution in /solution
+    DIR/solutions/NAME.npz    the certified solution and the map back to tractions
+    DIR/problems.json, problems.md   the catalogue
+
+and with ``--run`` runs every installed conic solver (Clarabel, SCS, ECOS, CVXOPT; natively on the CBF
+file and through cvxpy) at default and high-accuracy settings: ``DIR/results/report.md`` (qpbenchmark's
+style: success rate, shifted geometric mean of time, accuracy against the certified solutions) and
+``DIR/results/answers.jsonl`` (every solve). Needs the extra ``conicbench``.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from harness import machine_rows, pin_threads, table
+
+pin_threads()
+
+from rollqp.conicset import generate, report  # noqa: E402  (after the thread limit)
+from rollqp.conicset import run as runner  # noqa: E402
+
+
+def _generate(args) -> dict:
+    t0 = time.perf_counter()
+
+    def said(name, probs):
+        for p in probs:
+            print(f"  {p.name:34s} {p.kind:10s} n = {p.meta['n']:5d}  residual {p.meta['residual']:.1e} "
+                  f"(file {p.meta['residual_from_arrays']:.1e})  [{time.perf_counter() - t0:.0f} s]", flush=True)
+    only = args.only.split(",") if args.only else None
+    problems = generate.build(small=args.small, only=only, progress=said)
+    generate.write_set(problems, args.out)
+    catalogue = json.loads((Path(args.out) / "problems.json").read_text(encoding="utf-8"))
+    (Path(args.out) / "problems.md").write_text(report.catalogue_table(catalogue) + "\n", encoding="utf-8")
+    print(f"{len(problems)} problems written to {args.out} in {time.perf_counter() - t0:.0f} s")
+    return catalogue
+
+
+def _report(out: Path, answers, catalogue) -> None:
+    machine = table(["", ""], machine_rows())
+    text = report.report(answers, catalogue, machine)
+    (out / "results" / "report.md").write_text(text + "\n", encoding="utf-8")
+    print(text)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", default="conic-test-set")
+    ap.add_argument("--small", action="store_true", help="the small set of the tests (seconds)")
+    ap.add_argument("--only", help="comma-separated case names (" + ", ".join(generate.CASES) + ")")
+    ap.add_argument("--run", action="store_true", help="run the solvers and write the report")
+    ap.add_argument("--solver", help="comma-separated solver routes (" + ", ".join(runner.SOLVERS) + ")")
+    ap.add_argument("--settings", help="comma-separated: default, high")
+    ap.add_argument("--summarize", action="store_true", help="the report of the last run, again")
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    if args.summarize:
+        catalogue = json.loads((out / "problems.json").read_text(encoding="utf-8"))
+        lines = (out / "results" / "answers.jsonl").read_text(encoding="utf-8").splitlines()
+        _report(out, [runner.Answer(**json.loads(s)) for s in lines if s.strip()], catalogue)
+        return 0
+    catalogue = _generate(args)
+    if args.run:
+        solvers = args.solver.split(",") if args.solver else None
+        settings = tuple(args.settings.split(",")) if args.settings else runner.SETTINGS
+        missing = [s for s in (solvers or runner.SOLVERS) if not runner.available(s)]
+        if missing:
+            print(f"not installed, skipped: {', '.join(missing)} (pip install -e '.[conicbench]')")
+
+        def said(a):
+            print(f"  {a.problem:30s} {a.solver:15s} {a.settings:8s} {'ok' if a.ok else a.status[:24]:24s} "
+                  f"|x − x*| {a.dx:.1e}  residual {a.residual:.1e}  {a.time:.3f} s", flush=True)
+        answers = runner.run_set(out, solvers, settings, progress=said)
+        _report(out, answers, catalogue)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
