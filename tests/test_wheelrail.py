@@ -237,3 +237,22 @@ def test_rollqp_run_prints_patches_and_writes_the_keys(tmp_path):
               "patch_area", "patch_pmax", "wheel_force", "patch0_pn", "patch0_px", "patch0_py", "patch0_state"):
         assert k in z.files
     assert z["wheel_force"].shape == (2, 3) and np.allclose(z["wheel_force"][:, 2], -10000.0)
+
+
+def test_tread_and_flange_two_patches_share_the_wheel_load():
+    """Case 11 of A-2.2, right wheel: flange root and tread both overlap, 7 mm apart. Two patches (default
+    combine = 4 mm) share one vertical position: their vertical forces add up to the load; with combine =
+    8 mm (CONTACT's D_SEP) one patch, whose forces agree with CONTACT's combined patch within 0.5 % of the load
+    (docs/validation-wheel-rail.md, "Case 11")."""
+    w = _bench("right", 11)
+    assert len(w.patches) == 2 and all(p.FN > 0 for p in w.patches)
+    assert w.force_rail[2] == pytest.approx(10000.0, rel=1e-7)
+    assert {round(p.y_rail) for p in w.patches} == {-34, -24}
+    y, yaw, roll, pitch = POSITIONS[10]
+    scene = load_scene("wheel-rail").replace(**{"wheelset.lateral": y, "wheelset.yaw": yaw, "wheelset.roll": roll,
+                                               "wheelset.pitch_rate": pitch, "wheelset.side": "right",
+                                               "discretization.element_size": 0.2, "discretization.combine": 8.0})
+    (one,) = solve_scene(scene)
+    (p,), (r,) = one.patches, _ref("right", 11)["patches"]
+    for ours, theirs in ((p.FN, r["FN"]), (p.Fx, r["FX"]), (p.Fs, r["FS"])):
+        assert abs(ours - theirs) <= 0.005 * 10000.0

@@ -16,9 +16,9 @@ Examples
 >>> from rollqp.wheelrail.profiles import Profile
 >>> y = np.linspace(-36.0, 36.0, 145)
 >>> head = Profile.from_points(y, 300.0 - np.sqrt(300.0 ** 2 - y ** 2) + 20 * (np.abs(y) > 35.9), "rail")
->>> t = Track(head, gauge=1435.0, gauge_height=1.0)
->>> round(t.rail_y0, 3), round(t.rail_z0, 6)
-(742.1, 0.0)
+>>> t = Track(head, gauge=1435.0, gauge_height=1.0)      # the gauge face: 1 mm below the top
+>>> round(t.rail_y0, 3), round(float(t.z_at(1435.0 / 2)), 6)
+(741.974, 1.0)
 """
 from __future__ import annotations
 
