@@ -10,6 +10,7 @@
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
+    rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
     rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
@@ -104,7 +105,8 @@ def _parser():
     e.add_argument("--method", choices=METHOD_NAMES, help="method that marches to step K (default newton)")
     c = sub.add_parser("check-step", help="check a candidate solution of an exported step")
     c.add_argument("step_file", metavar="STEP.npz")
-    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi")
+    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi "
+                   "(3D: p (n,) and t (2, n) on the grid, optional delta, xi, eta)")
     c.add_argument("--tol", type=float, default=None, help="pass/fail limit on each nondimensional residual "
                    "(default 1e-6: see docs/stepfiles.md)")
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
@@ -112,6 +114,7 @@ def _parser():
     x.add_argument("--step", type=int, default=None, help="step K (default 1; a 3D scene: every step of its run)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
     _stresses_parser(sub)
+    _wheelrail_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
                        "(docs/performance.md; 'rollqp bench --help' for the options)")
     b.add_argument("bench_args", nargs=argparse.REMAINDER)
@@ -259,7 +262,8 @@ class Family:
     scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
     ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
     ``rollqp crossval``'s report and returns the exit code; ``check(kept, scene, budget)`` takes a time budget
-    in seconds (None: none).
+    in seconds (None: none); ``export_step(scene, k, method)`` the step file of step ``k``; ``sweep(scene, args)``
+    and ``creep_curve(scene, args)`` run those commands and return the exit code.
     """
 
     run: Callable
@@ -271,6 +275,9 @@ class Family:
     stresses: Callable | None
     commands: frozenset
     crossval: Callable
+    export_step: Callable | None = None
+    sweep: Callable | None = None
+    creep_curve: Callable | None = None
     #: ``refuse(scene, allow_long)``: raise an InputError, before any work, for a run that cannot finish in
     #: reasonable time or memory (3D conic runs: :func:`rollqp.three.advice.refusal`).
     refuse: Callable = lambda scene, allow_long: None
@@ -281,8 +288,10 @@ def _family_2d() -> Family:
     from .plot import plot_result
     from .report import summary
     from .subsurface import stress_history
+    from .stepfile import export_step
     return Family(run, summary, plot_result, _advise, _spot_steps, _spot_lines, stress_history,
-                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d)
+                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d,
+                  export_step=export_step, sweep=_sweep_2d, creep_curve=_creep_2d)
 
 
 def _family_3d() -> Family:
@@ -295,17 +304,25 @@ def _family_3d() -> Family:
         for note in notes(scene):
             print(f"rollqp: {note}", file=sys.stderr, flush=True)
 
-    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
-                  _crossval_3d, refusal)
+    from .stepfile.three import export_step_3d
+    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval", "export-step", "sweep",
+                                                                                       "creep-curve"}),
+                  _crossval_3d, refuse=refusal, export_step=export_step_3d, sweep=_sweep_3d, creep_curve=_creep_3d)
 
 
-#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
-FAMILIES = {2: _family_2d, 3: _family_3d}
+def _family_wheel_rail() -> Family:
+    from .wheelrail.cli import family_record
+    return family_record(Family)
+
+
+#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy); a scene whose
+#: ``family`` names another record (a wheel on its rail) uses that one.
+FAMILIES = {2: _family_2d, 3: _family_3d, "wheel-rail": _family_wheel_rail}
 
 
 def family(scene) -> Family:
-    """The :class:`Family` of ``scene``'s dimension."""
-    return FAMILIES[scene.dimension]()
+    """The :class:`Family` of ``scene``'s dimension (or of its ``family``)."""
+    return FAMILIES[getattr(scene, "family", scene.dimension)]()
 
 
 def _takes(scene, command: str) -> None:
@@ -522,22 +539,25 @@ def cmd_show(args) -> int:
 
 def cmd_export_step(args) -> int:
     from .scene import load_scene
-    from .stepfile import export_step
     from .result import check_output
     scene = load_scene(args.scene)
     _takes(scene, "export-step")
     out = check_output(args.out or default_output(scene.name, f"-step{args.step}.npz"), "step file")
-    step = export_step(scene, args.step, method=args.method)
+    step = family(scene).export_step(scene, args.step, method=args.method)
     for path in step.save(out):
         print(f"wrote {path}")
     return 0
 
 
 def cmd_check_step(args) -> int:
-    from .stepfile import DEFAULT_TOL, StepFile, check_step, load_solution
-    step = StepFile.load(args.step_file, arg="STEP.npz")
-    sol = load_solution(args.solution, step.n, arg="SOLUTION.npz")
-    rep = check_step(step, sol, tol=DEFAULT_TOL if args.tol is None else args.tol)
+    from .stepfile import DEFAULT_TOL, check_step, load_solution, load_step
+    from .stepfile.three import StepFile3D, check_step_3d, load_solution_3d
+    step = load_step(args.step_file, arg="STEP.npz")       # either dimension's, by its format key
+    tol = DEFAULT_TOL if args.tol is None else args.tol
+    if isinstance(step, StepFile3D):
+        rep = check_step_3d(step, load_solution_3d(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
+    else:
+        rep = check_step(step, load_solution(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
     print(rep)
     if rep.passed:
         return 0
@@ -602,9 +622,12 @@ def _sweep_parsers(sub):
     c = sub.add_parser("creep-curve", help="the steady creep curve Q/(mu P) against the creepage, on dask, "
                        "with Carter's law or the Bentall-Johnson limit (docs/sweeps.md)")
     c.add_argument("scene", help="the base scene: a TOML file or a built-in scene")
-    c.add_argument("--ratios", default="0.05:0.95:19", help="load ratios Q/(mu P): a,b,c or start:stop:count "
+    c.add_argument("--ratios", default=None, help="2D: load ratios Q/(mu P): a,b,c or start:stop:count "
                    "(default 0.05:0.95:19)")
-    c.add_argument("--friction", help="friction coefficients mu (default: the scene's)")
+    c.add_argument("--friction", help="2D: friction coefficients mu (default: the scene's)")
+    c.add_argument("--creepage", help="3D: the creepage swept: longitudinal | lateral | spin (default longitudinal)")
+    c.add_argument("--values", help="3D: its values, a,b,c or start:stop:count (default 1e-4:2e-3:12; spin in "
+                   "1/length)")
     c.add_argument("--plot", help="draw the creep-force figure to this file")
     c.add_argument("--out", help="the zarr store (default <scene name>-creep.zarr)")
     _cluster_options(c)
@@ -654,9 +677,42 @@ def _sweep_exit(summary) -> int:
 
 def cmd_sweep(args) -> int:
     from .scene import load_scene
-    from .sweep import sweep
     scene = load_scene(args.scene)
     _takes(scene, "sweep")
+    return family(scene).sweep(scene, args)
+
+
+def _sweep_3d(scene, args) -> int:
+    from .sweep.three import sweep_3d
+    out = args.out or default_output(scene.name, "-sweep.zarr")
+    _, summary = sweep_3d(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    if not args.quiet:
+        print(f"rollqp sweep of {scene.name} (3D): {out}")
+        print(summary.table())
+    return _sweep_exit(summary)
+
+
+def _creep_3d(scene, args) -> int:
+    from .errors import InputError
+    from .sweep.three import creep_curve_3d
+    if args.ratios is not None or args.friction is not None:
+        raise InputError("--ratios" if args.ratios is not None else "--friction",
+                         "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
+    out = args.out or default_output(scene.name, "-creep.zarr")
+    _check_plot(args.plot)
+    curve = creep_curve_3d(scene, args.creepage or "longitudinal", args.values or "1e-4:2e-3:12", out,
+                           scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    if args.plot:
+        curve.plot(args.plot)
+    if not args.quiet:
+        print(curve.table())
+        print(curve.summary.table())
+        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
+    return _sweep_exit(curve.summary)
+
+
+def _sweep_2d(scene, args) -> int:
+    from .sweep import sweep
     out = args.out or default_output(scene.name, "-sweep.zarr")
     summary = _sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
                                            quiet=args.quiet))
@@ -668,9 +724,18 @@ def cmd_sweep(args) -> int:
 
 def cmd_creep_curve(args) -> int:
     from .scene import load_scene
-    from .sweep.creep import creep_curve
     scene = load_scene(args.scene)
     _takes(scene, "creep-curve")
+    return family(scene).creep_curve(scene, args)
+
+
+def _creep_2d(scene, args) -> int:
+    from .errors import InputError
+    from .sweep.creep import creep_curve
+    if args.creepage is not None or args.values is not None:
+        raise InputError("--creepage" if args.creepage is not None else "--values",
+                         "a 2D creep curve prescribes the load ratios: --ratios (and --friction)")
+    args.ratios = "0.05:0.95:19" if args.ratios is None else args.ratios
     out = args.out or default_output(scene.name, "-creep.zarr")
     _check_plot(args.plot)
     curve = _sweep_signals(lambda: creep_curve(scene, args.ratios, args.friction, out, scheduler=args.scheduler,
@@ -697,7 +762,7 @@ def main(argv=None) -> int:
             return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
                     "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
                     "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
-                    "stresses": cmd_stresses}[args.command](args)
+                    "stresses": cmd_stresses, "wheelrail-table": cmd_wheelrail_table}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
@@ -714,6 +779,17 @@ def main(argv=None) -> int:
     except KeyboardInterrupt:
         print("rollqp: interrupted", file=sys.stderr)
         return 130
+
+
+# ----------------------------------------------------------------------------- wheel on rail
+def _wheelrail_parser(sub):
+    from .wheelrail.cli import add_parser
+    add_parser(sub)
+
+
+def cmd_wheelrail_table(args) -> int:
+    from .wheelrail.cli import cmd_table
+    return cmd_table(args)
 
 
 # ----------------------------------------------------------------------------- stresses

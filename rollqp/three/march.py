@@ -177,7 +177,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
 
     ``accelerate``: ``"chord"`` (similar bodies; default) Newton's method on the march map
-    (:mod:`rollqp.three.chord`, eq. 3D.29), every iterate evaluated by the method; ``"anderson"`` the
+    (:mod:`rollqp.three.chord`, eq. 3D.24), every iterate evaluated by the method; ``"anderson"`` the
     march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
     0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
     bodies; solved here if ``None``)."""

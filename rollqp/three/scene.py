@@ -20,7 +20,7 @@ the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a
 
 Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
 allowed range: radii nonzero (``< 0`` concave, ``inf`` straight), a concentrated contact (the summed
-curvature positive in both directions, eq. 3D.1), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
+curvature positive in both directions, eq. 3D.3), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
 element aspect ratio ``dx/dy`` in :data:`rollqp.three.grid.ASPECT_RANGE`, the forces below the sliding
 limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
@@ -291,7 +291,7 @@ class Scene3D(SceneBase):
 
     @functools.cached_property
     def curvatures(self) -> tuple[float, float]:
-        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.1); with a profile, its curvatures at the origin where
+        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.3); with a profile, its curvatures at the origin where
         both are positive, else the equivalent curvatures of the computed contact
         (:func:`rollqp.three.patch.equivalent_curvatures`)."""
         if self.shape.hertzian:
