@@ -55,8 +55,8 @@ def _stages(n):
 
 @pytest.mark.parametrize("n", [12, pytest.param(35, marks=pytest.mark.slow)])
 def test_spence35_stage_by_stage(n):
-    """Approach and peak pressure within CONTACT's 4 printed digits at every stage (measured ≤ 3.1e-4 and ≤ 4.2e-4 over the
-    35; the bound 5e-4 is half a unit of the 4th digit at a mantissa of 1); the printed counts equal, but at
+    """Approach and peak pressure within CONTACT's 4 printed digits at every stage (measured ≤ 3.1e-4 and
+    ≤ 4.2e-4 over the 35; the bound 5e-4 is half a unit of the 4th digit at a mantissa of 1); the printed counts equal, but at
     stage 35, where two boundary elements that CONTACT counts in contact (and slipping) carry no pressure
     here: 919/225/694 against 921/225/696, the adhesion area the same."""
     ref, ours = _stages(n)
