@@ -27,7 +27,7 @@ from ..atomic import stop_once
 from ..errors import InputError, SolverError
 from ..march import RESUME_TOL, _keep_every, _last_index, drive
 from ..methods import compose_3d, scene_method_3d
-from ..result import Layout, Result, ResumeSource, resume_source
+from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
@@ -297,6 +297,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
         ``err.partial`` holds the result of the completed states.
     """
     asked = scene if isinstance(scene, SceneBase) else load_scene(scene)
+    if out is not None:
+        out = check_output(out, key="out")
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
     scene, meth, contact = prepared = prepare(asked, method)
