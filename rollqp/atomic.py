@@ -12,19 +12,33 @@ file, and signals held back while a file is being written (docs/results.md, "Wri
   is taken over at once).
 * :func:`held_signals`: SIGINT and SIGTERM are held back while a file is written, so that a second
   Ctrl-C 0–40 ms after the first never interrupts the write of what the first one saves.
+* :func:`save_npz` writes a ``.npz`` this way (a 2D or 3D result file, a step file's arrays), with a
+  result's ``meta`` encoded by :func:`encode_meta` (its long lists as arrays; :func:`decode_meta` puts
+  them back).
 """
 from __future__ import annotations
 
 import contextlib
+import json
 import os
+import re
 import signal
 import tempfile
 import threading
 
+import numpy as np
+
 from .errors import InputError
+from .journal import json_default as _json_default
+from .npzfile import NpzStream
+
+#: A list of more than this many numbers in a result's ``meta`` is stored as an array of its own.
+META_ARRAY_MIN = 64
+#: Longest array referenced from ``meta`` (a profile table of a million points, a list of a million steps).
+MAX_META_ARRAY = 2_000_001
 
 __all__ = ["TEMP_PREFIX", "process_start", "alive", "remove_stale_temporaries", "temporary", "written", "replace",
-           "OutputLock", "held_signals", "stop_once"]
+           "OutputLock", "held_signals", "stop_once", "save_npz", "encode_meta", "decode_meta"]
 
 #: Temporary files of an atomic write start with this (module docstring).
 TEMP_PREFIX = ".rollqp-"
@@ -240,3 +254,85 @@ def stop_once():
     finally:
         for s, h in old.items():
             signal.signal(s, h)
+
+
+# =========================================================================== .npz files and their meta
+def save_npz(path, arrays: dict, what: str = "result file") -> str:
+    """Write ``arrays`` to the ``.npz`` ``path`` atomically (temporary file, then rename), SIGINT and SIGTERM
+    held back until it is written (:func:`rollqp.atomic.held_signals`).
+
+    A path not ending in ``.npz`` or in a missing folder is an :class:`InputError` on ``--out``.
+    Temporary files left in the folder by killed writers are removed first; an interrupted write
+    removes its own. A result's ``meta`` (a dict or its JSON text) is written with its long lists as
+    arrays (:func:`encode_meta`).
+    """
+    path = os.fspath(path)
+    if not path.endswith(".npz"):
+        raise InputError("--out", f"the {what} must end in .npz, got {path!r}")
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise InputError("--out", f"folder {folder!r} does not exist")
+    arrays = dict(arrays)
+    if "meta" in arrays and what == "result file":
+        meta = arrays["meta"]
+        meta = json.loads(str(meta)) if not isinstance(meta, dict) else meta
+        text, marrays = encode_meta(meta)
+        arrays["meta"] = np.asarray(text)
+        arrays.update(marrays)
+    with held_signals(), written(path) as (fh, _), NpzStream(fh) as z:
+        for k, v in arrays.items():
+            z.array(k, v)
+    return path
+
+
+def encode_meta(meta: dict) -> tuple[str, dict]:
+    """``(JSON text, arrays)``: every list of more than :data:`META_ARRAY_MIN` numbers in ``meta`` (a profile
+    table, a long list of steps) becomes an array ``meta.<path>`` and ``{"$array": "meta.<path>"}`` in the
+    text, so that the text stays the size of a scene file whatever the tables (:func:`decode_meta`)."""
+    arrays = {}
+
+    def walk(v, path):
+        if isinstance(v, np.ndarray):
+            v = v.tolist()
+        if isinstance(v, dict):
+            return {k: walk(x, path + (str(k),)) for k, x in v.items()}
+        if isinstance(v, (list, tuple)):
+            if len(v) > META_ARRAY_MIN and all(_is_number(e) for e in v):
+                key = "meta." + re.sub(r"[^A-Za-z0-9_.-]", "_", ".".join(path))[:200]
+                while key in arrays:
+                    key += "_"
+                ints = all(isinstance(e, (int, np.integer)) for e in v)
+                arrays[key] = np.asarray(v, dtype=np.int64 if ints else np.float64)
+                return {"$array": key}
+            return [walk(x, path + (str(i),)) for i, x in enumerate(v)]
+        return v
+    tree = walk(meta, ())
+    return json.dumps(tree, sort_keys=True, default=_json_default), arrays
+
+
+def _is_number(e) -> bool:
+    return isinstance(e, (int, float, np.integer, np.floating)) and not isinstance(e, (bool, np.bool_))
+
+
+def decode_meta(tree, arrays: dict, arg: str):
+    """``meta`` with its ``{"$array": key}`` entries replaced by the lists in ``arrays`` (each checked: a key
+    ``meta.*`` of the file, a 1-D array of at most :data:`MAX_META_ARRAY` real numbers)."""
+    def walk(v):
+        if isinstance(v, dict):
+            if set(v) == {"$array"}:
+                return _meta_array(v["$array"], arrays, arg)
+            return {k: walk(x) for k, x in v.items()}
+        if isinstance(v, list):
+            return [walk(x) for x in v]
+        return v
+    return walk(tree)
+
+
+def _meta_array(key, arrays, arg):
+    if not (isinstance(key, str) and key.startswith("meta.") and key in arrays):
+        raise InputError(arg, f"key 'meta' refers to an array {str(key)[:80]!r} that the file does not hold")
+    a = np.asarray(arrays[key])
+    if a.ndim != 1 or a.dtype.kind not in "iuf" or a.size > MAX_META_ARRAY:
+        raise InputError(arg, f"key {key!r} must be a 1-D array of at most {MAX_META_ARRAY} numbers, got "
+                              f"{a.dtype} of shape {a.shape}")
+    return a.tolist()

@@ -7,10 +7,13 @@
     rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
     rollqp crossval SCENE [--step K] [--methods M1,M2]
+    rollqp extrapolate SCENE [--grids N1,N2,N3]   (3D: creep forces from three grids, with an error estimate)
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
+    rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
     rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
+                    (3D: [--plane y=Y | --plane x=X | --line x=X,y=Y] [--depths Z1,Z2,...])
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first), 4 for a
@@ -104,14 +107,21 @@ def _parser():
     e.add_argument("--method", choices=METHOD_NAMES, help="method that marches to step K (default newton)")
     c = sub.add_parser("check-step", help="check a candidate solution of an exported step")
     c.add_argument("step_file", metavar="STEP.npz")
-    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi")
+    c.add_argument("solution", metavar="SOLUTION.npz", help="keys p and/or t (scene units), optional delta, xi "
+                   "(3D: p (n,) and t (2, n) on the grid, optional delta, xi, eta)")
     c.add_argument("--tol", type=float, default=None, help="pass/fail limit on each nondimensional residual "
                    "(default 1e-6: see docs/stepfiles.md)")
     x = sub.add_parser("crossval", help="every available method on one step, side by side")
     x.add_argument("scene", help="a TOML scene file, a built-in scene, or an exported STEP.npz")
     x.add_argument("--step", type=int, default=None, help="step K (default 1; a 3D scene: every step of its run)")
     x.add_argument("--methods", help="comma-separated methods (default: every available one)")
+    xp = sub.add_parser("extrapolate", help="3D: the steady state's creep forces on three grids, extrapolated "
+                        "(Richardson, the order measured) with an error estimate (docs/performance.md)")
+    xp.add_argument("scene", help="a TOML scene file or a built-in 3D scene with a rolling start")
+    xp.add_argument("--grids", help="three element counts along the shorter axis in a constant ratio, e.g. "
+                    "20,40,80 (default: half, once and twice the scene's)")
     _stresses_parser(sub)
+    _wheelrail_parser(sub)
     b = sub.add_parser("bench", add_help=False, help="benchmarks: work–precision and scaling "
                        "(docs/performance.md; 'rollqp bench --help' for the options)")
     b.add_argument("bench_args", nargs=argparse.REMAINDER)
@@ -158,6 +168,34 @@ def _progress(quiet):
                   flush=True)
 
     return line, lambda: None
+
+
+def _iteration_lines():
+    """A :mod:`rollqp.progress` listener: a line every :data:`LOG_EVERY` seconds of a long solve inside one
+    step (the Newton iterations of a large grid's steady step, with the residual), and from a minute on
+    the remaining time estimated from the residual's last decrease."""
+    from .progress import remaining_iterations
+    try:
+        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
+    except ValueError:
+        every = LOG_EVERY
+    state = {"last": 0.0, "res": []}
+
+    def listen(what, it, res, seconds, target):
+        if it == 1:  # a new solve
+            state["last"], state["res"] = 0.0, []
+        state["res"].append(res)
+        if seconds - state["last"] < every:
+            return
+        state["last"] = seconds
+        line = f"rollqp: {what} step: Newton iteration {it}, residual {res:.1e} (to reach {target:.0e}), {seconds:.0f} s"
+        left = remaining_iterations(state["res"], target) if seconds >= 60 else None
+        if left:
+            line += (f"; at most about {_minutes(left * seconds / it)} to go ({left} more iterations of "
+                     f"{seconds / it:.0f} s at the residual's last rate of decrease; Newton's only speeds up)")
+        print(line, file=sys.stderr, flush=True)
+
+    return listen
 
 
 class Terminated(KeyboardInterrupt):
@@ -248,6 +286,23 @@ def _give_back_freed_memory() -> None:
         pass
 
 
+def _keep_freed_memory() -> None:
+    """Linux (glibc): freed arrays below 32 MiB stay in the heap for the next allocation (the mapping threshold at
+    its largest, the heap trimmed only above 256 MiB free, grown 64 MiB at a time). Measured on a 150 × 150 steady
+    step in one process (load 14): 1.0 s of system time and 5.3 s of user time with glibc's defaults, 0.0 s and
+    4.8 s so; the 300 × 300 step with the 2D runs' setting spent 44 s of system time against 35 s of user time."""
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+        libc = ctypes.CDLL("libc.so.6")
+        libc.mallopt(-3, 32 << 20)   # M_MMAP_THRESHOLD
+        libc.mallopt(-1, 256 << 20)  # M_TRIM_THRESHOLD
+        libc.mallopt(-2, 64 << 20)   # M_TOP_PAD
+    except (OSError, AttributeError):  # not glibc
+        pass
+
+
 @dataclass(frozen=True)
 class Family:
     """What the command line does with the scenes of one dimension (``scene.dimension``): one record per
@@ -259,7 +314,8 @@ class Family:
     scene)`` its lines; ``stresses(result)`` the peak subsurface stresses (None: not for these scenes);
     ``commands``: the other subcommands that take its scenes; ``crossval(scene, step, methods)`` prints
     ``rollqp crossval``'s report and returns the exit code; ``check(kept, scene, budget)`` takes a time budget
-    in seconds (None: none).
+    in seconds (None: none); ``export_step(scene, k, method)`` the step file of step ``k``; ``sweep(scene, args)``
+    and ``creep_curve(scene, args)`` run those commands and return the exit code.
     """
 
     run: Callable
@@ -271,9 +327,17 @@ class Family:
     stresses: Callable | None
     commands: frozenset
     crossval: Callable
+    export_step: Callable | None = None
+    sweep: Callable | None = None
+    creep_curve: Callable | None = None
     #: ``refuse(scene, allow_long)``: raise an InputError, before any work, for a run that cannot finish in
     #: reasonable time or memory (3D conic runs: :func:`rollqp.three.advice.refusal`).
     refuse: Callable = lambda scene, allow_long: None
+    #: How freed memory goes back to the system (glibc): the dense 2D runs give arrays of 1 MiB and more back at
+    #: once (:func:`_give_back_freed_memory`, their peak memory); by default (None) the runs keep them for the
+    #: next FFT product (:func:`_keep_freed_memory`: a 3D step's products allocate and free arrays of a few MiB
+    #: thousands of times, and mapping each afresh cost more system time than the step's own work).
+    memory_policy: Callable | None = None
 
 
 def _family_2d() -> Family:
@@ -281,8 +345,11 @@ def _family_2d() -> Family:
     from .plot import plot_result
     from .report import summary
     from .subsurface import stress_history
+    from .stepfile import export_step
     return Family(run, summary, plot_result, _advise, _spot_steps, _spot_lines, stress_history,
-                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d)
+                  frozenset({"export-step", "crossval", "sweep", "creep-curve"}), _crossval_2d,
+                  export_step=export_step, sweep=_sweep_2d, creep_curve=_creep_2d,
+                  memory_policy=_give_back_freed_memory)
 
 
 def _family_3d() -> Family:
@@ -295,17 +362,25 @@ def _family_3d() -> Family:
         for note in notes(scene):
             print(f"rollqp: {note}", file=sys.stderr, flush=True)
 
-    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval"}),
-                  _crossval_3d, refusal)
+    from .stepfile.three import export_step_3d
+    return Family(run, summary, three_figure, advise, _spot_3d, _check_3d, None, frozenset({"crossval", "export-step", "sweep",
+                                                                                       "creep-curve", "extrapolate"}),
+                  _crossval_3d, refuse=refusal, export_step=export_step_3d, sweep=_sweep_3d, creep_curve=_creep_3d)
 
 
-#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy).
-FAMILIES = {2: _family_2d, 3: _family_3d}
+def _family_wheel_rail() -> Family:
+    from .wheelrail.cli import family_record
+    return family_record(Family)
+
+
+#: The record of each dimension (made on first use: ``rollqp --help`` imports nothing heavy); a scene whose
+#: ``family`` names another record (a wheel on its rail) uses that one.
+FAMILIES = {2: _family_2d, 3: _family_3d, "wheel-rail": _family_wheel_rail}
 
 
 def family(scene) -> Family:
-    """The :class:`Family` of ``scene``'s dimension."""
-    return FAMILIES[scene.dimension]()
+    """The :class:`Family` of ``scene``'s dimension (or of its ``family``)."""
+    return FAMILIES[getattr(scene, "family", scene.dimension)]()
 
 
 def _takes(scene, command: str) -> None:
@@ -346,7 +421,7 @@ def cmd_run(args) -> int:
         raise InputError("--stresses", f"the subsurface stresses are computed for 2D scenes only; {scene.name!r} is "
                                        f"{scene.dimension}D")
     fam.refuse(scene, getattr(args, "allow_long", False))
-    _give_back_freed_memory()
+    (fam.memory_policy or _keep_freed_memory)()
     if source is not None and source.journal is None and source.last == scene.n_steps:
         print(f"rollqp: {args.resume} is complete ({scene.n_steps} rolling steps): nothing to resume",
               file=sys.stderr)
@@ -358,8 +433,11 @@ def cmd_run(args) -> int:
     keep, observe = fam.spot(args, scene)
     t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _on_sigterm)
+    from contextlib import nullcontext
+
+    from .progress import listening
     try:
-        with OutputLock(out):
+        with OutputLock(out), (nullcontext() if args.quiet else listening(_iteration_lines())):
             try:
                 result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
             except KeyboardInterrupt as err:
@@ -522,22 +600,25 @@ def cmd_show(args) -> int:
 
 def cmd_export_step(args) -> int:
     from .scene import load_scene
-    from .stepfile import export_step
     from .result import check_output
     scene = load_scene(args.scene)
     _takes(scene, "export-step")
     out = check_output(args.out or default_output(scene.name, f"-step{args.step}.npz"), "step file")
-    step = export_step(scene, args.step, method=args.method)
+    step = family(scene).export_step(scene, args.step, method=args.method)
     for path in step.save(out):
         print(f"wrote {path}")
     return 0
 
 
 def cmd_check_step(args) -> int:
-    from .stepfile import DEFAULT_TOL, StepFile, check_step, load_solution
-    step = StepFile.load(args.step_file, arg="STEP.npz")
-    sol = load_solution(args.solution, step.n, arg="SOLUTION.npz")
-    rep = check_step(step, sol, tol=DEFAULT_TOL if args.tol is None else args.tol)
+    from .stepfile import DEFAULT_TOL, check_step, load_solution, load_step
+    from .stepfile.three import StepFile3D, check_step_3d, load_solution_3d
+    step = load_step(args.step_file, arg="STEP.npz")       # either dimension's, by its format key
+    tol = DEFAULT_TOL if args.tol is None else args.tol
+    if isinstance(step, StepFile3D):
+        rep = check_step_3d(step, load_solution_3d(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
+    else:
+        rep = check_step(step, load_solution(args.solution, step.n, arg="SOLUTION.npz"), tol=tol)
     print(rep)
     if rep.passed:
         return 0
@@ -565,6 +646,25 @@ def cmd_crossval(args) -> int:
     scene = load_scene(args.scene)
     _takes(scene, "crossval")
     return family(scene).crossval(scene, args.step, methods)
+
+
+def cmd_extrapolate(args) -> int:
+    """``rollqp extrapolate SCENE [--grids N1,N2,N3]`` (:func:`rollqp.three.extrapolate.extrapolate`)."""
+    from .errors import InputError
+    from .scene import load_scene
+    scene = load_scene(args.scene)
+    _takes(scene, "extrapolate")
+    grids = None
+    if args.grids:
+        try:
+            grids = tuple(int(v) for v in args.grids.split(","))
+        except ValueError:
+            raise InputError("--grids", f"must be three integers N1,N2,N3, got {args.grids!r}") from None
+        if any(g < 1 or g > 2000 for g in grids):
+            raise InputError("--grids", f"each count must be in [1, 2000], got {args.grids!r}")
+    from .three.extrapolate import extrapolate
+    print(extrapolate(scene, grids))
+    return 0
 
 
 def benchmarks_folder():
@@ -602,9 +702,12 @@ def _sweep_parsers(sub):
     c = sub.add_parser("creep-curve", help="the steady creep curve Q/(mu P) against the creepage, on dask, "
                        "with Carter's law or the Bentall-Johnson limit (docs/sweeps.md)")
     c.add_argument("scene", help="the base scene: a TOML file or a built-in scene")
-    c.add_argument("--ratios", default="0.05:0.95:19", help="load ratios Q/(mu P): a,b,c or start:stop:count "
+    c.add_argument("--ratios", default=None, help="2D: load ratios Q/(mu P): a,b,c or start:stop:count "
                    "(default 0.05:0.95:19)")
-    c.add_argument("--friction", help="friction coefficients mu (default: the scene's)")
+    c.add_argument("--friction", help="2D: friction coefficients mu (default: the scene's)")
+    c.add_argument("--creepage", help="3D: the creepage swept: longitudinal | lateral | spin (default longitudinal)")
+    c.add_argument("--values", help="3D: its values, a,b,c or start:stop:count (default 1e-4:2e-3:12; spin in "
+                   "1/length)")
     c.add_argument("--plot", help="draw the creep-force figure to this file")
     c.add_argument("--out", help="the zarr store (default <scene name>-creep.zarr)")
     _cluster_options(c)
@@ -654,9 +757,42 @@ def _sweep_exit(summary) -> int:
 
 def cmd_sweep(args) -> int:
     from .scene import load_scene
-    from .sweep import sweep
     scene = load_scene(args.scene)
     _takes(scene, "sweep")
+    return family(scene).sweep(scene, args)
+
+
+def _sweep_3d(scene, args) -> int:
+    from .sweep.three import sweep_3d
+    out = args.out or default_output(scene.name, "-sweep.zarr")
+    _, summary = sweep_3d(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    if not args.quiet:
+        print(f"rollqp sweep of {scene.name} (3D): {out}")
+        print(summary.table())
+    return _sweep_exit(summary)
+
+
+def _creep_3d(scene, args) -> int:
+    from .errors import InputError
+    from .sweep.three import creep_curve_3d
+    if args.ratios is not None or args.friction is not None:
+        raise InputError("--ratios" if args.ratios is not None else "--friction",
+                         "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
+    out = args.out or default_output(scene.name, "-creep.zarr")
+    _check_plot(args.plot)
+    curve = creep_curve_3d(scene, args.creepage or "longitudinal", args.values or "1e-4:2e-3:12", out,
+                           scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    if args.plot:
+        curve.plot(args.plot)
+    if not args.quiet:
+        print(curve.table())
+        print(curve.summary.table())
+        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
+    return _sweep_exit(curve.summary)
+
+
+def _sweep_2d(scene, args) -> int:
+    from .sweep import sweep
     out = args.out or default_output(scene.name, "-sweep.zarr")
     summary = _sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
                                            quiet=args.quiet))
@@ -668,9 +804,18 @@ def cmd_sweep(args) -> int:
 
 def cmd_creep_curve(args) -> int:
     from .scene import load_scene
-    from .sweep.creep import creep_curve
     scene = load_scene(args.scene)
     _takes(scene, "creep-curve")
+    return family(scene).creep_curve(scene, args)
+
+
+def _creep_2d(scene, args) -> int:
+    from .errors import InputError
+    from .sweep.creep import creep_curve
+    if args.creepage is not None or args.values is not None:
+        raise InputError("--creepage" if args.creepage is not None else "--values",
+                         "a 2D creep curve prescribes the load ratios: --ratios (and --friction)")
+    args.ratios = "0.05:0.95:19" if args.ratios is None else args.ratios
     out = args.out or default_output(scene.name, "-creep.zarr")
     _check_plot(args.plot)
     curve = _sweep_signals(lambda: creep_curve(scene, args.ratios, args.friction, out, scheduler=args.scheduler,
@@ -696,8 +841,9 @@ def main(argv=None) -> int:
         with limited():  # every BLAS pool at $ROLLQP_THREADS (default 1), scipy's included (rollqp.threads)
             return {"run": cmd_run, "scenes": cmd_scenes, "show": cmd_show, "export-step": cmd_export_step,
                     "check-step": cmd_check_step, "crossval": cmd_crossval, "bench": cmd_bench,
+                    "extrapolate": cmd_extrapolate,
                     "sweep": cmd_sweep, "creep-curve": cmd_creep_curve,
-                    "stresses": cmd_stresses}[args.command](args)
+                    "stresses": cmd_stresses, "wheelrail-table": cmd_wheelrail_table}[args.command](args)
     except SolverError as err:
         print(f"rollqp: solver error: {err}", file=sys.stderr)
         return EXIT_SOLVER
@@ -716,18 +862,65 @@ def main(argv=None) -> int:
         return 130
 
 
+# ----------------------------------------------------------------------------- wheel on rail
+def _wheelrail_parser(sub):
+    from .wheelrail.cli import add_parser
+    add_parser(sub)
+
+
+def cmd_wheelrail_table(args) -> int:
+    from .wheelrail.cli import cmd_table
+    return cmd_table(args)
+
+
 # ----------------------------------------------------------------------------- stresses
 def _stresses_parser(sub):
     t = sub.add_parser("stresses", help="subsurface stresses of one state of a result file (docs/stresses.md)")
     t.add_argument("result", metavar="RESULT.npz")
     t.add_argument("--step", type=int, required=True, help="the stored state K (0 = the starting state; "
                    "negative counts from the end)")
-    t.add_argument("--plot", help="contour maps of von Mises and tau1 with the stick/slip zones (PNG)")
-    t.add_argument("--out", help="stress file (.npz): x, z, every stress quantity, the maxima")
+    t.add_argument("--plot", help="contour maps of von Mises and tau1 (3D: Tresca) with the surface tractions (PNG)")
+    t.add_argument("--out", help="stress file (.npz): the points, every stress quantity, the maxima")
     t.add_argument("--body", default="A", choices=("A", "B"), help="body A (traction t) or B (-t)")
-    t.add_argument("--grid", default="200,200", help="NX,NZ points on ±WIDTH a_H and depths (0, DEPTH a_H]")
-    t.add_argument("--width", type=float, default=1.5, help="half-width of the grid in a_H (default 1.5)")
-    t.add_argument("--depth", type=float, default=2.0, help="depth of the grid in a_H (default 2)")
+    t.add_argument("--grid", default=None, help="2D: NX,NZ points on ±WIDTH a_H and depths (0, DEPTH a_H] "
+                   "(default 200,200)")
+    t.add_argument("--width", type=float, default=None, help="2D: half-width of the grid in a_H (default 1.5)")
+    t.add_argument("--depth", type=float, default=None, help="2D: depth of the grid in a_H (default 2)")
+    t.add_argument("--plane", help="3D: the plane y=Y (points along x at the element centres) or x=X "
+                   "(scene length units; default y=0)")
+    t.add_argument("--line", help="3D: the vertical line x=X,y=Y instead of a plane")
+    t.add_argument("--depths", help="3D: depths Z1,Z2,... (> 0, scene length units; default 40 down to 2a)")
+
+
+def _stresses_3d(args, arrays) -> int:
+    """``rollqp stresses`` on a 3D result: the section the user chose, its peaks, the stress file, the figure."""
+    from .errors import InputError
+    from .subsurface3d import (parse_depths, parse_line, parse_plane, plot_field3d, save_field3d, stresses3d,
+                               summary_rows3d)
+    for opt in ("grid", "width", "depth"):
+        if getattr(args, opt) is not None:
+            raise InputError(f"--{opt}", "is for 2D results; on a 3D result choose the points with --plane y=Y | "
+                                         "--plane x=X | --line x=X,y=Y and --depths Z1,Z2,...")
+    plane = parse_plane(args.plane) if args.plane is not None else None
+    line = parse_line(args.line) if args.line is not None else None
+    depths = parse_depths(args.depths) if args.depths is not None else None
+    names = {"step": "--step", "result": "RESULT.npz", "depths": "--depths", "points": "--depths"}
+    try:
+        sf = stresses3d(arrays, args.step, plane, line, depths, body=args.body)
+    except InputError as err:
+        raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
+    p0 = float(arrays["p0"])
+    nz, nh = sf.values["sxx"].shape
+    print(f"  state         {sf.step} (q = {sf.q:.6g}), body {sf.body}, {sf.section.label}, "
+          f"{nh} x {nz} points" if nh > 1 else f"  state         {sf.step} (q = {sf.q:.6g}), body {sf.body}, "
+          f"{sf.section.label}, {nz} depths")
+    for k, v in summary_rows3d(sf, p0):
+        print(f"  {k:<20}  {v}")
+    if args.out:
+        print(f"  stress file   {save_field3d(sf, args.out)}")
+    if args.plot:
+        print(f"  figure        {plot_field3d(sf, arrays, args.plot, p0)}")
+    return 0
 
 
 def cmd_stresses(args) -> int:
@@ -735,22 +928,27 @@ def cmd_stresses(args) -> int:
     from .influence import get_model
     from .result import check_output, load_result
     from .subsurface import _source, default_grid, plot_field, save_field, stresses, summary_rows
-    try:
-        nx, nz = (int(v) for v in args.grid.split(","))
-    except ValueError:
-        raise InputError("--grid", f"must be NX,NZ (two integers), got {args.grid!r}") from None
     if args.out:
         check_output(args.out, "stress file", "--out")
     _check_plot(args.plot)
+    loaded = load_result(args.result, "RESULT.npz")
+    if "y" in loaded:  # a grid of elements: a 3D result
+        return _stresses_3d(args, loaded)
+    for opt in ("plane", "line", "depths"):
+        if getattr(args, opt) is not None:
+            raise InputError(f"--{opt}", "is for 3D results; on a 2D result choose the points with --grid NX,NZ, "
+                                         "--width and --depth")
+    grid = "200,200" if args.grid is None else args.grid
+    width, depth = (1.5 if args.width is None else args.width), (2.0 if args.depth is None else args.depth)
+    try:
+        nx, nz = (int(v) for v in grid.split(","))
+    except ValueError:
+        raise InputError("--grid", f"must be NX,NZ (two integers), got {grid!r}") from None
     names = {"nx": "--grid", "nz": "--grid", "width": "--width", "depth": "--depth", "step": "--step",
              "result": "RESULT.npz"}
-    loaded = load_result(args.result, "RESULT.npz")
-    if "py" in loaded:                  # a 3D result: its lateral traction
-        raise InputError("RESULT.npz", f"{args.result} is a 3D result (Kalker's problem): rollqp stresses computes the "
-                                       "subsurface field of 2D results (docs/stresses.md)")
     try:
         arrays, scene = _source(loaded)
-        sf = stresses(arrays, args.step, default_grid(scene, nx, nz, args.width, args.depth), body=args.body)
+        sf = stresses(arrays, args.step, default_grid(scene, nx, nz, width, depth), body=args.body)
     except InputError as err:
         raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
     a, p0 = float(arrays["a_H"]), float(arrays["p0"])

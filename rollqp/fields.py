@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["Field", "FIELDS", "register", "fields_for", "Rows"]
+__all__ = ["Field", "FIELDS", "FIELDS_3D", "registry", "register", "fields_for", "Rows", "node_shape"]
 
 #: Shapes a field may have: per stored state and node, per stored state, per node, scalar.
 SHAPES = ("state", "step", "node", "scalar")
@@ -63,6 +63,14 @@ class Field:
         scene needs); the core fields are always there.
     contract : bool
         Part of the outer contract (docs/results.md: names and meanings never change).
+    columns : int
+        A ``"step"`` field with columns: ``(K+1, columns)`` (0: ``(K+1,)``).
+    low, high : float or None
+        The range a file's values must lie in (checked by :func:`rollqp.result.load_result`: a
+        value outside is a corrupt or edited file); None: unbounded.
+    finite : bool
+        The values are finite numbers (False: a run may write NaN or infinity, e.g. an undetermined
+        approach).
     """
 
     name: str
@@ -75,6 +83,10 @@ class Field:
     contract: bool = False
     derive: Callable | None = None
     reduce: str = "last"
+    columns: int = 0
+    low: float | None = None
+    high: float | None = None
+    finite: bool = True
 
     def __post_init__(self):
         if self.shape not in SHAPES:
@@ -94,17 +106,18 @@ class Rows:
     constants (``"f"``: the nodes' weights; ``"wear_A"``, ``"wear_B"``: Archard coefficients).
     """
 
-    def __init__(self, read, m: int, constants: dict, read_before=None):
+    def __init__(self, read, m: int, constants: dict, read_before=None, fields=None):
         self._read, self._before, self.m, self.constants = read, read_before, m, constants
+        self.fields = FIELDS if fields is None else fields
         self._cache = {}
 
     def __getitem__(self, name: str) -> np.ndarray:
         got = self._cache.get(name)
         if got is None:
-            f = FIELDS.get(name)
+            f = self.fields.get(name)
             got = self._read(name)
             if got is None and f is not None and f.derive is not None:
-                got = np.asarray(f.derive(self), dtype=dtype_of(name))
+                got = np.asarray(f.derive(self), dtype=dtype_of(name, self.fields))
             if got is None:
                 raise KeyError(name)
             self._cache[name] = got
@@ -126,19 +139,20 @@ FIELDS: dict[str, Field] = {f.name: f for f in (
     Field("slip", "state", "1", "slip s of A relative to B per unit rolled distance (step 0 of a braked start: "
                                 "per a_H of static shift)", contract=True),
     Field("gap", "state", LENGTH, "deformed normal gap", contract=True),
-    Field("state", "state", "1", "node state: 0 separation, 1 stick, 2 slip", dtype="int8", contract=True),
+    Field("state", "state", "1", "node state: 0 separation, 1 stick, 2 slip", dtype="int8", contract=True,
+          low=0, high=2),
     Field("P", "step", FORCE, "normal load on body A", contract=True),
     Field("Q", "step", FORCE, "tangential load on body A, +x", contract=True),
-    Field("creepage", "step", "1", "creepage xi = (V_A - V_B)/|V|", contract=True),
-    Field("approach", "step", LENGTH, "rigid approach delta", contract=True),
+    Field("creepage", "step", "1", "creepage xi = (V_A - V_B)/|V|", contract=True, finite=False),
+    Field("approach", "step", LENGTH, "rigid approach delta", contract=True, finite=False),
     Field("shift", "step", LENGTH, "rigid static shift of a braked start (0 for rolling states)"),
     Field("step", "step", "1", "index k of each stored state in the run, 0..K (every k unless the run kept only "
-                               "every k-th state: keep_every in meta)", dtype="int64"),
+                               "every k-th state: keep_every in meta)", dtype="int64", low=0),
     Field("iterations", "step", "1", "solver iterations of the step (outer iterations for N-T)", dtype="int64",
-          contract=True, reduce="sum"),
-    Field("step_time", "step", "s", "wall seconds of the step", contract=True, reduce="sum"),
+          contract=True, reduce="sum", low=0),
+    Field("step_time", "step", "s", "wall seconds of the step", contract=True, reduce="sum", low=0),
     Field("residual", "step", "1", "the step's complementarity residual (nondimensional max norm, "
-                                   "docs/formulation.md §5)", contract=True, reduce="max"),
+                                   "docs/formulation.md §5)", contract=True, reduce="max", finite=False),
     Field("inner_normal", "step", "1", "iterations of the normal halves (N-T: summed over outer iterations)",
           dtype="int64", reduce="sum"),
     Field("inner_tangential", "step", "1", "iterations of the tangential halves", dtype="int64", reduce="sum"),
@@ -153,42 +167,107 @@ FIELDS: dict[str, Field] = {f.name: f for f in (
 )}
 
 
-def register(f: Field) -> Field:
-    """Add a field to :data:`FIELDS` (a module that computes a new quantity registers it once)."""
-    if f.name in FIELDS and FIELDS[f.name] != f:
+#: Every field of a 3D scene's result (a grid of elements: ``"state"`` fields are ``(K+1, ny, nx)``, row ``j``
+#: is ``y_j``; the ``"node"`` fields ``x`` (nx,) and ``y`` (ny,) are the element centres), in file order. Forces
+#: and moments are whole (not per unit axial length).
+FIELDS_3D: dict[str, Field] = {f.name: f for f in (
+    Field("x", "node", LENGTH, "element centres along x (nx,), the rolling direction", contract=True),
+    Field("y", "node", LENGTH, "element centres along y (ny,), lateral", contract=True),
+    Field("q", "step", LENGTH, "rolled distance of each stored state (0: the starting state)", contract=True),
+    Field("pn", "state", STRESS, "pressure, >= 0", contract=True),
+    Field("px", "state", STRESS, "tangential traction on body A along x", contract=True),
+    Field("py", "state", STRESS, "tangential traction on body A along y", contract=True),
+    Field("sx", "state", "1", "slip of A relative to B along x per unit rolled distance (state 0 of a braked "
+                              "start: per c = sqrt(ab) of static shift)", contract=True),
+    Field("sy", "state", "1", "slip of A relative to B along y, as sx", contract=True),
+    Field("state", "state", "1", "element state: 0 separation, 1 stick, 2 slip", dtype="int8", contract=True,
+          low=0, high=2),
+    Field("FN", "step", "force", "normal force on body A", contract=True),
+    Field("Fx", "step", "force", "tangential force on body A along x", contract=True),
+    Field("Fy", "step", "force", "tangential force on body A along y", contract=True),
+    Field("Mz", "step", "force*length", "spin moment on body A about z (about the grid's origin)", contract=True),
+    Field("creepage", "step", "1", "(K+1, 3): xi, eta (rigid slip of A relative to B over |V|) and phi "
+                                   "(spin, 1/length)", contract=True, columns=3, finite=False),
+    Field("approach", "step", LENGTH, "rigid approach delta", contract=True, finite=False),
+    Field("step", "step", "1", "index k of each stored state in the run, 0..K", dtype="int64", low=0),
+    Field("iterations", "step", "1", "solver iterations of the step (N-T: sweeps times the tangential ones)",
+          dtype="int64", contract=True, reduce="sum", low=0),
+    Field("step_time", "step", "s", "wall seconds of the step", contract=True, reduce="sum", low=0),
+    Field("residual", "step", "1", "the step's residual (rollqp's, nondimensional max norm, docs/theory3d.md "
+                                   "§10)", contract=True, reduce="max", finite=False),
+    Field("a", "scalar", LENGTH, "Hertz semi-axis along x", contract=True),
+    Field("b", "scalar", LENGTH, "Hertz semi-axis along y", contract=True),
+    Field("p0", "scalar", STRESS, "Hertz peak pressure", contract=True),
+    Field("Estar", "scalar", STRESS, "contact modulus E*", contract=True),
+)}
+
+#: The registry of each dimension (``meta["dimension"]`` of a result file; 2 when absent).
+REGISTRIES = {2: FIELDS, 3: FIELDS_3D}
+
+
+def registry(dimension: int = 2) -> dict:
+    """The fields of a result of ``dimension`` (2: the strip, :data:`FIELDS`; 3: the grid, :data:`FIELDS_3D`)."""
+    return REGISTRIES[dimension]
+
+
+def node_shape(fields: dict, sizes: dict) -> tuple:
+    """The shape of a ``"state"`` field's row: the sizes of the ``"node"`` fields (the coordinates), the last
+    coordinate first (2D: ``(n,)``; 3D: ``(ny, nx)``). ``sizes``: each coordinate's length."""
+    return tuple(sizes[f.name] for f in reversed(list(fields.values())) if f.shape == "node")
+
+
+def register(f: Field, dimension: int = 2) -> Field:
+    """Add a field to the registry of ``dimension`` (a module that computes a new quantity registers it once)."""
+    fields = registry(dimension)
+    if f.name in fields and fields[f.name] != f:
         raise ValueError(f"a different result field {f.name!r} is already registered")
-    FIELDS[f.name] = f
+    fields[f.name] = f
     return f
 
 
 def fields_for(scene) -> list[Field]:
     """The computed and derived fields (``compute`` or ``derive`` set) that ``scene``'s result holds."""
-    return [f for f in FIELDS.values() if (f.compute is not None or f.derive is not None) and f.needed(scene)]
+    fields = registry(getattr(scene, "dimension", 2))
+    return [f for f in fields.values() if (f.compute is not None or f.derive is not None) and f.needed(scene)]
 
 
-def dtype_of(name: str):
-    """The numpy dtype of field ``name`` (float64 for a key that is not registered)."""
-    f = FIELDS.get(name)
+def dtype_of(name: str, fields: dict | None = None):
+    """The numpy dtype of field ``name`` of ``fields`` (default :data:`FIELDS`; float64 for a key that is not
+    registered)."""
+    f = (FIELDS if fields is None else fields).get(name)
     return np.dtype(f.dtype if f is not None else "float64")
 
 
-def markdown_table() -> str:
-    """The result-file reference table of docs/results.md, generated from :data:`FIELDS`."""
-    shapes = {"state": "(K+1, n)", "step": "(K+1,)", "node": "(n,)", "scalar": "()"}
+def markdown_table(dimension: int = 2) -> str:
+    """The result-file reference table of docs/results.md for ``dimension``, generated from its registry."""
+    fields = registry(dimension)
+    coords = [f.name for f in fields.values() if f.shape == "node"]
+    node = "n" if len(coords) == 1 else ", ".join(f"n{c}" for c in reversed(coords))
+    shapes = {"state": f"(K+1, {node})", "step": "(K+1,)", "scalar": "()"}
     rows = ["| key | shape | units | meaning |", "|---|---|---|---|"]
-    for f in FIELDS.values():
+    for f in fields.values():
+        shape = (f"(n{f.name},)" if len(coords) > 1 else "(n,)") if f.shape == "node" else \
+            f"(K+1, {f.columns})" if f.columns else shapes[f.shape]
         units = "–" if f.units == "1" else f.units
         note = "" if f.contract else " *(beyond the contract)*"
-        if f.reduce != "last":
+        if f.reduce != "last" and dimension == 2:
             note = f" (keeping every k-th state: the {'sum' if f.reduce == 'sum' else 'largest'} over the steps since " \
                    f"the previous stored state){note}"
         text = f.description.replace("|", "\\|")
-        rows.append(f"| `{f.name}` | {shapes[f.shape]} | {units} | {text}{note} |")
-    rows.append("| `meta` | () | – | JSON string: the full scene with defaults, the method, the model's data, "
-                "package versions, `keep_every`, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
-                "`rolling_start`); a list of more than 64 numbers in it (a profile table) is stored as the array "
-                "`meta.<path>` and written `{\"$array\": \"meta.<path>\"}` in its place |")
+        rows.append(f"| `{f.name}` | {shape} | {units} | {text}{note} |")
+    rows.append(_META_ROW[dimension])
     return "\n".join(rows)
+
+
+_META_ROW = {
+    2: "| `meta` | () | – | JSON string: the full scene with defaults, the method, the model's data, "
+       "package versions, `keep_every`, and notes (`failed`, `interrupted`, `resumed_from`, `gross_sliding`, "
+       "`rolling_start`); a list of more than 64 numbers in it (a profile table) is stored as the array "
+       "`meta.<path>` and written `{\"$array\": \"meta.<path>\"}` in its place |",
+    3: "| `meta` | () | – | JSON string: the full scene with defaults, the method, package versions, `dimension` (3), "
+       "`static_shift` (the braked start's rigid shift of A relative to B, x and y), `raw_distance` (a conic "
+       "method's raw answers against the refined ones) and notes (`failed`, `interrupted`, `resumed_from`); long "
+       "lists stored as arrays, as in 2D |"}
 
 
 # ------------------------------------------------------------------------- kinematics

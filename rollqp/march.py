@@ -54,7 +54,7 @@ from .errors import InputError, SolverError
 from .kinematics import HistoryCache, plan
 from .operators import SceneOperators
 from .problem import SLIP, STICK, State, StepSolution, classify
-from .result import Result
+from .result import Result, ResumeSource, _meta_of, check_output, resume_source
 from .scene import Scene, load_scene
 from .strip import RowSparse
 
@@ -839,10 +839,11 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     KeyboardInterrupt
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
-    from .result import ResumeSource, resume_source
     asked = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != asked.solver.method:
         asked = asked.replace(**{"solver.method": method})
+    if out is not None:
+        out = check_output(out, key="out")
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
     if out is None:  # before any work: the states it would hold, on the operators it would build
@@ -869,20 +870,32 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
 
 
 def _run(scene, prepared, result, source, resumed, observe, progress) -> Result:
-    """:func:`run`'s loop: the records into ``result``; on a failure or a signal, the result finished with a note."""
-    ops, K = prepared[2], scene.n_steps
+    """:func:`run`'s loop over the 2D march (:func:`drive`)."""
     tail, state, recorder, checked = resumed
+    records = march(scene, prepared=prepared, resume=tail, verify=False, record=recorder, state=state, _march=checked)
+    return drive(result, records, source=source, resumed_from=None if tail is None else _last_index(tail),
+                 operators=prepared[2], observe=observe, progress=progress, steps=scene.n_steps)
+
+
+def drive(result, records, *, source=None, resumed_from=None, operators=None, observe=None, progress=None,
+          steps: int = 0) -> Result:
+    """The run's loop, in either dimension: the ``records`` (an iterator of step records, started lazily) into
+    ``result``, after the states of ``source`` (a resumed run's, :meth:`Result.resume
+    <rollqp.result.Result.resume>`; ``resumed_from``: the index of its last one). ``observe(record,
+    operators)`` with every record, ``progress(k, steps)`` after each rolling step. On a failure or a signal
+    the result is finished with a note (``failed``, ``interrupted``: its completed states are written) and the
+    error raised with ``err.partial``; call it inside :func:`rollqp.atomic.stop_once`, so that a second
+    Ctrl-C never interrupts the writing of what the first one saves."""
     try:
         if source is not None:
             result.resume(source)
-            result.meta["resumed_from"] = _last_index(tail)
-        for rec in march(scene, prepared=prepared, resume=tail, verify=False, record=recorder, state=state,
-                         _march=checked):
-            result.add(rec, ops)
+            result.meta["resumed_from"] = resumed_from
+        for rec in records:
+            result.add(rec, operators)
             if observe is not None:
-                observe(rec, ops)
+                observe(rec, operators)
             if progress is not None and rec.k > 0:
-                progress(rec.k, K)
+                progress(rec.k, steps)
     except (SolverError, InputError, KeyboardInterrupt, MemoryError) as err:
         note = {"interrupted": "interrupted"} if isinstance(err, KeyboardInterrupt) else \
             {"failed": str(err) or type(err).__name__}
@@ -901,10 +914,10 @@ def _run(scene, prepared, result, source, resumed, observe, progress) -> Result:
 
 def _keep_every(keep_every, source) -> int:
     """``keep_every`` of a run: the resumed file's, which an explicit value must not contradict."""
-    from .result import ResumeSource
     had = source.keep_every if isinstance(source, ResumeSource) else \
-        int(source["meta"].get("keep_every", 1)) if isinstance(source, dict) and isinstance(source.get("meta"), dict) \
-        else None
+        _meta_of(source).get("keep_every", 1) if isinstance(source, dict) else None
+    if had is not None and (isinstance(had, bool) or not isinstance(had, int) or had < 1):
+        raise InputError("--resume", f"meta['keep_every'] must be a whole number >= 1, got {str(had)[:40]}")
     if keep_every is None:
         return had or 1
     if had is not None and keep_every != had:
@@ -918,7 +931,7 @@ def new_result(scene, ops: SceneOperators, method_name: str, keep_every: int = 1
     (``out``: written to that file through its journal, :func:`run`)."""
     from .version import __version__
     from .fields import fields_for
-    meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info),
+    meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info), "dimension": 2,
             "versions": _versions(), "rollqp": __version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
             "step_problem": "coupled" if ops.coupled else "normal + tangential",

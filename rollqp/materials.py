@@ -86,7 +86,8 @@ class Materials:
 
     @property
     def beta(self) -> float:
-        """Dundurs' constant ``β = K/(1 − ν)`` (the 2D project's β; Bentall–Johnson's κ = 2β)."""
+        """Dundurs' constant ``β = K/(1 − ν)`` with body 1 = A, body 2 = B (the 2D project's β; Bentall–Johnson's
+        κ = 2β; docs/theory3d.md §3): positive when A is the more compliant body in ``(1 − 2ν)/G``."""
         return self.K / (1 - self.nu)
 
     @property

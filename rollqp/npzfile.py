@@ -143,6 +143,8 @@ def read_npz(path, arg: str, map_above: int | None = None) -> dict:
                 if not info.filename.endswith(".npy"):
                     raise InputError(arg, f"{shown!r}: member {info.filename[:80]!r} is not a numpy array")
                 name, value = _member(zf, info, arg, shown, source, map_above)
+                if name in out:  # (numpy's own reader takes the last: a forged member would win)
+                    raise InputError(arg, f"{shown!r} holds the member {name[:80]!r} twice: a corrupt or forged file")
                 out[name] = value
     except InputError:
         raise

@@ -3,10 +3,10 @@ roll through it (docs/scenes.md, "Three dimensions: beyond Hertz").
 
 A body's surface is its distance ``z(x, y) ≥ 0`` from the common tangent plane, in the contact frame
 (x rolling, y lateral; positive away from the other body); the undeformed distance of a step is
-``h(x, y) = z_A(x, y) + z_B(x, y)`` (eq. 3D.1 for two paraboloids). A body is a **base** shape plus
+``h(x, y) = z_A(x, y) + z_B(x, y)`` (eq. 3D.3 for two paraboloids). A body is a **base** shape plus
 **features**:
 
-* no profile: the paraboloid of its principal radii, ``z = x²/(2R_x) + y²/(2R_y)`` (eq. 3D.1);
+* no profile: the paraboloid of its principal radii, ``z = x²/(2R_x) + y²/(2R_y)`` (eq. 3D.3);
 * ``kind = "lateral"``: a lateral profile ``z_l(y)`` added to the rolling radius, ``z = x²/(2R_x) + z_l(y)``
   (a wheel, or a rail head with ``radius = inf``); ``z_l`` is the not-a-knot cubic spline through the
   points (``interpolation = "spline"``, the default: it reproduces any quadratic to round-off) or the
@@ -281,7 +281,7 @@ class Shape:
         return lambda x, y: self(x, y, shift)
 
     def curvatures(self) -> tuple[float, float]:
-        """``(A, B)`` of ``h ≈ A x² + B y²`` at the origin (eq. 3D.1 for the paraboloids)."""
+        """``(A, B)`` of ``h ≈ A x² + B y²`` at the origin (eq. 3D.3 for the paraboloids)."""
         (ax, ay), (bx, by) = self.A.curvatures(), self.B.curvatures()
         return ax + bx, ay + by
 
@@ -292,7 +292,7 @@ class Shape:
 
     @property
     def hertzian(self) -> bool:
-        """Two paraboloids without features: eq. 3D.1 exactly."""
+        """Two paraboloids without features: eq. 3D.3 exactly."""
         return all(b.base is None and not b.features for b in (self.A, self.B))
 
     def check_cover(self, grid, key_of, shifts=(0.0, 0.0)) -> None:

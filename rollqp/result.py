@@ -23,18 +23,19 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import weakref
+from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
-from .atomic import (TEMP_PREFIX, OutputLock, alive, held_signals, remove_stale_temporaries, replace,  # noqa: F401
-                     temporary, written)
+from .atomic import (META_ARRAY_MIN, MAX_META_ARRAY, TEMP_PREFIX, OutputLock, alive, decode_meta,  # noqa: F401
+                     encode_meta, held_signals, remove_stale_temporaries, replace, save_npz, temporary, written)
 from .errors import InputError
-from .fields import FIELDS, Rows, dtype_of
+from .fields import FIELDS, Rows, dtype_of, node_shape, registry
 from .journal import json_default as _json_default
 
-__all__ = ["Result", "load_result", "save_npz", "check_output", "resume_source", "OutputLock", "TEMP_PREFIX",
+__all__ = ["Result", "Layout", "STRIP", "load_result", "save_npz", "check_output", "resume_source", "OutputLock", "TEMP_PREFIX",
            "remove_stale_temporaries", "encode_meta", "decode_meta"]
 
 #: The core fields read off each record (:mod:`rollqp.fields` documents them).
@@ -45,8 +46,6 @@ _PER_STEP = ("q", "P", "Q", "creepage", "approach", "shift", "iterations", "step
 #: starting state) and whether it rolled (``_rolling``). Kept in the journal, not in the file.
 _HIDDEN = ("_dq", "_rolling")
 _HIDDEN_DTYPES = {"_dq": "<f8", "_rolling": "|i1"}
-#: A list of more than this many numbers in ``meta`` is stored as an array of its own.
-META_ARRAY_MIN = 64
 #: Stored members of a result file larger than this are memory-mapped, not read (bytes): a long run's
 #: file is read without its states filling the memory (the pages a reader touches are read in).
 MAP_ABOVE = 1 << 20
@@ -59,8 +58,27 @@ BLOCK_BYTES = 2 << 20
 META_LIMIT = (16 << 20) + (1 << 20)
 
 
-#: Longest array referenced from ``meta`` (a profile table of a million points, a list of a million steps).
-MAX_META_ARRAY = 2_000_001
+
+
+@dataclass(frozen=True)
+class Layout:
+    """What a result of one discretization keeps of each state: its field registry
+    (:func:`rollqp.fields.registry`), the core fields read off each record (``core``), the fields kept in the
+    journal only for the derived ones (``hidden``, with their dtypes) and ``read(record, operators) ->
+    (values, notes)``: the core fields' values of a record and its notes for ``meta``."""
+
+    dimension: int
+    core: tuple
+    read: Callable
+    hidden: tuple = ()
+
+    @property
+    def fields(self) -> dict:
+        return registry(self.dimension)
+
+
+#: The notes of an earlier part of a run that a resumed run keeps in ``meta``.
+_CARRIED = ("gross_sliding", "rolling_start", "start_note", "static_shift", "raw_distance")
 
 
 class Result:
@@ -77,18 +95,23 @@ class Result:
     """
 
     def __init__(self, x, scalars: dict, meta: dict, extra=(), *, constants=None, keep_every: int = 1,
-                 out=None, operators=None):
+                 out=None, operators=None, layout: Layout | None = None, coords: dict | None = None):
         if isinstance(keep_every, bool) or not isinstance(keep_every, (int, np.integer)) or not 1 <= keep_every <= 10**9:
             raise InputError("keep_every", f"must be a whole number >= 1, got {keep_every!r}")
-        self.x = np.asarray(x, dtype=float)
+        self.layout = STRIP if layout is None else layout
+        self.fields = self.layout.fields
+        self.coords = {k: np.asarray(v, dtype=float) for k, v in (coords or {"x": x}).items()}
+        self.x = self.coords["x"]
+        self.node_shape = node_shape(self.fields, {k: v.size for k, v in self.coords.items()})
         self.scalars, self.meta, self.extra = dict(scalars), meta, list(extra)
         self.keep_every = int(keep_every)
         self.meta["keep_every"] = self.keep_every
+        self.meta["dimension"] = self.layout.dimension
         self.constants = {k: np.asarray(v) for k, v in (constants or {}).items()}
         self.out = None if out is None else os.fspath(out)
         self._ops = None if operators is None else weakref.ref(operators)
-        self.names = list(_PER_STATE + _PER_STEP) + [f.name for f in self.extra]
-        self.stored = [n for n in self.names if FIELDS[n].derive is None] + list(_HIDDEN)
+        self.names = list(self.layout.core) + [f.name for f in self.extra]
+        self.stored = [n for n in self.names if self.fields[n].derive is None] + list(self.layout.hidden)
         self._store = _Memory(self) if out is None else _Journaled(self)
         self._cache = None
 
@@ -99,34 +122,23 @@ class Result:
         ops = operators if operators is not None else (self._ops() if self._ops is not None else None)
         if rec.k != self.steps:
             raise ValueError(f"record {rec.k} appended as state {self.steps}")
-        st, c, tsol = rec.state, rec.counters, rec.state.tsol
-        values = dict(pn=st.p, pt=st.t, slip=tsol.s, gap=st.nsol.g, state=rec.nodes, q=rec.q, P=rec.P, Q=rec.Q,
-                      creepage=tsol.xi, approach=st.nsol.delta, shift=rec.shift, iterations=c.iterations,
-                      step_time=rec.step_time, residual=c.residual, inner_normal=c.inner_normal,
-                      inner_tangential=c.inner_tangential, backtracks=c.backtracks, step=rec.k)
+        values, notes = self.layout.read(rec, ops)
         for f in self.extra:
             if f.compute is not None:
                 values[f.name] = f.compute(rec, ops)
-        values["_dq"] = _step_length(rec)
-        values["_rolling"] = rec.phase == "rolling" and st.p is not None
-        notes = {}
-        if rec.gross_sliding:  # possible with a prescribed creepage beyond the sliding creepage
-            notes["gross_sliding"] = True
-        if rec.k == 0 and rec.phase in ("steady", "rolling"):
-            notes["rolling_start"] = "direct steady solve" if rec.phase == "steady" else "marching to steady state"
-        if rec.note is not None:
-            notes["start_note"] = rec.note
+        values["step"] = rec.k
+        solver = notes.pop("solver", None)
         _apply_notes(self.meta, rec.k, notes)
-        if rec.solver is not None:  # what the method carries to the next step (journal only: rollqp.solverstate)
-            notes["solver"] = rec.solver
+        if solver is not None:  # what the method carries to the next step (journal only: rollqp.solverstate)
+            notes["solver"] = solver
         self._store.append(values, notes)
         self._cache = None
 
     def extend(self, arrays: dict) -> None:
         """Append every state of a result file's ``arrays`` (an earlier part of the same run, checked by
         :func:`load_result`); its notes (``gross_sliding``, ``rolling_start``, ``start_note``) are kept."""
-        meta = arrays.get("meta", {})
-        for k in ("gross_sliding", "rolling_start", "start_note"):
+        meta = _meta_of(arrays)
+        for k in _CARRIED:
             if k in meta:
                 self.meta[k] = meta[k]
         missing = [k for k in self.names if k not in arrays and k != "step"]
@@ -143,7 +155,7 @@ class Result:
         continued, or its result file's states imported) or the arrays of a result file."""
         if isinstance(source, dict):
             return self.extend(source)
-        for k in ("gross_sliding", "rolling_start", "start_note"):
+        for k in _CARRIED:
             if k in source.meta:
                 self.meta[k] = source.meta[k]
         store = self._store
@@ -195,6 +207,45 @@ class Result:
         return self
 
 
+def _read_strip(rec, ops) -> tuple[dict, dict]:
+    """The core fields and notes of a 2D :class:`~rollqp.march.StepRecord` (:data:`STRIP`)."""
+    st, c, tsol = rec.state, rec.counters, rec.state.tsol
+    values = dict(pn=st.p, pt=st.t, slip=tsol.s, gap=st.nsol.g, state=rec.nodes, q=rec.q, P=rec.P, Q=rec.Q,
+                  creepage=tsol.xi, approach=st.nsol.delta, shift=rec.shift, iterations=c.iterations,
+                  step_time=rec.step_time, residual=c.residual, inner_normal=c.inner_normal,
+                  inner_tangential=c.inner_tangential, backtracks=c.backtracks, step=rec.k)
+    values["_dq"] = _step_length(rec)
+    values["_rolling"] = rec.phase == "rolling" and st.p is not None
+    notes = {}
+    if rec.gross_sliding:  # possible with a prescribed creepage beyond the sliding creepage
+        notes["gross_sliding"] = True
+    if rec.k == 0 and rec.phase in ("steady", "rolling"):
+        notes["rolling_start"] = "direct steady solve" if rec.phase == "steady" else "marching to steady state"
+    if rec.note is not None:
+        notes["start_note"] = rec.note
+    if rec.solver is not None:
+        notes["solver"] = rec.solver
+    return values, notes
+
+
+#: The strip's result (a 2D scene): :data:`rollqp.fields.FIELDS`.
+STRIP = Layout(2, _PER_STATE + _PER_STEP, _read_strip, _HIDDEN)
+
+
+def _meta_of(arrays: dict) -> dict:
+    """The ``meta`` of a result's arrays as a dict (``arrays()`` holds its JSON text, :func:`load_result` the dict)."""
+    meta = arrays.get("meta", {})
+    if isinstance(meta, dict):
+        return meta
+    try:
+        meta = json.loads(str(meta))
+    except (json.JSONDecodeError, RecursionError):
+        raise InputError("--resume", "key 'meta' must be a JSON object") from None
+    if not isinstance(meta, dict):
+        raise InputError("--resume", "key 'meta' must be a JSON object")
+    return meta
+
+
 def _step_length(rec) -> float:
     """The length the step's slip is per (``Δq_k``, ``Δ = a_H`` for a step at rest, 0 for the start;
     :func:`rollqp.energy.friction_work`)."""
@@ -218,8 +269,8 @@ class _Thinning:
     """Which states a result keeps (``k % keep == 0`` and the last two) and the step fields of the kept
     ones, combined over the steps in between (``Field.reduce``), fed in order a block at a time."""
 
-    def __init__(self, names, keep: int):
-        self.names, self.keep = list(names), keep
+    def __init__(self, names, keep: int, fields=FIELDS):
+        self.names, self.keep, self.fields = list(names), keep, fields
         self.pending = {}  # the combined values of steps fed since the last kept one
 
     def feed(self, steps: np.ndarray, values: dict, last_two: bool) -> tuple[np.ndarray, dict]:
@@ -231,7 +282,7 @@ class _Thinning:
         kept = np.flatnonzero(keep)
         out = {}
         for name in self.names:
-            v, how = np.asarray(values[name]), FIELDS[name].reduce
+            v, how = np.asarray(values[name]), self.fields[name].reduce
             if how == "last":
                 out[name] = v[kept]
                 continue
@@ -254,12 +305,12 @@ def _combine(how, a, b):
     return a + b if how == "sum" else np.maximum(a, b)
 
 
-def _step_names(names) -> list:
-    return [n for n in names if FIELDS[n].shape == "step"]
+def _step_names(names, fields=FIELDS) -> list:
+    return [n for n in names if fields[n].shape == "step"]
 
 
-def _state_names(names) -> list:
-    return [n for n in names if FIELDS[n].shape == "state"]
+def _state_names(names, fields=FIELDS) -> list:
+    return [n for n in names if fields[n].shape == "state"]
 
 
 def _block_rows(rows: Rows, names) -> dict:
@@ -280,7 +331,7 @@ class _Memory:
         self.before = {}                           # the last row combined, for Rows.before
         self.out = {name: [] for name in result.names}
         self.committed = 0                         # kept rows in self.out
-        self.thin = _Thinning(_step_names(result.names), result.keep_every)
+        self.thin = _Thinning(_step_names(result.names, result.fields), result.keep_every, result.fields)
         self.imported = []                         # rows of an earlier part (every field, combined)
         self.next_step = 0
 
@@ -310,7 +361,7 @@ class _Memory:
         if not self.cols:
             for name in self.r.stored:
                 v = np.asarray(values[name])
-                self.cols[name] = np.empty((16,) + v.shape, dtype=_HIDDEN_DTYPES.get(name) or dtype_of(name))
+                self.cols[name] = np.empty((16,) + v.shape, dtype=_HIDDEN_DTYPES.get(name) or dtype_of(name, self.r.fields))
         if self.n == next(iter(self.cols.values())).shape[0]:
             for name, a in self.cols.items():
                 self.cols[name] = np.concatenate([a, np.empty_like(a)])
@@ -330,7 +381,7 @@ class _Memory:
         def drop():
             self.before = {k: v[-1] for k, v in cols.items()}
             self.imported = []
-        return Rows(cols.get, len(rows), self.r.constants, None), cols["step"], len(rows), drop
+        return Rows(cols.get, len(rows), self.r.constants, None, self.r.fields), cols["step"], len(rows), drop
 
     def _raw_block(self, m: int):
         """``(rows, steps, m, drop)`` of the oldest ``m`` raw rows, their predecessor from ``self.before``."""
@@ -350,13 +401,13 @@ class _Memory:
                 cols[name] = a[m:].copy()
             self.base += m
             self.n -= m
-        return Rows(read, m, self.r.constants, read_before), cols["step"][:m], m, drop
+        return Rows(read, m, self.r.constants, read_before, self.r.fields), cols["step"][:m], m, drop
 
     def _combine(self, block, last_two: bool, thin: _Thinning) -> dict:
         rows, steps, m, _ = block
-        names = self.r.names
-        kept, out = thin.feed(np.asarray(steps), _block_rows(rows, _step_names(names)), last_two)
-        out.update({n: rows[n][kept] for n in _state_names(names)})
+        names, fields = self.r.names, self.r.fields
+        kept, out = thin.feed(np.asarray(steps), _block_rows(rows, _step_names(names, fields)), last_two)
+        out.update({n: rows[n][kept] for n in _state_names(names, fields)})
         return out
 
     def _commit(self, block, last_two: bool) -> None:
@@ -381,12 +432,12 @@ class _Memory:
             tail = {}
         for n, v in tail.items():
             parts[n].append(v)
-        out = {"x": r.x}
+        out = dict(r.coords)
         for name in r.names:
-            f = FIELDS[name]
-            chunks = [np.asarray(c, dtype=dtype_of(name)) for c in parts[name]]
-            shape = (0,) + (r.x.shape if f.shape == "state" else ())
-            out[name] = np.concatenate(chunks) if chunks else np.empty(shape, dtype=dtype_of(name))
+            f = r.fields[name]
+            chunks = [np.asarray(c, dtype=dtype_of(name, r.fields)) for c in parts[name]]
+            shape = (0,) + (r.node_shape if f.shape == "state" else (f.columns,) if f.columns else ())
+            out[name] = np.concatenate(chunks) if chunks else np.empty(shape, dtype=dtype_of(name, r.fields))
         out.update({k: np.asarray(v) for k, v in r.scalars.items()})
         out["meta"] = np.asarray(json.dumps(r.meta, sort_keys=True, default=_json_default))
         return out
@@ -399,7 +450,7 @@ class _Memory:
 
 
 def _copy_thinning(t: _Thinning) -> _Thinning:
-    c = _Thinning(t.names, t.keep)
+    c = _Thinning(t.names, t.keep, t.fields)
     c.pending = dict(t.pending)
     return c
 
@@ -436,9 +487,10 @@ class _Journaled:
         from .journal import Journal, layout_of
         r = self.r
         text, marrays = encode_meta(r.meta)
-        arrays = {"x": r.x, **{k: np.asarray(v) for k, v in r.scalars.items()},
+        arrays = {**r.coords, **{k: np.asarray(v) for k, v in r.scalars.items()},
                   **{f"constant.{k}": v for k, v in r.constants.items()}, **marrays}
-        info = {"layout": _layouts(r, sample, layout_of), "keep_every": r.keep_every, "names": r.names, "version": 1}
+        info = {"layout": _layouts(r, sample, layout_of), "keep_every": r.keep_every, "names": r.names, "version": 1,
+                "dimension": r.layout.dimension}
         self.journal = Journal.create(self.path, arrays, text, info)
 
     def continue_journal(self, source) -> None:
@@ -457,7 +509,8 @@ class _Journaled:
         """Continue ``journal`` (the same scene's, opened for appending; its notes are in :class:`ResumeSource`'s
         ``meta``, which :meth:`Result.resume` copies)."""
         info = journal.header["info"]
-        if info.get("keep_every") != self.r.keep_every or info.get("names") != self.r.names:
+        if (info.get("keep_every") != self.r.keep_every or info.get("names") != self.r.names
+                or info.get("dimension", 2) != self.r.layout.dimension):
             raise InputError("--resume", f"the journal {journal.path!r} was written by another version of rollqp "
                                          "or with another keep_every: resume it with that one")
         self.journal = journal
@@ -516,10 +569,10 @@ def _layouts(r: Result, sample: dict, layout_of) -> dict:
     def shape(name):
         if name in sample:
             return list(np.shape(sample[name]))
-        return node if name in FIELDS and FIELDS[name].shape == "state" else []
+        return node if name in r.fields and r.fields[name].shape == "state" else []
 
     def dt(name):
-        return _HIDDEN_DTYPES[name] if name in _HIDDEN_DTYPES else dtype_of(name).str
+        return _HIDDEN_DTYPES[name] if name in _HIDDEN_DTYPES else dtype_of(name, r.fields).str
     S = [[n, dt(n), shape(n)] for n in r.stored]
     R = [[n, dt(n), shape(n)] for n in r.names]
     return {"S": S, "R": R}
@@ -540,7 +593,7 @@ def _journal_blocks(journal, ids):
         i = j
 
 
-def _journal_rows(journal, ids, constants) -> Rows:
+def _journal_rows(journal, ids, constants, fields=FIELDS) -> Rows:
     """:class:`~rollqp.fields.Rows` of the journal's frames ``ids`` (one kind; predecessors read as needed)."""
     recs = journal.records(ids)
     consecutive = ids.size < 2 or int(ids[-1] - ids[0]) == ids.size - 1
@@ -558,7 +611,7 @@ def _journal_rows(journal, ids, constants) -> Rows:
             return np.concatenate([np.asarray(predecessor(int(ids[0]) - 1, name), dtype=float)[None],
                                    recs[name][:-1]])
         return np.stack([np.asarray(predecessor(int(i) - 1, name), dtype=float) for i in ids])
-    return Rows(read, len(ids), constants, read_before)
+    return Rows(read, len(ids), constants, read_before, fields)
 
 
 def _assemble(journal, r: Result, path):
@@ -566,24 +619,25 @@ def _assemble(journal, r: Result, path):
     fields of every state first (combined over the states that are not kept), then each state field
     of the kept states, a block of rows at a time."""
     n = len(journal)
-    steps, thin = _step_names(r.names), _Thinning(_step_names(r.names), r.keep_every)
+    steps = _step_names(r.names, r.fields)
+    thin = _Thinning(steps, r.keep_every, r.fields)
     kept_ids, parts = [], {k: [] for k in steps}
     all_ids = np.arange(n)
     for ids in _journal_blocks(journal, all_ids):
-        rows = _journal_rows(journal, ids, r.constants)
+        rows = _journal_rows(journal, ids, r.constants, r.fields)
         kept, values = thin.feed(journal.frames.index[ids], _block_rows(rows, steps), last_two=ids[-1] == n - 1)
         kept_ids.append(ids[kept])
         for k in steps:
-            parts[k].append(np.asarray(values[k], dtype=dtype_of(k)))
+            parts[k].append(np.asarray(values[k], dtype=dtype_of(k, r.fields)))
     kept_ids = np.concatenate(kept_ids)
     columns = {k: np.concatenate(v) for k, v in parts.items()}
 
     def state_blocks(name):
         for ids in _journal_blocks(journal, kept_ids):
-            yield _journal_rows(journal, ids, r.constants)[name]
+            yield _journal_rows(journal, ids, r.constants, r.fields)[name]
     meta_text, marrays = encode_meta(r.meta)
     if path is None:
-        out = {"x": r.x}
+        out = dict(r.coords)
         for name in r.names:
             out[name] = columns[name] if name in columns else np.concatenate(list(state_blocks(name)))
         out.update({k: np.asarray(v) for k, v in r.scalars.items()})
@@ -596,14 +650,15 @@ def _write_result(path, r: Result, columns, state_blocks, K1, meta_text, marrays
     """Write the result file atomically: a temporary file beside ``path``, then a rename."""
     from .npzfile import NpzStream
     with written(path) as (fh, _), NpzStream(fh) as z:
-        z.array("x", r.x)
+        for k, v in r.coords.items():
+            z.array(k, v)
         for name in r.names:
             if name in columns:
                 z.array(name, columns[name])
                 continue
             blocks = state_blocks(name)
             first = next(blocks)
-            z.rows(name, dtype_of(name), (K1,) + first.shape[1:], _chain(first, blocks))
+            z.rows(name, dtype_of(name, r.fields), (K1,) + first.shape[1:], _chain(first, blocks))
         for k, v in r.scalars.items():
             z.array(k, np.asarray(v))
         z.array("meta", np.asarray(meta_text))
@@ -618,6 +673,10 @@ def _chain(first, rest):
 
 
 # =========================================================================== files
+#: The longest suffix of a file written beside a result file (its journal; its lock is ``.lock``).
+_LONGEST_SUFFIX = ".journal"
+
+
 def check_output(path, what: str = "result file", key: str = "--out") -> str:
     """``path`` as a string if a ``.npz`` can be written there: checked before any work.
 
@@ -626,12 +685,26 @@ def check_output(path, what: str = "result file", key: str = "--out") -> str:
     InputError
         ``key``: not ending in ``.npz``, a missing or unwritable folder, or a folder in its place.
     """
-    path = os.fspath(path)
+    try:
+        path = os.fspath(path)
+    except TypeError:
+        raise InputError(key, f"the {what} must be a path, got {type(path).__name__}") from None
+    if not isinstance(path, str) or "\x00" in path:
+        raise InputError(key, f"the {what} must be a path without NUL characters, got {str(path)[:80]!r}")
     if not path.endswith(".npz"):
         raise InputError(key, f"the {what} must end in .npz, got {path!r}")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise InputError(key, f"folder {folder!r} does not exist")
+    try:
+        longest = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        longest = 255
+    name = os.path.basename(path)
+    if len(os.fsencode(name)) + len(_LONGEST_SUFFIX) > longest:   # its journal and lock sit beside it
+        raise InputError(key, f"the {what}'s name is too long: {len(os.fsencode(name))} bytes, at most "
+                              f"{longest - len(_LONGEST_SUFFIX)} (its journal {name[:20]}…{_LONGEST_SUFFIX} must fit "
+                              f"in {longest})")
     if os.path.isdir(path):
         raise InputError(key, f"{path!r} is a folder, not a file")
     try:
@@ -641,89 +714,6 @@ def check_output(path, what: str = "result file", key: str = "--out") -> str:
     os.close(fd)
     os.unlink(probe)
     return path
-
-
-def save_npz(path, arrays: dict, what: str = "result file") -> str:
-    """Write ``arrays`` to the ``.npz`` ``path`` atomically (temporary file, then rename), SIGINT and SIGTERM
-    held back until it is written (:func:`rollqp.atomic.held_signals`).
-
-    A path not ending in ``.npz`` or in a missing folder is an :class:`InputError` on ``--out``.
-    Temporary files left in the folder by killed writers are removed first; an interrupted write
-    removes its own. A result's ``meta`` (a dict or its JSON text) is written with its long lists as
-    arrays (:func:`encode_meta`).
-    """
-    from .npzfile import NpzStream
-    path = os.fspath(path)
-    if not path.endswith(".npz"):
-        raise InputError("--out", f"the {what} must end in .npz, got {path!r}")
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise InputError("--out", f"folder {folder!r} does not exist")
-    arrays = dict(arrays)
-    if "meta" in arrays and what == "result file":
-        meta = arrays["meta"]
-        meta = json.loads(str(meta)) if not isinstance(meta, dict) else meta
-        text, marrays = encode_meta(meta)
-        arrays["meta"] = np.asarray(text)
-        arrays.update(marrays)
-    with held_signals(), written(path) as (fh, _), NpzStream(fh) as z:
-        for k, v in arrays.items():
-            z.array(k, v)
-    return path
-
-
-# =========================================================================== meta
-def encode_meta(meta: dict) -> tuple[str, dict]:
-    """``(JSON text, arrays)``: every list of more than :data:`META_ARRAY_MIN` numbers in ``meta`` (a profile
-    table, a long list of steps) becomes an array ``meta.<path>`` and ``{"$array": "meta.<path>"}`` in the
-    text, so that the text stays the size of a scene file whatever the tables (:func:`decode_meta`)."""
-    arrays = {}
-
-    def walk(v, path):
-        if isinstance(v, np.ndarray):
-            v = v.tolist()
-        if isinstance(v, dict):
-            return {k: walk(x, path + (str(k),)) for k, x in v.items()}
-        if isinstance(v, (list, tuple)):
-            if len(v) > META_ARRAY_MIN and all(_is_number(e) for e in v):
-                key = "meta." + re.sub(r"[^A-Za-z0-9_.-]", "_", ".".join(path))[:200]
-                while key in arrays:
-                    key += "_"
-                ints = all(isinstance(e, (int, np.integer)) for e in v)
-                arrays[key] = np.asarray(v, dtype=np.int64 if ints else np.float64)
-                return {"$array": key}
-            return [walk(x, path + (str(i),)) for i, x in enumerate(v)]
-        return v
-    tree = walk(meta, ())
-    return json.dumps(tree, sort_keys=True, default=_json_default), arrays
-
-
-def _is_number(e) -> bool:
-    return isinstance(e, (int, float, np.integer, np.floating)) and not isinstance(e, (bool, np.bool_))
-
-
-def decode_meta(tree, arrays: dict, arg: str):
-    """``meta`` with its ``{"$array": key}`` entries replaced by the lists in ``arrays`` (each checked: a key
-    ``meta.*`` of the file, a 1-D array of at most :data:`MAX_META_ARRAY` real numbers)."""
-    def walk(v):
-        if isinstance(v, dict):
-            if set(v) == {"$array"}:
-                return _meta_array(v["$array"], arrays, arg)
-            return {k: walk(x) for k, x in v.items()}
-        if isinstance(v, list):
-            return [walk(x) for x in v]
-        return v
-    return walk(tree)
-
-
-def _meta_array(key, arrays, arg):
-    if not (isinstance(key, str) and key.startswith("meta.") and key in arrays):
-        raise InputError(arg, f"key 'meta' refers to an array {str(key)[:80]!r} that the file does not hold")
-    a = np.asarray(arrays[key])
-    if a.ndim != 1 or a.dtype.kind not in "iuf" or a.size > MAX_META_ARRAY:
-        raise InputError(arg, f"key {key!r} must be a 1-D array of at most {MAX_META_ARRAY} numbers, got "
-                              f"{a.dtype} of shape {a.shape}")
-    return a.tolist()
 
 
 # =========================================================================== reading
@@ -747,46 +737,64 @@ def load_result(path, arg: str = "RESULT.npz", map_above: int | None = MAP_ABOVE
     for key in ("x", "q", "meta"):
         if key not in z:
             raise InputError(arg, f"{os.fspath(path)!r} is not a rollqp result file (no key {key!r})")
-    if "y" in z:  # a grid of elements: a 3D scene's result file (docs/results.md, "Three dimensions")
-        from .three.fields import read_checked
-        return read_checked(z, arg)
-    n, K1 = np.shape(z["x"])[0] if np.ndim(z["x"]) == 1 else -1, np.shape(z["q"])[0] if np.ndim(z["q"]) == 1 else -1
-    if n < 1 or K1 < 1:
-        raise InputError(arg, f"keys 'x' and 'q' must be non-empty 1-D arrays, got shapes {np.shape(z['x'])}, "
-                              f"{np.shape(z['q'])}")
-    missing = [key for key, f in FIELDS.items() if f.contract and key not in z]
-    if missing:  # the contract's keys are in every result file rollqp writes
-        raise InputError(arg, f"{os.fspath(path)!r} is not a complete rollqp result file (no key {missing[0]!r}"
-                              + (f" and {len(missing) - 1} more)" if len(missing) > 1 else ")"))
-    shapes = {"state": (K1, n), "step": (K1,), "node": (n,), "scalar": ()}
-    for key in z:
-        f = FIELDS.get(key)
-        if f is not None and key != "meta":
-            _check_array(z, key, shapes[f.shape], arg, finite=key not in ("approach", "creepage", "residual"))
-    _check_scalars(z, arg)
-    if "step" in z:
-        st = np.asarray(z["step"])
-        if st.dtype.kind not in "iu" or (K1 and st[0] < 0) or np.any(np.diff(st) <= 0):
-            raise InputError(arg, "key 'step' must hold increasing whole numbers >= 0 (the stored states' indices)")
     try:
         meta = json.loads(text_value(z, "meta", arg, limit=META_LIMIT))
     except (json.JSONDecodeError, RecursionError) as exc:
         raise InputError(arg, f"key 'meta' must be a JSON string ({type(exc).__name__})") from exc
     if not isinstance(meta, dict):
         raise InputError(arg, "key 'meta' must be a JSON object")
+    dim = meta.get("dimension", 2)
+    if isinstance(dim, bool) or dim not in (2, 3):
+        raise InputError(arg, f"meta['dimension'] must be 2 or 3, got {str(dim)[:40]}")
+    check_arrays(z, registry(dim), arg, what=os.fspath(path))
     out = {k: v for k, v in z.items() if not k.startswith("meta.")}
     out["meta"] = decode_meta(meta, z, arg)
     return out
 
 
-def _check_array(z: dict, key: str, shape: tuple, arg: str, finite: bool = True) -> None:
-    """``z[key]`` holds real numbers of ``shape`` (finite unless ``finite=False``), checked a block of rows at a
-    time (no converted copy of a memory-mapped member)."""
+def check_arrays(z: dict, fields: dict, arg: str, what: str = "the result") -> None:
+    """The arrays ``z`` of a result of the registry ``fields`` checked: the coordinates non-empty and 1-D, every
+    key of the contract there, each registered key of its shape (``"state"``: ``(K+1,)`` and the coordinates'
+    sizes, last first), dtype kind, finiteness and range (``Field.low``, ``Field.high``), the scalars in
+    their ranges, ``step`` increasing."""
+    coords = [f.name for f in fields.values() if f.shape == "node"]
+    for key in coords + ["q"]:
+        if key not in z or np.ndim(z[key]) != 1 or np.shape(z[key])[0] < 1:
+            raise InputError(arg, f"key {key!r} must be a non-empty 1-D array, got shape "
+                                  f"{np.shape(z[key]) if key in z else None}")
+    missing = [key for key, f in fields.items() if f.contract and key not in z]
+    if missing:  # the contract's keys are in every result file rollqp writes
+        raise InputError(arg, f"{what!r} is not a complete rollqp result file (no key {missing[0]!r}"
+                              + (f" and {len(missing) - 1} more)" if len(missing) > 1 else ")"))
+    K1 = np.shape(z["q"])[0]
+    node = node_shape(fields, {c: np.shape(z[c])[0] for c in coords})
+    for key in z:
+        f = fields.get(key)
+        if f is None or key == "meta":
+            continue
+        shape = {"state": (K1,) + node, "step": (K1,) + ((f.columns,) if f.columns else ()),
+                 "node": (np.shape(z[key])[0] if np.ndim(z[key]) == 1 else -1,), "scalar": ()}[f.shape]
+        _check_array(z, key, shape, arg, finite=f.finite, field=f)
+    _check_scalars(z, arg)
+    if "step" in z:
+        st = np.asarray(z["step"])
+        if st.dtype.kind not in "iu" or (K1 and st[0] < 0) or np.any(np.diff(st) <= 0):
+            raise InputError(arg, "key 'step' must hold increasing whole numbers >= 0 (the stored states' indices)")
+
+
+def _check_array(z: dict, key: str, shape: tuple, arg: str, finite: bool = True, field=None) -> None:
+    """``z[key]`` holds real numbers of ``shape`` (finite unless ``finite=False``; of ``field``'s dtype kind and
+    range), checked a block of rows at a time (no converted copy of a memory-mapped member)."""
     v = z[key]
     if not isinstance(v, np.ndarray) or v.dtype.kind not in "iuf":  # bool, complex, strings, objects
         raise InputError(arg, f"key {key!r} must hold real numbers, got dtype {np.asarray(v).dtype}")
+    if field is not None and (np.dtype(field.dtype).kind == "f") != (v.dtype.kind == "f"):
+        raise InputError(arg, f"key {key!r} must hold {'floating-point' if field.dtype.startswith('float') else 'whole'}"
+                              f" numbers ({field.dtype}), got dtype {v.dtype}")
     if v.shape != tuple(shape):
         raise InputError(arg, f"key {key!r} must have shape {tuple(shape)}, got {v.shape}")
+    if field is not None and (field.low is not None or field.high is not None):
+        _check_range(v, key, field, arg)
     if not finite or v.dtype.kind != "f":
         return
     known = getattr(v, "all_finite", None)  # a mapped member, checked as it was read (rollqp.npzfile)
@@ -800,8 +808,20 @@ def _check_array(z: dict, key: str, shape: tuple, arg: str, finite: bool = True)
             raise InputError(arg, f"key {key!r} must be finite")
 
 
+def _check_range(v, key, field, arg) -> None:
+    """``field.low <= v <= field.high`` (NaN allowed where the field is not finite), a block of rows at a time."""
+    lo = -np.inf if field.low is None else field.low
+    hi = np.inf if field.high is None else field.high
+    rows = max(1, BLOCK_BYTES // max(v[0].nbytes if v.ndim else v.nbytes, 1)) if v.ndim else 1
+    for i in range(0, max(len(v) if v.ndim else 1, 1), rows):
+        b = np.asarray(v[i:i + rows] if v.ndim else v)
+        bad = (b < lo) | (b > hi)
+        if np.any(bad):
+            raise InputError(arg, f"key {key!r} must lie in [{lo:g}, {hi:g}], got {b[bad].flat[0]!r}")
+
+
 #: The scalars every reader divides by or builds a grid from: their allowed ranges.
-_SCALAR_RANGES = {"a_H": ("> 0", lambda v: v > 0), "p0": ("> 0", lambda v: v > 0), "R": ("> 0", lambda v: v > 0),
+_SCALAR_RANGES = {"a": ("> 0", lambda v: v > 0), "b": ("> 0", lambda v: v > 0), "a_H": ("> 0", lambda v: v > 0), "p0": ("> 0", lambda v: v > 0), "R": ("> 0", lambda v: v > 0),
                   "Estar": ("> 0", lambda v: v > 0), "beta": ("in [-0.5, 0.5]", lambda v: -0.5 <= v <= 0.5),
                   "leading_edge": ("+1 or -1", lambda v: v in (1, -1))}
 
@@ -845,8 +865,10 @@ class ResumeSource:
         """``x``, every stored state's ``q`` and ``step``, and the last two stored states (all fields)."""
         if self.journal is None:
             a = self.arrays
-            out = {k: np.asarray(v[-2:]) for k, v in a.items() if k in FIELDS and FIELDS[k].shape in ("state", "step")}
-            out.update(x=np.asarray(a["x"]), q=np.asarray(a["q"]), step=self.steps)
+            fields = registry(a["meta"].get("dimension", 2))
+            out = {k: np.asarray(v[-2:]) for k, v in a.items() if k in fields and fields[k].shape in ("state", "step")}
+            out.update({k: np.asarray(a[k]) for k, f in fields.items() if f.shape == "node"})
+            out.update(q=np.asarray(a["q"]), step=self.steps)
             return out
         j = self.journal
         n = len(j)
@@ -855,8 +877,9 @@ class ResumeSource:
         for name in set(last[0].dtype.names).intersection(last[-1].dtype.names):
             out[name] = np.stack([np.asarray(r[name]) for r in last])
         qs = [j.records(ids)["q"] for ids in _journal_blocks(j, np.arange(n))]
-        out.update(x=np.asarray(j.header["arrays"]["x"]), q=np.concatenate(qs) if qs else np.zeros(0),
-                   step=self.steps)
+        head = j.header["arrays"]
+        out.update({k: np.asarray(head[k]) for k in ("x", "y") if k in head})
+        out.update(q=np.concatenate(qs) if qs else np.zeros(0), step=self.steps)
         out["_notes"] = j.notes  # the method's records (rollqp.solverstate) and a stored state's p and t
         out["_state_at"] = self._state_at
         return out
@@ -901,6 +924,9 @@ def resume_source(path, arg: str = "--resume") -> ResumeSource:
             journal.close()   # the file holds more: the journal of an older part
             journal = None
     if journal is None and arrays is None:
+        if os.path.isfile(jpath):
+            raise InputError(arg, f"the journal {jpath!r} holds no completed state (the run was stopped before its "
+                                  f"first state was complete): run the scene again")
         raise InputError(arg, f"no such file: {npz!r} (nor a journal {jpath!r} of a killed run)")
     return ResumeSource(npz, arg, journal=journal, arrays=None if journal is not None else arrays)
 

@@ -439,6 +439,7 @@ def test_builtin_scenes_listed():
     paths = {"stop-reverse", "fretting", "dent"}   # load paths and profiles (docs/kinematics.md)
     paths.add("falling-friction")                  # a slip-velocity law (docs/friction.md)
     paths |= {"kalker-circular", "kalker-elliptic", "cattaneo-3d", "ball-in-groove"}   # 3D (docs/scenes.md, "Three dimensions")
+    paths.add("wheel-rail")                        # a wheelset on its track (docs/wheel-rail.md)
     paths.add("quartic-roller")                    # a 3D profile (docs/scenes.md, "Three dimensions: beyond Hertz")
     assert set(b) == set(expected) | paths, f"the built-ins listed: {sorted(b)}"
     for name, section in expected.items():

@@ -1,5 +1,5 @@
 """Curvatures as users write them: a concave body (a negative radius) is allowed wherever the summed
-curvature of eq. 3D.1 stays positive, and only those sums matter (docs/theory3d.md §2)."""
+curvature of eq. 3D.3 stays positive, and only those sums matter (docs/theory3d.md §2)."""
 from __future__ import annotations
 
 import math

@@ -52,7 +52,7 @@ CONIC = [pytest.param(lambda: ClarabelMethod(), id="clarabel"),
 @pytest.mark.parametrize("make", CONIC + [pytest.param(lambda: OsqpMethod(), id="osqp"),
                                           pytest.param(lambda: NewtonMethod(path="krylov"), id="newton-krylov")])
 def test_normal_step_two_ways(contact, pressure, make):
-    """eq. 3D.14 as the QP of eq. 3D.20 (approach from the load row's multiplier) and by Newton."""
+    """eq. 3D.14 as the QP of eq. 3D.22 (approach from the load row's multiplier) and by Newton."""
     sol = make().solve(contact.normal_step(FN))
     p0 = contact.scales.stress
     assert sol.residual <= 1e-10 and pressure.residual <= 1e-10
@@ -68,8 +68,8 @@ SHIFT_LOADS = [Loads(Fx=0.5 * MU * FN, Fy=-0.3 * MU * FN, phi=0.0),
 @pytest.mark.parametrize("loads", SHIFT_LOADS, ids=["forces", "mixed", "creepages"])
 @pytest.mark.parametrize("make", CONIC)
 def test_shift_step_socp_against_newton(contact, pressure, loads, make):
-    """A static shift (eq. 3D.16) as the SOCP of eq. 3D.21 and by Newton: tractions, creepages (the load
-    rows' multipliers, eq. 3D.22) and the stick/slip partition agree."""
+    """A static shift (eq. 3D.16) as the SOCP of eq. 3D.20 and by Newton: tractions, creepages (the load
+    rows' multipliers, eq. 3D.21) and the stick/slip partition agree."""
     prob = contact.tangential_step("shift", pressure.p, loads)
     ref = NewtonMethod().solve(prob)
     sol = make().solve(prob)
@@ -93,7 +93,7 @@ def test_rolling_step_with_spin_socp_against_newton(contact, pressure):
 
 def test_raw_clarabel_is_close_and_the_refinement_is_kept_only_when_better(contact, pressure):
     """The interior point answer alone is ~1e-8 off (complementarity ends near √gap, as in 2D); the
-    active-set refinement (its KKT system on the active set it found, eq. 3D.28) takes it below 1e-10,
+    active-set refinement (its KKT system on the active set it found, eq. 3D.23) takes it below 1e-10,
     and the raw answer and its residual are kept beside it."""
     prob = contact.tangential_step("shift", pressure.p, SHIFT_LOADS[0])
     raw = ClarabelMethod(refine=False, residual_limit=1e-6).solve(prob)
@@ -227,7 +227,7 @@ def test_scales_are_hertz():
 
 def test_the_2d_normal_machinery_solves_the_3d_normal_step(contact, pressure):
     """The 2D package's normal step takes the 3D operator unchanged: a flattened grid is a set of nodes
-    with weights f = area/c and load FN/c (its load row (fᵀp − P)/(c p0) is then eq. 3D.27's). Its
+    with weights f = area/c and load FN/c (its load row (fᵀp − P)/(c p0) is then eq. 3D.29's). Its
     Newton and QP backends give the 3D step's solution: a third route."""
     import rollqp
     L = contact.scales.length

@@ -3,7 +3,7 @@ r"""Rolling contact as a test set for conic and friction-contact solvers (docs/c
 The 3D steps of rollqp (docs/theory3d.md §5) exported with certified solutions:
 
 * :mod:`~rollqp.conicset.forms` — the step's conic program as plain arrays (:class:`ProgramData`)
-  and rollqp's residual (eq. 3D.27) of any answer, computed from those arrays alone;
+  and rollqp's residual (eq. 3D.29) of any answer, computed from those arrays alone;
 * :mod:`~rollqp.conicset.cbf` — the programs in the Conic Benchmark Format (CBF, version 3),
   the QP's objective through a rotated-cone epigraph;
 * :mod:`~rollqp.conicset.fclib` — the coupled static steps as FCLib local problems (HDF5, h5py);

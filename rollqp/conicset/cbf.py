@@ -3,7 +3,7 @@ r"""The step programs in the Conic Benchmark Format (CBF, version 3, as CBLIB pu
 CBF states ``min cᵀz + c₀`` subject to ``z_j ∈ K_j`` (``VAR``, cones over consecutive variables)
 and ``g = A z + b ∈ K_i`` (``CON``, cones over consecutive rows), with ``OBJACOORD`` (``c``),
 ``ACOORD`` (``A``, ``row col value``) and ``BCOORD`` (``b``). Its objective is linear, so the
-quadratic objective of eq. 3D.20/3D.21 goes through an epigraph with a **rotated** second-order
+quadratic objective of eq. 3D.22/3D.20 goes through an epigraph with a **rotated** second-order
 cone ``QR = {u : 2u₁u₂ ≥ ‖u_{3:}‖², u₁, u₂ ≥ 0}``: with ``H = LLᵀ`` (Cholesky),
 
 .. math::
@@ -18,7 +18,7 @@ and the variables ``z = (x, τ)``. The rows, in this order:
 
 The normal QP's ``x ≥ 0`` is the variables' cone (``VAR``: ``L+ m`` then ``F 1``); the tangential
 variables are free. The optimum's ``τ`` is ``½x*ᵀHx*``, its objective the QP's. A load row's
-multiplier ``y`` (eq. 3D.22, rollqp's sign: Lagrangian ``+y(ax − b)``) is minus the CBF dual of
+multiplier ``y`` (eq. 3D.21, rollqp's sign: Lagrangian ``+y(ax − b)``) is minus the CBF dual of
 its ``L=`` row (``c = Aᵀλ + …``, ``λ`` in the dual cone).
 
 :func:`read` parses a CBF file into :class:`Conic` (a minimal reader: the keywords written here and

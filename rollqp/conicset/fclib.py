@@ -26,7 +26,7 @@ Layout written (FCLib's ``fclib_write_local`` and ``fclib_write_solution``, ``sr
     /fclib_local/info/{title,description,math_info}   strings
     /solution/{u,r}                   the certified solution
 
-``numberOfContacts`` (Siconos' name) is ``m/3``. rollqp's residual of ``(u, r)`` (eq. 3D.27 of the
+``numberOfContacts`` (Siconos' name) is ``m/3``. rollqp's residual of ``(u, r)`` (eq. 3D.29 of the
 coupled step: ``‖min(r_N, u_N)‖∞`` and ``|r_T − Proj_{μ r_N⁺}(r_T − u_T)|``) needs the file only:
 :func:`residual`.
 """

@@ -1,6 +1,6 @@
 r"""A 3D step's conic program as plain arrays, and rollqp's residual computed from them.
 
-:class:`ProgramData` is :class:`rollqp.problem.conic.ConicForm` (eq. 3D.20/3D.21) written out:
+:class:`ProgramData` is :class:`rollqp.problem.conic.ConicForm` (eq. 3D.22/3D.20) written out:
 ``min ½xᵀHx + qᵀx`` s.t. ``a x = b`` and ``x ∈ K`` — ``x ≥ 0`` (normal) or one cone
 ``(bound_i, x_i, x_{nv+i}) ∈ Q³`` per element (tangential). With ``slip_scale = obj/â`` the
 gradient of the Lagrangian is the step's own gap or slip (docs/theory3d.md §5):
@@ -9,7 +9,7 @@ gradient of the Lagrangian is the step's own gap or slip (docs/theory3d.md §5):
     \hat g = \texttt{slip\_scale}\,(Hx + q + a^Ty)\ \text{(normal)},\qquad
     \hat s = \texttt{slip\_scale}\,(Hx + q + a^Ty)\ \text{(tangential)}
 
-so rollqp's residual (eq. 3D.27) of an answer ``(x, y)`` — ``‖min(p̂, ĝ)‖∞`` or
+so rollqp's residual (eq. 3D.29) of an answer ``(x, y)`` — ``‖min(p̂, ĝ)‖∞`` or
 ``max_i |t̂_i − Proj_{b̂_i}(t̂_i − ŝ_i)|``, and the load rows ``eq·|a x − b|`` — needs these arrays
 only, not rollqp's operators: a test set reader can evaluate it.
 
@@ -95,7 +95,7 @@ def kkt_gradient(d: ProgramData, x, y) -> np.ndarray:
 
 
 def residual(d: ProgramData, x, y) -> float:
-    """rollqp's residual (eq. 3D.27) of the answer ``(x, y)`` (module docstring); NaN if not finite."""
+    """rollqp's residual (eq. 3D.29) of the answer ``(x, y)`` (module docstring); NaN if not finite."""
     x = np.asarray(x, dtype=float)
     if x.shape != (d.m,) or not np.all(np.isfinite(x)) or not np.all(np.isfinite(y)):
         return float("nan")

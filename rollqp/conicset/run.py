@@ -12,7 +12,7 @@ Two routes per solver:
 Two settings: ``default`` (the solver's defaults, a time limit only) and ``high`` (every gap and
 feasibility tolerance :data:`HIGH_ACCURACY`, qpbenchmark's high-accuracy value). Each answer is
 scored by its distance from the certified solution, ``max|x − x*|`` in ``p0`` (the solver's
-primal variables: pressures or tractions), by rollqp's residual of ``(x, y)`` (eq. 3D.27, from
+primal variables: pressures or tractions), by rollqp's residual of ``(x, y)`` (eq. 3D.29, from
 the program's arrays, :func:`~rollqp.conicset.forms.residual`; ``y`` the load rows' multipliers
 from the solver's duals), by its status and by its wall time.
 """

@@ -24,6 +24,8 @@ convex programs on that external solver — and each dimension has its own table
 ``socp-scs``              cvxpy's statement solved by SCS (first order, extra ``cvxpy``)
 ``qp-osqp``               OSQP: the normal QP only; no cones, so a 3D scene (tangential SOCPs)
                           refuses it up front, naming the methods that can
+``fastsim``               Kalker's simplified theory (FASTSIM), steady rolling only: the fast
+                          approximation (:mod:`rollqp.methods.fastsim`)
 ========================  ==========================================================
 
 A name registered for one dimension only (``nt-newton``, ``mf-newton``, ``qps-*``; the ``socp-*``
@@ -61,6 +63,7 @@ from .base import (FRICTION_KINDS, KINDS, Capabilities, Method, check_kind,  # n
                    check_options)
 from .continuation import SlipContinuation
 from .fixedpoint import BoundFixedPoint
+from .fastsim import FastsimMethod
 from .krylov import KrylovNewton
 from .newton import NewtonMethod
 from .newton.disc import NewtonMethod as _DiscNewton
@@ -100,6 +103,7 @@ _TABLE: dict[str, tuple] = {
     "socp-clarabel": (ClarabelMethod,),
     "socp-cvxpy": (CvxpyMethod,),
     "socp-scs": (ScsMethod,),
+    "fastsim": (FastsimMethod,),
 }
 
 

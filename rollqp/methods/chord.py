@@ -6,14 +6,14 @@ splitting) reaches the steady state as the fixed point ``x = G(x)`` of one rolli
 ``Δq = dx``: ``G`` maps the previous tractions ``x`` to the step's tractions, each evaluation a
 conic program. Marching (``x ← G(x)``, Anderson-accelerated) takes a contact length or more of
 steps. Instead, Newton's method on ``F(x) = G(x) − x``: with ``z = (t̂, ξ̂, η̂)`` the step's unknowns,
-``Φ(z; x) = 0`` its equations (eq. 3D.23, the rolling step: ``ŝ = ŝ₀ + Ŝ t̂ − Ŝ_sh x + E ζ``) and
+``Φ(z; x) = 0`` its equations (eq. 3D.25, the rolling step: ``ŝ = ŝ₀ + Ŝ t̂ − Ŝ_sh x + E ζ``) and
 ``P`` the tractions of ``z``, a Newton step for ``z + dz = G(x + dx)``, ``P(z + dz) = x + dx`` is
 
 .. math::
     J_{ss}\,dz = −J_x\,F(x),\qquad x_{new} = P(z + dz),\qquad
-    J_x = ∂Φ/∂x = −r M Ŝ_{sh},\quad J_{ss} = ∂Φ/∂z + J_x P          \qquad (3D.29)
+    J_x = ∂Φ/∂x = −r M Ŝ_{sh},\quad J_{ss} = ∂Φ/∂z + J_x P          \qquad (3D.24)
 
-— ``J_ss`` is the steady problem's Jacobian (eq. 3D.26 with ``Ŝ − Ŝ_sh``), both at the partition
+— ``J_ss`` is the steady problem's Jacobian (eq. 3D.28 with ``Ŝ − Ŝ_sh``), both at the partition
 ``M = ∂Proj`` of the conic answer ``z``. Only the path uses Newton's algebra: every iterate is
 evaluated by the conic method (``z = G(x)``), and the answer is certified by it, ``|G(x) − x| ≤ tol``
 — the same fixed point the march stops at. A Newton iterate that does not reduce ``|F|`` is
@@ -28,7 +28,7 @@ __all__ = ["chord_step"]
 
 
 def _derivative(z, b):
-    """``(m_xx, m_xy, m_yy)`` of ``∂Proj`` onto the discs of radii ``b`` at ``z`` (eq. 3D.24)."""
+    """``(m_xx, m_xy, m_yy)`` of ``∂Proj`` onto the discs of radii ``b`` at ``z`` (eq. 3D.26)."""
     norm = np.hypot(z[0], z[1])
     slip = norm > b
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -46,7 +46,7 @@ def _rows(m, R):
 
 
 def chord_step(problem, solution, shifted, x):
-    """The Newton iterate ``x_new`` of eq. 3D.29 (tractions ``(2, n)``, scene units), or None if the
+    """The Newton iterate ``x_new`` of eq. 3D.24 (tractions ``(2, n)``, scene units), or None if the
     system is singular.
 
     ``problem``: the rolling step ``G`` solved at ``x`` (:class:`~rollqp.problem.grid.TangentialStep`,

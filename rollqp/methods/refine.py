@@ -11,14 +11,14 @@ caller keeps the result only if rollqp's residual of it is smaller than that of 
 answer, and keeps the raw answer beside it (``info["raw"]``), so the distance of the solver's own
 answer from any other method stays visible.
 
-**The active set** is read off the answer as the complementarity functions read it (eq. 3D.23 at
+**The active set** is read off the answer as the complementarity functions read it (eq. 3D.25 at
 ``r = 1``): element ``i`` is in contact where ``p̂_i > ĝ_i`` (else ``p_i = 0``); it slips where
 ``|t̂_i − ŝ_i| > b̂_i`` (the disc constraint active), else it sticks.
 
-**Normal QP** (eq. 3D.20) on the contact set ``F``: ``Â_FF p̂_F − δ̂ = −ĥ_F`` and ``â Σ p̂_F = F̂_N`` —
+**Normal QP** (eq. 3D.22) on the contact set ``F``: ``Â_FF p̂_F − δ̂ = −ĥ_F`` and ``â Σ p̂_F = F̂_N`` —
 one linear solve (Cholesky of ``Â_FF``, positive definite, and the Schur complement of the load row).
 
-**Tangential SOCP** (eq. 3D.21) on the stick set ``S`` and slip set ``L``: the KKT conditions are
+**Tangential SOCP** (eq. 3D.20) on the stick set ``S`` and slip set ``L``: the KKT conditions are
 ``ŝ_i = 0`` (``i ∈ S``: the gradient vanishes inside the cone) and ``ŝ_i = −λ_i t̂_i``, ``|t̂_i| = b̂_i``
 (``i ∈ L``: on the cone's boundary, the gradient along the outward normal), with the load rows;
 eliminating ``λ_i``:
@@ -26,7 +26,7 @@ eliminating ``λ_i``:
 .. math::
     \hat s_i = 0\ (i\in S),\qquad
     \hat t_{x,i}\hat s_{y,i} − \hat t_{y,i}\hat s_{x,i} = 0,\ \ \tfrac12(|\hat t_i|^2 − \hat b_i^2) = 0\ (i\in L),
-    \qquad \hat a\textstyle\sum\hat t_j = \hat F_j                                      \qquad (3D.28)
+    \qquad \hat a\textstyle\sum\hat t_j = \hat F_j                                      \qquad (3D.23)
 
 smooth in ``(t̂, ξ̂, η̂)``; Newton's method on it from the solver's answer (the slip elements' tractions
 put on their circles first). The sign ``λ_i ≥ 0`` (friction opposes the slip) is not imposed: a wrong
@@ -41,7 +41,7 @@ import scipy.linalg as sla
 
 __all__ = ["active_set_refine", "REFINE_ITERATIONS"]
 
-#: Newton iterations on eq. 3D.28: from an interior-point answer with the right active set they converge
+#: Newton iterations on eq. 3D.23: from an interior-point answer with the right active set they converge
 #: quadratically from ~1e-8 to round-off in 2–3 (measured); more means the active set is wrong.
 REFINE_ITERATIONS = 8
 #: Stop once the scaled equations are this small (round-off of the dense products of order-one numbers).
@@ -84,7 +84,7 @@ def _refine_normal(problem, sol):
 
 
 class _Kkt:
-    """Eq. 3D.28 on the elements ``V`` of positive bound, stick set ``S``/slip set ``L`` fixed."""
+    """Eq. 3D.23 on the elements ``V`` of positive bound, stick set ``S``/slip set ``L`` fixed."""
 
     def __init__(self, problem, sol):
         sc = problem.scales

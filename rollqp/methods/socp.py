@@ -1,9 +1,9 @@
 r"""The 3D steps on external conic solvers: Clarabel natively, OSQP (normal step only), cvxpy
 (docs/theory3d.md §5–6).
 
-Each backend poses the normal step as the QP of eq. 3D.20 and the tangential step as the SOCP
-of eq. 3D.21 (:mod:`rollqp.problem.conic`), maps the answer back (pressures, tractions, and the
-load rows' multipliers as the approach and the creepages, eq. 3D.22) and evaluates it with
+Each backend poses the normal step as the QP of eq. 3D.22 and the tangential step as the SOCP
+of eq. 3D.20 (:mod:`rollqp.problem.conic`), maps the answer back (pressures, tractions, and the
+load rows' multipliers as the approach and the creepages, eq. 3D.21) and evaluates it with
 rollqp's own residuals on the step problem. On top of the solver:
 
 * **tolerances** from the requested residual, never the solvers' defaults (Clarabel's defaults
@@ -15,7 +15,7 @@ rollqp's own residuals on the step problem. On top of the solver:
 * **active-set refinement** (:mod:`rollqp.methods.refine`): an interior point method ends with every
   complementary pair small but not zero, so elements at the edge of the contact or of the stick area
   are off by about ``√gap``. The answer is refined by the conic program's own KKT system on the
-  active set the solver identified (eq. 3D.28: Newton iterations on smooth equations, the active set
+  active set the solver identified (eq. 3D.23: Newton iterations on smooth equations, the active set
   held fixed — OSQP's polish carried to the cone, as the 2D QPs' ``active_set_refine``) and kept only
   if rollqp's residual drops; ``info["raw"]`` keeps the solver's own answer and ``info["raw_residual"]``
   its residual, so that its distance from any other method stays visible;
@@ -92,7 +92,7 @@ class ConicMethod:
         self._solvers = {}
 
     def solve(self, problem, warm=None):
-        """Solve a normal or tangential step (eq. 3D.20/3D.21); rollqp's residuals decide."""
+        """Solve a normal or tangential step (eq. 3D.22/3D.20); rollqp's residuals decide."""
         if problem.kind not in self.capabilities.solves:   # a scene is refused up front by the registry, naming the methods that can
             raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step (it solves: "
                                               f"{', '.join(sorted(self.capabilities.solves))}; its capabilities)")
@@ -205,7 +205,7 @@ def raw_solution(problem, solution):
 
 
 def _solution(problem, form, x, y, name, info):
-    """Map a solver's ``(x, y)`` back to the step's unknowns (eq. 3D.22) and evaluate it."""
+    """Map a solver's ``(x, y)`` back to the step's unknowns (eq. 3D.21) and evaluate it."""
     sc = problem.scales
     unknowns = form.multipliers_to_unknowns(y)
     if form.kind == "normal":
@@ -264,7 +264,7 @@ def _constraint_rows(form):
 
 
 class ClarabelMethod(ConicMethod):
-    """Clarabel (interior point, native cones): the QP of eq. 3D.20 and the SOCP of eq. 3D.21."""
+    """Clarabel (interior point, native cones): the QP of eq. 3D.22 and the SOCP of eq. 3D.20."""
 
     name = "clarabel"
 
@@ -275,11 +275,16 @@ class ClarabelMethod(ConicMethod):
         A, b, cones = _constraint_rows(form)
         if entry is None or entry[0] is not form.H:
             P = sp.triu(sp.csc_matrix(form.H), format="csc")
-            solver = clarabel.DefaultSolver(P, q, A, b, cones, _clarabel_settings(self.tolerance, self.max_iterations))
+            # built without the step's q and b, then given them: Clarabel scales its data once, when it is built
+            # (its cost scaling reads q), so that a solver object built at another step would steer the last bits
+            # of every later answer; built from (P, A) alone, the answer to a step is the same whichever step
+            # built it (a resumed run repeats the uninterrupted one bit for bit)
+            solver = clarabel.DefaultSolver(P, np.zeros_like(q), A, np.zeros_like(b), cones,
+                                            _clarabel_settings(self.tolerance, self.max_iterations))
             self._solvers = {key: (form.H, solver)}
         else:
             solver = entry[1]
-            solver.update(q=q, b=b)
+        solver.update(q=q, b=b)
         deadline = self.deadline
         if deadline is not None:  # a time budget (the run's cross-check): stop at its end
             solver.set_termination_callback(lambda info: time.perf_counter() > deadline)
@@ -296,7 +301,7 @@ class ClarabelMethod(ConicMethod):
 
 
 class OsqpMethod(ConicMethod):
-    """OSQP (ADMM, polished) on the normal QP of eq. 3D.20; a tangential step is an InputError."""
+    """OSQP (ADMM, polished) on the normal QP of eq. 3D.22; a tangential step is an InputError."""
 
     name = "osqp"
     #: No cones: the friction disc cannot be posed, so it solves the normal QP only.
@@ -332,7 +337,7 @@ class OsqpMethod(ConicMethod):
 
 
 class CvxpyMethod(ConicMethod):
-    """cvxpy's textbook statement of eq. 3D.20/3D.21 (DPP parameters), on ``solver`` (``"CLARABEL"``
+    """cvxpy's textbook statement of eq. 3D.22/3D.20 (DPP parameters), on ``solver`` (``"CLARABEL"``
     or ``"SCS"``)."""
 
     name = "cvxpy"
@@ -393,7 +398,9 @@ class CvxpyMethod(ConicMethod):
             bnd.value = form.bound
         with warnings.catch_warnings():   # "may be inaccurate": rollqp's residual decides, not the status
             warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=self.solver, **self._options())
+            # warm_start=False: cvxpy would otherwise keep Clarabel's solver object from step to step, whose
+            # scaling (made from the first step's data) steers the last bits of every later answer
+            prob.solve(solver=self.solver, warm_start=False, **self._options())
         if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
             raise SolverError(f"cvxpy/{self.solver} did not solve the step", method=self.name, status=prob.status)
         y = np.asarray(cons[0].dual_value, dtype=float).ravel() if bp is not None else np.zeros(0)

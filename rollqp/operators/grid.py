@@ -50,7 +50,7 @@ class Contact:
     grid : rollqp.discretization.grid.Grid
     materials : rollqp.materials.Materials
     curvatures : (float, float)
-        ``(A, B)`` of eq. 3D.1 (for the Hertz ellipse and the default profile).
+        ``(A, B)`` of eq. 3D.3 (for the Hertz ellipse and the default profile).
     FN : float
         The nominal normal force: the Hertz ellipse and the scales.
     mu : float or FrictionLaw
@@ -168,7 +168,7 @@ class Contact:
         return StepSolution(residuals=Residuals(), p=e.pressure(self.x, self.y), delta=e.delta)
 
     def moments(self, t) -> tuple[float, float, float]:
-        """``(Fx, Fy, Mz)`` on body A of the tractions ``t`` (eq. 3D.6): ``Mz = Σ (x t_y − y t_x)·area``."""
+        """``(Fx, Fy, Mz)`` on body A of the tractions ``t`` (eq. 3D.2): ``Mz = Σ (x t_y − y t_x)·area``."""
         t = np.asarray(t, dtype=float).reshape(2, -1)
         a = self.grid.area
         return a * float(t[0].sum()), a * float(t[1].sum()), a * float(np.sum(self.x * t[1] - self.y * t[0]))

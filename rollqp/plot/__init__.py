@@ -12,7 +12,9 @@ kind           the scene                                              figure
 ``path``       a stop or a reversal of the rolling (``load.rolled``)  :func:`path_figure`
 ``friction``   a friction law: μ that varies with x or slip velocity  :func:`friction_figure`
 ``transient``  similar bodies rolling (Cattaneo to Carter, a ramp)    :func:`transient_figure`
-``three``      a 3D scene (Kalker's problem: an ellipse, ξ, η, φ)      :func:`three_figure`
+``three``      a 3D scene (Kalker's problem): its linear theory, a     :func:`three_figure`
+               point of the creep curve, or a transient
+               (:func:`~rollqp.plot.three.three_kind`)
 =============  =====================================================  ==========================
 
 Every figure labels its axes in mathtext, gives each closed form a colour of its own

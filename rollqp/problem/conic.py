@@ -1,26 +1,26 @@
 r"""The convex programs of a 3D step in rollqp's scaled variables (docs/theory3d.md §5–6).
 
-**Normal step: a QP** (eq. 3D.20). With ``F = â I`` (every element has the same area) and
+**Normal step: a QP** (eq. 3D.22). With ``F = â I`` (every element has the same area) and
 ``Â = A_nn E*/c`` symmetric (Betti on the uniform grid), the Signorini conditions of eq. 3D.14 are
 the KKT conditions of
 
 .. math::
     \min_{\hat p \ge 0}\ \tfrac12 \hat p^T(\hat a\hat A)\hat p + \hat a\,\hat h^T\hat p
-    \quad\text{s.t.}\quad \hat a\textstyle\sum\hat p = \hat F_N,            \qquad (3D.20)
+    \quad\text{s.t.}\quad \hat a\textstyle\sum\hat p = \hat F_N,            \qquad (3D.22)
 
 the approach being the load row's multiplier: ``δ̂ = −(obj/eq)·y``.
 
-**Tangential step: an SOCP** (eq. 3D.21). The friction conditions of eq. 3D.15 — ``|t_i| ≤ b_i``,
+**Tangential step: an SOCP** (eq. 3D.20). The friction conditions of eq. 3D.15 — ``|t_i| ≤ b_i``,
 ``s_i = 0`` inside the disc, ``s_i = −λ t_i`` on its rim — are the KKT conditions of
 
 .. math::
     \min_{\hat t}\ \tfrac12\hat t^T\,\mathrm{sym}(\hat a\hat S)\,\hat t + \hat a\,\hat s_0^T\hat t
     \quad\text{s.t.}\quad (\hat b_i, \hat t_{x,i}, \hat t_{y,i}) \in \mathcal{Q}^3,\quad
-    \hat a\textstyle\sum\hat t_x = \hat F_x,\ \hat a\sum\hat t_y = \hat F_y,          \qquad (3D.21)
+    \hat a\textstyle\sum\hat t_x = \hat F_x,\ \hat a\sum\hat t_y = \hat F_y,          \qquad (3D.20)
 
 one second-order cone ``Q³ = {(u, v): |v| ≤ u}`` per element in contact, provided ``â Ŝ`` is
 symmetric (shift and transient steps: ``Ŝ = E* A_tt/Δq``); the load rows' multipliers are the
-creepages, ``ξ̂ = (obj/eq)·y_x`` (eq. 3D.22). A non-symmetric ``Ŝ`` (the steady operator) is
+creepages, ``ξ̂ = (obj/eq)·y_x`` (eq. 3D.21). A non-symmetric ``Ŝ`` (the steady operator) is
 split, ``âŜ = H + K`` with ``K`` skew, and the skew part moved to the linear term at the previous
 iterate (docs/theory3d.md §6; docs/formulation.md §8).
 
@@ -40,7 +40,7 @@ __all__ = ["ConicForm", "normal_form", "tangential_form", "asymmetry"]
 
 @dataclass(frozen=True)
 class ConicForm:
-    """``min ½xᵀHx + qᵀx`` s.t. ``a x = b`` (rows of ``a``) and ``x ∈ K`` (eq. 3D.20/3D.21).
+    """``min ½xᵀHx + qᵀx`` s.t. ``a x = b`` (rows of ``a``) and ``x ∈ K`` (eq. 3D.22/3D.20).
 
     ``kind`` ``"normal"`` (``K``: ``x ≥ 0``) or ``"tangential"`` (``K``: a cone ``(bound_i, x_i,
     x_{nv+i})`` per element, ``x = [t̂_x(V), t̂_y(V)]``). ``elements`` are the grid elements of the
@@ -86,7 +86,7 @@ def _split(FA):
 
 
 def normal_form(problem, elements=None) -> ConicForm:
-    """The QP of eq. 3D.20 for a :class:`~rollqp.problem.grid.NormalStep` (dense ``Â``), over
+    """The QP of eq. 3D.22 for a :class:`~rollqp.problem.grid.NormalStep` (dense ``Â``), over
     ``elements`` (default: every element of the grid; the others are held at ``p = 0``)."""
     sc = problem.scales
     V = np.arange(problem.n) if elements is None else np.asarray(elements)
@@ -108,7 +108,7 @@ def normal_form(problem, elements=None) -> ConicForm:
 
 
 def tangential_form(problem, elements=None) -> ConicForm:
-    """The SOCP of eq. 3D.21 for a :class:`~rollqp.problem.grid.TangentialStep` (dense ``Ŝ``)
+    """The SOCP of eq. 3D.20 for a :class:`~rollqp.problem.grid.TangentialStep` (dense ``Ŝ``)
     on ``elements`` (default: those with a positive bound)."""
     sc = problem.scales
     V = np.flatnonzero(problem.bound > 0) if elements is None else np.asarray(elements)

@@ -25,7 +25,7 @@ projection onto the disc of radius ``b_i`` (eq. 3D.19): ``|t_i| ≤ b_i``, ``s_i
 Nondimensional form (:class:`Scales`): stresses by ``p0``, lengths by ``c = √(ab)``, gaps by
 ``u0 = c p0/E*``, slips and creepages by ``p0/E*``, forces by ``p0 c²``. The residuals are the
 max-norms of ``min(p̂, ĝ)`` (Signorini), ``|t̂_i − Proj_{b̂_i}(t̂_i − ŝ_i)|`` (friction) and the
-load rows (eq. 3D.27).
+load rows (eq. 3D.29).
 """
 from __future__ import annotations
 
@@ -48,13 +48,14 @@ SEPARATION, STICK, SLIP = 0, 1, 2
 
 
 def disc_projection(z: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``Proj_{|·| ≤ b_i}(z_i)`` element by element (eq. 3D.19); ``z`` of shape ``(2, n)``, ``b ≥ 0``: the
-    ball of radius ``b`` for ``k = 2`` (:func:`rollqp.friction.projection.project`)."""
+    """``Proj_{|·| ≤ b_i}(z_i)`` element by element (eq. 3D.19: Coulomb's law on the disc, the variational
+    inequality 3D.18, as a projection); ``z`` of shape ``(2, n)``, ``b ≥ 0``: the ball of radius ``b`` for
+    ``k = 2`` (:func:`rollqp.friction.projection.project`)."""
     return project(z, b)
 
 
 def rigid_slip(xi: float, eta: float, phi: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """The rigid slip of A relative to B over ``|V|`` (eq. 3D.5): ``(ξ − φ y, η + φ x)``, ``(2, n)``."""
+    """The rigid slip of A relative to B over ``|V|`` (eq. 3D.1): ``(ξ − φ y, η + φ x)``, ``(2, n)``."""
     return np.stack([xi - phi * y, eta + phi * x])
 
 
@@ -89,7 +90,7 @@ class NormalStep:
     area : float
         Element area ``dx·dy``.
     h : (n,) array
-        Undeformed distance at the element centres (eq. 3D.1).
+        Undeformed distance at the element centres (eq. 3D.3).
     FN, delta : float
         The normal force (``> 0``) or the prescribed approach: exactly one.
     offset : (n,) array, optional
@@ -132,7 +133,7 @@ class NormalStep:
         return self.h_total - delta + (self.A @ p if Ap is None else Ap)
 
     def residuals(self, p, delta, g=None) -> Residuals:
-        """``‖min(p̂, ĝ)‖∞`` and the load row ``|area·Σp − FN|/(p0 c²)`` (eq. 3D.27)."""
+        """``‖min(p̂, ĝ)‖∞`` and the load row ``|area·Σp − FN|/(p0 c²)`` (eq. 3D.29)."""
         sc = self.scales
         g = self.gap(p, delta) if g is None else g
         sig = float(np.max(np.abs(np.minimum(p / sc.stress, g / sc.displacement))))
@@ -160,7 +161,7 @@ class TangentialStep:
     bound : (n,) array
         The traction bound ``μ p̄⁺`` (``>= 0``; zero outside the contact).
     x, y : (n,) arrays
-        Element centres (the spin's lever arms, eq. 3D.5).
+        Element centres (the spin's lever arms, eq. 3D.1).
     c : (2, n) array
         The history and coupling vector: ``Δq s = Δq w + c + B t``.
     dq : float
@@ -237,7 +238,7 @@ class TangentialStep:
         return rigid_slip(xi, eta, self.phi, self.x, self.y) + (self.c + Bt) / self.dq
 
     def residuals(self, t, xi=None, eta=None, s=None) -> Residuals:
-        """``max_i |t̂_i − Proj_{b̂_i}(t̂_i − ŝ_i)|`` and the load rows (eq. 3D.27)."""
+        """``max_i |t̂_i − Proj_{b̂_i}(t̂_i − ŝ_i)|`` and the load rows (eq. 3D.29)."""
         sc = self.scales
         t = np.asarray(t, dtype=float).reshape(2, -1)
         s = self.slip(t, xi, eta) if s is None else s

@@ -27,8 +27,8 @@ def friction_residual(t, s, bound, minus_bound=None, out=None):
 
 @dataclass
 class Residuals:
-    """rollqp's own nondimensional residuals of a step (max norms; see module docstring; eq. 3D.27 on a
-    grid): ``load_tangential`` is the tangential load equation (along x on a grid), ``load_lateral`` the
+    """rollqp's own nondimensional residuals of a step (max norms; see module docstring; on a
+    grid, eq. 3D.29): ``load_tangential`` is the tangential load equation (along x on a grid), ``load_lateral`` the
     lateral one (along y; a grid's second traction component, zero on a strip)."""
 
     signorini: float = 0.0

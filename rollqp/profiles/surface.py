@@ -9,7 +9,7 @@ deformation, at zero approach) is
 
 .. math::
     h(x, y) = A x^2 + B y^2,\qquad A = \tfrac12\Big(\frac1{R_x^A} + \frac1{R_x^B}\Big),\quad
-    B = \tfrac12\Big(\frac1{R_y^A} + \frac1{R_y^B}\Big)                          \qquad (3D.1)
+    B = \tfrac12\Big(\frac1{R_y^A} + \frac1{R_y^B}\Big)                          \qquad (3D.3)
 
 (CONTACT's ``A1, B1``). Only these summed curvatures enter the contact problem: a body may be
 concave in a direction as long as the sum ``A`` (or ``B``) stays positive — the convex body more
@@ -55,7 +55,7 @@ class Body:
 
 
 def curvatures(A: Body, B: Body) -> tuple[float, float]:
-    """The combined curvatures ``(A, B)`` of eq. 3D.1; an :class:`InputError` naming both radii if
+    """The combined curvatures ``(A, B)`` of eq. 3D.3; an :class:`InputError` naming both radii if
     either sum is not positive (both bodies straight in one direction, or a concave body more curved
     than the convex one: no concentrated contact).
 
@@ -90,7 +90,7 @@ def curvatures(A: Body, B: Body) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class QuadraticProfile:
-    """``h(x, y) = A x² + B y²`` (eq. 3D.1), the Hertzian undeformed distance."""
+    """``h(x, y) = A x² + B y²`` (eq. 3D.3), the Hertzian undeformed distance."""
 
     A: float
     B: float

@@ -20,7 +20,7 @@ the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a
 
 Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
 allowed range: radii nonzero (``< 0`` concave, ``inf`` straight), a concentrated contact (the summed
-curvature positive in both directions, eq. 3D.1), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
+curvature positive in both directions, eq. 3D.3), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
 element aspect ratio ``dx/dy`` in :data:`rollqp.discretization.grid.ASPECT_RANGE`, the forces below the sliding
 limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
@@ -83,6 +83,7 @@ class Body3D:
     E: float = None
     nu: float = None
     profile: Any = None
+    wear: float | None = None
 
 
 @dataclass(frozen=True)
@@ -156,8 +157,10 @@ def _body(key, b: Body3D) -> Body3D:
         if getattr(b, k) is None:
             raise InputError(f"{key}.{k}", "missing required key")
     shape = parse_body({k: getattr(b, k) for k in ("radius", "radius_y", "profile") if getattr(b, k) is not None}, key)
+    wear = None if b.wear is None else number(f"{key}.wear", b.wear, ">= 0 (Archard's k/H in 1/stress) or absent",
+                                              lambda x: x >= 0)
     return Body3D(shape.rx, shape.ry, number(f"{key}.E", b.E, "> 0", lambda x: x > 0),
-                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict())
+                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict(), wear)
 
 
 def _contact(c: Contact3D) -> Contact3D:
@@ -296,7 +299,7 @@ class Scene3D(SceneBase):
 
     @functools.cached_property
     def curvatures(self) -> tuple[float, float]:
-        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.1); with a profile, its curvatures at the origin where
+        """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.3); with a profile, its curvatures at the origin where
         both are positive, else the equivalent curvatures of the computed contact
         (:func:`rollqp.three.patch.equivalent_curvatures`)."""
         if self.shape.hertzian:
@@ -441,6 +444,10 @@ def _check_whole(scene) -> None:
                                                       "ellipse to scale discretization.zone by; give the grid in length "
                                                       "units, extent = [[x0, x1], [y0, y1]]")
     _check_ellipse(scene)
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):  # Archard's k·p0/H <= 1, as in 2D
+        if body.wear is not None and not body.wear * scene.ellipse.p0 <= 1.0:
+            raise InputError(f"{key}.wear", f"must be a number in [0, 1/p0 = {1.0 / scene.ellipse.p0:.6g}] (k/H in "
+                                            f"1/stress: Archard's k·p0/H is at most 1), got {body.wear!r}")
     if scene.discretization.extent is None:
         _check_grid(scene)
     elif scene.shape.hertzian and not scene.grid.covers(scene.ellipse.a, scene.ellipse.b):

@@ -45,6 +45,9 @@ MAX_FILE_BYTES = 16 << 20
 
 
 def _parse_3d(d: dict, source: str, default_name: str):
+    if isinstance(d.get("contact"), dict) and d["contact"].get("kind") == "wheel-rail":
+        from ..wheelrail.scene import scene_from_dict as wheel_rail  # a wheelset on its track (docs/wheel-rail.md)
+        return wheel_rail(d, source=source, default_name=default_name)
     from .grid import scene_from_dict as parse  # imported on first use: import rollqp stays light
     return parse(d, source=source, default_name=default_name)
 

@@ -26,7 +26,7 @@ half does not see ``t``, and rollqp solves the normal half, then the tangential 
 pressure. ``kind = "coupled"``: ``A_nt ≠ 0``, a quasi-variational inequality, not a QP.
 
 The package: :mod:`.export` (a step of a scene), :mod:`.file` (the file), :mod:`.check` (checking and
-solving a stored step), :mod:`.script` (the cvxpy script).
+solving a stored step), :mod:`.script` (the cvxpy script), :mod:`.three` (the step files of 3D scenes).
 """
 from __future__ import annotations
 
@@ -35,7 +35,21 @@ from .check import (CONDITIONS, DEFAULT_TOL, SOLUTION_KEYS, CheckReport, Failure
 from .export import export_step, from_record
 from .file import FORMAT, MAX_NODES, STEP_TYPES, StepFile, clarabel_json
 from .script import CVXPY_SCRIPT, cvxpy_script
+from .three import FORMAT_3D, StepFile3D, check_step_3d, export_step_3d
 
 __all__ = ["FORMAT", "DEFAULT_TOL", "CONDITIONS", "SOLUTION_KEYS", "MAX_NODES", "STEP_TYPES", "export_step", "from_record",
            "StepFile", "clarabel_json", "solve_stored", "Failure", "CheckReport", "load_solution", "validate_solution",
-           "check_step", "cvxpy_script", "CVXPY_SCRIPT"]
+           "check_step", "cvxpy_script", "CVXPY_SCRIPT", "FORMAT_3D", "StepFile3D", "export_step_3d", "check_step_3d",
+           "load_step"]
+
+
+def load_step(path, arg: str = "STEP.npz"):
+    """A step file of either dimension (:class:`StepFile` or :class:`StepFile3D`), chosen by its ``format`` key."""
+    import numpy as np
+
+    from ..npzfile import read_npz
+    z = read_npz(path, arg)
+    fmt = np.asarray(z.get("format", ""))
+    if fmt.dtype.kind in "US" and fmt.shape == () and str(fmt) == FORMAT_3D:
+        return StepFile3D.load(path, arg, z=z)
+    return StepFile.load(path, arg)

@@ -1,12 +1,12 @@
 r"""Closed forms and published tables that the 3D solutions are held against
-(docs/theory3d.md §2, docs/validation3d.md).
+(docs/theory3d.md §2, "Two closed forms on the ellipse", eq. 3D.6–3D.8; docs/validation3d.md).
 
 * **Cattaneo–Mindlin** (a circle of radius ``a`` pressed by ``FN``, then shifted by ``Q < μ FN``
   along x; Cattaneo 1938, Mindlin 1949; Johnson 1985 §7.2):
 
   .. math::
       t_x = \mu p_0\Big[\sqrt{1 − r^2/a^2} − \frac{c}{a}\sqrt{1 − r^2/c^2}\Big]\ (r < c),\quad
-      \mu p\ (c \le r \le a),\qquad \frac{c}{a} = \Big(1 − \frac{Q}{\mu F_N}\Big)^{1/3},
+      \mu p\ (c \le r \le a),\qquad \frac{c}{a} = \Big(1 − \frac{Q}{\mu F_N}\Big)^{1/3}   \qquad (3D.6)
 
       \delta_x = \frac{3\mu F_N (2 − \nu)}{8 G a}\Big[1 − \Big(1 − \frac{Q}{\mu F_N}\Big)^{2/3}\Big]   \qquad (3D.7)
 
@@ -90,7 +90,7 @@ def _table_row(a_over_b: float):
 
 
 def kalker_coefficients(a_over_b: float, nu: float) -> tuple:
-    """``(C11, C22, C23)`` of Kalker's Table E.3 (:data:`KALKER_E3`) at a tabulated ``a/b`` (``g`` =
+    """``(C11, C22, C23)`` of Kalker's linear law (eq. 3D.8) from Table E.3 (:data:`KALKER_E3`) at a tabulated ``a/b`` (``g`` =
     0.1, 0.2, …, 1) and ``ν`` (0, 0.25, 0.5).
 
     Examples
@@ -110,7 +110,7 @@ def kalker_coefficients(a_over_b: float, nu: float) -> tuple:
 
 
 def kalker_linear(a_over_b: float, nu: float) -> tuple | None:
-    """``(C11, C22, C23)`` at any ``a/b`` with ``0.1 <= min(a/b, b/a) <= 1`` and ``ν ∈ [0, 0.5]``: linear in
+    """``(C11, C22, C23)`` of eq. 3D.8 at any ``a/b`` with ``0.1 <= min(a/b, b/a) <= 1`` and ``ν ∈ [0, 0.5]``: linear in
     ``g`` between the rows of Table E.3, and ``1/C`` by the parabola in ``ν`` through the table's three
     values (Kalker's table has no other ``ν``; CONTACT interpolates so). ``None`` outside the table.
 
@@ -135,14 +135,14 @@ def kalker_linear(a_over_b: float, nu: float) -> tuple | None:
 
 
 def cattaneo_stick_radius(a: float, ratio: float) -> float:
-    """``c = a (1 − Q/(μFN))^{1/3}`` (eq. 3D.7); ``ratio = Q/(μFN)`` in [0, 1)."""
+    """``c = a (1 − Q/(μFN))^{1/3}`` (eq. 3D.6); ``ratio = Q/(μFN)`` in [0, 1)."""
     if not 0 <= ratio < 1:
         raise InputError("ratio", f"Q/(μ FN) must be in [0, 1), got {ratio!r}")
     return a * (1 - ratio) ** (1 / 3)
 
 
 def cattaneo_traction(r, a: float, p0: float, mu: float, ratio: float) -> np.ndarray:
-    """The traction magnitude along the force at radius ``r`` (eq. 3D.7)."""
+    """The traction magnitude along the force at radius ``r`` (eq. 3D.6)."""
     r = np.asarray(r, dtype=float)
     c = cattaneo_stick_radius(a, ratio)
     outer = np.sqrt(np.maximum(0.0, 1 - (r / a) ** 2))

@@ -8,11 +8,11 @@ A semi-ellipsoidal pressure ``p = p0 √(1 − x²/a² − y²/b²)`` on the ell
 .. math::
     D_{major} = \frac{p_0\,\beta}{E^*\alpha^2}\,\frac{K − E}{m},\qquad
     D_{minor} = \frac{p_0\,\beta}{E^*\alpha^2}\,\frac{E/g^2 − K}{m},\qquad
-    \delta = \frac{p_0\,\beta}{E^*}\,K,\qquad F_N = \tfrac23\pi a b\,p_0          \qquad (3D.2)
+    \delta = \frac{p_0\,\beta}{E^*}\,K,\qquad F_N = \tfrac23\pi a b\,p_0          \qquad (3D.4)
 
-where ``D_major`` is the curvature (``A`` or ``B`` of eq. 3D.1) in the direction of the major
+where ``D_major`` is the curvature (``A`` or ``B`` of eq. 3D.3) in the direction of the major
 axis — the flatter one. Given ``A, B``, the ratio ``D_major/D_minor = (K − E)/(E/g² − K)``
-(increasing in ``g`` from 0 to 1) fixes ``g``; ``F_N`` then fixes the size (eq. 3D.3):
+(increasing in ``g`` from 0 to 1) fixes ``g``; ``F_N`` then fixes the size (eq. 3D.5):
 ``α³ = 3 F_N (K − E)/(2π E* m D_major)``. The quotients ``(K − E)/m`` and ``(E/g² − K)/m`` are
 evaluated by their power series below ``m = 10⁻³`` (no cancellation; the circle is ``m = 0``).
 """
@@ -44,7 +44,7 @@ def _quotients(m: float) -> tuple[float, float, float, float]:
 
 
 def curvature_ratio(g: float) -> float:
-    """``D_major/D_minor`` for the semi-axis ratio ``g = minor/major ∈ (0, 1]`` (eq. 3D.2).
+    """``D_major/D_minor`` for the semi-axis ratio ``g = minor/major ∈ (0, 1]`` (eq. 3D.4).
 
     Examples
     --------
@@ -71,7 +71,7 @@ def _ratio_to_g(y: float) -> float:
 
 @dataclass(frozen=True)
 class HertzEllipse:
-    """The Hertz solution (eq. 3D.2–3D.3): semi-axes ``a`` (x) and ``b`` (y), peak pressure ``p0``,
+    """The Hertz solution (eq. 3D.4–3D.5): semi-axes ``a`` (x) and ``b`` (y), peak pressure ``p0``,
     approach ``delta``, for curvatures ``A, B``, contact modulus ``Estar`` and normal force ``FN``."""
 
     a: float
@@ -105,7 +105,7 @@ def _positive(name, v) -> float:
 
 
 def hertz(A: float, B: float, Estar: float, FN: float) -> HertzEllipse:
-    """The Hertz ellipse for ``h = A x² + B y²`` (eq. 3D.1) pressed by ``FN``.
+    """The Hertz ellipse for ``h = A x² + B y²`` (eq. 3D.3) pressed by ``FN``.
 
     Examples
     --------

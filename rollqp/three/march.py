@@ -177,7 +177,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
 
     ``accelerate``: ``"chord"`` (similar bodies; default) Newton's method on the march map
-    (:mod:`rollqp.methods.chord`, eq. 3D.29), every iterate evaluated by the method; ``"anderson"`` the
+    (:mod:`rollqp.methods.chord`, eq. 3D.24), every iterate evaluated by the method; ``"anderson"`` the
     march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
     0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
     bodies; solved here if ``None``)."""
@@ -294,7 +294,9 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                            FN, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, nsol.delta, nsol.iterations, 0.0, nsol.residual,
                            {"normal": nsol.info})
     yield start
-    prev, warm = start, (_warm_of(start) if start.phase == "resumed" else None)
+    # the step after a rolling step sets out from it; the first rolling step from nothing (as a run that never
+    # stopped does, whatever the start: a resumed run repeats the same computations)
+    prev, warm = start, (_warm_of(start) if start.k >= 1 else None)
     fixed = None
     move = getattr(contact, "move", None)       # a profile feature rolls through: a normal step every step
     if not contact.ops.coupled and move is None:

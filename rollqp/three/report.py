@@ -70,7 +70,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
 
 
 def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
-    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.7)."""
+    """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.6–3D.7)."""
     e, m, mu = scene.ellipse, scene.materials, scene.mu
     FN, Fx = float(res["FN"][0]), float(res["Fx"][0])
     if mu == 0:

@@ -16,21 +16,27 @@ own halves (:func:`rollqp.three.march.coupled_step`).
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
-import json
+import os
 from typing import Iterator
 
 import numpy as np
 
+from ..atomic import stop_once
 from ..errors import InputError, SolverError
+from ..fields import fields_for
+from ..march import RESUME_TOL, _keep_every, _last_index, drive
+from ..methods import compose_3d, scene_method_3d
+from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
 from ..scene.core import SceneBase
+from ..version import __version__
 from ..operators.grid import Contact
 from .patch import moving_profile
 from .march import StepRecord, static_shift, steady, transient
-from .result import Result3D
 
-__all__ = ["prepare", "march", "run", "new_result", "resumed_record", "resume_arrays"]
+__all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "GRID"]
 
 
 def prepare(scene, method=None):
@@ -40,7 +46,6 @@ def prepare(scene, method=None):
     ``method``: a name (overrides ``solver.method``) or a method object (checked by its record,
     :func:`rollqp.methods.compose_3d`).
     """
-    from ..methods import compose_3d, scene_method_3d
     scene = scene if isinstance(scene, SceneBase) else load_scene(scene)
     if scene.dimension != 3:
         raise InputError("contact.dimension", "rollqp.three.run runs 3D scenes; this one is "
@@ -57,6 +62,7 @@ def prepare(scene, method=None):
 
 
 def _start(scene, meth, contact) -> StepRecord:
+    """State 0: the braked start's last static shift step, or the steady rolling state."""
     ld = scene.load
     if ld.start == "rolling":
         return steady(contact, meth, ld.normal, scene.loads_at(0.0), direction=ld.direction)
@@ -64,22 +70,29 @@ def _start(scene, meth, contact) -> StepRecord:
     if loads.xi is not None or loads.eta is not None:
         raise InputError("load.start", "a braked start shifts the bodies by the tangential forces: prescribe "
                                        "load.tangential and load.lateral (or start = \"rolling\")")
-    return static_shift(contact, meth, ld.normal, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps)[-1]
+    last = static_shift(contact, meth, ld.normal, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps)[-1]
+    return dataclasses.replace(last, k=0)   # the shift steps are numbered within the start; it is state 0
 
 
-def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRecord]:
+def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=None) -> Iterator[StepRecord]:
     """The 3D run as a stream of :class:`~rollqp.three.march.StepRecord`: ``k = 0`` (the starting
     state), then the rolling steps (module docstring); with ``resume`` (the arrays of an earlier
-    result file of this scene) only the steps after its last state.
+    result file of this scene, or :meth:`ResumeSource.tail <rollqp.result.ResumeSource.tail>`) only the
+    steps after its last state, once that state is checked to solve its own step (:func:`check_resumed`;
+    ``verify=False`` with ``state``, the state it returned).
 
     Raises
     ------
     SolverError
         A step failed; ``err.step`` names it (0: the start).
+    InputError
+        ``--resume``: the stored states are another scene's, or the last one does not solve its step.
     """
-    scene, meth, contact = prepared if prepared is not None else prepare(scene, method)
+    scene, meth, contact = prepared = prepared if prepared is not None else prepare(scene, method)
     if resume is not None:
-        start, first = resumed_record(scene, contact, resume), len(resume["q"])
+        if state is None:
+            state = check_resumed(scene, prepared, resume) if verify else resumed_record(scene, contact, resume)
+        start, first = state, _last_index(resume) + 1
     else:
         try:
             start = _start(scene, meth, contact)
@@ -94,34 +107,134 @@ def march(scene, method=None, *, prepared=None, resume=None) -> Iterator[StepRec
     yield from records
 
 
-def resumed_record(scene, contact, arrays: dict) -> StepRecord:
-    """The last state of a 3D result file of ``scene``, as the run continues from it."""
+def resumed_record(scene, contact, arrays: dict, row: int = -1) -> StepRecord:
+    """A stored state of a 3D result file of ``scene`` (the last one, ``row = -1``), as the run continues from
+    it: the grid, the number of steps and the rolled distances checked to be the scene's.
+
+    Raises
+    ------
+    InputError
+        ``--resume``: the file belongs to another scene (another grid, other rolled distances).
+    """
     g = scene.grid
-    if arrays["pn"].shape[1:] != g.shape or not np.allclose(arrays["x"], g.x, rtol=0, atol=1e-12 * g.dx * g.nx):
-        raise InputError("--resume", "the result file's grid is not this scene's: another scene")
-    k = len(arrays["q"]) - 1
+    x, y, q = (np.asarray(arrays[k]) for k in ("x", "y", "q"))
+    if (x.shape != (g.nx,) or y.shape != (g.ny,) or np.shape(arrays["pn"])[1:] != g.shape
+            or not np.allclose(x, g.x, rtol=0, atol=1e-12 * g.dx * g.nx)
+            or not np.allclose(y, g.y, rtol=0, atol=1e-12 * g.dy * g.ny)):
+        raise InputError("--resume", f"the result file's grid ({y.size} x {x.size} elements) is not this scene's "
+                                     f"({g.ny} x {g.nx}): another scene")
+    steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(q.size)
+    qs = scene.q_steps
+    if (steps.shape != q.shape or q.size == 0 or steps[-1] >= qs.size
+            or not np.allclose(q, qs[steps], rtol=1e-12, atol=1e-15 * scene.ellipse.a)):
+        raise InputError("--resume", f"the result file's rolled distances are not this scene's (it has {q.size} "
+                                     f"states, the scene {qs.size}): another scene")
+    k = int(steps[row])
+    p = np.array(arrays["pn"][row], dtype=float).ravel()
+    t = np.stack([np.array(arrays[c][row], dtype=float).ravel() for c in ("px", "py")])
+    s = np.stack([np.array(arrays[c][row], dtype=float).ravel() for c in ("sx", "sy")])
+    xi, eta, phi = (float(v) for v in arrays["creepage"][row])
+    return StepRecord(k, "resumed", float(q[row]), p, np.zeros_like(p), t, s,
+                      np.array(arrays["state"][row]).ravel(), float(arrays["FN"][row]), float(arrays["Fx"][row]),
+                      float(arrays["Fy"][row]), float(arrays["Mz"][row]), xi, eta, phi,
+                      float(arrays["approach"][row]), 0, 0.0, float(arrays["residual"][row]))
+
+
+def check_resumed(scene, prepared, arrays: dict) -> StepRecord:
+    """The state to continue from: the last stored state of ``arrays``, checked to solve its own step.
+
+    The step is solved again from the state before it (from the start for state 0), with the warm start
+    a run that never stopped gives it (the state before, for a rolling step after the first): the same
+    computation, so it repeats the stored state bit for bit and the run continues from it. Otherwise it
+    must agree to :data:`rollqp.march.RESUME_TOL` (pressures in p0, tractions in μp0; the forces, moment
+    and creepages with them, the element states exactly) and the run continues from the stored state;
+    else the file was changed or is corrupt: an :class:`InputError` on ``--resume``, one line, nothing run.
+    """
+    scene, meth, contact = prepared
+    k = _last_index(arrays)
     if k > scene.n_steps:
         raise InputError("--resume", f"the result file has {k} rolling steps, the scene {scene.n_steps}")
-    p = np.asarray(arrays["pn"][-1], dtype=float).ravel()
-    t = np.stack([np.asarray(arrays[c][-1], dtype=float).ravel() for c in ("px", "py")])
-    s = np.stack([np.asarray(arrays[c][-1], dtype=float).ravel() for c in ("sx", "sy")])
-    xi, eta, phi = (float(v) for v in arrays["creepage"][-1])
-    return StepRecord(k, "resumed", float(arrays["q"][-1]), p, np.zeros_like(p), t, s,
-                      np.asarray(arrays["state"][-1]).ravel(), float(arrays["FN"][-1]), float(arrays["Fx"][-1]),
-                      float(arrays["Fy"][-1]), float(arrays["Mz"][-1]), xi, eta, phi, float(arrays["approach"][-1]),
-                      0, 0.0, float(arrays["residual"][-1]))
+    stored = resumed_record(scene, contact, arrays, -1)
+    steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(len(arrays["q"]))
+    try:
+        if k == 0:
+            again = _start(scene, meth, contact)
+        elif steps.size >= 2 and int(steps[-2]) == k - 1:
+            before = resumed_record(scene, contact, arrays, -2)
+            again = list(transient(contact, meth, scene.load.normal, scene.loads_at, scene.dq, k,
+                                   scene.load.direction, start=before, first=k))[-1]
+        else:
+            raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
+                                         "which it needs to be continued")
+    except SolverError as err:
+        raise InputError("--resume", f"the last state ({k}) cannot be checked: its step, solved again, failed "
+                                     f"({str(err)[:120]})") from None
+    _compare(again, stored, contact, k)
+    return again if _identical(again, stored) else stored
 
 
-def new_result(scene, contact, method_name: str, out=None) -> Result3D:
-    """An empty :class:`~rollqp.three.result.Result3D` with the scene's scalars and metadata (``out``: its
-    result file, journaled as the run goes)."""
-    from ..version import __version__
-    e = scene.ellipse
+def _identical(a: StepRecord, b: StepRecord) -> bool:
+    return all(np.array_equal(np.asarray(u, dtype=float), np.asarray(v, dtype=float)) for u, v in (
+        (a.p, b.p), (a.t, b.t), (a.s, b.s), (a.delta, b.delta), ((a.xi, a.eta, a.phi), (b.xi, b.eta, b.phi)),
+        ((a.FN, a.Fx, a.Fy, a.Mz), (b.FN, b.Fx, b.Fy, b.Mz)), (a.state, b.state)))
+
+
+def _compare(again: StepRecord, stored: StepRecord, contact, k: int) -> None:
+    """``stored`` is ``again`` (its step solved again) to :data:`RESUME_TOL`, else a one-line :class:`InputError`."""
+    sc = contact.scales
+    mu = min(float(contact.mu), 1.0)
+    force = sc.stress * contact.grid.area * contact.grid.n
+    checks = (("pressure", again.p, stored.p, sc.stress, "p0"),
+              ("traction", again.t, stored.t, mu * sc.stress, "mu p0"),
+              ("slip", again.s, stored.s, sc.slip, "p0/E*"),
+              ("approach", again.delta, stored.delta, sc.displacement, "its scale"),
+              ("creepage", (again.xi, again.eta), (stored.xi, stored.eta), sc.slip, "p0/E*"),
+              ("spin creepage", again.phi, stored.phi, sc.slip / sc.length, "p0/(E* c)"),
+              ("normal force", again.FN, stored.FN, force, "p0 times the grid's area"),
+              ("tangential forces", (again.Fx, again.Fy), (stored.Fx, stored.Fy), mu * force,
+               "mu p0 times the grid's area"),
+              ("spin moment", again.Mz, stored.Mz, mu * force * sc.length, "mu p0 c times the grid's area"))
+    for what, a, b, scale, unit in checks:
+        d = np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) / scale
+        worst = float(np.max(d)) if np.all(np.isfinite(d)) else np.inf
+        if not worst <= RESUME_TOL:
+            raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
+                                         f"state before it, its {what} differs by {worst:.3g} {unit} (more than "
+                                         f"{RESUME_TOL:g}): the file was changed or is corrupt")
+    from .march import _states
+    if not np.array_equal(_states(contact, stored.p, stored.t, stored.s), np.asarray(stored.state)):
+        raise InputError("--resume", f"the last state ({k}): its element states are not those of its pressure, "
+                                     "traction and slip: the file was changed or is corrupt")
+
+
+def _read_grid(rec: StepRecord, contact) -> tuple[dict, dict]:
+    """The core fields and notes of a 3D :class:`~rollqp.three.march.StepRecord` (:data:`GRID`)."""
+    g = contact.grid
+    t, s = np.asarray(rec.t).reshape(2, -1), np.asarray(rec.s).reshape(2, -1)
+    values = dict(q=rec.q, pn=g.field(rec.p), px=g.field(t[0]), py=g.field(t[1]), sx=g.field(s[0]),
+                  sy=g.field(s[1]), state=g.field(rec.state), FN=rec.FN, Fx=rec.Fx, Fy=rec.Fy, Mz=rec.Mz,
+                  creepage=(rec.xi, rec.eta, rec.phi), approach=rec.delta, step=rec.k,
+                  iterations=rec.iterations, step_time=rec.time, residual=rec.residual)
+    return values, dict(rec.info.get("notes", {}))
+
+
+#: The grid's result (a 3D scene): :data:`rollqp.fields.FIELDS_3D`, one :class:`~rollqp.result.Result`.
+GRID = Layout(3, ("q", "pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "creepage", "approach",
+                  "step", "iterations", "step_time", "residual"), _read_grid)
+
+
+def new_result(scene, contact, method_name: str, out=None, keep_every: int = 1) -> Result:
+    """An empty :class:`~rollqp.result.Result` of the grid (:data:`GRID`) with the scene's scalars and metadata
+    (``out``: its result file, journaled as the run goes)."""
+    e, g = scene.ellipse, contact.grid
     meta = {"scene": scene.to_dict(), "method": method_name, "rollqp": __version__, "versions": dict(_versions()),
-            "dimension": 3, "dq": scene.dq, "elements": int(contact.grid.n), "coupled": bool(contact.ops.coupled),
+            "dimension": 3, "dq": scene.dq, "elements": int(g.n), "coupled": bool(contact.ops.coupled),
             "slip_note": ("state 0 of a braked start: static-shift slip per c = sqrt(ab) of shift"
                           if scene.load.start == "braked" else "state 0: the steady state")}
-    return Result3D(contact.grid, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, out=out)
+    constants = {"area": g.area, "wear_A": scene.A.wear or 0.0, "wear_B": scene.B.wear or 0.0,
+                 "braked": float(scene.load.start == "braked")}
+    return Result(g.x, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, fields_for(scene), keep_every=keep_every,
+                  out=out, operators=contact, layout=GRID, coords={"x": g.x, "y": g.y}, constants=constants)
 
 
 @functools.lru_cache(maxsize=1)
@@ -137,97 +250,67 @@ def _versions() -> tuple:
     return tuple(out)
 
 
-def _raw_distance(meta: dict, rec: StepRecord, contact) -> None:
+def _raw_distance(meta: dict, rec: StepRecord, contact) -> bool:
     """A conic method's raw answers (the solver's own, before the active-set refinement,
     :mod:`rollqp.methods.refine`) against the refined ones the run keeps: the largest distance over the
     run in ``meta["raw_distance"]`` (``dp`` in p0, ``dt`` in μp0, ``steps`` compared); nothing for a
-    method without a raw answer (Newton)."""
+    method without a raw answer (Newton). True if it was updated."""
     sc = contact.scales
     rp, rt = (rec.info.get(part, {}).get("raw") for part in ("normal", "tangential"))
     if rp is None and rt is None:
-        return
+        return False
     row = meta.setdefault("raw_distance", {"dp": 0.0, "dt": 0.0, "steps": 0})
     if rp is not None:
         row["dp"] = max(row["dp"], float(np.max(np.abs(rp["p"] - rec.p))) / sc.stress)
     if rt is not None:
         row["dt"] = max(row["dt"], float(np.max(np.abs(rt["t"] - rec.t))) / ((contact.mu or 1.0) * sc.stress))
     row["steps"] += 1
+    return True
 
 
-def resume_arrays(resume):
-    """The arrays to continue from: ``resume`` is the arrays of a result file (a dict,
-    :func:`rollqp.load_result`) or what ``rollqp run --resume`` read (:func:`rollqp.result.resume_source`:
-    a 3D run writes its result file, no journal), or None."""
-    if resume is None or isinstance(resume, dict):
-        return resume
-    if resume.journal is not None:      # a killed run's journal (it holds more than the result file)
-        from .result import journal_arrays
-        return journal_arrays(resume.journal)
-    return resume.arrays
+def _noted(meta: dict, records, contact):
+    """The records, each with the notes it adds to the result's ``meta`` (``rec.info["notes"]``: journaled with
+    the state, so that a resumed run has them)."""
+    for rec in records:
+        notes = {}
+        if rec.k == 0 and "marched" in rec.info:
+            notes["rolling_start"] = f"marched to the steady state in {rec.info['marched']} steps"
+        if rec.k == 0 and "shift" in rec.info:
+            notes["static_shift"] = [float(v) for v in rec.info["shift"]]
+        if _raw_distance(meta, rec, contact):
+            notes["raw_distance"] = dict(meta["raw_distance"])
+        rec.info["notes"] = notes
+        yield rec
 
 
-def _started(result, resume) -> None:
-    """A resumed run's result: the earlier states, and what state 0 and the earlier steps noted. With a
-    result file, the earlier states are written to it first, so that they are on disk while the new
-    journal is filled (a run killed then resumes from the file)."""
-    if result.out is not None:
-        earlier = Result3D(result.grid, result.scalars, dict(result.meta))
-        earlier.extend(resume)
-        earlier.save(result.out)
-    result.extend(resume)
-    result.meta["resumed_from"] = len(result) - 1
-    earlier = resume.get("meta", {})
-    earlier = earlier if isinstance(earlier, dict) else json.loads(str(earlier))
-    for key in ("static_shift", "rolling_start", "raw_distance"):
-        if key in earlier:
-            result.meta[key] = earlier[key]
-
-
-def _noted(result, rec, contact) -> None:
-    """What a record adds to the result's notes (``meta``)."""
-    if rec.k == 0 and "marched" in rec.info:
-        result.meta["rolling_start"] = f"marched to the steady state in {rec.info['marched']} steps"
-    if rec.k == 0 and "shift" in rec.info:
-        result.meta["static_shift"] = [float(v) for v in rec.info["shift"]]
-    _raw_distance(result.meta, rec, contact)
-
-
-def run(scene, method=None, progress=None, resume=None, observe=None, out=None, keep_every=None) -> Result3D:
-    """Run a 3D scene and return its :class:`~rollqp.three.result.Result3D` (arguments as
-    :func:`rollqp.march.run`: ``progress(k, K)`` after each rolling step, ``observe(record, contact)``
-    with every record, ``resume`` an earlier result file's arrays or :func:`resume_arrays`' source,
-    ``out`` the result file: every state journaled as it is completed (``out.journal``: a run killed
-    even by SIGKILL loses at most the state in flight), the file written at the end — and, with the
-    completed states and the reason in ``meta["failed"]`` or ``meta["interrupted"]``, when the run
-    fails or is interrupted).
-    ``keep_every``: a 3D run keeps every state (None or 1).
+def run(scene, method=None, progress=None, resume=None, observe=None, out=None, keep_every=None) -> Result:
+    """Run a 3D scene and return its :class:`~rollqp.result.Result` — :func:`rollqp.march.run` for the grid, with
+    the same arguments and guarantees (docs/results.md): ``progress(k, K)`` after each rolling step,
+    ``observe(record, contact)`` with every record, ``resume`` an earlier part of the run (the path of its
+    result file or journal, a :class:`~rollqp.result.ResumeSource`, or a result file's arrays), whose last
+    state is checked to solve its own step first (:func:`check_resumed`); ``out`` the result file: every
+    state journaled as it is completed (``out.journal``: a run killed even by SIGKILL loses at most the
+    state in flight; no state is kept in memory), the file written at the end — and, with the completed
+    states and the reason in ``meta["failed"]`` or ``meta["interrupted"]``, when the run fails or is
+    interrupted; ``keep_every``: keep every k-th state (and the last two).
 
     Raises
     ------
     SolverError, InputError, KeyboardInterrupt
         ``err.partial`` holds the result of the completed states.
     """
-    if keep_every not in (None, 1):
-        raise InputError("--keep-every", f"a 3D run keeps every state (1), got {keep_every!r}")
-    resume = resume_arrays(resume)
     asked = scene if isinstance(scene, SceneBase) else load_scene(scene)
+    if out is not None:
+        out = check_output(out, key="out")
+    source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
+    keep = _keep_every(keep_every, source)
     scene, meth, contact = prepared = prepare(asked, method)
-    result = new_result(scene, contact, meth.name, out)
-    if resume is not None:
-        _started(result, resume)
-    K = scene.n_steps
-    try:
-        for rec in march(scene, prepared=prepared, resume=resume):
-            result.add(rec)
-            _noted(result, rec, contact)
-            if observe is not None:
-                observe(rec, contact)
-            if progress is not None and rec.k > 0:
-                progress(rec.k, K)
-    except (SolverError, InputError, KeyboardInterrupt) as err:
-        err.partial = result
-        if out is not None and len(result):
-            result.finish({"interrupted" if isinstance(err, KeyboardInterrupt) else "failed": str(err) or "interrupted"})
-        raise
-    result.finish()
-    return result
+    tail = state = None
+    if source is not None:
+        tail = source.tail() if isinstance(source, ResumeSource) else source
+        state = check_resumed(scene, prepared, tail)
+    result = new_result(scene, contact, meth.name, out=out, keep_every=keep)
+    records = _noted(result.meta, march(scene, prepared=prepared, resume=tail, verify=False, state=state), contact)
+    with stop_once():  # a second Ctrl-C never interrupts the writing of what the first one saves
+        return drive(result, records, source=source, resumed_from=None if tail is None else _last_index(tail),
+                     operators=contact, observe=observe, progress=progress, steps=scene.n_steps)

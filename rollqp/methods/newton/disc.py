@@ -7,7 +7,7 @@ nondimensional variables of :mod:`rollqp.problem.grid` the steps are the nonsmoo
     \Phi_N = \begin{bmatrix} \min(\hat p,\ r\hat g) \\ \hat a\sum\hat p − \hat F_N\end{bmatrix},
     \qquad
     \Phi_T = \begin{bmatrix} \hat t_i − \mathrm{Proj}_{|\cdot|\le \hat b_i}(\hat t_i − r\hat s_i) \\
-             \hat a\sum\hat t_x − \hat F_x \\ \hat a\sum\hat t_y − \hat F_y\end{bmatrix}   \qquad (3D.23)
+             \hat a\sum\hat t_x − \hat F_x \\ \hat a\sum\hat t_y − \hat F_y\end{bmatrix}   \qquad (3D.25)
 
 (``ĝ = ĥ − δ̂ + Â p̂``, ``ŝ = ŝ₀ + ξ̂ e_x + η̂ e_y + Ŝ t̂``; a load row is dropped where the
 creepage — or the approach — is prescribed). The projection onto the disc of radius ``b``,
@@ -15,7 +15,7 @@ creepage — or the approach — is prescribed). The projection onto the disc of
 
 .. math::
     \partial P(z) = I \ (|z| \le b),\qquad
-    \partial P(z) = \kappa\,(I − \hat z\hat z^T),\ \kappa = b/|z|,\ \hat z = z/|z| \ (|z| > b)  \qquad (3D.24)
+    \partial P(z) = \kappa\,(I − \hat z\hat z^T),\ \kappa = b/|z|,\ \hat z = z/|z| \ (|z| > b)  \qquad (3D.26)
 
 so the Newton matrix has, per element, the stick rows ``r ∂ŝ_i`` (the slip vanishes) and the
 slip rows ``(I − M_i) e_i + r M_i ∂ŝ_i`` (``M_i = ∂P``: along ``ẑ_i`` the traction is fixed at
@@ -42,6 +42,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
+from ... import progress
 from ...errors import InputError, SolverError
 from ..base import Capabilities, check_options
 from ...problem.grid import disc_projection
@@ -77,7 +78,7 @@ def _line_search(theta0, phi_at, rho, sigma, max_backtracks=30):
 
 
 class NewtonMethod:
-    r"""GNMls on the 3D normal and tangential steps (eq. 3D.23–3D.26).
+    r"""GNMls on the 3D normal and tangential steps (eq. 3D.25–3D.28).
 
     Parameters
     ----------
@@ -148,11 +149,15 @@ class NewtonMethod:
 
     def _iterate(self, x, Kx, phi_fn, step_fn, r, what):
         """The GNMls loop: ``phi_fn(x, Kx) → Φ``, ``step_fn(x, Kx, Φ) → (d, Kd)``."""
+        t0 = time.perf_counter()
         phi = phi_fn(x, Kx)
         info = {"r": r, "nonmonotone": 0, "directions": 0}
         target = self.tolerance * min(1.0, r)
         for it in range(self.max_iterations + 1):
-            if np.max(np.abs(phi), initial=0.0) <= target:
+            res = float(np.max(np.abs(phi), initial=0.0))
+            if it:  # the progress lines of a long solve (rollqp.progress: the command line listens)
+                progress.iteration(what, it, res, time.perf_counter() - t0, target)
+            if res <= target:
                 info["directions"] = it
                 return x, Kx, info
             if it == self.max_iterations:
@@ -208,7 +213,7 @@ def _solve_normal(method, problem, warm):
 
 
 def _normal_direction(method, A, s, x, Kx, phi, r, hh, ah, free_delta):
-    """The reduced Newton system of the normal step (eq. 3D.25): identity rows off the contact
+    """The reduced Newton system of the normal step (eq. 3D.27): identity rows off the contact
     set ``F = {p̂ > r ĝ}``, ``Â_FF d_F − dδ e = −ĝ_F − Â_FN d_N`` on it, and the load row."""
     n = hh.size
     p, g = x[:n], hh - x[n] + Kx
@@ -258,7 +263,7 @@ def _spd_solver(method, A, s, F):
 
 # ------------------------------------------------------------------------- tangential step
 def _tangential_scaled(problem):
-    """``(Ŝ factor, ŝ₀, b̂, â, free creepage columns, load targets)`` of eq. 3D.23."""
+    """``(Ŝ factor, ŝ₀, b̂, â, free creepage columns, load targets)`` of eq. 3D.25."""
     sc = problem.scales
     k = sc.modulus / problem.dq                      # Ŝ = E* B/Δq
     xi0 = problem.xi if problem.xi is not None else 0.0
@@ -317,7 +322,7 @@ def _cold_start(k, B, s0, bh, ah, free, targets, V):
 
 
 class _TangentialSystem:
-    """Φ_T of eq. 3D.23 on the contact elements ``V`` and its Newton directions (eq. 3D.24–3D.26)."""
+    """Φ_T of eq. 3D.25 on the contact elements ``V`` and its Newton directions (eq. 3D.26–3D.28)."""
 
     def __init__(self, method, problem, V, k, s0, bh, ah, free, targets, r):
         self.method, self.problem, self.V, self.k = method, problem, V, k
@@ -344,7 +349,7 @@ class _TangentialSystem:
         return np.concatenate([res, loads])
 
     def projection_derivative(self, x, Kx):
-        """``(m_xx, m_xy, m_yy)`` of ``M_i = ∂P(z_i)`` (eq. 3D.24), per element."""
+        """``(m_xx, m_xy, m_yy)`` of ``M_i = ∂P(z_i)`` (eq. 3D.26), per element."""
         t, _, sh = self.split(x, Kx)
         z = (t - self.r * sh).reshape(2, self.nv)
         norm = np.hypot(z[0], z[1])
@@ -399,7 +404,7 @@ class _TangentialSystem:
         nv, r, nf = self.nv, self.r, len(self.free)
         m = 2 * nv
 
-        def apply_J(dt):   # the rows of eq. 3D.26 on d_t (dζ = 0)
+        def apply_J(dt):   # the rows of eq. 3D.28 on d_t (dζ = 0)
             Rd = r * self.product(dt)
             tx, ty = dt[:nv], dt[nv:]
             return np.concatenate([mxx * Rd[:nv] + mxy * Rd[nv:] + tx - (mxx * tx + mxy * ty),
