@@ -80,6 +80,7 @@ class Body3D:
     E: float = None
     nu: float = None
     profile: Any = None
+    wear: float | None = None
 
 
 @dataclass(frozen=True)
@@ -152,8 +153,10 @@ def _body(key, b: Body3D) -> Body3D:
         if getattr(b, k) is None:
             raise InputError(f"{key}.{k}", "missing required key")
     shape = parse_body({k: getattr(b, k) for k in ("radius", "radius_y", "profile") if getattr(b, k) is not None}, key)
+    wear = None if b.wear is None else number(f"{key}.wear", b.wear, ">= 0 (Archard's k/H in 1/stress) or absent",
+                                              lambda x: x >= 0)
     return Body3D(shape.rx, shape.ry, number(f"{key}.E", b.E, "> 0", lambda x: x > 0),
-                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict())
+                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict(), wear)
 
 
 def _contact(c: Contact3D) -> Contact3D:
@@ -438,6 +441,10 @@ def _check_whole(scene) -> None:
                                                       "ellipse to scale discretization.zone by; give the grid in length "
                                                       "units, extent = [[x0, x1], [y0, y1]]")
     _check_ellipse(scene)
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):  # Archard's k·p0/H <= 1, as in 2D
+        if body.wear is not None and not body.wear * scene.ellipse.p0 <= 1.0:
+            raise InputError(f"{key}.wear", f"must be a number in [0, 1/p0 = {1.0 / scene.ellipse.p0:.6g}] (k/H in "
+                                            f"1/stress: Archard's k·p0/H is at most 1), got {body.wear!r}")
     if scene.discretization.extent is None:
         _check_grid(scene)
     elif scene.shape.hertzian and not scene.grid.covers(scene.ellipse.a, scene.ellipse.b):
