@@ -40,8 +40,7 @@ def project(z: np.ndarray, b: np.ndarray, minus_b: np.ndarray | None = None, out
         u = np.minimum(z, b)
         return np.maximum(u, minus_b, out=out)
     norm = np.hypot(z[0], z[1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.where(norm > b, b / norm, 1.0)
+    k = np.divide(b, norm, out=np.ones_like(norm), where=norm > b)   # b/|z| only where it is < 1 (no overflow)
     return z * k
 
 
