@@ -6,7 +6,7 @@ import importlib
 
 import pytest
 
-MODULES = ["discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
+MODULES = ["discretization", "discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
            "profiles.surface", "three.hertz", "three.closedforms", "methods.newton.disc", "operators.grid"]
 
 

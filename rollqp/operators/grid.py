@@ -100,6 +100,7 @@ class Contact:
                                                                      self.scales.modulus, dimension=3)
         self.ops = get_model(model, "contact.model", dimension=3).build(grid, materials)
         self.x, self.y = grid.centres()
+        self.record = grid.record()   # the points, weights and components a law or a field reads
         h = np.asarray(self.profile(self.x, self.y), dtype=float)
         if h.shape != (grid.n,) or not np.all(np.isfinite(h)):
             raise InputError("profile", f"h(x, y) must give finite values of shape ({grid.n},)")
@@ -163,7 +164,7 @@ class Contact:
         if self.law.kind == "constant":
             return self.mu
         a = self.ellipse.a
-        mu = np.asarray(self.law.coefficient(np.stack([self.x, self.y]) / a, float(q) / a, direction), dtype=float)
+        mu = np.asarray(self.law.coefficient(self.record.points / a, float(q) / a, direction), dtype=float)
         if mu.shape != (self.grid.n,) or not np.all(np.isfinite(mu) & (mu >= 0)):
             raise InputError("contact.friction", f"law {self.law.law!r} must give a finite μ >= 0 at each of the "
                                                  f"{self.grid.n} elements, got shape {mu.shape}")
