@@ -329,10 +329,12 @@ def _takes(scene, command: str) -> None:
     """Refuse a scene whose dimension's record does not list ``command``."""
     if command not in family(scene).commands:
         from .errors import InputError
-        dims = " and ".join(f"{d}D" for d, f in FAMILIES.items() if command in f().commands)
+        name = lambda d: f"{d}D" if isinstance(d, int) else d   # noqa: E731 - a dimension or a family's name
+        dims = " and ".join(name(d) for d, f in FAMILIES.items() if command in f().commands)
         takes = ", ".join(["run", "show", "scenes", *sorted(family(scene).commands)])
-        raise InputError("SCENE", f"{scene.name!r} is a {scene.dimension}D scene; rollqp {command} works on {dims} "
-                                  f"scenes (a {scene.dimension}D scene: rollqp {takes})")
+        what = name(getattr(scene, "family", scene.dimension))
+        raise InputError("SCENE", f"{scene.name!r} is a {what} scene; rollqp {command} works on {dims} "
+                                  f"scenes (a {what} scene: rollqp {takes})")
 
 
 def _unwritten(err: OSError, out) -> str:
