@@ -136,5 +136,5 @@ def test_operator_refuses_a_dense_block_beyond_its_budget(monkeypatch):
     g = Grid.centred(30, 30, 1.0, 1.0)
     op = ContactOperators(g, Materials.from_young(1.0, 0.3, 1.0, 0.3)).Att
     monkeypatch.setattr("rollqp.three.operator.DENSE_MAX", 1000)
-    with pytest.raises(InputError, match="FFT product"):
+    with pytest.raises(InputError, match="FFT products"):
         op.dense()

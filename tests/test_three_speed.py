@@ -100,3 +100,26 @@ def test_crossval_step_choice_still_checks(kept):
     scene, _ = kept
     check = crossval(scene, step=1, methods=["socp-clarabel"])
     assert check.agrees() and check.steps == [1]
+
+
+# ------------------------------------------------------------------------------- extrapolation
+def test_richardson_recovers_a_power_law_and_its_order():
+    from rollqp.three.extrapolate import richardson
+    for p in (0.7, 1.0, 2.0):
+        e = richardson([3.0 + 0.4 * h ** p for h in (0.2, 0.1, 0.05)], 2.0)
+        assert e.order == pytest.approx(p, rel=1e-9) and e.value == pytest.approx(3.0, rel=1e-12)
+        assert e.error == pytest.approx(0.4 * 0.05 ** p, rel=1e-9)      # the finest grid's error
+    e = richardson([1.0, 1.1, 1.05], 2.0)                                # not monotone: no order claimed
+    assert e.order is None and e.value == 1.05 and e.error == pytest.approx(0.1)
+
+
+def test_extrapolate_command(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["extrapolate", "kalker-circular", "--grids", "10,20,40"]) == 0
+    out = capsys.readouterr().out
+    assert "grid 40" in out and "error estimate" in out and "Fy   zero by symmetry" in out
+    for bad in ("10,20", "10,20,30", "a,b,c", "40,20,10"):
+        assert cli.main(["extrapolate", "kalker-circular", "--grids", bad]) == cli.EXIT_INPUT
+        assert "--grids" in capsys.readouterr().err
+    assert cli.main(["extrapolate", "cattaneo-3d"]) == cli.EXIT_INPUT        # a braked start: no steady state
+    assert "rolling start" in capsys.readouterr().err

@@ -24,6 +24,8 @@ convex programs on that external solver — and each dimension has its own table
 ``socp-scs``              cvxpy's statement solved by SCS (first order, extra ``cvxpy``)
 ``qp-osqp``               OSQP: the normal QP only; no cones, so a 3D scene (tangential SOCPs)
                           refuses it up front, naming the methods that can
+``fastsim``               Kalker's simplified theory (FASTSIM), steady rolling only: the fast
+                          approximation (:mod:`rollqp.methods.fastsim`)
 ========================  ==========================================================
 
 A name registered for one dimension only (``nt-newton``, ``mf-newton``, ``qps-*``; the ``socp-*``
@@ -80,6 +82,7 @@ _REGISTRY_3D = {
     "socp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
     "socp-scs": ("rollqp.three.socp", "ScsMethod", "cvxpy"),
     "qp-osqp": ("rollqp.three.socp", "OsqpMethod", None),
+    "fastsim": ("rollqp.methods.fastsim", "FastsimMethod", None),
 }
 _TABLES = {2: _REGISTRY, 3: _REGISTRY_3D}
 

@@ -117,6 +117,13 @@ def refusal(scene, allow_long: bool = False) -> None:
     """Refuse, before any work, a conic run that cannot finish in reasonable time or memory (one
     :class:`~rollqp.errors.InputError` naming ``--method newton`` and a coarser grid); ``allow_long``
     lets a run above :data:`REFUSE_SECONDS` start (never one whose dense matrix does not fit)."""
+    from ..methods import method_class
+    if getattr(method_class(scene.solver.method, 3), "steady_only", False) and (
+            scene.n_steps > 0 or scene.load.start != "rolling"):
+        raise InputError("solver.method", f"{scene.solver.method} solves the steady state of a rolling start only "
+                                          f"(load.start = 'rolling', discretization.distance = 0; this scene has "
+                                          f"{scene.n_steps} rolling steps and start {scene.load.start!r}); use "
+                                          "--method newton for the rolling steps")
     if not _conic(scene):
         return
     n = scene.contact_elements()

@@ -42,6 +42,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
+from .. import progress
 from ..errors import InputError, SolverError
 from ..methods.base import Capabilities, check_options
 from .problem import disc_projection
@@ -148,11 +149,15 @@ class NewtonMethod:
 
     def _iterate(self, x, Kx, phi_fn, step_fn, r, what):
         """The GNMls loop: ``phi_fn(x, Kx) → Φ``, ``step_fn(x, Kx, Φ) → (d, Kd)``."""
+        t0 = time.perf_counter()
         phi = phi_fn(x, Kx)
         info = {"r": r, "nonmonotone": 0, "directions": 0}
         target = self.tolerance * min(1.0, r)
         for it in range(self.max_iterations + 1):
-            if np.max(np.abs(phi), initial=0.0) <= target:
+            res = float(np.max(np.abs(phi), initial=0.0))
+            if it:  # the progress lines of a long solve (rollqp.progress: the command line listens)
+                progress.iteration(what, it, res, time.perf_counter() - t0, target)
+            if res <= target:
                 info["directions"] = it
                 return x, Kx, info
             if it == self.max_iterations:

@@ -148,7 +148,10 @@ class BlockToeplitz:
         cols = np.arange(g.n) if cols is None else np.asarray(cols, dtype=np.intp)
         size = self.m_out * rows.size * self.m_in * cols.size
         if size > DENSE_MAX:
-            raise InputError(self.name, f"a dense block of {size} entries exceeds {DENSE_MAX}: use the FFT product")
+            raise InputError("solver.method", f"the influence matrix as a dense matrix ({self.name}): {size:,} entries "
+                                              f"({size * 8 / 1e9:.1f} GB), above the limit of {DENSE_MAX:,}; use "
+                                              "--method newton (FFT products, no matrix) or a coarser grid "
+                                              "(discretization.elements)")
         bi = (rows // g.nx)[:, None] - (cols // g.nx)[None, :] + g.ny - 1
         ai = (rows % g.nx)[:, None] - (cols % g.nx)[None, :] + g.nx - 1
         out = np.zeros((self.m_out * rows.size, self.m_in * cols.size))
