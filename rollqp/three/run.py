@@ -25,9 +25,10 @@ import numpy as np
 
 from ..atomic import stop_once
 from ..errors import InputError, SolverError
+from ..fields import fields_for
 from ..march import RESUME_TOL, _keep_every, _last_index, drive
 from ..methods import compose_3d, scene_method_3d
-from ..result import Layout, Result, ResumeSource, resume_source
+from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
@@ -230,8 +231,10 @@ def new_result(scene, contact, method_name: str, out=None, keep_every: int = 1) 
             "dimension": 3, "dq": scene.dq, "elements": int(g.n), "coupled": bool(contact.ops.coupled),
             "slip_note": ("state 0 of a braked start: static-shift slip per c = sqrt(ab) of shift"
                           if scene.load.start == "braked" else "state 0: the steady state")}
-    return Result(g.x, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, keep_every=keep_every, out=out,
-                  operators=contact, layout=GRID, coords={"x": g.x, "y": g.y})
+    constants = {"area": g.area, "wear_A": scene.A.wear or 0.0, "wear_B": scene.B.wear or 0.0,
+                 "braked": float(scene.load.start == "braked")}
+    return Result(g.x, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, fields_for(scene), keep_every=keep_every,
+                  out=out, operators=contact, layout=GRID, coords={"x": g.x, "y": g.y}, constants=constants)
 
 
 @functools.lru_cache(maxsize=1)
@@ -297,6 +300,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
         ``err.partial`` holds the result of the completed states.
     """
     asked = scene if isinstance(scene, SceneBase) else load_scene(scene)
+    if out is not None:
+        out = check_output(out, key="out")
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
     scene, meth, contact = prepared = prepare(asked, method)
