@@ -439,7 +439,8 @@ def cmd_run(args) -> int:
     try:
         with OutputLock(out), (nullcontext() if args.quiet else listening(_iteration_lines())):
             try:
-                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
+                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every,
+                                 start_progress=None if args.quiet or source is not None else start_progress())
             except KeyboardInterrupt as err:
                 # the run is over and its states are written: a later Ctrl-C or SIGTERM must not cut the exit short
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -532,6 +533,36 @@ def _advise(scene) -> None:
     notes.append(alternation_note(plan.scene))
     for note in filter(None, notes):
         print(f"rollqp: {note}", file=sys.stderr, flush=True)
+
+
+def start_progress():
+    """The report of a start's steps (a march to the steady state, the static shift steps): after the first
+    :data:`START_ESTIMATE_SECONDS`, once, the estimated time of the whole start if it exceeds
+    :data:`ANNOUNCE_SECONDS`; then a line every ``ROLLQP_PROGRESS_SECONDS`` (default :data:`LOG_EVERY`)."""
+    t0 = time.perf_counter()
+    state = {"last": t0, "said": False}
+    try:
+        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
+    except ValueError:
+        every = LOG_EVERY
+
+    def tick(j, expected):
+        now = time.perf_counter()
+        if not state["said"] and now - t0 >= START_ESTIMATE_SECONDS:
+            state["said"] = True
+            total = (now - t0) / j * max(expected, j)
+            if total > ANNOUNCE_SECONDS:
+                print(f"rollqp: the starting state: about {_minutes(total)} ({expected} steps usually, "
+                      f"{(now - t0) / j:.3g} s a step measured on the first {j})", file=sys.stderr, flush=True)
+        if now - state["last"] >= every:
+            state["last"] = now
+            print(f"rollqp: the starting state: step {j} (about {expected} usually), {now - t0:.1f} s",
+                  file=sys.stderr, flush=True)
+    return tick
+
+
+#: Seconds of a start's steps after which its total time is estimated (:func:`start_progress`).
+START_ESTIMATE_SECONDS = 3.0
 
 
 def estimate_progress(cb, steps: int):

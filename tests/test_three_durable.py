@@ -445,3 +445,21 @@ def test_stresses_of_a_3d_result(tmp_path, capsys):
     run(scene, out=str(tmp_path / "r.npz"))
     assert cli.main(["stresses", str(tmp_path / "r.npz"), "--step", "1"]) == 0
     assert "peak" in capsys.readouterr().out
+
+
+# ----------------------------------------------------------------------------- a long start says so
+def test_a_marched_start_reports_its_steps_and_an_estimate(tmp_path, capsys, monkeypatch):
+    """A conic method marches to a rolling start's steady state (minutes on a fine grid with dissimilar bodies):
+    ``rollqp run`` says how long the start will take, measured on its first steps, and reports its steps."""
+    scene = coarse("kalker-circular", **{"solver.method": "socp-clarabel", "discretization.distance": 0.2})
+    ticks = []
+    run(scene, start_progress=lambda j, expected: ticks.append((j, expected)))
+    assert ticks and ticks[0][0] == 1 and all(e == ticks[0][1] > 1 for _, e in ticks)
+    assert [j for j, _ in ticks] == list(range(1, len(ticks) + 1))
+    (tmp_path / "s.toml").write_text(scene.to_toml(), encoding="utf-8")
+    monkeypatch.setattr(cli, "START_ESTIMATE_SECONDS", 0.0)
+    monkeypatch.setattr(cli, "ANNOUNCE_SECONDS", 0.0)
+    monkeypatch.setenv("ROLLQP_PROGRESS_SECONDS", "0")
+    assert cli.main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "r.npz")]) == 0
+    err = capsys.readouterr().err
+    assert "rollqp: the starting state: about " in err and "rollqp: the starting state: step 1 " in err, err
