@@ -149,7 +149,98 @@ def section_chord(quick):
                   "Anderson / chord", "max\\|Δt\\|/μp0"], rows)
 
 
-SECTIONS = {"steady": ("steady rolling step, Newton", section_steady), "socp": ("SOCP against Newton", section_socp),
+def _cpu(fn, repeats):
+    """(best CPU seconds of this process over ``repeats`` calls, the last result): CPU time, not wall time, so
+    that the other jobs of a shared machine weigh less (a job's CPU time still grows with the cache misses they
+    cause)."""
+    best, out = np.inf, None
+    for _ in range(repeats):
+        t0 = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def _circle(per, nu=0.28):
+    """A circle of ``per`` elements per semi-axis (CONTACT's count): ``2·per + 2`` elements on zone
+    ``(per + 1)/per``, one row to spare on each side."""
+    zone = (per + 1) / per
+    return Contact.hertzian(Materials.from_young(210e3, nu, 210e3, nu), (1 / 60, 1 / 60), FN, MU,
+                            elements=(2 * per + 2, 2 * per + 2), zone=(zone, zone))
+
+
+#: CONTACT's figures on the same problems (circle, partial slip; single-threaded, whole process CPU time),
+#: as measured on another machine with CONTACT (not installed here): the ratios rollqp / CONTACT then and
+#: CONTACT's own transient step times.
+CONTACT_RATIO_STEADY = {10: "38× (SteadyGS)", 20: "3.5× (SteadyGS), 4.9× (GDsteady)", 40: "0.29× (SteadyGS), 1.0× (GDsteady)"}
+CONTACT_TRANSIENT_MS = {10: (3.0, 5.0), 20: (21.0, 21.0)}
+
+
+def section_contact(quick):
+    """The problems CONTACT was timed on: the steady rolling step (normal + steady tangential, ξ alone and ξ, η, φ
+    together, partial slip) and a transient rolling step, on circles of 10 and 20 elements per semi-axis (22 × 22
+    and 44 × 44), CPU seconds of this process (best of several), beside CONTACT's figures."""
+    from rollqp.three.march import transient
+    rows = []
+    a = 0.5857  # mm, the circle's Hertz radius (curvature 1/60 per body, FN = 1000 N)
+    cases = (("ξ", Loads(xi=-1e-3, eta=0.0, phi=0.0)), ("ξ, η, φ", Loads(xi=-1e-3, eta=5e-4, phi=5e-4 / a)))
+    for per in (10, 20) if quick else (10, 20, 40):
+        for label, loads in cases:
+            m = NewtonMethod()
+            c = _circle(per)
+            tn, p = _cpu(lambda: normal(c, m, FN), 7)
+            tt, rec = _cpu(lambda: steady(c, m, FN, loads, pressure=p), 7)
+            slip, on = int(np.sum(rec.state == 2)), int(np.sum(rec.state > 0))
+            recs = list(transient(c, m, FN, loads, c.grid.dx, 12))
+            step = float(np.median([r.time for r in recs[2:]]))
+            ratio = CONTACT_RATIO_STEADY.get(per, "–")
+            lo, hi = CONTACT_TRANSIENT_MS.get(per, (None, None))
+            tr = f"{step * 1e3:.1f}" + (f" ({step * 1e3 / hi:.1f}–{step * 1e3 / lo:.1f}× CONTACT's {lo:g}–{hi:g} ms)"
+                                        if lo else "")
+            rows.append([f"{per} ({c.grid.nx} × {c.grid.ny})", label, f"{slip}/{on}", f"{tn * 1e3:.1f}",
+                         f"{tt * 1e3:.1f}", f"{(tn + tt) * 1e3:.1f}", ratio, tr])
+    return table(["elements per semi-axis (grid)", "creepages", "slip/contact", "normal [ms CPU]",
+                  "steady tangential [ms CPU]", "steady step [ms CPU]", "CONTACT: rollqp / CONTACT then",
+                  "transient step, median [ms wall]"], rows)
+
+
+def section_startup(quick):
+    """The start-up of a small 3D run, each in a fresh process (best of 3 wall times): the import, the import and
+    the influence coefficients of a 22 × 22 contact (kernels and their FFTs), and the whole command on a 22 × 22
+    steady state (kalker-circular's circle, ξ = 1e-3, no rolling steps, no cross-check)."""
+    import subprocess
+    import sys
+    import tempfile
+    from rollqp import load_scene
+    folder = tempfile.mkdtemp()
+    scene = load_scene("kalker-circular", {"discretization.elements": [22, 22], "discretization.zone": [1.1, 1.1],
+                                           "discretization.distance": 0.0, "load.creepage.longitudinal": 1e-3})
+    path = os.path.join(folder, "c22.toml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(scene.to_toml())
+    contact = ("import numpy as np, rollqp\nfrom rollqp.three.contact import Contact\n"
+               "from rollqp.three.materials import Materials\n"
+               "c = Contact.hertzian(Materials.from_young(210e3, .28, 210e3, .28), (1/60, 1/60), 1e3, .3, "
+               "elements=(22, 22), zone=(1.1, 1.1))\nc.ops.Att @ np.ones(2 * c.grid.n); c.ops.Ann @ np.ones(c.grid.n)")
+    cases = (("import rollqp", [sys.executable, "-c", "import rollqp"]),
+             ("import + a 22 × 22 contact's influence coefficients", [sys.executable, "-c", contact]),
+             ("rollqp run c22.toml --quiet --no-cross-check (22 × 22 steady state)",
+              [sys.executable, "-m", "rollqp.cli", "run", path, "--quiet", "--no-cross-check", "--out",
+               os.path.join(folder, "c22.npz")]))
+    rows = []
+    for label, cmd in cases:
+        best = np.inf
+        for _ in range(3):
+            t0 = time.perf_counter()
+            subprocess.run(cmd, check=True, capture_output=True, cwd=folder)
+            best = min(best, time.perf_counter() - t0)
+        rows.append([label, f"{best:.2f}"])
+    return table(["what (a fresh process)", "wall [s], best of 3"], rows)
+
+
+SECTIONS = {"contact": ("CONTACT's problems: steady and transient steps", section_contact),
+            "startup": ("start-up of a small 3D run", section_startup),
+            "steady": ("steady rolling step, Newton", section_steady), "socp": ("SOCP against Newton", section_socp),
             "builtins": ("the built-in 3D scenes", section_builtins),
             "chord": ("the conic route to a steady state", section_chord)}
 
