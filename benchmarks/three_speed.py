@@ -191,8 +191,16 @@ def section_contact(quick):
             tn, p = _cpu(lambda: normal(c, m, FN), 7)
             tt, rec = _cpu(lambda: steady(c, m, FN, loads, pressure=p), 7)
             slip, on = int(np.sum(rec.state == 2)), int(np.sum(rec.state > 0))
-            recs = list(transient(c, m, FN, loads, c.grid.dx, 12))
-            step = float(np.median([r.time for r in recs[2:]]))
+            gen, cpu = transient(c, m, FN, loads, c.grid.dx, 12), []
+            next(gen)                                        # the start (its normal step)
+            while True:
+                t0 = time.process_time()
+                try:
+                    next(gen)
+                except StopIteration:
+                    break
+                cpu.append(time.process_time() - t0)
+            step = float(np.median(cpu[1:]))
             ratio = CONTACT_RATIO_STEADY.get(per, "–")
             lo, hi = CONTACT_TRANSIENT_MS.get(per, (None, None))
             tr = f"{step * 1e3:.1f}" + (f" ({step * 1e3 / hi:.1f}–{step * 1e3 / lo:.1f}× CONTACT's {lo:g}–{hi:g} ms)"
@@ -201,11 +209,11 @@ def section_contact(quick):
                          f"{tt * 1e3:.1f}", f"{(tn + tt) * 1e3:.1f}", ratio, tr])
     return table(["elements per semi-axis (grid)", "creepages", "slip/contact", "normal [ms CPU]",
                   "steady tangential [ms CPU]", "steady step [ms CPU]", "CONTACT: rollqp / CONTACT then",
-                  "transient step, median [ms wall]"], rows)
+                  "transient rolling step, median [ms CPU]"], rows)
 
 
 def section_startup(quick):
-    """The start-up of a small 3D run, each in a fresh process (best of 3 wall times): the import, the import and
+    """The start-up of a small 3D run, each in a fresh process (best of 3, CPU and wall): the import, the import and
     the influence coefficients of a 22 × 22 contact (kernels and their FFTs), and the whole command on a 22 × 22
     steady state (kalker-circular's circle, ξ = 1e-3, no rolling steps, no cross-check)."""
     import subprocess
@@ -227,18 +235,100 @@ def section_startup(quick):
              ("rollqp run c22.toml --quiet --no-cross-check (22 × 22 steady state)",
               [sys.executable, "-m", "rollqp.cli", "run", path, "--quiet", "--no-cross-check", "--out",
                os.path.join(folder, "c22.npz")]))
+    import resource
     rows = []
     for label, cmd in cases:
-        best = np.inf
+        best, wall = np.inf, np.inf
         for _ in range(3):
-            t0 = time.perf_counter()
+            r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
             subprocess.run(cmd, check=True, capture_output=True, cwd=folder)
-            best = min(best, time.perf_counter() - t0)
-        rows.append([label, f"{best:.2f}"])
-    return table(["what (a fresh process)", "wall [s], best of 3"], rows)
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            best = min(best, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+            wall = min(wall, time.perf_counter() - t0)
+        rows.append([label, f"{best:.2f}", f"{wall:.2f}"])
+    return table(["what (a fresh process)", "CPU [s] (user + system), best of 3", "wall [s], best of 3"], rows)
+
+
+def _steady_run(n, method="newton", xi=1e-3):
+    """kalker-circular's circle (zone 1.25: the edge on element boundaries for n a multiple of 5) at ξ alone, its
+    steady state on n × n elements by ``method``: (Fx, CPU seconds of the run, wall seconds)."""
+    from rollqp import load_scene
+    from rollqp.three.run import run
+    scene = load_scene("kalker-circular", {"discretization.elements": [n, n], "discretization.distance": 0.0,
+                                           "load.creepage.longitudinal": xi, "solver.method": method})
+    c0, w0 = time.process_time(), time.perf_counter()
+    r = run(scene).arrays()
+    return float(r["Fx"][0]), time.process_time() - c0, time.perf_counter() - w0
+
+
+#: CONTACT's point on the work–precision figure: 1 % error in Fx at 30 elements per semi-axis in 1–2 s of CPU
+#: (CONTACT's default solvers, single-threaded, measured on another machine: CONTACT is not installed here).
+CONTACT_POINT = (1.5, 1e-2)
+
+
+def section_precision(quick):
+    """Force error against CPU time on the circle at ξ = 1e-3 (partial slip): Newton on 20 … 160 elements,
+    FASTSIM on the same grids, the extrapolation from three grids; the reference is Richardson's extrapolation
+    from 75, 150 and 300 elements (its own estimate printed). Draws docs/figures/perf-3d-work-precision.png."""
+    from rollqp.three.extrapolate import richardson
+    ref_grids = (40, 80, 160) if quick else (75, 150, 300)
+    ref_vals = [_steady_run(n)[0] for n in ref_grids]
+    ref = richardson(ref_vals, 2.0)
+    F = ref.value
+    rows, pts = [], {"newton": [], "fastsim": [], "extrapolated": []}
+    grids = (20, 40, 80) if quick else (20, 40, 80, 160)
+    runs = {n: _steady_run(n) for n in grids}
+    for n in grids:
+        Fx, cpu, wall = runs[n]
+        pts["newton"].append((cpu, abs(Fx / F - 1)))
+        rows.append([f"newton {n} × {n}", f"{Fx:.5f}", f"{abs(Fx / F - 1):.2e}", f"{cpu:.2f}", f"{wall:.2f}", ""])
+    for n in grids:
+        Fx, cpu, wall = _steady_run(n, "fastsim")
+        pts["fastsim"].append((cpu, abs(Fx / F - 1)))
+        rows.append([f"fastsim {n} × {n}", f"{Fx:.5f}", f"{abs(Fx / F - 1):.2e}", f"{cpu:.2f}", f"{wall:.2f}", ""])
+    for trio in zip(grids, grids[1:], grids[2:]):
+        e = richardson([runs[n][0] for n in trio], 2.0)
+        cpu = sum(runs[n][1] for n in trio)
+        pts["extrapolated"].append((cpu, abs(e.value / F - 1), e.error / abs(e.value)))
+        order = f"{e.order:.2f}" if e.order is not None else "–"
+        rows.append([f"extrapolated {'/'.join(map(str, trio))} (order {order})", f"{e.value:.5f}",
+                     f"{abs(e.value / F - 1):.2e}", f"{cpu:.2f}", f"{sum(runs[n][2] for n in trio):.2f}",
+                     f"{e.error / abs(e.value):.2e}"])
+    _figure(pts, F)
+    head = (f"reference Fx = {F:.5f} N: Richardson from {', '.join(map(str, ref_grids))} elements "
+            f"({', '.join(f'{v:.5f}' for v in ref_vals)}; order {ref.order if ref.order is None else round(ref.order, 2)}, "
+            f"estimate {ref.error / abs(F):.2e})\n\n")
+    return head + table(["method and grid", "Fx [N]", "error against the reference", "CPU [s]", "wall [s]",
+                         "its own error estimate"], rows)
+
+
+def _figure(pts, F):
+    from pathlib import Path
+    from harness import pyplot
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for key, marker in (("newton", "o-"), ("fastsim", "s-")):
+        xs, ys = zip(*pts[key])
+        ax.loglog(xs, ys, marker, label={"newton": "Newton, 20 … 160 elements across",
+                                         "fastsim": "FASTSIM (Kalker's simplified theory), same grids"}[key])
+    if pts["extrapolated"]:
+        xs, ys, es = zip(*pts["extrapolated"])
+        ax.errorbar(xs, ys, yerr=[[0] * len(es), es], fmt="D", capsize=3,
+                    label="extrapolated from three grids (bar: its own error estimate)")
+    ax.loglog(*CONTACT_POINT, "k*", markersize=11, label="CONTACT, 30 per semi-axis (another machine)")
+    ax.axhline(1e-3, color="0.6", lw=0.8, ls=":")
+    ax.set_xlabel("CPU time [s] (this machine, one thread)")
+    ax.set_ylabel("|Fx / Fx,ref − 1|")
+    ax.set_title("Circle, ξ = 1e-3 (partial slip): creep force error against time", fontsize=10)
+    ax.legend(fontsize=7)
+    out = Path(__file__).resolve().parent.parent / "docs" / "figures" / "perf-3d-work-precision.png"
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
 
 
 SECTIONS = {"contact": ("CONTACT's problems: steady and transient steps", section_contact),
+            "precision": ("work–precision: Newton, FASTSIM, extrapolation", section_precision),
             "startup": ("start-up of a small 3D run", section_startup),
             "steady": ("steady rolling step, Newton", section_steady), "socp": ("SOCP against Newton", section_socp),
             "builtins": ("the built-in 3D scenes", section_builtins),
