@@ -13,6 +13,7 @@
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
     rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
     rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
+                    (3D: [--plane y=Y | --plane x=X | --line x=X,y=Y] [--depths Z1,Z2,...])
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first), 4 for a
@@ -386,10 +387,12 @@ def _takes(scene, command: str) -> None:
     """Refuse a scene whose dimension's record does not list ``command``."""
     if command not in family(scene).commands:
         from .errors import InputError
-        dims = " and ".join(f"{d}D" for d, f in FAMILIES.items() if command in f().commands)
+        name = lambda d: f"{d}D" if isinstance(d, int) else d   # noqa: E731 - a dimension or a family's name
+        dims = " and ".join(name(d) for d, f in FAMILIES.items() if command in f().commands)
         takes = ", ".join(["run", "show", "scenes", *sorted(family(scene).commands)])
-        raise InputError("SCENE", f"{scene.name!r} is a {scene.dimension}D scene; rollqp {command} works on {dims} "
-                                  f"scenes (a {scene.dimension}D scene: rollqp {takes})")
+        what = name(getattr(scene, "family", scene.dimension))
+        raise InputError("SCENE", f"{scene.name!r} is a {what} scene; rollqp {command} works on {dims} "
+                                  f"scenes (a {what} scene: rollqp {takes})")
 
 
 def _unwritten(err: OSError, out) -> str:
@@ -438,7 +441,8 @@ def cmd_run(args) -> int:
     try:
         with OutputLock(out), (nullcontext() if args.quiet else listening(_iteration_lines())):
             try:
-                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
+                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every,
+                                 start_progress=None if args.quiet or source is not None else start_progress())
             except KeyboardInterrupt as err:
                 # the run is over and its states are written: a later Ctrl-C or SIGTERM must not cut the exit short
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -531,6 +535,36 @@ def _advise(scene) -> None:
     notes.append(alternation_note(plan.scene))
     for note in filter(None, notes):
         print(f"rollqp: {note}", file=sys.stderr, flush=True)
+
+
+def start_progress():
+    """The report of a start's steps (a march to the steady state, the static shift steps): after the first
+    :data:`START_ESTIMATE_SECONDS`, once, the estimated time of the whole start if it exceeds
+    :data:`ANNOUNCE_SECONDS`; then a line every ``ROLLQP_PROGRESS_SECONDS`` (default :data:`LOG_EVERY`)."""
+    t0 = time.perf_counter()
+    state = {"last": t0, "said": False}
+    try:
+        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
+    except ValueError:
+        every = LOG_EVERY
+
+    def tick(j, expected):
+        now = time.perf_counter()
+        if not state["said"] and now - t0 >= START_ESTIMATE_SECONDS:
+            state["said"] = True
+            total = (now - t0) / j * max(expected, j)
+            if total > ANNOUNCE_SECONDS:
+                print(f"rollqp: the starting state: about {_minutes(total)} ({expected} steps usually, "
+                      f"{(now - t0) / j:.3g} s a step measured on the first {j})", file=sys.stderr, flush=True)
+        if now - state["last"] >= every:
+            state["last"] = now
+            print(f"rollqp: the starting state: step {j} (about {expected} usually), {now - t0:.1f} s",
+                  file=sys.stderr, flush=True)
+    return tick
+
+
+#: Seconds of a start's steps after which its total time is estimated (:func:`start_progress`).
+START_ESTIMATE_SECONDS = 3.0
 
 
 def estimate_progress(cb, steps: int):
@@ -878,12 +912,48 @@ def _stresses_parser(sub):
     t.add_argument("result", metavar="RESULT.npz")
     t.add_argument("--step", type=int, required=True, help="the stored state K (0 = the starting state; "
                    "negative counts from the end)")
-    t.add_argument("--plot", help="contour maps of von Mises and tau1 with the stick/slip zones (PNG)")
-    t.add_argument("--out", help="stress file (.npz): x, z, every stress quantity, the maxima")
+    t.add_argument("--plot", help="contour maps of von Mises and tau1 (3D: Tresca) with the surface tractions (PNG)")
+    t.add_argument("--out", help="stress file (.npz): the points, every stress quantity, the maxima")
     t.add_argument("--body", default="A", choices=("A", "B"), help="body A (traction t) or B (-t)")
-    t.add_argument("--grid", default="200,200", help="NX,NZ points on ±WIDTH a_H and depths (0, DEPTH a_H]")
-    t.add_argument("--width", type=float, default=1.5, help="half-width of the grid in a_H (default 1.5)")
-    t.add_argument("--depth", type=float, default=2.0, help="depth of the grid in a_H (default 2)")
+    t.add_argument("--grid", default=None, help="2D: NX,NZ points on ±WIDTH a_H and depths (0, DEPTH a_H] "
+                   "(default 200,200)")
+    t.add_argument("--width", type=float, default=None, help="2D: half-width of the grid in a_H (default 1.5)")
+    t.add_argument("--depth", type=float, default=None, help="2D: depth of the grid in a_H (default 2)")
+    t.add_argument("--plane", help="3D: the plane y=Y (points along x at the element centres) or x=X "
+                   "(scene length units; default y=0)")
+    t.add_argument("--line", help="3D: the vertical line x=X,y=Y instead of a plane")
+    t.add_argument("--depths", help="3D: depths Z1,Z2,... (> 0, scene length units; default 40 down to 2a)")
+
+
+def _stresses_3d(args, arrays) -> int:
+    """``rollqp stresses`` on a 3D result: the section the user chose, its peaks, the stress file, the figure."""
+    from .errors import InputError
+    from .subsurface3d import (parse_depths, parse_line, parse_plane, plot_field3d, save_field3d, stresses3d,
+                               summary_rows3d)
+    for opt in ("grid", "width", "depth"):
+        if getattr(args, opt) is not None:
+            raise InputError(f"--{opt}", "is for 2D results; on a 3D result choose the points with --plane y=Y | "
+                                         "--plane x=X | --line x=X,y=Y and --depths Z1,Z2,...")
+    plane = parse_plane(args.plane) if args.plane is not None else None
+    line = parse_line(args.line) if args.line is not None else None
+    depths = parse_depths(args.depths) if args.depths is not None else None
+    names = {"step": "--step", "result": "RESULT.npz", "depths": "--depths", "points": "--depths"}
+    try:
+        sf = stresses3d(arrays, args.step, plane, line, depths, body=args.body)
+    except InputError as err:
+        raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
+    p0 = float(arrays["p0"])
+    nz, nh = sf.values["sxx"].shape
+    print(f"  state         {sf.step} (q = {sf.q:.6g}), body {sf.body}, {sf.section.label}, "
+          f"{nh} x {nz} points" if nh > 1 else f"  state         {sf.step} (q = {sf.q:.6g}), body {sf.body}, "
+          f"{sf.section.label}, {nz} depths")
+    for k, v in summary_rows3d(sf, p0):
+        print(f"  {k:<20}  {v}")
+    if args.out:
+        print(f"  stress file   {save_field3d(sf, args.out)}")
+    if args.plot:
+        print(f"  figure        {plot_field3d(sf, arrays, args.plot, p0)}")
+    return 0
 
 
 def cmd_stresses(args) -> int:
@@ -891,22 +961,27 @@ def cmd_stresses(args) -> int:
     from .influence import get_model
     from .result import check_output, load_result
     from .subsurface import _source, default_grid, plot_field, save_field, stresses, summary_rows
-    try:
-        nx, nz = (int(v) for v in args.grid.split(","))
-    except ValueError:
-        raise InputError("--grid", f"must be NX,NZ (two integers), got {args.grid!r}") from None
     if args.out:
         check_output(args.out, "stress file", "--out")
     _check_plot(args.plot)
+    loaded = load_result(args.result, "RESULT.npz")
+    if "y" in loaded:  # a grid of elements: a 3D result
+        return _stresses_3d(args, loaded)
+    for opt in ("plane", "line", "depths"):
+        if getattr(args, opt) is not None:
+            raise InputError(f"--{opt}", "is for 3D results; on a 2D result choose the points with --grid NX,NZ, "
+                                         "--width and --depth")
+    grid = "200,200" if args.grid is None else args.grid
+    width, depth = (1.5 if args.width is None else args.width), (2.0 if args.depth is None else args.depth)
+    try:
+        nx, nz = (int(v) for v in grid.split(","))
+    except ValueError:
+        raise InputError("--grid", f"must be NX,NZ (two integers), got {grid!r}") from None
     names = {"nx": "--grid", "nz": "--grid", "width": "--width", "depth": "--depth", "step": "--step",
              "result": "RESULT.npz"}
-    loaded = load_result(args.result, "RESULT.npz")
-    if "py" in loaded:                  # a 3D result: its lateral traction
-        raise InputError("RESULT.npz", f"{args.result} is a 3D result (Kalker's problem): rollqp stresses computes the "
-                                       "subsurface field of 2D results (docs/stresses.md)")
     try:
         arrays, scene = _source(loaded)
-        sf = stresses(arrays, args.step, default_grid(scene, nx, nz, args.width, args.depth), body=args.body)
+        sf = stresses(arrays, args.step, default_grid(scene, nx, nz, width, depth), body=args.body)
     except InputError as err:
         raise InputError(names.get(err.key, err.key), str(err).split(": ", 1)[-1]) from None
     a, p0 = float(arrays["a_H"]), float(arrays["p0"])

@@ -173,7 +173,7 @@ class Journal:
                     raise InputError(arg, f"{path!r}: a second header frame at byte {pos}: corrupt journal")
                 header = os.pread(fd, length, pos + HEAD_BYTES)
                 if zlib.crc32(header) != crc:
-                    if _torn(fd, pos + HEAD_BYTES + length, size):
+                    if _torn(fd, pos + HEAD_BYTES + length, size) and _zero_tail(fd, pos + HEAD_BYTES, length):
                         break
                     raise InputError(arg, f"{path!r}: the header fails its CRC: corrupt journal")
                 head, layouts = _header(header, path, arg)
@@ -181,7 +181,7 @@ class Journal:
                 if header is None:
                     raise InputError(arg, f"{path!r}: a state frame before the header: corrupt journal")
                 if not _payload_crc(fd, pos + HEAD_BYTES, length) == crc:
-                    if _torn(fd, pos + HEAD_BYTES + length, size):
+                    if _torn(fd, pos + HEAD_BYTES + length, size) and _zero_tail(fd, pos + HEAD_BYTES, length):
                         break
                     raise InputError(arg, f"{path!r}: the state frame at byte {pos} fails its CRC: corrupt journal")
                 frames.add(pos + HEAD_BYTES, kind, flags, length, index, crc)
@@ -337,6 +337,20 @@ def _torn(fd, pos, size) -> bool:
             return not block
         pos += len(block)
     return True
+
+
+#: The unit in which a machine that loses power leaves unwritten data as zeros (a page of the file).
+PAGE = 4096
+
+
+def _zero_tail(fd, offset, length) -> bool:
+    """The payload at ``offset`` ends in zeros from its last page boundary on (or is all zeros): what a write that
+    never reached the disk leaves (the file's length updated, its last pages not). A complete last frame whose
+    CRC fails otherwise was changed after it was written: a corrupt journal, not a torn one."""
+    end = offset + length
+    start = max(offset, (end - 1) // PAGE * PAGE)
+    block = os.pread(fd, end - start, start)
+    return block.count(0) == len(block)
 
 
 def _payload_crc(fd, offset, length) -> int:

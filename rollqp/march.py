@@ -54,7 +54,7 @@ from .errors import InputError, SolverError
 from .kinematics import HistoryCache, plan
 from .operators import SceneOperators
 from .problem import SLIP, STICK, State, StepSolution, classify
-from .result import Result
+from .result import Result, ResumeSource, _meta_of, check_output, resume_source
 from .scene import Scene, load_scene
 from .strip import RowSparse
 
@@ -797,7 +797,7 @@ def _identical(again: State, stored: State) -> bool:
 
 
 def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None,
-        geometry=None) -> Result:
+        geometry=None, start_progress=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -827,6 +827,9 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         ones (``Field.reduce``). Default 1, or the resumed file's.
     geometry : Memo, optional
         Shared by the runs it is handed to: what the influence model keeps of the bodies (:func:`prepare`).
+    start_progress : callable, optional
+        The 3D run's report of the steps of its start (:func:`rollqp.three.run.run`); a 2D start (its
+        problems on a strip: milliseconds to seconds) is not reported.
 
     Raises
     ------
@@ -839,10 +842,11 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     KeyboardInterrupt
         Interrupted (Ctrl-C, or SIGTERM in the command line): ``partial`` as above.
     """
-    from .result import ResumeSource, resume_source
     asked = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != asked.solver.method:
         asked = asked.replace(**{"solver.method": method})
+    if out is not None:
+        out = check_output(out, key="out")
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
     if out is None:  # before any work: the states it would hold, on the operators it would build
@@ -913,7 +917,6 @@ def drive(result, records, *, source=None, resumed_from=None, operators=None, ob
 
 def _keep_every(keep_every, source) -> int:
     """``keep_every`` of a run: the resumed file's, which an explicit value must not contradict."""
-    from .result import ResumeSource, _meta_of
     had = source.keep_every if isinstance(source, ResumeSource) else \
         _meta_of(source).get("keep_every", 1) if isinstance(source, dict) else None
     if had is not None and (isinstance(had, bool) or not isinstance(had, int) or had < 1):

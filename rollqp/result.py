@@ -673,6 +673,10 @@ def _chain(first, rest):
 
 
 # =========================================================================== files
+#: The longest suffix of a file written beside a result file (its journal; its lock is ``.lock``).
+_LONGEST_SUFFIX = ".journal"
+
+
 def check_output(path, what: str = "result file", key: str = "--out") -> str:
     """``path`` as a string if a ``.npz`` can be written there: checked before any work.
 
@@ -681,12 +685,26 @@ def check_output(path, what: str = "result file", key: str = "--out") -> str:
     InputError
         ``key``: not ending in ``.npz``, a missing or unwritable folder, or a folder in its place.
     """
-    path = os.fspath(path)
+    try:
+        path = os.fspath(path)
+    except TypeError:
+        raise InputError(key, f"the {what} must be a path, got {type(path).__name__}") from None
+    if not isinstance(path, str) or "\x00" in path:
+        raise InputError(key, f"the {what} must be a path without NUL characters, got {str(path)[:80]!r}")
     if not path.endswith(".npz"):
         raise InputError(key, f"the {what} must end in .npz, got {path!r}")
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise InputError(key, f"folder {folder!r} does not exist")
+    try:
+        longest = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        longest = 255
+    name = os.path.basename(path)
+    if len(os.fsencode(name)) + len(_LONGEST_SUFFIX) > longest:   # its journal and lock sit beside it
+        raise InputError(key, f"the {what}'s name is too long: {len(os.fsencode(name))} bytes, at most "
+                              f"{longest - len(_LONGEST_SUFFIX)} (its journal {name[:20]}…{_LONGEST_SUFFIX} must fit "
+                              f"in {longest})")
     if os.path.isdir(path):
         raise InputError(key, f"{path!r} is a folder, not a file")
     try:
@@ -906,6 +924,9 @@ def resume_source(path, arg: str = "--resume") -> ResumeSource:
             journal.close()   # the file holds more: the journal of an older part
             journal = None
     if journal is None and arrays is None:
+        if os.path.isfile(jpath):
+            raise InputError(arg, f"the journal {jpath!r} holds no completed state (the run was stopped before its "
+                                  f"first state was complete): run the scene again")
         raise InputError(arg, f"no such file: {npz!r} (nor a journal {jpath!r} of a killed run)")
     return ResumeSource(npz, arg, journal=journal, arrays=None if journal is not None else arrays)
 

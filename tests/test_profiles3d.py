@@ -73,7 +73,7 @@ def _quartic(n, c=0.2):
 
 def test_a_quartic_lateral_profile_gives_a_non_elliptic_patch_whose_area_converges():
     """z = x²/60 + 0.2 y⁴: no curvature across y at the origin, so a, b, p0 come from the computed contact,
-    and the patch is no ellipse (its area differs from πab by more than the discretization). The contact
+    and the patch is no ellipse (its area is 15 % above πab, the discretization error 0.2 %). The contact
     area of the normal step against the 113-element grid converges at first order or better: the
     least-squares slope of log|A_n − A_113| over n = 10 … 80 (√2 apart) was 1.9 (1.7 against n = 160,
     docs/validation3d.md); the element count quantizes the boundary to dx/2, hence the scatter the bound
@@ -87,8 +87,8 @@ def test_a_quartic_lateral_profile_gives_a_non_elliptic_patch_whose_area_converg
     s = ref
     assert s.ellipse.a == pytest.approx(s.patch.a) and s.ellipse.b == pytest.approx(s.patch.b)
     assert s.ellipse.p0 == pytest.approx(3 * s.load.normal / (2 * np.pi * s.patch.a * s.patch.b), rel=1e-12)
-    # not an ellipse: the area of the patch is 2 % away from pi a b (a discretization error is below 0.5 %)
-    assert abs(s.patch.area / (np.pi * s.patch.a * s.patch.b) - 1) > 0.015
+    # not an ellipse: the area of the patch is 15 % above pi a b (measured; a discretization error is 0.2 %)
+    assert abs(s.patch.area / (np.pi * s.patch.a * s.patch.b) - 1) > 0.1
 
 
 def test_the_quartic_roller_runs_and_its_contact_is_the_normal_step_s():

@@ -145,7 +145,8 @@ def test_cli(carter_result, tmp_path, capsys):
     s = np.load(tmp_path / "s.npz")
     assert s["von_mises"].shape == (30, 40) and s["max_tau1"].shape == (3,)
     for argv, key in ((["--step", "999"], "--step"), (["--step", "0", "--depth", "-1"], "--depth"),
-                      (["--step", "0", "--grid", "4"], "--grid")):
+                      (["--step", "0", "--grid", "4"], "--grid"), (["--step", "0", "--plane", "y=0"], "--plane"),
+                      (["--step", "0", "--depths", "0.1"], "--depths")):
         assert main(["stresses", path] + argv) == 2
         err = capsys.readouterr().err.strip()
         assert err.startswith(f"rollqp: error: {key}:") and "\n" not in err

@@ -353,10 +353,10 @@ def field_figure(res, scene=None, path: str | None = None, k: int = -1, title: s
     --------
     >>> from rollqp import load_scene
     >>> from rollqp.three.run import run
-    >>> s = load_scene("kalker-elliptic").replace(**{"discretization.elements": [12, 24]})
+    >>> s = load_scene("kalker-elliptic").replace(**{"discretization.elements": [18, 36]})
     >>> fig = field_figure(run(s).arrays(), s)
-    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][:3]
-    ['$t$, element in stick', '$t = -\\mu p\\, s/|s|$, element in slip', 'stick area']
+    >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2:]
+    ['stick area', '$p/p_0$ = 0.2, 0.4, 0.6, 0.8', 'Hertz ellipse (3D.4)']
     """
     plt = pyplot()
     res = arrays(res)

@@ -262,18 +262,15 @@ class CreepCurve3D:
         return out
 
     def origin_slope(self) -> float:
-        """The computed slope at the origin: the secant through the two values of least |creepage| on either
-        side of 0 (or through 0 and the least one), from the computed curve."""
+        """The computed slope at the origin: the secant through the two values of least absolute creepage
+        (NaN with fewer than two computed points)."""
         F, v = self.force, self.values
         ok = np.isfinite(F)
         F, v = F[ok], v[ok]
-        i = np.argsort(np.abs(v))
-        if v.size == 0:
+        if v.size < 2:
             return float("nan")
-        if v.size == 1 or v[i[0]] == 0 and v.size == 1:
-            return float(F[i[0]] / v[i[0]]) if v[i[0]] != 0 else float("nan")
-        a, b = i[0], i[1]
-        return float((F[b] - F[a]) / (v[b] - v[a])) if v[a] != 0 or v[b] != 0 else float("nan")
+        a, b = np.argsort(np.abs(v))[:2]
+        return float((F[b] - F[a]) / (v[b] - v[a]))
 
     def table(self) -> str:
         s = self.scene
@@ -309,7 +306,8 @@ class CreepCurve3D:
         ax.plot(self.values, self.force / cap, "o-", ms=4, label=f"rollqp: {comp}/(μFN)")
         if k is not None:
             v = np.linspace(min(self.values.min(), 0.0), max(self.values.max(), 0.0), 200)
-            lin = np.clip(k * v / cap, -1.5, 1.5)
+            lin = k * v / cap
+            lin[np.abs(lin) > 1.2] = np.nan       # the line only where it is near the curve's range
             ax.plot(v, lin, "k:", lw=1, label="Kalker's linear theory")
         for y in (-1.0, 1.0):
             ax.axhline(y, color="0.5", lw=0.8, ls="--")

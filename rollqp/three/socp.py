@@ -276,11 +276,16 @@ class ClarabelMethod(ConicMethod):
         A, b, cones = _constraint_rows(form)
         if entry is None or entry[0] is not form.H:
             P = sp.triu(sp.csc_matrix(form.H), format="csc")
-            solver = clarabel.DefaultSolver(P, q, A, b, cones, _clarabel_settings(self.tolerance, self.max_iterations))
+            # built without the step's q and b, then given them: Clarabel scales its data once, when it is built
+            # (its cost scaling reads q), so that a solver object built at another step would steer the last bits
+            # of every later answer; built from (P, A) alone, the answer to a step is the same whichever step
+            # built it (a resumed run repeats the uninterrupted one bit for bit)
+            solver = clarabel.DefaultSolver(P, np.zeros_like(q), A, np.zeros_like(b), cones,
+                                            _clarabel_settings(self.tolerance, self.max_iterations))
             self._solvers = {key: (form.H, solver)}
         else:
             solver = entry[1]
-            solver.update(q=q, b=b)
+        solver.update(q=q, b=b)
         deadline = self.deadline
         if deadline is not None:  # a time budget (the run's cross-check): stop at its end
             solver.set_termination_callback(lambda info: time.perf_counter() > deadline)
@@ -394,7 +399,9 @@ class CvxpyMethod(ConicMethod):
             bnd.value = form.bound
         with warnings.catch_warnings():   # "may be inaccurate": rollqp's residual decides, not the status
             warnings.simplefilter("ignore", UserWarning)
-            prob.solve(solver=self.solver, **self._options())
+            # warm_start=False: cvxpy would otherwise keep Clarabel's solver object from step to step, whose
+            # scaling (made from the first step's data) steers the last bits of every later answer
+            prob.solve(solver=self.solver, warm_start=False, **self._options())
         if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
             raise SolverError(f"cvxpy/{self.solver} did not solve the step", method=self.name, status=prob.status)
         y = np.asarray(cons[0].dual_value, dtype=float).ravel() if bp is not None else np.zeros(0)
