@@ -16,6 +16,10 @@
    against the Anderson-accelerated march, at a small creepage (all stick) and a large one (partial slip).
 
     python benchmarks/three_speed.py --only builtins chord     # sections 4 and 5 alone (about 5 minutes)
+    python benchmarks/three_speed.py --only contact startup    # CONTACT's problems (22 × 22 … 82 × 82), start-up
+    python benchmarks/three_speed.py --only precision --figure docs/figures/perf-3d-work-precision.png
+                                                               # Newton, FASTSIM, extrapolation against a reference
+                                                               # from 75/150/300 elements (about 10 min at load 12)
 
 The machine is shared (2 cores, other jobs running): the load average is printed with the tables,
 and only ratios within one run are meaningful.
@@ -232,7 +236,8 @@ def section_startup(quick):
                "elements=(22, 22), zone=(1.1, 1.1))\nc.ops.Att @ np.ones(2 * c.grid.n); c.ops.Ann @ np.ones(c.grid.n)")
     cases = (("import rollqp", [sys.executable, "-c", "import rollqp"]),
              ("import + a 22 × 22 contact's influence coefficients", [sys.executable, "-c", contact]),
-             ("rollqp run c22.toml --quiet --no-cross-check (22 × 22 steady state)",
+             ("the command on a 22 × 22 steady state (kalker-circular's circle, ξ = 1e-3, no rolling steps; quiet, "
+              "no cross-check)",
               [sys.executable, "-m", "rollqp.cli", "run", path, "--quiet", "--no-cross-check", "--out",
                os.path.join(folder, "c22.npz")]))
     import resource
@@ -294,7 +299,7 @@ def section_precision(quick):
         rows.append([f"extrapolated {'/'.join(map(str, trio))} (order {order})", f"{e.value:.5f}",
                      f"{abs(e.value / F - 1):.2e}", f"{cpu:.2f}", f"{sum(runs[n][2] for n in trio):.2f}",
                      f"{e.error / abs(e.value):.2e}"])
-    _figure(pts, F)
+    _figure(pts, F, FIGURE[0])
     head = (f"reference Fx = {F:.5f} N: Richardson from {', '.join(map(str, ref_grids))} elements "
             f"({', '.join(f'{v:.5f}' for v in ref_vals)}; order {ref.order if ref.order is None else round(ref.order, 2)}, "
             f"estimate {ref.error / abs(F):.2e})\n\n")
@@ -302,7 +307,11 @@ def section_precision(quick):
                          "its own error estimate"], rows)
 
 
-def _figure(pts, F):
+#: Where section_precision draws its figure (``--figure``).
+FIGURE = ["docs/figures/perf-3d-work-precision.png"]
+
+
+def _figure(pts, F, path):
     from pathlib import Path
     from harness import pyplot
     plt = pyplot()
@@ -321,7 +330,9 @@ def _figure(pts, F):
     ax.set_ylabel("|Fx / Fx,ref − 1|")
     ax.set_title("Circle, ξ = 1e-3 (partial slip): creep force error against time", fontsize=10)
     ax.legend(fontsize=7)
-    out = Path(__file__).resolve().parent.parent / "docs" / "figures" / "perf-3d-work-precision.png"
+    out = Path(path)
+    if not out.is_absolute():
+        out = Path(__file__).resolve().parent.parent / out
     fig.tight_layout()
     fig.savefig(out, dpi=120)
     plt.close(fig)
@@ -339,7 +350,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description="Speed of the 3D steps (ratios within one run).")
     ap.add_argument("--quick", action="store_true", help="without the 300 × 300 grid and the 30 × 30 SOCP")
     ap.add_argument("--only", nargs="+", choices=sorted(SECTIONS), help="these sections only")
+    ap.add_argument("--figure", default=FIGURE[0], help="the work–precision figure (section precision; "
+                    "relative to the repository)")
     args = ap.parse_args(argv)
+    FIGURE[0] = args.figure
     pin_threads()
     print(f"load average at start: {', '.join(f'{x:.2f}' for x in os.getloadavg())} (2 cores, shared)\n")
     for key in args.only or SECTIONS:
