@@ -12,8 +12,7 @@
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
     rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
-    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
-                    (3D: [--plane y=Y | --plane x=X | --line x=X,y=Y] [--depths Z1,Z2,...])
+    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ] (3D: --plane, --line, --depths)
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first), 4 for a
