@@ -12,8 +12,7 @@
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
     rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
-    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
-                    (3D: [--plane y=Y | --plane x=X | --line x=X,y=Y] [--depths Z1,Z2,...])
+    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ] (3D: --plane, --line, --depths)
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first), 4 for a
@@ -387,10 +386,12 @@ def _takes(scene, command: str) -> None:
     """Refuse a scene whose dimension's record does not list ``command``."""
     if command not in family(scene).commands:
         from .errors import InputError
-        dims = " and ".join(f"{d}D" for d, f in FAMILIES.items() if command in f().commands)
+        name = lambda d: f"{d}D" if isinstance(d, int) else d   # noqa: E731 - a dimension or a family's name
+        dims = " and ".join(name(d) for d, f in FAMILIES.items() if command in f().commands)
         takes = ", ".join(["run", "show", "scenes", *sorted(family(scene).commands)])
-        raise InputError("SCENE", f"{scene.name!r} is a {scene.dimension}D scene; rollqp {command} works on {dims} "
-                                  f"scenes (a {scene.dimension}D scene: rollqp {takes})")
+        what = name(getattr(scene, "family", scene.dimension))
+        raise InputError("SCENE", f"{scene.name!r} is a {what} scene; rollqp {command} works on {dims} "
+                                  f"scenes (a {what} scene: rollqp {takes})")
 
 
 def _unwritten(err: OSError, out) -> str:
