@@ -111,6 +111,9 @@ class NormalStep:
         n = self.A.shape[1]
         if self.A.shape != (n, n):
             raise InputError("A", f"the normal operator must be square (1 × 1 blocks), got {self.A.shape}")
+        if not isinstance(self.scales, Scales) or self.scales.dimension != 3:
+            raise InputError("scales", "a grid's step takes Scales(..., dimension=3) (forces in p0 c²), got "
+                                       f"{self.scales!r}")
         object.__setattr__(self, "area", _number("area", self.area, positive=True))
         object.__setattr__(self, "h", _vector("h", self.h, n))
         if self.offset is not None:
@@ -194,6 +197,9 @@ class TangentialStep:
         n = self.B.shape[1] // 2
         if self.B.shape != (2 * n, 2 * n):
             raise InputError("B", f"the slip operator must be 2 × 2 blocks, got shape {self.B.shape}")
+        if not isinstance(self.scales, Scales) or self.scales.dimension != 3:
+            raise InputError("scales", "a grid's step takes Scales(..., dimension=3) (forces in p0 c²), got "
+                                       f"{self.scales!r}")
         object.__setattr__(self, "area", _number("area", self.area, positive=True))
         bound = _vector("bound", self.bound, n)
         if np.any(bound < 0):

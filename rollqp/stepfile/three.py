@@ -126,7 +126,7 @@ class StepFile3D:
 
     def scales(self):
         from ..problem.grid import Scales
-        return Scales(self.length, self.stress, self.modulus)
+        return Scales(self.length, self.stress, self.modulus, dimension=3)
 
     def normal(self, t):
         """The normal step (eq. 3D.14) at the traction ``t`` (its gap ``A_nt t``)."""
@@ -270,7 +270,7 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     method = method or REFERENCE_METHOD
     prepared = prepare(scene, method)
     scene, meth, contact = prepared
-    if getattr(contact, "law", None) is not None or np.ndim(getattr(contact, "mu", 0.0)) != 0:
+    if contact.law.kind != "constant":   # a law along the surface: μ differs from element to element
         raise InputError("contact.friction", "a 3D step file holds one constant coefficient of friction; this "
                                              "scene's friction law cannot be exported")
     prev: StepRecord | None = None
