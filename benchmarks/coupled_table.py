@@ -255,6 +255,9 @@ def variants(scene, repeats):
         def setup(self, operators):
             self.inner.setup(operators)
 
+        def carrier(self):
+            return self.inner.carrier()
+
         def solve(self, problem, warm=None):
             return self.inner.solve(problem, warm=None)
 

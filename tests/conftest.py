@@ -230,6 +230,10 @@ class Delegate:
     def setup(self, operators):
         self.inner.setup(operators)
 
+    def carrier(self):
+        """The inner method's (called where the capabilities it copies declare ``carries_state``)."""
+        return self.inner.carrier()
+
     def solve(self, problem, warm=None):
         return self.inner.solve(problem, warm=warm)
 

@@ -200,7 +200,7 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
             for k in order:
                 rec, before = kept[k]
                 kind, loads, previous, dq = _pose(scene, contact, rec, before)
-                key = _key(kind, loads, previous, dq)
+                key = _key(kind, contact.posed(loads), previous, dq)
                 if key not in done:
                     m = max(int(np.sum(rec.p > 0)), 1)
                     # the estimate: the model's before the first conic step, then that step's own time
