@@ -56,7 +56,9 @@ def prepare(scene, method=None):
     contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu,
                       profile=None if scene.shape.hertzian else scene.shape.at(0.0))
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
-        contact.move = moving_profile(contact, scene.shape, scene.load.direction)
+        contact.move = moving_profile(contact, scene.shape, scene.load.direction,
+                                      "discretization.extent" if scene.discretization.extent is not None
+                                      else "discretization.zone")
     meth.setup(contact)
     return scene, meth, contact
 
