@@ -16,6 +16,10 @@
    against the Anderson-accelerated march, at a small creepage (all stick) and a large one (partial slip).
 
     python benchmarks/three_speed.py --only builtins chord     # sections 4 and 5 alone (about 5 minutes)
+    python benchmarks/three_speed.py --only contact startup    # CONTACT's problems (22 × 22 … 82 × 82), start-up
+    python benchmarks/three_speed.py --only precision --figure docs/figures/perf-3d-work-precision.png
+                                                               # Newton, FASTSIM, extrapolation against a reference
+                                                               # from 75/150/300 elements (about 10 min at load 12)
 
 The machine is shared (2 cores, other jobs running): the load average is printed with the tables,
 and only ratios within one run are meaningful.
@@ -149,7 +153,195 @@ def section_chord(quick):
                   "Anderson / chord", "max\\|Δt\\|/μp0"], rows)
 
 
-SECTIONS = {"steady": ("steady rolling step, Newton", section_steady), "socp": ("SOCP against Newton", section_socp),
+def _cpu(fn, repeats):
+    """(best CPU seconds of this process over ``repeats`` calls, the last result): CPU time, not wall time, so
+    that the other jobs of a shared machine weigh less (a job's CPU time still grows with the cache misses they
+    cause)."""
+    best, out = np.inf, None
+    for _ in range(repeats):
+        t0 = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - t0)
+    return best, out
+
+
+def _circle(per, nu=0.28):
+    """A circle of ``per`` elements per semi-axis (CONTACT's count): ``2·per + 2`` elements on zone
+    ``(per + 1)/per``, one row to spare on each side."""
+    zone = (per + 1) / per
+    return Contact.hertzian(Materials.from_young(210e3, nu, 210e3, nu), (1 / 60, 1 / 60), FN, MU,
+                            elements=(2 * per + 2, 2 * per + 2), zone=(zone, zone))
+
+
+#: CONTACT's figures on the same problems (circle, partial slip; single-threaded, whole process CPU time),
+#: as measured on another machine with CONTACT (not installed here): the ratios rollqp / CONTACT then and
+#: CONTACT's own transient step times.
+CONTACT_RATIO_STEADY = {10: "38× (SteadyGS)", 20: "3.5× (SteadyGS), 4.9× (GDsteady)", 40: "0.29× (SteadyGS), 1.0× (GDsteady)"}
+CONTACT_TRANSIENT_MS = {10: (3.0, 5.0), 20: (21.0, 21.0)}
+
+
+def section_contact(quick):
+    """The problems CONTACT was timed on: the steady rolling step (normal + steady tangential, ξ alone and ξ, η, φ
+    together, partial slip) and a transient rolling step, on circles of 10 and 20 elements per semi-axis (22 × 22
+    and 44 × 44), CPU seconds of this process (best of several), beside CONTACT's figures."""
+    from rollqp.three.march import transient
+    rows = []
+    a = 0.5857  # mm, the circle's Hertz radius (curvature 1/60 per body, FN = 1000 N)
+    cases = (("ξ", Loads(xi=-1e-3, eta=0.0, phi=0.0)), ("ξ, η, φ", Loads(xi=-1e-3, eta=5e-4, phi=5e-4 / a)))
+    for per in (10, 20) if quick else (10, 20, 40):
+        for label, loads in cases:
+            m = NewtonMethod()
+            c = _circle(per)
+            tn, p = _cpu(lambda: normal(c, m, FN), 7)
+            tt, rec = _cpu(lambda: steady(c, m, FN, loads, pressure=p), 7)
+            slip, on = int(np.sum(rec.state == 2)), int(np.sum(rec.state > 0))
+            gen, cpu = transient(c, m, FN, loads, c.grid.dx, 12), []
+            next(gen)                                        # the start (its normal step)
+            while True:
+                t0 = time.process_time()
+                try:
+                    next(gen)
+                except StopIteration:
+                    break
+                cpu.append(time.process_time() - t0)
+            step = float(np.median(cpu[1:]))
+            ratio = CONTACT_RATIO_STEADY.get(per, "–")
+            lo, hi = CONTACT_TRANSIENT_MS.get(per, (None, None))
+            tr = f"{step * 1e3:.1f}" + (f" ({step * 1e3 / hi:.1f}–{step * 1e3 / lo:.1f}× CONTACT's {lo:g}–{hi:g} ms)"
+                                        if lo else "")
+            rows.append([f"{per} ({c.grid.nx} × {c.grid.ny})", label, f"{slip}/{on}", f"{tn * 1e3:.1f}",
+                         f"{tt * 1e3:.1f}", f"{(tn + tt) * 1e3:.1f}", ratio, tr])
+    return table(["elements per semi-axis (grid)", "creepages", "slip/contact", "normal [ms CPU]",
+                  "steady tangential [ms CPU]", "steady step [ms CPU]", "CONTACT: rollqp / CONTACT then",
+                  "transient rolling step, median [ms CPU]"], rows)
+
+
+def section_startup(quick):
+    """The start-up of a small 3D run, each in a fresh process (best of 3, CPU and wall): the import, the import and
+    the influence coefficients of a 22 × 22 contact (kernels and their FFTs), and the whole command on a 22 × 22
+    steady state (kalker-circular's circle, ξ = 1e-3, no rolling steps, no cross-check)."""
+    import subprocess
+    import sys
+    import tempfile
+    from rollqp import load_scene
+    folder = tempfile.mkdtemp()
+    scene = load_scene("kalker-circular", {"discretization.elements": [22, 22], "discretization.zone": [1.1, 1.1],
+                                           "discretization.distance": 0.0, "load.creepage.longitudinal": 1e-3})
+    path = os.path.join(folder, "c22.toml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(scene.to_toml())
+    contact = ("import numpy as np, rollqp\nfrom rollqp.three.contact import Contact\n"
+               "from rollqp.three.materials import Materials\n"
+               "c = Contact.hertzian(Materials.from_young(210e3, .28, 210e3, .28), (1/60, 1/60), 1e3, .3, "
+               "elements=(22, 22), zone=(1.1, 1.1))\nc.ops.Att @ np.ones(2 * c.grid.n); c.ops.Ann @ np.ones(c.grid.n)")
+    cases = (("import rollqp", [sys.executable, "-c", "import rollqp"]),
+             ("import + a 22 × 22 contact's influence coefficients", [sys.executable, "-c", contact]),
+             ("the command on a 22 × 22 steady state (kalker-circular's circle, ξ = 1e-3, no rolling steps; quiet, "
+              "no cross-check)",
+              [sys.executable, "-m", "rollqp.cli", "run", path, "--quiet", "--no-cross-check", "--out",
+               os.path.join(folder, "c22.npz")]))
+    import resource
+    rows = []
+    for label, cmd in cases:
+        best, wall = np.inf, np.inf
+        for _ in range(3):
+            r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+            subprocess.run(cmd, check=True, capture_output=True, cwd=folder)
+            r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+            best = min(best, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+            wall = min(wall, time.perf_counter() - t0)
+        rows.append([label, f"{best:.2f}", f"{wall:.2f}"])
+    return table(["what (a fresh process)", "CPU [s] (user + system), best of 3", "wall [s], best of 3"], rows)
+
+
+def _steady_run(n, method="newton", xi=1e-3):
+    """kalker-circular's circle (zone 1.25: the edge on element boundaries for n a multiple of 5) at ξ alone, its
+    steady state on n × n elements by ``method``: (Fx, CPU seconds of the run, wall seconds)."""
+    from rollqp import load_scene
+    from rollqp.three.run import run
+    scene = load_scene("kalker-circular", {"discretization.elements": [n, n], "discretization.distance": 0.0,
+                                           "load.creepage.longitudinal": xi, "solver.method": method})
+    c0, w0 = time.process_time(), time.perf_counter()
+    r = run(scene).arrays()
+    return float(r["Fx"][0]), time.process_time() - c0, time.perf_counter() - w0
+
+
+#: CONTACT's point on the work–precision figure: 1 % error in Fx at 30 elements per semi-axis in 1–2 s of CPU
+#: (CONTACT's default solvers, single-threaded, measured on another machine: CONTACT is not installed here).
+CONTACT_POINT = (1.5, 1e-2)
+
+
+def section_precision(quick):
+    """Force error against CPU time on the circle at ξ = 1e-3 (partial slip): Newton on 20 … 160 elements,
+    FASTSIM on the same grids, the extrapolation from three grids; the reference is Richardson's extrapolation
+    from 75, 150 and 300 elements (its own estimate printed). Draws docs/figures/perf-3d-work-precision.png."""
+    from rollqp.three.extrapolate import richardson
+    ref_grids = (40, 80, 160) if quick else (75, 150, 300)
+    ref_vals = [_steady_run(n)[0] for n in ref_grids]
+    ref = richardson(ref_vals, 2.0)
+    F = ref.value
+    rows, pts = [], {"newton": [], "fastsim": [], "extrapolated": []}
+    grids = (20, 40, 80) if quick else (20, 40, 80, 160)
+    runs = {n: _steady_run(n) for n in grids}
+    for n in grids:
+        Fx, cpu, wall = runs[n]
+        pts["newton"].append((cpu, abs(Fx / F - 1)))
+        rows.append([f"newton {n} × {n}", f"{Fx:.5f}", f"{abs(Fx / F - 1):.2e}", f"{cpu:.2f}", f"{wall:.2f}", ""])
+    for n in grids:
+        Fx, cpu, wall = _steady_run(n, "fastsim")
+        pts["fastsim"].append((cpu, abs(Fx / F - 1)))
+        rows.append([f"fastsim {n} × {n}", f"{Fx:.5f}", f"{abs(Fx / F - 1):.2e}", f"{cpu:.2f}", f"{wall:.2f}", ""])
+    for trio in zip(grids, grids[1:], grids[2:]):
+        e = richardson([runs[n][0] for n in trio], 2.0)
+        cpu = sum(runs[n][1] for n in trio)
+        pts["extrapolated"].append((cpu, abs(e.value / F - 1), e.error / abs(e.value)))
+        order = f"{e.order:.2f}" if e.order is not None else "–"
+        rows.append([f"extrapolated {'/'.join(map(str, trio))} (order {order})", f"{e.value:.5f}",
+                     f"{abs(e.value / F - 1):.2e}", f"{cpu:.2f}", f"{sum(runs[n][2] for n in trio):.2f}",
+                     f"{e.error / abs(e.value):.2e}"])
+    _figure(pts, F, FIGURE[0])
+    head = (f"reference Fx = {F:.5f} N: Richardson from {', '.join(map(str, ref_grids))} elements "
+            f"({', '.join(f'{v:.5f}' for v in ref_vals)}; order {ref.order if ref.order is None else round(ref.order, 2)}, "
+            f"estimate {ref.error / abs(F):.2e})\n\n")
+    return head + table(["method and grid", "Fx [N]", "error against the reference", "CPU [s]", "wall [s]",
+                         "its own error estimate"], rows)
+
+
+#: Where section_precision draws its figure (``--figure``).
+FIGURE = ["docs/figures/perf-3d-work-precision.png"]
+
+
+def _figure(pts, F, path):
+    from pathlib import Path
+    from harness import pyplot
+    plt = pyplot()
+    fig, ax = plt.subplots(figsize=(6.4, 4.4))
+    for key, marker in (("newton", "o-"), ("fastsim", "s-")):
+        xs, ys = zip(*pts[key])
+        ax.loglog(xs, ys, marker, label={"newton": "Newton, 20 … 160 elements across",
+                                         "fastsim": "FASTSIM (Kalker's simplified theory), same grids"}[key])
+    if pts["extrapolated"]:
+        xs, ys, es = zip(*pts["extrapolated"])
+        ax.errorbar(xs, ys, yerr=[[0] * len(es), es], fmt="D", capsize=3,
+                    label="extrapolated from three grids (bar: its own error estimate)")
+    ax.loglog(*CONTACT_POINT, "k*", markersize=11, label="CONTACT, 30 per semi-axis (another machine)")
+    ax.axhline(1e-3, color="0.6", lw=0.8, ls=":")
+    ax.set_xlabel("CPU time [s] (this machine, one thread)")
+    ax.set_ylabel("|Fx / Fx,ref − 1|")
+    ax.set_title("Circle, ξ = 1e-3 (partial slip): creep force error against time", fontsize=10)
+    ax.legend(fontsize=7)
+    out = Path(path)
+    if not out.is_absolute():
+        out = Path(__file__).resolve().parent.parent / out
+    fig.tight_layout()
+    fig.savefig(out, dpi=120)
+    plt.close(fig)
+
+
+SECTIONS = {"contact": ("CONTACT's problems: steady and transient steps", section_contact),
+            "precision": ("work–precision: Newton, FASTSIM, extrapolation", section_precision),
+            "startup": ("start-up of a small 3D run", section_startup),
+            "steady": ("steady rolling step, Newton", section_steady), "socp": ("SOCP against Newton", section_socp),
             "builtins": ("the built-in 3D scenes", section_builtins),
             "chord": ("the conic route to a steady state", section_chord)}
 
@@ -158,7 +350,10 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description="Speed of the 3D steps (ratios within one run).")
     ap.add_argument("--quick", action="store_true", help="without the 300 × 300 grid and the 30 × 30 SOCP")
     ap.add_argument("--only", nargs="+", choices=sorted(SECTIONS), help="these sections only")
+    ap.add_argument("--figure", default=FIGURE[0], help="the work–precision figure (section precision; "
+                    "relative to the repository)")
     args = ap.parse_args(argv)
+    FIGURE[0] = args.figure
     pin_threads()
     print(f"load average at start: {', '.join(f'{x:.2f}' for x in os.getloadavg())} (2 cores, shared)\n")
     for key in args.only or SECTIONS:

@@ -12,8 +12,7 @@
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
     rollqp creep-curve SCENE3D --creepage longitudinal|lateral|spin --values V [--plot F.png]
-    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ]
-                    (3D: [--plane y=Y | --plane x=X | --line x=X,y=Y] [--depths Z1,Z2,...])
+    rollqp stresses RESULT.npz --step K [--plot F.png] [--out S.npz] [--body A|B] [--grid NX,NZ] (3D: --plane, --line, --depths)
 
 Errors are one line on stderr and a non-zero exit: 2 for invalid input, 3 for a solver
 that did not converge (the completed steps are written to the result file first), 4 for a
@@ -387,10 +386,12 @@ def _takes(scene, command: str) -> None:
     """Refuse a scene whose dimension's record does not list ``command``."""
     if command not in family(scene).commands:
         from .errors import InputError
-        dims = " and ".join(f"{d}D" for d, f in FAMILIES.items() if command in f().commands)
+        name = lambda d: f"{d}D" if isinstance(d, int) else d   # noqa: E731 - a dimension or a family's name
+        dims = " and ".join(name(d) for d, f in FAMILIES.items() if command in f().commands)
         takes = ", ".join(["run", "show", "scenes", *sorted(family(scene).commands)])
-        raise InputError("SCENE", f"{scene.name!r} is a {scene.dimension}D scene; rollqp {command} works on {dims} "
-                                  f"scenes (a {scene.dimension}D scene: rollqp {takes})")
+        what = name(getattr(scene, "family", scene.dimension))
+        raise InputError("SCENE", f"{scene.name!r} is a {what} scene; rollqp {command} works on {dims} "
+                                  f"scenes (a {what} scene: rollqp {takes})")
 
 
 def _unwritten(err: OSError, out) -> str:
@@ -439,7 +440,8 @@ def cmd_run(args) -> int:
     try:
         with OutputLock(out), (nullcontext() if args.quiet else listening(_iteration_lines())):
             try:
-                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every)
+                result = fam.run(scene, progress=cb, resume=source, observe=observe, out=out, keep_every=args.keep_every,
+                                 start_progress=None if args.quiet or source is not None else start_progress())
             except KeyboardInterrupt as err:
                 # the run is over and its states are written: a later Ctrl-C or SIGTERM must not cut the exit short
                 signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -532,6 +534,36 @@ def _advise(scene) -> None:
     notes.append(alternation_note(plan.scene))
     for note in filter(None, notes):
         print(f"rollqp: {note}", file=sys.stderr, flush=True)
+
+
+def start_progress():
+    """The report of a start's steps (a march to the steady state, the static shift steps): after the first
+    :data:`START_ESTIMATE_SECONDS`, once, the estimated time of the whole start if it exceeds
+    :data:`ANNOUNCE_SECONDS`; then a line every ``ROLLQP_PROGRESS_SECONDS`` (default :data:`LOG_EVERY`)."""
+    t0 = time.perf_counter()
+    state = {"last": t0, "said": False}
+    try:
+        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
+    except ValueError:
+        every = LOG_EVERY
+
+    def tick(j, expected):
+        now = time.perf_counter()
+        if not state["said"] and now - t0 >= START_ESTIMATE_SECONDS:
+            state["said"] = True
+            total = (now - t0) / j * max(expected, j)
+            if total > ANNOUNCE_SECONDS:
+                print(f"rollqp: the starting state: about {_minutes(total)} ({expected} steps usually, "
+                      f"{(now - t0) / j:.3g} s a step measured on the first {j})", file=sys.stderr, flush=True)
+        if now - state["last"] >= every:
+            state["last"] = now
+            print(f"rollqp: the starting state: step {j} (about {expected} usually), {now - t0:.1f} s",
+                  file=sys.stderr, flush=True)
+    return tick
+
+
+#: Seconds of a start's steps after which its total time is estimated (:func:`start_progress`).
+START_ESTIMATE_SECONDS = 3.0
 
 
 def estimate_progress(cb, steps: int):

@@ -33,7 +33,8 @@ import numpy as np
 from .fields import FORCE, STRESS, Field, register
 
 __all__ = ["friction_power", "dissipation", "friction_work", "step_length", "elastic_energy", "load_work", "balance",
-           "steady_identity", "power"]
+           "steady_identity", "power", "grid_dissipation", "grid_frictional_power", "grid_elastic_energy",
+           "grid_balance"]
 
 
 def friction_power(rows) -> np.ndarray:
@@ -180,3 +181,75 @@ def power(res: dict, speed: float) -> np.ndarray:
     if "dissipation" not in res:
         raise InputError("result", "holds no 'dissipation' (a frictionless scene, or written before rollqp had it)")
     return np.asarray(res["dissipation"], dtype=float) * float(speed)
+
+
+# =========================================================================== the grid (3D)
+# The same quantities on Kalker's grid of rectangles (docs/stresses.md §10), CONTACT's definitions (its
+# user guide, "ELEN" and "FRIC"): element tractions times element areas. Signs as in 2D: (px, py) on A,
+# (sx, sy) the slip of A relative to B per unit rolled distance, so the dissipation density
+# −(px sx + py sy) is >= 0; CONTACT prints FRIC = (V/1000) dx dy Σ p·s <= 0 (its units: W with N, mm, mm/s).
+def grid_dissipation(rows) -> np.ndarray:
+    """``−(p_x s_x + p_y s_y)`` on the grid of a block of states: the frictional power density per unit rolled
+    distance (times ``|V|``: per unit time), ``(m, ny, nx)``."""
+    return -(rows["px"] * rows["sx"] + rows["py"] * rows["sy"])
+
+
+def grid_frictional_power(rows) -> np.ndarray:
+    """``dx dy Σ −(p·s)``: the frictional power per unit rolled distance of each state (a force; times ``|V|``
+    the power, CONTACT's −1000·FRIC)."""
+    d = rows["dissipation"]
+    return float(rows.constants["area"]) * d.reshape(d.shape[0], -1).sum(axis=1)
+
+
+def grid_elastic_energy(rec, contact) -> float:
+    """``U = ½ dx dy (pᵀ u_n + tᵀ u_t)``, ``u = A·(p, t)`` the displacement differences of the two bodies
+    (docs/theory3d.md §3; CONTACT's ELEN times 1000): two products by the grid's operators."""
+    return elastic_energy_of(contact.ops, rec.p, rec.t)
+
+
+def elastic_energy_of(ops, p, t) -> float:
+    """:func:`grid_elastic_energy` of tractions ``p`` (n,) and ``t`` (2, n) with the operators ``ops``
+    (:class:`~rollqp.three.operators.ContactOperators`)."""
+    p = np.asarray(p, dtype=float).ravel()
+    t = np.asarray(t, dtype=float).ravel()
+    if not np.any(p) and not np.any(t):
+        return 0.0
+    un, ut = ops.Ann @ p, ops.Att @ t
+    if ops.coupled:
+        un, ut = un + ops.Ant @ t, ut + ops.Atn @ p
+    return 0.5 * ops.grid.area * float(p @ un + t @ ut)
+
+
+def grid_balance(res: dict) -> dict:
+    """The energy balance of a 3D run (arrays of a result): accumulated frictional work ``Σ P_f Δq``, the work of
+    the loads through the rigid motions ``Σ [−(F̄x ξ + F̄y η + M̄z φ) Δq + F̄N Δδ]`` (means of the step's two
+    states, as in 2D), ``delta_U = U_k − U_0`` and ``residual = load_work − delta_U − friction_work``, each
+    (K+1,). Rolling steps only: the starting state's static shift is not a rolled distance."""
+    q = np.asarray(res["q"], dtype=float)
+    dq = np.abs(np.diff(q, prepend=q[0]))
+    c = np.asarray(res["creepage"], dtype=float)
+    P = np.asarray(res["frictional_power"], dtype=float)
+    mean = {k: 0.5 * (np.asarray(res[k], dtype=float) + np.roll(np.asarray(res[k], dtype=float), 1))
+            for k in ("Fx", "Fy", "Mz", "FN")}
+    dd = np.diff(np.asarray(res["approach"], dtype=float), prepend=float(res["approach"][0]))
+    W = -(mean["Fx"] * c[:, 0] + mean["Fy"] * c[:, 1] + mean["Mz"] * c[:, 2]) * dq + mean["FN"] * dd
+    W[0] = 0.0
+    Wf = np.cumsum(np.where(np.arange(q.size) > 0, P * dq, 0.0))
+    U = np.asarray(res["elastic_energy"], dtype=float)
+    return dict(friction_work=Wf, load_work=np.cumsum(W), delta_U=U - U[0], residual=np.cumsum(W) - (U - U[0]) - Wf)
+
+
+def _mu3(scene) -> bool:
+    return float(getattr(scene, "mu", 0.0) or 0.0) > 0
+
+
+for _f in (
+    Field("dissipation", "state", STRESS, "frictional power density -(px sx + py sy) >= 0 per unit rolled distance "
+          "(times |V|: power per unit area; CONTACT's fricdens)", derive=grid_dissipation, needed=_mu3),
+    Field("frictional_power", "step", "force", "frictional power dx dy sum(-(p.s)) per unit rolled distance (times "
+          "|V|: the power; CONTACT's FRIC.POWER = -|V| times this / 1000 in its units)", derive=grid_frictional_power,
+          needed=_mu3),
+    Field("elastic_energy", "step", "force*length", "elastic energy 1/2 dx dy (p.u_n + t.u_t) of the two bodies "
+          "(CONTACT's ELAST.EN times 1000 in its units)", compute=grid_elastic_energy),
+):
+    register(_f, 3)

@@ -227,7 +227,8 @@ def register(f: Field, dimension: int = 2) -> Field:
 
 def fields_for(scene) -> list[Field]:
     """The computed and derived fields (``compute`` or ``derive`` set) that ``scene``'s result holds."""
-    return [f for f in FIELDS.values() if (f.compute is not None or f.derive is not None) and f.needed(scene)]
+    fields = registry(getattr(scene, "dimension", 2))
+    return [f for f in fields.values() if (f.compute is not None or f.derive is not None) and f.needed(scene)]
 
 
 def dtype_of(name: str, fields: dict | None = None):

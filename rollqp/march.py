@@ -797,7 +797,7 @@ def _identical(again: State, stored: State) -> bool:
 
 
 def run(scene, method=None, progress=None, resume=None, observe=None, *, out=None, keep_every=None,
-        geometry=None) -> Result:
+        geometry=None, start_progress=None) -> Result:
     """Run a scene's transient and return its :class:`~rollqp.result.Result`.
 
     Parameters
@@ -827,6 +827,9 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         ones (``Field.reduce``). Default 1, or the resumed file's.
     geometry : Memo, optional
         Shared by the runs it is handed to: what the influence model keeps of the bodies (:func:`prepare`).
+    start_progress : callable, optional
+        The 3D run's report of the steps of its start (:func:`rollqp.three.run.run`); a 2D start (its
+        problems on a strip: milliseconds to seconds) is not reported.
 
     Raises
     ------

@@ -21,7 +21,7 @@ import numpy as np
 from .errors import InputError
 from .fields import Field, register
 
-__all__ = ["wear_rate", "profile"]
+__all__ = ["wear_rate", "grid_wear_rate", "profile"]
 
 
 def wear_rate(body: str):
@@ -39,6 +39,24 @@ for _b in ("A", "B"):
     register(Field(f"wear_rate_{_b}", "state", "1", f"Archard worn-depth rate (k/H) p |s| of body {_b} per unit "
                    f"rolled distance (written when bodies.{_b}.wear is set; 0 for a braked starting state)",
                    derive=wear_rate(_b), needed=(lambda b: lambda scene: getattr(scene, b).wear is not None)(_b)))
+
+
+def grid_wear_rate(body: str):
+    """``derive(rows)`` of the 3D field ``wear_rate_<body>``: ``(k/H)·p·|s|``, ``|s| = √(s_x² + s_y²)``, on the grid
+    (0 for the static shift of a braked start, state 0; a steady state is rolling)."""
+    def derive(rows):
+        k = float(rows.constants[f"wear_{body}"])
+        shift = (np.asarray(rows["step"]) == 0) & bool(float(rows.constants.get("braked", 0.0)))
+        rate = k * rows["pn"] * np.hypot(rows["sx"], rows["sy"])
+        return np.where(shift[:, None, None], 0.0, rate)
+    return derive
+
+
+for _b in ("A", "B"):
+    register(Field(f"wear_rate_{_b}", "state", "1", f"Archard worn-depth rate (k/H) p |s| of body {_b} per unit "
+                   f"rolled distance on the grid (written when bodies.{_b}.wear is set; 0 for a braked start's shift)",
+                   derive=grid_wear_rate(_b), needed=(lambda b: lambda scene: getattr(scene, b).wear is not None)(_b)),
+             3)
 
 
 def profile(result, body: str = "A", coefficient=None, resolution: int = 4):

@@ -365,3 +365,101 @@ def test_a_complete_last_frame_that_fails_its_crc_is_corrupt_not_torn(part, tmp_
     src = resume_source(tmp_path / "k.npz")
     assert len(src.journal) == len(_frames(data)) - 1
     src.close()
+
+
+# ----------------------------------------------------------------------------- physics at extreme inputs
+def physics_violations(res, scene) -> dict:
+    """The physics checks of a 3D result, each as a number to hold below its tolerance: the stored normal force
+    against ∫p dA (relative to FN), the tractions beyond the friction disc (in mu p0; in p0 when mu = 0), the
+    stored element states against those of the stored p, t, s (the number that differ), stick elements' slip
+    (in mu p0/E*) and slipping elements' slip not opposite their traction (the largest
+    |t/|t| + s/|s|| where both are resolved)."""
+    from rollqp.three.problem import Scales, element_states
+    a = res
+    K1 = len(a["q"])
+    area = float((a["x"][1] - a["x"][0]) * (a["y"][1] - a["y"][0])) if a["x"].size > 1 and a["y"].size > 1 else \
+        scene.grid.area
+    p0, Estar, mu = float(a["p0"]), float(a["Estar"]), scene.mu
+    FN = area * a["pn"].reshape(K1, -1).sum(1)
+    out = {"FN": float(np.max(np.abs(FN - a["FN"]))) / scene.load.normal}
+    tn, bound = np.hypot(a["px"], a["py"]), mu * np.maximum(a["pn"], 0.0)
+    out["disc"] = float(np.max(tn - bound)) / (mu * p0 if mu > 0 else p0)
+    unit = mu * p0 if mu > 0 else p0                   # (the states do not depend on the unit: |t - E* s| > b)
+    sc = Scales(float(np.sqrt(a["a"] * a["b"])), unit, Estar)
+    states = np.stack([element_states(np.stack([a["px"][i].ravel(), a["py"][i].ravel()]),
+                                      np.stack([a["sx"][i].ravel(), a["sy"][i].ravel()]),
+                                      bound[i].ravel(), sc) for i in range(K1)])
+    out["states"] = int(np.sum(states != a["state"].reshape(K1, -1)))
+    sn = np.hypot(a["sx"], a["sy"])
+    stick, slip = a["state"] == 1, a["state"] == 2
+    out["stick slip"] = float(np.max(sn[stick], initial=0.0)) / sc.slip
+    big = slip & (sn > 1e-6 * sc.slip) & (tn > 1e-6 * mu * p0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        d = np.hypot(a["px"] / tn + a["sx"] / sn, a["py"] / tn + a["sy"] / sn)
+    out["direction"] = float(np.max(d[big], initial=0.0))
+    return out
+
+
+#: What the physics checks allow: the stored forces are sums of the stored pressures (round-off); the tractions
+#: are inside the disc to the tangential steps' tolerance (1e-10 of their unit, at most 100 mu p0 below mu = 0.01)
+#: with a margin of 100 for the steps that stop below it (measured: 1.2e-10 mu p0); the states are those of p, t, s;
+#: a stick element's slip is its step's residual (1e-10 of the steps' slip unit, at most 100 mu p0/E*: measured 3e-17
+#: to 3e-12 mu p0/E*); a slipping
+#: element's slip is opposite its traction to 1e-6 where both are resolved.
+PHYSICS_TOL = {"FN": 1e-12, "disc": 1e-8, "states": 0, "stick slip": 1e-8, "direction": 1e-6}
+
+
+def assert_physics(res, scene):
+    got = physics_violations(res, scene)
+    bad = {k: v for k, v in got.items() if not v <= PHYSICS_TOL[k]}
+    assert not bad, (scene.name, bad)
+
+
+@pytest.mark.parametrize("mu", [1e-6, 1e-12])
+def test_tiny_friction_keeps_the_tractions_in_the_disc_in_mu_p0(mu):
+    for name in ("cattaneo-3d", "kalker-circular"):
+        scene = coarse(name, **{"contact.friction": mu})
+        assert_physics(run(scene).arrays(), scene)
+
+
+def test_a_load_where_the_creepage_sets_no_resolvable_traction_is_refused_in_one_line():
+    with pytest.raises(InputError, match=r"^load\.creepage\.longitudinal: .*below 100 times solver\.tolerance"):
+        coarse("kalker-circular", **{"load.normal": 1e30})
+    scene = coarse("kalker-circular", **{"load.normal": 1e15})      # resolvable: a right answer
+    assert_physics(run(scene).arrays(), scene)
+
+
+def test_extreme_moduli_and_subnormal_loads_give_no_warning_and_name_the_key():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match=r"^bodies\.B\.E: the contact's compliance"):
+            coarse("cattaneo-3d", **{"bodies.B.E": 1e-300})
+        with pytest.raises(InputError, match=r"^load\.normal: "):
+            coarse("cattaneo-3d", **{"bodies.A.E": 1e300, "bodies.B.E": 1e300, "load.normal": 1e-300})
+        scene = coarse("cattaneo-3d", **{"load.tangential": 5e-324})
+        assert_physics(run(scene).arrays(), scene)
+
+
+def test_stresses_of_a_3d_result(tmp_path, capsys):
+    scene = coarse("cattaneo-3d", **{"discretization.distance": 0.3})
+    run(scene, out=str(tmp_path / "r.npz"))
+    assert cli.main(["stresses", str(tmp_path / "r.npz"), "--step", "1"]) == 0
+    assert "peak" in capsys.readouterr().out
+
+
+# ----------------------------------------------------------------------------- a long start says so
+def test_a_marched_start_reports_its_steps_and_an_estimate(tmp_path, capsys, monkeypatch):
+    """A conic method marches to a rolling start's steady state (minutes on a fine grid with dissimilar bodies):
+    ``rollqp run`` says how long the start will take, measured on its first steps, and reports its steps."""
+    scene = coarse("kalker-circular", **{"solver.method": "socp-clarabel", "discretization.distance": 0.2})
+    ticks = []
+    run(scene, start_progress=lambda j, expected: ticks.append((j, expected)))
+    assert ticks and ticks[0][0] == 1 and all(e == ticks[0][1] > 1 for _, e in ticks)
+    assert [j for j, _ in ticks] == list(range(1, len(ticks) + 1))
+    (tmp_path / "s.toml").write_text(scene.to_toml(), encoding="utf-8")
+    monkeypatch.setattr(cli, "START_ESTIMATE_SECONDS", 0.0)
+    monkeypatch.setattr(cli, "ANNOUNCE_SECONDS", 0.0)
+    monkeypatch.setenv("ROLLQP_PROGRESS_SECONDS", "0")
+    assert cli.main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "r.npz")]) == 0
+    err = capsys.readouterr().err
+    assert "rollqp: the starting state: about " in err and "rollqp: the starting state: step 1 " in err, err

@@ -1,6 +1,6 @@
 """A 3D scene in the user's words: μ = 0 runs as in 2D, creepages far beyond any rolling contact are
 refused naming the key and the range, the summary of a resumed run says whose wall time it is,
-``rollqp stresses`` on a 3D result says what it takes, and ``rollqp scenes`` tags every scene by its
+``rollqp stresses`` takes a 3D result, and ``rollqp scenes`` tags every scene by its
 dimension. Coarse grids: each run takes a fraction of a second."""
 from __future__ import annotations
 
@@ -100,12 +100,13 @@ def test_resumed_summary_names_the_steps_its_wall_time_covers():
     assert "resumed" not in fresh
 
 
-def test_stresses_on_a_3d_result_is_one_line(tmp_path, capsys, monkeypatch):
+def test_stresses_on_a_3d_result_computes_its_field(tmp_path, capsys, monkeypatch):
+    """No more "no key 'pt'": a 3D result goes to the 3D subsurface field (docs/stresses.md)."""
     monkeypatch.chdir(tmp_path)
     run(coarse("kalker-elliptic")).save(tmp_path / "k.npz")
-    assert cli.main(["stresses", "k.npz", "--step", "0"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert "\n" not in err and "3D result" in err and "Traceback" not in err
+    assert cli.main(["stresses", "k.npz", "--step", "0"]) == 0
+    out = capsys.readouterr()
+    assert "no key 'pt'" not in out.err and "state" in out.out
 
 
 def test_scenes_tags_every_scene_by_its_dimension(capsys):

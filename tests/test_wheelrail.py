@@ -256,3 +256,19 @@ def test_tread_and_flange_two_patches_share_the_wheel_load():
     (p,), (r,) = one.patches, _ref("right", 11)["patches"]
     for ours, theirs in ((p.FN, r["FN"]), (p.Fx, r["FX"]), (p.Fs, r["FS"])):
         assert abs(ours - theirs) <= 0.005 * 10000.0
+
+
+def test_a_profile_files_own_file_key_is_never_opened(tmp_path):
+    """SIMPACK's ``file = '…'`` names the profile's original data: read as text, never used as a path."""
+    text = (PKG / "MBench_UIC60_v3.prr").read_text().replace("'UIC60_v3.rai.txt'", "'/nonexistent/../../etc/passwd'")
+    p = read_profile(_write(tmp_path, "r.prr", text), "rail")
+    assert p.span == read_profile(PKG / "MBench_UIC60_v3.prr", "rail").span
+
+
+def test_smoothed_profiles_in_a_scene():
+    """``wheel_smooth``/``rail_smooth`` (mm): the smoothing spline through the scene; a 1 mm wavelength barely
+    moves the benchmark's smooth profiles (the contact's normal force within 1 % of the load)."""
+    base = load_scene("wheel-rail").replace(**{"wheelset.side": "right"})
+    (a,) = solve_scene(base)
+    (b,) = solve_scene(base.replace(**{"wheelset.wheel_smooth": 1.0, "wheelset.rail_smooth": 1.0}))
+    assert abs(a.patches[0].FN - b.patches[0].FN) < 100.0 and abs(a.patches[0].y_rail - b.patches[0].y_rail) < 0.2

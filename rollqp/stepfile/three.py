@@ -270,6 +270,9 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     method = method or REFERENCE_METHOD
     prepared = prepare(scene, method)
     scene, meth, contact = prepared
+    if getattr(contact, "law", None) is not None or np.ndim(getattr(contact, "mu", 0.0)) != 0:
+        raise InputError("contact.friction", "a 3D step file holds one constant coefficient of friction; this "
+                                             "scene's friction law cannot be exported")
     prev: StepRecord | None = None
     rec = None
     for rec in march(scene, prepared=prepared):

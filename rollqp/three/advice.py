@@ -99,10 +99,34 @@ def _conic(scene) -> bool:
     return not capabilities(scene.solver.method, 3).matrix_free
 
 
-def notes(scene) -> list[str]:
-    """One line before a 3D run with a conic method whose estimated time exceeds :data:`NOTE_SECONDS`."""
-    if not _conic(scene):
+#: Newton's steady step on the FFT path, in yardsticks per ``n log n`` (``n`` the grid's elements): the
+#: 300 × 300 partial-slip step (ξ = 1e-3, 12 iterations) took 33.5 s of CPU with a yardstick of 2.7 ms.
+NEWTON_STEADY = 0.0119
+#: Grids from which ``rollqp run`` says what Newton's steady step will take (elements).
+NEWTON_NOTE_ELEMENTS = 40_000
+
+
+def newton_steady_seconds(elements: int, y: float | None = None) -> float:
+    """The estimated CPU time of Newton's steady step on a grid of ``elements`` (FFT path; module constants)."""
+    n = max(int(elements), 2)
+    return (yardstick() if y is None else y) * NEWTON_STEADY * n * np.log(n)
+
+
+def _newton_note(scene) -> list[str]:
+    from ..methods import capabilities
+    n = scene.grid.nx * scene.grid.ny
+    if n < NEWTON_NOTE_ELEMENTS or "steady" not in capabilities(scene.solver.method, 3).solves:
         return []
+    t = newton_steady_seconds(n)
+    return [f"{scene.grid.nx} × {scene.grid.ny} elements: a steady step of about {duration(t)} of CPU (estimate "
+            f"from this machine's speed, the 300 × 300 step measured); progress lines follow"]
+
+
+def notes(scene) -> list[str]:
+    """One line before a 3D run with a conic method whose estimated time exceeds :data:`NOTE_SECONDS`, or
+    before a large grid's steady step by Newton (its estimated CPU time)."""
+    if not _conic(scene):
+        return _newton_note(scene) if scene.load.start == "rolling" else []
     n = scene.contact_elements()
     steps, per, total = conic_run(scene)
     if total <= NOTE_SECONDS:

@@ -39,6 +39,13 @@ class Loads:
     phi: float = 0.0
 
 
+#: Below this coefficient of friction the tangential steps measure tractions in (mu / MU_REFERENCE) p0 instead of
+#: p0 (:attr:`Contact.tangential_scales`): a method's tolerance then bounds the tractions' error by at most
+#: MU_REFERENCE⁻¹ = 100 times the tolerance in mu p0, whatever mu. At and above it (every built-in scene) nothing
+#: changes.
+MU_REFERENCE = 0.01
+
+
 class Contact:
     """The shared data of a 3D contact (module docstring).
 
@@ -76,6 +83,12 @@ class Contact:
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
         self.scales = Scales.hertz(self.ellipse)
+        # the tangential steps' units: tractions in p0, and in (mu / MU_REFERENCE) p0 where friction is smaller, so
+        # that a method's tolerance stays a fraction of mu p0 (at mu = 1e-6 a tolerance in p0 would allow tractions
+        # beyond mu p by 1e-4 mu p0)
+        f = min(1.0, coefficient / MU_REFERENCE) if coefficient > 0 else 1.0
+        self.tangential_scales = self.scales if f == 1.0 else Scales(self.scales.length, self.scales.stress * f,
+                                                                     self.scales.modulus)
         self.ops = ContactOperators(grid, materials)
         self.x, self.y = grid.centres()
         h = np.asarray(self.profile(self.x, self.y), dtype=float)
@@ -132,7 +145,7 @@ class Contact:
             raise InputError("kind", f"must be 'shift', 'rolling' or 'steady', got {kind!r}")
         bound = self.mu * np.maximum(p, 0.0)
         return TangentialStep(B, g.area, bound, self.x, self.y, c.reshape(2, g.n), dq, Fx=loads.Fx, xi=loads.xi,
-                              Fy=loads.Fy, eta=loads.eta, phi=loads.phi, scales=self.scales)
+                              Fy=loads.Fy, eta=loads.eta, phi=loads.phi, scales=self.tangential_scales)
 
     def hertz_start(self, FN: float):
         """The Hertz pressure and approach of ``FN`` as a start for an iterative normal solve: the

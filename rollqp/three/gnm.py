@@ -333,6 +333,7 @@ class _TangentialSystem:
             self.E[j * self.nv:(j + 1) * self.nv, i] = 1.0
         self.dense = method._use_dense(2 * self.nv + len(free))
         self.S = k * problem.B.memo(("dense", V.tobytes()), lambda: problem.B.dense(V, V)) if self.dense else None
+        self._rS = None
 
     def split(self, x, Kx):
         m = 2 * self.nv
@@ -374,8 +375,38 @@ class _TangentialSystem:
         return self.k * (self.problem.B @ full.ravel()).reshape(2, n)[:, V].ravel()
 
     def _dense_step(self, mxx, mxy, myy, phi):
-        nv, r = self.nv, self.r
-        R = r * np.hstack([self.S, self.E])
+        nv, r, nf = self.nv, self.r, len(self.free)
+        m = 2 * nv
+        if self._rS is None:   # r·[Ŝ E] once per solve (the same numbers as forming it each iteration)
+            self._rS = r * np.hstack([self.S, self.E])
+        R = self._rS
+        Rx, Ry = R[:nv], R[nv:]
+        # J of eq. 3D.26 filled in place, row blocks and load rows (no stacking copies)
+        J = np.empty((m + nf, m + nf), order="F")
+        Jx, Jy = J[:nv], J[nv:m]
+        np.multiply(mxx[:, None], Rx, out=Jx)
+        Jx += mxy[:, None] * Ry
+        np.multiply(mxy[:, None], Rx, out=Jy)
+        Jy += myy[:, None] * Ry
+        i = np.arange(nv)
+        Jx[i, i] += 1 - mxx
+        Jx[i, nv + i] -= mxy
+        Jy[i, i] -= mxy
+        Jy[i, nv + i] += 1 - myy
+        for row, j in enumerate(self.free):
+            J[m + row] = 0.0
+            J[m + row, j * nv:(j + 1) * nv] = self.ah
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            d = sla.lu_solve(sla.lu_factor(J, overwrite_a=True, check_finite=False), -phi, check_finite=False)
+        if not np.all(np.isfinite(d)):   # singular (e.g. every element slipping): least squares
+            d = self._dense_step_lstsq(mxx, mxy, myy, phi)
+        return d
+
+    def _dense_step_lstsq(self, mxx, mxy, myy, phi):
+        """The least-squares Newton direction where ``J`` is singular (built again: the LU overwrote it)."""
+        nv, R, nf = self.nv, self._rS, len(self.free)
+        m = 2 * nv
         Rx, Ry = R[:nv], R[nv:]
         Jx = mxx[:, None] * Rx + mxy[:, None] * Ry
         Jy = mxy[:, None] * Rx + myy[:, None] * Ry
@@ -384,18 +415,10 @@ class _TangentialSystem:
         Jx[i, nv + i] -= mxy
         Jy[i, i] -= mxy
         Jy[i, nv + i] += 1 - myy
-        rows = [Jx, Jy]
-        for j in self.free:
-            row = np.zeros(2 * nv + len(self.free))
-            row[j * nv:(j + 1) * nv] = self.ah
-            rows.append(row[None, :])
-        J = np.vstack(rows)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", sla.LinAlgWarning)
-            d = sla.lu_solve(sla.lu_factor(J, check_finite=False), -phi, check_finite=False)
-        if not np.all(np.isfinite(d)):   # singular (e.g. every element slipping): least squares
-            d = np.linalg.lstsq(J, -phi, rcond=None)[0]
-        return d
+        L = np.zeros((nf, m + nf))
+        for row, j in enumerate(self.free):
+            L[row, j * nv:(j + 1) * nv] = self.ah
+        return np.linalg.lstsq(np.vstack([Jx, Jy, L]), -phi, rcond=None)[0]
 
     def _krylov_step(self, mxx, mxy, myy, phi):
         """``J d = −Φ`` without the matrix: the load rows eliminated (``d_t = J_tt⁻¹(−Φ_t − J_tζ dζ)``,

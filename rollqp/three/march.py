@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, SolverError
+from .advice import MARCH_LENGTHS
 from .contact import Loads
 from .problem import SEPARATION, SLIP, STICK, disc_projection, element_states
 
@@ -145,7 +146,8 @@ def _states(contact, p, t, s):
     return element_states(np.asarray(t), np.asarray(s), contact.mu * np.maximum(p, 0.0), contact.scales)
 
 
-def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, phi: float = 0.0, steps: int = 1):
+def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, phi: float = 0.0, steps: int = 1,
+                 tick=None):
     """Cattaneo–Mindlin: ``FN``, then ``(Fx, Fy)`` in ``steps`` equal increments (shift steps).
 
     Returns the list of :class:`StepRecord` (phase ``"shift"``), the last one the braked state;
@@ -167,11 +169,13 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
         rec.info.update(shift=tuple(shift), loads=loads, before=previous)
         out.append(rec)
         previous, warm = (ns.p, ts.t), (ns, ts)
+        if tick is not None:
+            tick(j, int(steps))
     return out
 
 
 def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=None, memory: int = None,
-           pressure=None, accelerate: str = "chord"):
+           pressure=None, accelerate: str = "chord", tick=None):
     """Steady rolling (eq. 3D.17): directly if ``"steady" in method.capabilities.solves``, else as the fixed
     point of rolling steps of ``Δq = dx`` from ``start`` (a :class:`StepRecord`, or zero tractions), reached
     when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
@@ -180,7 +184,8 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     (:mod:`rollqp.three.chord`, eq. 3D.24), every iterate evaluated by the method; ``"anderson"`` the
     march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
     0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
-    bodies; solved here if ``None``)."""
+    bodies; solved here if ``None``). ``tick(j, expected)``: called after each step of the march (``expected``: the
+    steps a march usually takes, ``MARCH_LENGTHS`` contact lengths of ``dx``; it may take more or fewer)."""
     t0 = time.perf_counter()
     if "steady" in method.capabilities.solves or contact.mu == 0:
         warm = (start, start) if start is not None else None
@@ -191,12 +196,18 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     if accelerate not in ("chord", "anderson"):
         raise InputError("accelerate", f"must be 'chord' or 'anderson', got {accelerate!r}")
     if accelerate == "chord" and not contact.ops.coupled:
-        return _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure)
+        return _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure, tick)
     return _march_to_steady(contact, method, FN, loads, direction, start, t0,
-                            ANDERSON_MEMORY if memory is None else int(memory), pressure)
+                            ANDERSON_MEMORY if memory is None else int(memory), pressure, tick)
 
 
-def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure=None):
+def _expected_march(contact) -> int:
+    """The steps a march to the steady state usually takes (:data:`rollqp.three.advice.MARCH_LENGTHS` contact
+    lengths of ``dx``), for its progress."""
+    return int(MARCH_LENGTHS * 2 * contact.ellipse.a / contact.grid.dx) + 1
+
+
+def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure=None, tick=None):
     """The fixed point of the march by Newton's method on the march map (:func:`rollqp.three.chord.chord_step`),
     a march step wherever a Newton iterate does not reduce the change by :data:`NEWTON_DECREASE`."""
     from .chord import chord_step
@@ -208,7 +219,10 @@ def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure
     x, best, warm = base, None, None       # best: (change, x, G(x)) of the last accepted base point
     limit = int(np.ceil(MAX_MARCH_DISTANCE * contact.scales.length / dx))
     bound = contact.mu * np.maximum(nsol.p, 0.0)
+    expected = _expected_march(contact)
     for k in range(1, limit + 1):
+        if tick is not None and k > 1:
+            tick(k - 1, expected)
         prob = contact.tangential_step("rolling", nsol.p, loads, (nsol.p, x), dx, direction)
         try:
             ts = method.solve(prob, warm)
@@ -236,7 +250,8 @@ def _pack(p, t):
     return np.concatenate([np.asarray(p, dtype=float), np.asarray(t, dtype=float).ravel()])
 
 
-def _march_to_steady(contact, method, FN, loads, direction, start, t0, memory=ANDERSON_MEMORY, pressure=None):
+def _march_to_steady(contact, method, FN, loads, direction, start, t0, memory=ANDERSON_MEMORY, pressure=None,
+                     tick=None):
     """The fixed point ``x = G(x)`` of a rolling step of ``Δq = dx`` (``x = (p, t)``: the state whose
     displacements the step shifts), by Anderson's acceleration (type II, ``memory`` last
     differences; 0: the plain march). Every iterate is a solution of its own step; the answer
@@ -252,7 +267,10 @@ def _march_to_steady(contact, method, FN, loads, direction, start, t0, memory=AN
     scale = np.concatenate([np.full(n, contact.scales.stress), np.full(2 * n, contact.mu * contact.scales.stress)])
     X, Gs, warm = [], [], None
     limit = int(np.ceil(MAX_MARCH_DISTANCE * contact.scales.length / contact.grid.dx))
+    expected = _expected_march(contact)
     for k in range(1, limit + 1):
+        if tick is not None and k > 1:
+            tick(k - 1, expected)
         ns, ts, sw = coupled_step(contact, method, FN, "rolling", loads, (x[:n], x[n:].reshape(2, n)),
                                   contact.grid.dx, direction, warm=warm, pressure=nsol)
         gx = _pack(ns.p, ts.t)

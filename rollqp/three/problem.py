@@ -126,8 +126,8 @@ def disc_projection(z: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``Proj_{|·| ≤ b_i}(z_i)`` element by element (eq. 3D.19: Coulomb's law on the disc, the variational
     inequality 3D.18, as a projection); ``z`` of shape ``(2, n)``, ``b ≥ 0``."""
     norm = np.hypot(z[0], z[1])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = np.where(norm > b, b / norm, 1.0)
+    outside = norm > b
+    k = np.divide(b, norm, out=np.ones_like(norm), where=outside)   # b/|z| only where it is < 1 (no overflow)
     return z * k
 
 

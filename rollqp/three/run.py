@@ -25,6 +25,7 @@ import numpy as np
 
 from ..atomic import stop_once
 from ..errors import InputError, SolverError
+from ..fields import fields_for
 from ..march import RESUME_TOL, _keep_every, _last_index, drive
 from ..methods import compose_3d, scene_method_3d
 from ..result import Layout, Result, ResumeSource, check_output, resume_source
@@ -60,25 +61,27 @@ def prepare(scene, method=None):
     return scene, meth, contact
 
 
-def _start(scene, meth, contact) -> StepRecord:
+def _start(scene, meth, contact, tick=None) -> StepRecord:
     """State 0: the braked start's last static shift step, or the steady rolling state."""
     ld = scene.load
     if ld.start == "rolling":
-        return steady(contact, meth, ld.normal, scene.loads_at(0.0), direction=ld.direction)
+        return steady(contact, meth, ld.normal, scene.loads_at(0.0), direction=ld.direction, tick=tick)
     loads = scene.loads_at(0.0)
     if loads.xi is not None or loads.eta is not None:
         raise InputError("load.start", "a braked start shifts the bodies by the tangential forces: prescribe "
                                        "load.tangential and load.lateral (or start = \"rolling\")")
-    last = static_shift(contact, meth, ld.normal, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps)[-1]
+    last = static_shift(contact, meth, ld.normal, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps, tick=tick)[-1]
     return dataclasses.replace(last, k=0)   # the shift steps are numbered within the start; it is state 0
 
 
-def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=None) -> Iterator[StepRecord]:
+def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=None,
+          start_progress=None) -> Iterator[StepRecord]:
     """The 3D run as a stream of :class:`~rollqp.three.march.StepRecord`: ``k = 0`` (the starting
     state), then the rolling steps (module docstring); with ``resume`` (the arrays of an earlier
     result file of this scene, or :meth:`ResumeSource.tail <rollqp.result.ResumeSource.tail>`) only the
     steps after its last state, once that state is checked to solve its own step (:func:`check_resumed`;
-    ``verify=False`` with ``state``, the state it returned).
+    ``verify=False`` with ``state``, the state it returned). ``start_progress(j, expected)``: called after each
+    step of the start (a march to the steady state, or a static shift step; ``expected`` steps usually).
 
     Raises
     ------
@@ -94,7 +97,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
         start, first = state, _last_index(resume) + 1
     else:
         try:
-            start = _start(scene, meth, contact)
+            start = _start(scene, meth, contact, start_progress)
         except SolverError as err:
             raise (err.with_step(0) if err.step is None else err) from err
         first = 1
@@ -230,8 +233,10 @@ def new_result(scene, contact, method_name: str, out=None, keep_every: int = 1) 
             "dimension": 3, "dq": scene.dq, "elements": int(g.n), "coupled": bool(contact.ops.coupled),
             "slip_note": ("state 0 of a braked start: static-shift slip per c = sqrt(ab) of shift"
                           if scene.load.start == "braked" else "state 0: the steady state")}
-    return Result(g.x, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, keep_every=keep_every, out=out,
-                  operators=contact, layout=GRID, coords={"x": g.x, "y": g.y})
+    constants = {"area": g.area, "wear_A": scene.A.wear or 0.0, "wear_B": scene.B.wear or 0.0,
+                 "braked": float(scene.load.start == "braked")}
+    return Result(g.x, {"a": e.a, "b": e.b, "p0": e.p0, "Estar": e.Estar}, meta, fields_for(scene), keep_every=keep_every,
+                  out=out, operators=contact, layout=GRID, coords={"x": g.x, "y": g.y}, constants=constants)
 
 
 @functools.lru_cache(maxsize=1)
@@ -280,7 +285,8 @@ def _noted(meta: dict, records, contact):
         yield rec
 
 
-def run(scene, method=None, progress=None, resume=None, observe=None, out=None, keep_every=None) -> Result:
+def run(scene, method=None, progress=None, resume=None, observe=None, out=None, keep_every=None,
+        start_progress=None) -> Result:
     """Run a 3D scene and return its :class:`~rollqp.result.Result` — :func:`rollqp.march.run` for the grid, with
     the same arguments and guarantees (docs/results.md): ``progress(k, K)`` after each rolling step,
     ``observe(record, contact)`` with every record, ``resume`` an earlier part of the run (the path of its
@@ -289,7 +295,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     state journaled as it is completed (``out.journal``: a run killed even by SIGKILL loses at most the
     state in flight; no state is kept in memory), the file written at the end — and, with the completed
     states and the reason in ``meta["failed"]`` or ``meta["interrupted"]``, when the run fails or is
-    interrupted; ``keep_every``: keep every k-th state (and the last two).
+    interrupted; ``keep_every``: keep every k-th state (and the last two); ``start_progress(j, expected)`` after
+    each step of the start (:func:`march`: a conic method's march to a steady state can take minutes).
 
     Raises
     ------
@@ -307,7 +314,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
         tail = source.tail() if isinstance(source, ResumeSource) else source
         state = check_resumed(scene, prepared, tail)
     result = new_result(scene, contact, meth.name, out=out, keep_every=keep)
-    records = _noted(result.meta, march(scene, prepared=prepared, resume=tail, verify=False, state=state), contact)
+    records = _noted(result.meta, march(scene, prepared=prepared, resume=tail, verify=False, state=state,
+                                        start_progress=start_progress), contact)
     with stop_once():  # a second Ctrl-C never interrupts the writing of what the first one saves
         return drive(result, records, source=source, resumed_from=None if tail is None else _last_index(tail),
                      operators=contact, observe=observe, progress=progress, steps=scene.n_steps)

@@ -46,6 +46,7 @@ from ..scene.core import SceneBase
 from ..validate import choice, integer, number, string, suggestion
 from .contact import Loads
 from .geometry import Body, curvatures
+from .contact import MU_REFERENCE
 from .grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
 from .hertz import hertz
 from .materials import Materials
@@ -79,6 +80,7 @@ class Body3D:
     E: float = None
     nu: float = None
     profile: Any = None
+    wear: float | None = None
 
 
 @dataclass(frozen=True)
@@ -151,8 +153,10 @@ def _body(key, b: Body3D) -> Body3D:
         if getattr(b, k) is None:
             raise InputError(f"{key}.{k}", "missing required key")
     shape = parse_body({k: getattr(b, k) for k in ("radius", "radius_y", "profile") if getattr(b, k) is not None}, key)
+    wear = None if b.wear is None else number(f"{key}.wear", b.wear, ">= 0 (Archard's k/H in 1/stress) or absent",
+                                              lambda x: x >= 0)
     return Body3D(shape.rx, shape.ry, number(f"{key}.E", b.E, "> 0", lambda x: x > 0),
-                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict())
+                  number(f"{key}.nu", b.nu, "in (-1, 0.5)", lambda x: -1.0 < x < 0.5), shape.profile_dict(), wear)
 
 
 def _contact(c: Contact3D) -> Contact3D:
@@ -437,6 +441,10 @@ def _check_whole(scene) -> None:
                                                       "ellipse to scale discretization.zone by; give the grid in length "
                                                       "units, extent = [[x0, x1], [y0, y1]]")
     _check_ellipse(scene)
+    for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):  # Archard's k·p0/H <= 1, as in 2D
+        if body.wear is not None and not body.wear * scene.ellipse.p0 <= 1.0:
+            raise InputError(f"{key}.wear", f"must be a number in [0, 1/p0 = {1.0 / scene.ellipse.p0:.6g}] (k/H in "
+                                            f"1/stress: Archard's k·p0/H is at most 1), got {body.wear!r}")
     if scene.discretization.extent is None:
         _check_grid(scene)
     elif scene.shape.hertzian and not scene.grid.covers(scene.ellipse.a, scene.ellipse.b):
@@ -452,6 +460,11 @@ def _check_whole(scene) -> None:
     _check_creepages(scene)
 
 
+#: The range of a contact's compliance c/E* (length per stress) whose influence coefficients, and their sums over
+#: up to a million elements, are finite normal floating-point numbers (1e±308), with 1e58 to spare.
+COMPLIANCE_RANGE = (1e-250, 1e250)
+
+
 def _check_ellipse(scene) -> None:
     try:
         e = scene.ellipse
@@ -460,9 +473,22 @@ def _check_ellipse(scene) -> None:
             raise
         key = "bodies.A.radius" if err.key == "A" else "bodies.A.radius_y"
         raise InputError(key, str(err).split(": ", 1)[-1]) from None
+    except ArithmeticError:   # the ellipse's lengths under- or overflow (a load of 1e-300 on moduli of 1e300)
+        raise InputError("load.normal", f"the Hertz ellipse of FN = {scene.load.normal!r} with these radii and moduli "
+                                        "is not a finite, nonzero size: extreme input; use other units") from None
     if not all(math.isfinite(v) and v > 0 for v in (e.a, e.b, e.p0, e.delta)):
         raise InputError("load.normal", f"the Hertz ellipse of FN = {scene.load.normal!r} with these radii and moduli "
                                         f"is not finite (a = {e.a:.3g}, b = {e.b:.3g}, p0 = {e.p0:.3g}): extreme input")
+    # the influence coefficients are about c/E* (a displacement per unit pressure on an element of size c): beyond
+    # this range their sums over the grid overflow or underflow in floating point, whatever the units
+    flex = math.sqrt(e.a * e.b) / scene.materials.Estar
+    if not COMPLIANCE_RANGE[0] <= flex <= COMPLIANCE_RANGE[1]:
+        soft = min("AB", key=lambda k: getattr(scene, k).E / (1 - getattr(scene, k).nu ** 2))
+        key = f"bodies.{soft if flex > 1 else 'AB'[soft == 'A']}.E"
+        raise InputError(key, f"the contact's compliance c/E* = {flex:.3g} (c = sqrt(ab) = {math.sqrt(e.a * e.b):.3g}, "
+                              f"E* = {scene.materials.Estar:.3g}) must be in [{COMPLIANCE_RANGE[0]:g}, "
+                              f"{COMPLIANCE_RANGE[1]:g}]: the influence coefficients would not be finite numbers; "
+                              "use other units")
 
 
 def _check_grid(scene) -> None:
@@ -521,6 +547,11 @@ def _check_sliding_limit(scene) -> None:
                               "exists only below the sliding limit (prescribe creepages for gross sliding)")
 
 
+#: A prescribed nonzero creepage must set tractions of at least this many times the tangential steps' tolerance
+#: (in their unit): the answer is then resolved to 1 % or better.
+MEANINGFUL = 100.0
+
+
 def _check_creepages(scene) -> None:
     """Prescribed creepages: ``|ξ|, |η| <= MAX_CREEPAGE`` and ``|φ|·max(a, b) <= MAX_CREEPAGE`` at every step
     (and the histories' breakpoints)."""
@@ -540,6 +571,19 @@ def _check_creepages(scene) -> None:
                                                      f"{MAX_CREEPAGE:g}{here}: a creepage is a slip velocity over the "
                                                      f"rolling speed, and full sliding sets in near 3 mu a/R (a few 1e-3 "
                                                      f"for steel wheels on rails): larger is a typing error")
+        # the tractions a creepage sets are about E* |xi| (at most mu p0): where that is below the tangential steps'
+        # tolerance a step stops at zero tractions, however wrong (a creepage of 1e-3 under FN = 1e30)
+        mu = scene.mu
+        if mu > 0:
+            unit = e.p0 * min(1.0, mu / MU_REFERENCE)          # the tangential steps' stress unit (rollqp.three.contact)
+            lowest = float(np.min(v[v > 0], initial=np.inf)) * scene.materials.Estar / unit
+            if lowest < MEANINGFUL * scene.solver.tolerance:
+                raise InputError(f"load.creepage.{key}", f"{what} = {float(np.min(v[v > 0])):.4g} sets tractions of "
+                                                         f"about {lowest:.3g} times the unit {unit:.3g} of the tangential "
+                                                         f"steps, below {MEANINGFUL:g} times solver.tolerance: at this "
+                                                         f"load (p0 = {e.p0:.4g}) the steps would stop at zero tractions; "
+                                                         f"a larger creepage, a smaller load.normal, or a smaller "
+                                                         f"solver.tolerance")
 
 
 # =========================================================================== from a dict

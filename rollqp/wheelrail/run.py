@@ -93,8 +93,10 @@ class WheelRailResult:
             np.savez(fh, **self.arrays())
 
 
-def run(scene, progress=None, resume=None, observe=None, out=None, keep_every=None) -> WheelRailResult:
-    """Solve the scene and write its result file ``out`` (``rollqp run``'s family interface)."""
+def run(scene, progress=None, resume=None, observe=None, out=None, keep_every=None,
+        start_progress=None) -> WheelRailResult:
+    """Solve the scene and write its result file ``out`` (``rollqp run``'s family interface; a wheel–rail
+    scene is one state: ``progress``, ``keep_every`` and ``start_progress`` have nothing to report)."""
     if resume is not None:
         raise InputError("--resume", "a wheel-rail scene is one state: there is nothing to resume")
     t0 = time.perf_counter()
