@@ -320,8 +320,13 @@ def result_grid(arrays, scene=None):
             if not (np.all(d > 0) and np.ptp(d) <= 1e-9 * max(abs(d[0]), 1e-300) + 1e-12 * np.max(np.abs(c))):
                 raise InputError("RESULT.npz", f"key {key!r} must hold the uniformly spaced element centres of a grid")
             sizes.append(float(np.mean(d)))
-        elif scene is not None:
-            sizes.append(float(getattr(scene.grid, "d" + key)))
+        elif scene is not None:  # one element along this axis: its size is the scene's, if its grid is this one
+            sg = scene.grid
+            mine = getattr(sg, key)
+            if mine.size != 1 or not abs(float(mine[0]) - float(c[0])) <= 1e-9 * (abs(float(c[0])) + getattr(sg, "d" + key)):
+                raise InputError("RESULT.npz", f"key {key!r} is not the grid of the scene stored in the file "
+                                               f"({mine.size} elements along {key}): a corrupt or edited file")
+            sizes.append(float(getattr(sg, "d" + key)))
         else:
             raise InputError("RESULT.npz", f"one element along {key}: its size comes from the scene")
     dx, dy = sizes
@@ -362,6 +367,15 @@ def _scale(arrays) -> float:
     return a
 
 
+def _finite(s) -> None:
+    """The stresses (and so their invariants, whose squares are within the range then) are finite: else the
+    tractions are beyond the floating-point range, a one-line error, never NaN peaks."""
+    s = np.asarray(s)
+    if not (np.all(np.isfinite(s)) and np.max(np.abs(s), initial=0.0) < 1e150):
+        raise InputError("result", "the stresses of these tractions are not finite (or beyond 1e150): the file's "
+                                   "tractions are out of range")
+
+
 def _body_nu(scene, body: str):
     if body not in ("A", "B"):
         raise InputError("body", f"must be 'A' or 'B', got {body!r}")
@@ -393,9 +407,11 @@ def stresses3d(result, step: int, plane=None, line=None, depths=None, body: str 
     nu, sign = _body_nu(scene, body)
     sec = section(grid, _scale(arrays), plane, line, depths, along)
     pts = sec.points()
-    s = stress_components(grid, *pts, arrays["pn"][k], sign * np.asarray(arrays["px"][k]),
-                          sign * np.asarray(arrays["py"][k]), nu)
-    values = {n: v.reshape(pts[0].shape) for n, v in invariants(s).items()}
+    with np.errstate(all="ignore"):
+        s = stress_components(grid, *pts, arrays["pn"][k], sign * np.asarray(arrays["px"][k]),
+                              sign * np.asarray(arrays["py"][k]), nu)
+        _finite(s)
+        values = {n: v.reshape(pts[0].shape) for n, v in invariants(s).items()}
     return StressField3D(sec, values, body, k, float(arrays["q"][k]), _maxima(values, pts))
 
 
@@ -424,10 +440,13 @@ def stress_history3d(result, plane=None, line=None, depths=None, body: str = "A"
     per = max(1, (1 << 22) // max(1, pts[0].size * 6))
     for b in range(0, ks.size, per):
         sel = ks[b:b + per]
-        s = stress_components(grid, *pts, np.asarray(arrays["pn"])[sel], sign * np.asarray(arrays["px"])[sel],
-                              sign * np.asarray(arrays["py"])[sel], nu)
+        with np.errstate(all="ignore"):
+            s = stress_components(grid, *pts, np.asarray(arrays["pn"])[sel], sign * np.asarray(arrays["px"])[sel],
+                                  sign * np.asarray(arrays["py"])[sel], nu)
+        _finite(s)
         for r in range(sel.size):
-            inv = invariants(s[r])
+            with np.errstate(all="ignore"):
+                inv = invariants(s[r])
             for name, (v, x, y, z) in _maxima({n: inv[n] for n in PEAKS}, [c.ravel() for c in pts]).items():
                 peaks[name][b + r] = (v, x, y, z)
     overall = {}
