@@ -2,7 +2,7 @@ r"""Subsurface stresses in three dimensions: exact Boussinesq–Cerruti integral
 
 Body A is the half-space ``z > 0`` (z into A, as everywhere in rollqp's 3D), loaded on its surface by
 the pressure ``p ≥ 0`` and the tangential tractions ``(p_x, p_y)`` on A, constant on each rectangular
-element of the grid (:mod:`rollqp.three.grid`, eq. 3D.9). The stresses are Love's potentials
+element of the grid (:mod:`rollqp.discretization.grid`, eq. 3D.9). The stresses are Love's potentials
 (Love 1929; Johnson, *Contact Mechanics*, 1985, §3.1, eq. 3.2–3.7) of those loads: every component is a
 sum of third and fourth derivatives of ``W = ∫∫ Ω dξ dη``, ``Ω = z ln(ρ + z) − ρ``, and over a rectangle
 each such derivative is the corner sum (docs/stresses.md §9)
@@ -92,7 +92,7 @@ def stress_components(grid, x, y, z, pn, px, py, nu: float) -> np.ndarray:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
+    grid : rollqp.discretization.grid.Grid
     x, y, z : array_like
         Points (broadcast together; z > 0, the depth into the body).
     pn, px, py : array_like
@@ -109,7 +109,7 @@ def stress_components(grid, x, y, z, pn, px, py, nu: float) -> np.ndarray:
 
     Examples
     --------
-    >>> from rollqp.three.grid import Grid
+    >>> from rollqp.discretization.grid import Grid
     >>> g = Grid.centred(1, 1, 0.5, 0.5)                     # a unit square under unit pressure
     >>> s = stress_components(g, 0.0, 0.0, 1e-6, [[1.0]], [[0.0]], [[0.0]], 0.3)
     >>> bool(abs(s[2, 0] + 1.0) < 1e-5)                      # σzz = −p just below the surface
@@ -310,8 +310,8 @@ def _state(arrays, step: int):
 
 
 def result_grid(arrays, scene=None):
-    """The :class:`~rollqp.three.grid.Grid` of a 3D result's element centres ``x``, ``y`` (uniform)."""
-    from .three.grid import Grid
+    """The :class:`~rollqp.discretization.grid.Grid` of a 3D result's element centres ``x``, ``y`` (uniform)."""
+    from .discretization.grid import Grid
     x, y = (np.asarray(arrays[k], dtype=float) for k in ("x", "y"))
     sizes = []
     for key, c in (("x", x), ("y", y)):

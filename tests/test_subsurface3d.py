@@ -11,10 +11,10 @@ from rollqp.closedforms.hertz3d import hamilton_normal, huber_axis, sliding_axis
 from rollqp.errors import InputError
 from rollqp.subsurface3d import (COMPONENTS, invariants, parse_depths, parse_line, parse_plane, point_load,
                                  stress_components)
-from rollqp.three.contact import Contact
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.grid import Grid
-from rollqp.three.materials import Materials
+from rollqp.operators.grid import Contact
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.discretization.grid import Grid
+from rollqp.materials import Materials
 
 from pathlib import Path
 
