@@ -1,7 +1,7 @@
 r"""Generalized Newton method with line search for the 3D steps (docs/theory3d.md §7).
 
 The 2D project's GNMls (González & Abascal 2002 §4; Pang 1990) carried to the disc. In the
-nondimensional variables of :mod:`rollqp.three.problem` the steps are the nonsmooth equations
+nondimensional variables of :mod:`rollqp.problem.grid` the steps are the nonsmooth equations
 
 .. math::
     \Phi_N = \begin{bmatrix} \min(\hat p,\ r\hat g) \\ \hat a\sum\hat p − \hat F_N\end{bmatrix},
@@ -42,10 +42,10 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from .. import progress
-from ..errors import InputError, SolverError
-from ..methods.base import Capabilities, check_options
-from .problem import disc_projection
+from ... import progress
+from ...errors import InputError, SolverError
+from ..base import Capabilities, check_options
+from ...problem.grid import disc_projection
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 
@@ -53,6 +53,10 @@ __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 #: on CONTACT's 48 × 44 steady case (2768 unknowns) a dense LU step takes 1.3 s, the GMRES step
 #: 0.07 s; at 500 unknowns (a 20 × 20 grid) they are even. Above this, FFT products and GMRES.
 DENSE_UNKNOWNS = 1200
+#: The same for a transient or shift step (the operator ``A_tt`` itself: GMRES converges in a few dozen
+#: products): measured on circles, CPU of a transient rolling step dense / Krylov: 2.4 / 9.0 ms at 160
+#: unknowns, 8.9 / 13.6 ms at 300, 36.6 / 17.4 ms at 632 (the same forces to 8 digits).
+TRANSIENT_DENSE_UNKNOWNS = 450
 #: Relative tolerance of the Krylov solves, against ‖Φ‖: an inexact Newton step of this
 #: accuracy keeps the local convergence superlinear (Eisenstat–Walker forcing ≤ 1e-2 ‖Φ‖).
 KRYLOV_FORCING = 1e-3
@@ -105,7 +109,7 @@ class NewtonMethod:
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "newton-3d"
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
-                                dimension=3, traction_components=2, friction_set="disc")
+                                dimensions=frozenset({3}), traction_components=2, friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, r: float | None = None,
                  rho: float = 0.5, sigma: float = 1e-4, path: str = "auto"):
@@ -132,8 +136,8 @@ class NewtonMethod:
         """Nothing to build: the dense blocks are memoized by the operators themselves."""
 
     def solve(self, problem, warm=None):
-        """Solve a :class:`~rollqp.three.problem.NormalStep` or
-        :class:`~rollqp.three.problem.TangentialStep`; ``warm``: a previous solution."""
+        """Solve a :class:`~rollqp.problem.grid.NormalStep` or
+        :class:`~rollqp.problem.grid.TangentialStep`; ``warm``: a previous solution."""
         t0 = time.perf_counter()
         if problem.kind == "normal":
             sol = _solve_normal(self, problem, warm)
@@ -144,8 +148,8 @@ class NewtonMethod:
         sol.info["time"] = time.perf_counter() - t0
         return sol
 
-    def _use_dense(self, unknowns: int) -> bool:
-        return self.path == "dense" or (self.path == "auto" and unknowns <= DENSE_UNKNOWNS)
+    def _use_dense(self, unknowns: int, limit: int = DENSE_UNKNOWNS) -> bool:
+        return self.path == "dense" or (self.path == "auto" and unknowns <= limit)
 
     def _iterate(self, x, Kx, phi_fn, step_fn, r, what):
         """The GNMls loop: ``phi_fn(x, Kx) → Φ``, ``step_fn(x, Kx, Φ) → (d, Kd)``."""
@@ -209,7 +213,7 @@ def _solve_normal(method, problem, warm):
     p = np.maximum(x[:n], 0.0) * sc.stress
     Ap = (A @ p)
     return problem.solution(p, x[n] * sc.displacement, Ap=Ap, method=method.name,
-                            iterations=info["directions"], info=info)
+                            iterations=info["directions"], extras=info)
 
 
 def _normal_direction(method, A, s, x, Kx, phi, r, hh, ah, free_delta):
@@ -281,7 +285,7 @@ def _solve_tangential(method, problem, warm):
     n, B = problem.n, problem.B
     V = np.flatnonzero(bh > 0)
     if V.size == 0:   # no contact: no traction (the sliding limit check rejects a nonzero force)
-        return problem.solution(np.zeros((2, n)), 0.0, 0.0, method=method.name, info={"contact": 0})
+        return problem.solution(np.zeros((2, n)), 0.0, 0.0, method=method.name, extras={"contact": 0})
     diag = k * B.diagonal()
     r = method.r if method.r is not None else 1.0 / float(np.mean(np.concatenate([diag[V], diag[n + V]])))
     if warm is not None and warm.t is not None and np.shape(warm.t) == (2, n):
@@ -297,7 +301,7 @@ def _solve_tangential(method, problem, warm):
     t[:, V] = x[:2 * V.size].reshape(2, V.size) * sc.stress
     crp = {j: x[2 * V.size + i] * sc.slip for i, j in enumerate(free)}
     sol = problem.solution(t, crp.get(0), crp.get(1), method=method.name, iterations=info["directions"],
-                           info={**info, "contact": int(V.size)})
+                           extras={**info, "contact": int(V.size)})
     # ‖Φ‖∞ ≤ tol·min(1, r) bounds the residual on the same products; the fresh FFT product of
     # problem.solution can differ by round-off times the condition: 100× is the 2D QPs' residual_limit
     if not sol.residual <= 100 * method.tolerance:
@@ -331,7 +335,8 @@ class _TangentialSystem:
         self.E = np.zeros((2 * self.nv, len(free)))     # ∂ŝ/∂(ξ̂, η̂): ones on the x (y) rows
         for i, j in enumerate(free):
             self.E[j * self.nv:(j + 1) * self.nv, i] = 1.0
-        self.dense = method._use_dense(2 * self.nv + len(free))
+        steady = str(getattr(problem.B, "name", "")).startswith("steady")   # the steady operator (eq. 3D.17)
+        self.dense = method._use_dense(2 * self.nv + len(free), DENSE_UNKNOWNS if steady else TRANSIENT_DENSE_UNKNOWNS)
         self.S = k * problem.B.memo(("dense", V.tobytes()), lambda: problem.B.dense(V, V)) if self.dense else None
         self._rS = None
 
