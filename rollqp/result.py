@@ -892,6 +892,22 @@ class ResumeSource:
         rec = self.journal.records([i])[0]
         return {"p": np.array(rec["pn"], dtype=float), "t": np.array(rec["pt"], dtype=float)}
 
+    def blocks(self, names):
+        """Every stored state's ``names`` (those it holds), a block of states at a time: dicts of arrays whose first
+        axis is the block's states (the states an earlier part hands on, to be checked before they are imported)."""
+        if self.journal is None:
+            a = self.arrays
+            K1 = len(a["q"])
+            size = sum(np.asarray(a[k][:1]).nbytes for k in names if k in a) or 1
+            m = max(1, BLOCK_BYTES // size)
+            for i in range(0, K1, m):
+                yield {k: np.asarray(a[k][i:i + m]) for k in names if k in a}
+            return
+        j = self.journal
+        for ids in _journal_blocks(j, np.arange(len(j))):
+            recs = j.records(ids)
+            yield {k: np.asarray(recs[k]) for k in names if k in recs.dtype.names}
+
     def rows(self, names):
         """Every stored state as ``{name: value}`` of ``names`` (an earlier part to import)."""
         a = self.arrays

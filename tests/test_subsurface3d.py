@@ -224,3 +224,28 @@ def test_command_refuses_bad_3d_input_in_one_line(result3d, args, key, capsys):
     assert cli.main(argv) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith(f"rollqp: error: {key}:"), err
+
+
+def test_history_and_body_b(result3d):
+    """The peaks of every state on a line (``stress_history3d``) are those of each state's field; body B is loaded
+    by p and −(p_x, p_y): just below a slipping element its σxz is +p_x where A's is −p_x."""
+    from rollqp.result import load_result
+    from rollqp.subsurface3d import stress_history3d, stresses3d
+    a = load_result(result3d)
+    z = [0.01, 0.05, 0.2]
+    h = stress_history3d(a, line=(0.0, 0.0), depths=z)
+    for k in range(len(a["q"])):
+        sf = stresses3d(a, k, line=(0.0, 0.0), depths=z)
+        # the same sums, states in one matrix product or one at a time: equal to round-off
+        assert abs(h.peaks["von_mises"][k, 0] - sf.values["von_mises"].max()) <= 1e-13 * float(a["p0"])
+        assert abs(h.peaks["s3"][k, 0] - sf.values["s3"].min()) <= 1e-13 * float(a["p0"])
+    k = int(np.argmax(h.peaks["von_mises"][:, 0]))
+    assert h.overall["von_mises"][4] == k
+    j, i = np.unravel_index(np.argmax(np.abs(a["px"][-1])), a["px"][-1].shape)
+    x0, y0, dz = float(a["x"][i]), float(a["y"][j]), 1e-6 * float(a["a"])
+    A = stresses3d(a, -1, line=(x0, y0), depths=[dz])
+    B = stresses3d(a, -1, line=(x0, y0), depths=[dz], body="B")
+    px = float(a["px"][-1][j, i])
+    # the surface limit σxz → ∓p_x, to O(dz/dx) ≈ 1e-5 of p_x (the field of the neighbours' tractions)
+    assert abs(A["sxz"][0, 0] + px) < 1e-4 * abs(px) and abs(B["sxz"][0, 0] - px) < 1e-4 * abs(px)
+    assert abs(A["szz"][0, 0] - B["szz"][0, 0]) < 1e-4 * float(a["p0"])

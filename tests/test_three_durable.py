@@ -409,8 +409,15 @@ def physics_violations(res, scene) -> dict:
 PHYSICS_TOL = {"FN": 1e-12, "disc": 1e-8, "states": 0, "stick slip": 1e-8, "direction": 1e-6}
 
 
+#: The checks of an approximate method's result (FASTSIM, Kalker's simplified theory: its slips are those of its own
+#: flexibility, not of the half-space's steps, so stick and slip follow its model, not these checks).
+APPROXIMATE = ("FN", "disc")
+
+
 def assert_physics(res, scene):
     got = physics_violations(res, scene)
+    if scene.solver.method == "fastsim":
+        got = {k: v for k, v in got.items() if k in APPROXIMATE}
     bad = {k: v for k, v in got.items() if not v <= PHYSICS_TOL[k]}
     assert not bad, (scene.name, bad)
 

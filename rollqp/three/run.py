@@ -38,7 +38,7 @@ from .loads import start_force
 from .patch import moving_profile
 from .march import StepRecord, static_shift, steady
 
-__all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "GRID"]
+__all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
 
 
 def prepare(scene, method=None):
@@ -211,6 +211,58 @@ def _compare(again: StepRecord, stored: StepRecord, contact, k: int) -> None:
                                      "traction and slip: the file was changed or is corrupt")
 
 
+def check_states(scene, contact, source) -> None:
+    """Every state of an earlier part of the run (``source``: a :class:`~rollqp.result.ResumeSource` or a result
+    file's arrays) consistent in itself, a block of states at a time: pressures >= 0, tractions in the friction
+    disc and the element states those of p, t, s (to :data:`~rollqp.march.RESUME_TOL` of p0 and μp0), the forces
+    and moment those of the pressures and tractions, the rolled distances the scene's (checked with the last
+    state, :func:`resumed_record`). A state that is not is a changed or corrupt file: a one-line
+    :class:`InputError` on ``--resume``, before anything is run or written. (The last state is moreover solved
+    again: :func:`check_resumed`.)"""
+    from .march import _states
+    g, sc = contact.grid, contact.scales
+    mu = float(contact.mu)
+    tunit = (min(mu, 1.0) if mu > 0 else 1.0) * sc.stress
+    force = sc.stress * g.area * g.n
+    names = ("pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "step")
+    blocks = source.blocks(names) if isinstance(source, ResumeSource) else _array_blocks(source, names)
+    seen = 0
+    for b in blocks:
+        m = len(b["pn"])
+        p = np.asarray(b["pn"], dtype=float).reshape(m, -1)
+        t = np.stack([np.asarray(b["px"], dtype=float).reshape(m, -1), np.asarray(b["py"], dtype=float).reshape(m, -1)], 1)
+        sl = np.stack([np.asarray(b["sx"], dtype=float).reshape(m, -1), np.asarray(b["sy"], dtype=float).reshape(m, -1)], 1)
+        k = np.asarray(b["step"]) if "step" in b else np.arange(seen, seen + m)
+        bad = []
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(t)) and np.all(np.isfinite(sl))):
+            bad = ["its fields are not finite"]
+        elif np.min(p) < -RESUME_TOL * sc.stress:
+            bad = [f"a pressure of {np.min(p) / sc.stress:.3g} p0 < 0"]
+        elif np.max(np.hypot(t[:, 0], t[:, 1]) - mu * np.maximum(p, 0.0)) > RESUME_TOL * tunit:
+            bad = ["a traction beyond the friction disc"]
+        for i in range(m):
+            if bad:
+                break
+            Fx, Fy, Mz = contact.moments(t[i])
+            FN = g.area * float(p[i].sum())
+            if not (abs(FN - float(b["FN"][i])) <= 1e-12 * force and abs(Fx - float(b["Fx"][i])) <= 1e-12 * force
+                    and abs(Fy - float(b["Fy"][i])) <= 1e-12 * force
+                    and abs(Mz - float(b["Mz"][i])) <= 1e-12 * force * sc.length):
+                bad = [f"state {int(k[i])}: its forces are not those of its pressure and tractions"]
+            elif not np.array_equal(_states(contact, p[i], t[i], sl[i]), np.asarray(b["state"][i]).ravel()):
+                bad = [f"state {int(k[i])}: its element states are not those of its pressure, traction and slip"]
+        if bad:
+            where = bad[0] if bad[0].startswith("state") else f"a state of the file: {bad[0]}"
+            raise InputError("--resume", f"{where}: the file was changed or is corrupt")
+        seen += m
+
+
+def _array_blocks(arrays, names, rows: int = 256):
+    K1 = len(arrays["q"])
+    for i in range(0, K1, rows):
+        yield {k: np.asarray(arrays[k][i:i + rows]) for k in names if k in arrays}
+
+
 def _read_grid(rec: StepRecord, contact) -> tuple[dict, dict]:
     """The core fields and notes of a 3D :class:`~rollqp.three.march.StepRecord` (:data:`GRID`)."""
     g = contact.grid
@@ -315,6 +367,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
         state = check_resumed(scene, prepared, tail)
+        check_states(scene, contact, source)
     result = new_result(scene, contact, meth.name, out=out, keep_every=keep)
     records = _noted(result.meta, march(scene, prepared=prepared, resume=tail, verify=False, state=state,
                                         start_progress=start_progress), contact)
