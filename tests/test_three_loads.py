@@ -240,3 +240,25 @@ def test_a_load_path_round_trips_and_plain_scenes_are_unchanged():
                          "load.rolled": {"kind": "ramp", "start": 0.0, "end": 10.0, "over": 10.0}})
     a, b = run(plain).arrays(), run(same).arrays()
     assert np.allclose(a["px"], b["px"], rtol=0, atol=1e-12 * plain.ellipse.p0)
+
+
+def test_a_load_path_resumes_where_it_stopped():
+    """Roll, stop while the load (and Fx with it: the same history scaled) drops to 0 and comes back, roll back:
+    a run resumed from any stored state (rolling, shift, out of contact) continues as the run that never stopped
+    (to the resume check's tolerance; measured 2.4e-12 μp0)."""
+    nh = {"kind": "table", "q": [0, 1, 1.2, 1.9, 2.2, 4], "value": [1, 1, 0, 0, 1, 1.2]}
+    s = braked(12, **{"load.tangential": nh | {"value": [0.5 * v for v in nh["value"]]},
+                      "load.rolled": {"kind": "table", "q": [0, 1, 2.5, 4], "value": [0, 1, 1, -0.5]},
+                      "load.normal_history": nh, "discretization.distance": 4.0})
+    full = run(s).arrays()
+    K = full["q"].size
+    phases = {"rolling": np.flatnonzero(plan(s).d != 0)[3], "unloaded": int(np.flatnonzero(full["FN"] == 0)[0]),
+              "shift": int(np.flatnonzero(plan(s).d == 0)[-1])}
+    assert full["FN"][phases["unloaded"]] == 0 and plan(s).d[phases["unloaded"]] == 0
+    for what, k in phases.items():
+        part = {n: (v[:k + 1] if isinstance(v, np.ndarray) and v.ndim >= 1 and v.shape[0] == K else v)
+                for n, v in full.items()}
+        again = run(s, resume=part).arrays()
+        assert again["q"].size == K, what
+        assert np.max(np.abs(again["px"] - full["px"])) / (s.mu * s.ellipse.p0) < 1e-10, what
+        assert np.max(np.abs(again["pn"] - full["pn"])) / s.ellipse.p0 < 1e-10, what

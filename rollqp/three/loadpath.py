@@ -114,17 +114,19 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
                 fixed = (FN, normal(contact, method, FN))
             pressure = fixed[1]
         previous = (prev.p, prev.t)
+        if prev.FN != FN:       # the last step's tractions may lie outside this load's discs: a cold start
+            warm = None
+        phase = "shift" if d == 0 else "rolling"       # a stop: a static shift step under the loads of τ_k
+        dq = None if d == 0 else shifted.snap(float(pl.dq[k]))
         try:
-            if d == 0:     # a stop: a static shift step under the loads of τ_k
-                ns, ts, sw = coupled_step(contact, method, FN, "shift", ld, previous, warm=warm, pressure=pressure)
-                phase = "shift"
-            else:
-                dq = shifted.snap(float(pl.dq[k]))
-                ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, previous, dq, d, warm=warm,
-                                          pressure=pressure)
-                phase = "rolling"
+            ns, ts, sw = coupled_step(contact, method, FN, phase, ld, previous, dq, d, warm=warm, pressure=pressure)
         except SolverError as exc:
-            raise exc.with_step(k) from None
+            if warm is None:
+                raise exc.with_step(k) from None
+            try:                # a warm start can mislead Newton's active set: once more from cold
+                ns, ts, sw = coupled_step(contact, method, FN, phase, ld, previous, dq, d, pressure=pressure)
+            except SolverError as again:
+                raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
                       _states(contact, ns.p, ts.t, ts.s))
         rec.info["direction"] = d
