@@ -7,7 +7,7 @@ import importlib
 import pytest
 
 MODULES = ["grid", "materials", "influence", "operator", "operators", "geometry", "hertz", "closedforms", "gnm",
-           "contact"]
+           "contact", "loads"]
 
 
 @pytest.mark.parametrize("name", MODULES)

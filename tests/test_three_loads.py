@@ -50,14 +50,15 @@ def _hertz_errors(n):
 
 def test_normal_history_gives_hertz_at_the_current_load():
     """Every step's pressure is Hertz's at the step's load to the discretization error, which falls as the
-    grid is refined (relative L2 error, max over the steps: measured 0.0356 on 16², 0.0278 on 24²: slope 0.6,
-    the error of the elements cut by the ellipse's edge)."""
+    grid is refined (relative L2 error, max over the steps: measured 0.0335 on 16², 0.0222 on 24², 0.0202 on 32²,
+    as irregular as the normal step's own error at constant loads in [1, 1.3] FN_ref, 0.034, 0.024, 0.014 at
+    most: the elements the ellipse's edge cuts change with the load; benchmarks/three_loads.py)."""
     s16, a16, e16 = _hertz_errors(16)
     _, _, e24 = _hertz_errors(24)
     fn = s16.load.normal * s16.load.normal_history(s16.time_steps / s16.ellipse.a)
     # the load is the history's (the normal step's force equation, solved to 1e-10)
     assert np.allclose(a16["FN"], fn, rtol=1e-9, atol=0) and fn.max() > 1.25 * s16.load.normal
-    assert e16.max() < 0.037 and e24.max() < 0.029 and e24.max() < 0.85 * e16.max()
+    assert e16.max() < 0.036 and e24.max() < 0.024 and e24.max() < 0.75 * e16.max()   # first order: 0.67
     # not Hertz at the reference load: at the largest load that error is 7 times the discretization error
     _, _, contact = prepare(s16)
     k = int(np.argmax(a16["FN"]))
@@ -132,8 +133,8 @@ def _stick_centroid(x, state):
 def test_reversal_moves_the_stick_zone_to_the_new_leading_edge_as_in_2d():
     """Roll 3 a, stop, roll back 6 a with Fx = 0.75 μFN held (the 2D scene stop-reverse's path): the stick
     zone is at the leading edge (x > 0 rolling forward with direction −1, x < 0 rolling back) at every rolling
-    step, from the first step after the reversal on, in 3D as in 2D on the same history; the end state is the
-    forward run's mirrored (measured 1.8e-7 μp0: the transient left after 6 a, as 2D's 7.5e-7)."""
+    step, from the first step after the reversal on (its Δq is 0.025 a), in 3D as in 2D on the same history; the
+    end state is the forward run's mirrored (measured 1.8e-7 μp0: the transient left after 6 a, as 2D's 7.5e-7)."""
     s = braked(**{"load.rolled": REVERSE, "discretization.distance": 10.0})
     a = run(s).arrays()
     c3 = _stick_centroid(a["x"], a["state"]) / s.ellipse.a
@@ -163,8 +164,8 @@ def test_reversal_moves_the_stick_zone_to_the_new_leading_edge_as_in_2d():
 def test_fretting_at_rest_follows_mindlin_deresiewicz():
     """At rest (rolled = 0 throughout) Fx cycles 0.6 → −0.6 → 0.6 μFN from the Cattaneo state: the state at −0.6
     is the first one negated and the state back at 0.6 the first one (Mindlin–Deresiewicz's loop closes; measured
-    5e-12 μp0); and unloading to 0 gives t(0.6) − 2·t(0.3), Cattaneo's states superposed (measured 2e-3 μp0 on
-    16²: the discrete stick zones are not exactly nested)."""
+    4.8e-4 and 3.5e-4 μp0, below); and unloading to 0 gives t(0.6) − 2·t(0.3), Cattaneo's states superposed
+    (measured 1.1e-4 μp0 on 16²: the same discrete path dependence)."""
     L = 8 * braked().grid.dx / braked().ellipse.a          # 8 steps per quarter cycle: the turns are steps
     s = braked(**{"load.rolled": {"kind": "constant", "value": 0.0}, "discretization.distance": 4 * L,
                   "load.tangential": {"kind": "table", "q": [0, L, 2 * L, 3 * L, 4 * L],
@@ -182,13 +183,13 @@ def test_fretting_at_rest_follows_mindlin_deresiewicz():
     _, meth, contact = prepare(s)
     cat = {F: static_shift(contact, meth, s.load.normal, F * s.mu * s.load.normal)[-1].t[0] for F in (0.6, 0.3)}
     md = contact.grid.field(cat[0.6] - 2 * cat[0.3])
-    assert np.max(np.abs(a["px"][k1] - md)) / mu_p0 < 5e-3
+    assert np.max(np.abs(a["px"][k1] - md)) / mu_p0 < 1e-3
 
 
 # =========================================================================== variable Δq and a second method
 def test_variable_steps_stop_reversal_and_load_agree_between_methods():
     """Variable Δq (three slopes), a stop, a reversal and a varying normal load: Newton against the conic
-    method (Clarabel, refined) to its accuracy (measured 1e-9 μp0)."""
+    method (Clarabel, refined by the active set) to the tolerance 1e-10 (measured 5e-11 μp0, 5e-15 p0)."""
     pytest.importorskip("clarabel")
     s = braked(12, **{"load.rolled": {"kind": "table", "q": [0, 1, 1.5, 2.5, 4], "value": [0, 0.5, 0.5, 1.5, 0.75]},
                       "load.normal_history": {"kind": "table", "q": [0, 1.2, 4], "value": [1.0, 1.2, 0.9]},
@@ -199,8 +200,8 @@ def test_variable_steps_stop_reversal_and_load_agree_between_methods():
     a = run(s).arrays()
     b = run(s, method="socp-clarabel").arrays()
     scale = s.mu * s.ellipse.p0
-    assert np.max(np.abs(a["px"] - b["px"])) / scale < 1e-6
-    assert np.max(np.abs(a["pn"] - b["pn"])) / s.ellipse.p0 < 1e-6
+    assert np.max(np.abs(a["px"] - b["px"])) / scale < 1e-9
+    assert np.max(np.abs(a["pn"] - b["pn"])) / s.ellipse.p0 < 1e-9
 
 
 # =========================================================================== (c) errors naming the key
