@@ -53,6 +53,10 @@ __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 #: on CONTACT's 48 × 44 steady case (2768 unknowns) a dense LU step takes 1.3 s, the GMRES step
 #: 0.07 s; at 500 unknowns (a 20 × 20 grid) they are even. Above this, FFT products and GMRES.
 DENSE_UNKNOWNS = 1200
+#: The same for a transient or shift step (the operator ``A_tt`` itself: GMRES converges in a few dozen
+#: products): measured on circles, CPU of a transient rolling step dense / Krylov: 2.4 / 9.0 ms at 160
+#: unknowns, 8.9 / 13.6 ms at 300, 36.6 / 17.4 ms at 632 (the same forces to 8 digits).
+TRANSIENT_DENSE_UNKNOWNS = 450
 #: Relative tolerance of the Krylov solves, against ‖Φ‖: an inexact Newton step of this
 #: accuracy keeps the local convergence superlinear (Eisenstat–Walker forcing ≤ 1e-2 ‖Φ‖).
 KRYLOV_FORCING = 1e-3
@@ -144,8 +148,8 @@ class NewtonMethod:
         sol.info["time"] = time.perf_counter() - t0
         return sol
 
-    def _use_dense(self, unknowns: int) -> bool:
-        return self.path == "dense" or (self.path == "auto" and unknowns <= DENSE_UNKNOWNS)
+    def _use_dense(self, unknowns: int, limit: int = DENSE_UNKNOWNS) -> bool:
+        return self.path == "dense" or (self.path == "auto" and unknowns <= limit)
 
     def _iterate(self, x, Kx, phi_fn, step_fn, r, what):
         """The GNMls loop: ``phi_fn(x, Kx) → Φ``, ``step_fn(x, Kx, Φ) → (d, Kd)``."""
@@ -331,7 +335,8 @@ class _TangentialSystem:
         self.E = np.zeros((2 * self.nv, len(free)))     # ∂ŝ/∂(ξ̂, η̂): ones on the x (y) rows
         for i, j in enumerate(free):
             self.E[j * self.nv:(j + 1) * self.nv, i] = 1.0
-        self.dense = method._use_dense(2 * self.nv + len(free))
+        steady = str(getattr(problem.B, "name", "")).startswith("steady")   # the steady operator (eq. 3D.17)
+        self.dense = method._use_dense(2 * self.nv + len(free), DENSE_UNKNOWNS if steady else TRANSIENT_DENSE_UNKNOWNS)
         self.S = k * problem.B.memo(("dense", V.tobytes()), lambda: problem.B.dense(V, V)) if self.dense else None
         self._rS = None
 
