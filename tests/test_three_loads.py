@@ -263,3 +263,30 @@ def test_a_load_path_resumes_where_it_stopped():
         assert again["q"].size == K, what
         assert np.max(np.abs(again["px"] - full["px"])) / (s.mu * s.ellipse.p0) < 1e-10, what
         assert np.max(np.abs(again["pn"] - full["pn"])) / s.ellipse.p0 < 1e-10, what
+
+
+def test_export_step_and_cross_check_pose_a_load_paths_steps():
+    """export-step and the run's cross-check pose each step as the run did (its load, Δq, direction and loads):
+    the run's own solution solves the exported step (rollqp's residuals at the solver tolerance) and the
+    conic method agrees on the kept steps; an out-of-contact step is refused naming --step."""
+    from rollqp.stepfile.three import export_step_3d
+    from rollqp.three.crosscheck import SpotObserver, cross_check
+    nh = {"kind": "table", "q": [0, 1, 1.2, 1.9, 2.2, 4], "value": [1.2, 1, 0, 0, 1, 1.2]}
+    s = braked(12, **{"load.tangential": nh | {"value": [0.5 * v for v in nh["value"]]},
+                      "load.rolled": {"kind": "table", "q": [0, 1, 2.5, 4], "value": [0, 1, 1, -0.5]},
+                      "load.normal_history": nh, "discretization.distance": 4.0})
+    pl, fn = plan(s), s.load.normal_history(s.time_steps / s.ellipse.a)
+    picks = {"start": 0, "rolling": 2, "stop with a changing load": int(np.flatnonzero((pl.d == 0) & (fn > 0))[-1]),
+             "rolling back": int(np.flatnonzero(pl.d == 1)[1])}
+    for what, k in picks.items():
+        step = export_step_3d(s, k)
+        assert step.FN == pytest.approx(s.load.normal * fn[k], rel=1e-12), what
+        assert step.ref_residual < 1e-9, (what, step.ref_residual)
+    with pytest.raises(InputError) as err:
+        export_step_3d(s, int(np.flatnonzero(fn == 0)[0]))
+    assert err.value.key == "--step" and "out of contact" in str(err.value)
+    pytest.importorskip("clarabel")
+    observer = SpotObserver(list(picks.values()))
+    run(s, observe=observer)
+    check = cross_check(s, observer, "newton", methods=["socp-clarabel"])
+    assert len(check.per_step) == len(picks) and check.agrees, check.table()

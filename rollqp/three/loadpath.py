@@ -31,11 +31,11 @@ import numpy as np
 
 from ..errors import SolverError
 from ..kinematics import plan
-from .loads import has_load_path, normal_force
+from .loads import has_load_path, normal_force, start_force
 from .march import StepRecord, _record, _states, _warm_of, coupled_step, normal, transient
 from .problem import SEPARATION
 
-__all__ = ["out_of_contact", "rolling_steps", "SHIFTED_KEPT"]
+__all__ = ["out_of_contact", "rolling_steps", "posed_force", "SHIFTED_KEPT"]
 
 #: Shifted influence operators kept for the distinct Δq of a load path (least recently used out): a table whose
 #: slopes all differ would otherwise keep one per step.
@@ -129,6 +129,15 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
                 raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
                       _states(contact, ns.p, ts.t, ts.s))
-        rec.info["direction"] = d
+        rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.three.crosscheck
         yield rec
         prev, warm = rec, (ns, ts)
+
+
+def posed_force(scene, rec) -> tuple[float, int]:
+    """``(FN, direction)`` of the step behind the record ``rec`` of a run of ``scene``: a load path's own
+    (``rec.info["pose"]``), else the starting state's ``FN(0)`` or ``load.normal``, and ``load.direction``."""
+    pose = rec.info.get("pose")
+    if pose is not None:
+        return pose[1], pose[3] if pose[3] != 0 else scene.load.direction
+    return (start_force(scene) if rec.k == 0 else float(scene.load.normal)), scene.load.direction

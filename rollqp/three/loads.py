@@ -21,9 +21,10 @@ from ..errors import InputError
 from ..histories import Constant, Harmonic
 from ..kinematics import plan
 from ..methods import REFERENCE_METHOD, scene_method_3d
+from .hertz import hertz
 from .patch import check_patch, computed_patch
 
-__all__ = ["has_load_path", "normal_force", "start_force", "check_load_path", "MAX_STEP_RATIO"]
+__all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "MAX_STEP_RATIO"]
 
 #: Largest ``|Δq_k|`` of a step of a load path, in elements ``dx``: the range of ``discretization.step``.
 MAX_STEP_RATIO = 8.0
@@ -124,3 +125,12 @@ def _check_sliding_limit(scene, s_end: float) -> None:
 def start_force(scene) -> float:
     """The normal force of the starting state, ``FN(τ = 0)`` (``load.normal`` without a normal history)."""
     return float(normal_force(scene, 0.0)) if has_load_path(scene) else float(scene.load.normal)
+
+
+def start_ellipse(scene):
+    """The Hertz ellipse of the starting state's load ``FN(0)`` (the scene's own without a normal history;
+    None at ``FN(0) = 0``, out of contact): what the starting state is compared with."""
+    FN = start_force(scene)
+    if FN == scene.load.normal:
+        return scene.ellipse
+    return None if FN <= 0 else hertz(*scene.curvatures, scene.materials.Estar, FN)
