@@ -15,12 +15,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rollqp.three.contact import Contact, Loads
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.grid import Grid
+from rollqp.operators.grid import Contact, Loads
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.discretization.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import static_shift, steady, transient
-from rollqp.three.materials import Materials
+from rollqp.materials import Materials
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data" / "contact3d"
 

@@ -28,12 +28,12 @@ from rollqp import load_scene  # noqa: E402
 from rollqp.closedforms.hertz3d import hamilton_normal, huber_axis, sliding_axis_shear  # noqa: E402
 from rollqp.energy import elastic_energy_of, grid_balance  # noqa: E402
 from rollqp.subsurface3d import invariants, plot_field3d, point_load, stress_components, stresses3d  # noqa: E402
-from rollqp.three.contact import Contact, Loads  # noqa: E402
-from rollqp.three.gnm import NewtonMethod  # noqa: E402
-from rollqp.three.grid import Grid  # noqa: E402
+from rollqp.operators.grid import Contact, Loads  # noqa: E402
+from rollqp.methods.newton.disc import NewtonMethod  # noqa: E402
+from rollqp.discretization.grid import Grid  # noqa: E402
 from rollqp.three.hertz import curvatures_for_ratio, hertz  # noqa: E402
 from rollqp.three.march import steady  # noqa: E402
-from rollqp.three.materials import Materials  # noqa: E402
+from rollqp.materials import Materials  # noqa: E402
 from rollqp.three.run import run  # noqa: E402
 
 

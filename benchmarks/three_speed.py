@@ -33,13 +33,13 @@ import time
 import numpy as np
 from harness import pin_threads, table
 
-from rollqp.three.contact import Contact, Loads
-from rollqp.three.grid import Grid
+from rollqp.operators.grid import Contact, Loads
+from rollqp.discretization.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import normal, steady
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.socp import ClarabelMethod
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.methods.socp import ClarabelMethod
 
 FN, MU = 1000.0, 0.3
 STEEL = Materials.from_young(210e3, 0.28, 210e3, 0.28)
@@ -230,8 +230,8 @@ def section_startup(quick):
     path = os.path.join(folder, "c22.toml")
     with open(path, "w", encoding="utf-8") as f:
         f.write(scene.to_toml())
-    contact = ("import numpy as np, rollqp\nfrom rollqp.three.contact import Contact\n"
-               "from rollqp.three.materials import Materials\n"
+    contact = ("import numpy as np, rollqp\nfrom rollqp.operators.grid import Contact\n"
+               "from rollqp.materials import Materials\n"
                "c = Contact.hertzian(Materials.from_young(210e3, .28, 210e3, .28), (1/60, 1/60), 1e3, .3, "
                "elements=(22, 22), zone=(1.1, 1.1))\nc.ops.Att @ np.ones(2 * c.grid.n); c.ops.Ann @ np.ones(c.grid.n)")
     cases = (("import rollqp", [sys.executable, "-c", "import rollqp"]),

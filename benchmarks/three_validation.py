@@ -24,14 +24,14 @@ import contact3d_cases
 from harness import pin_threads, table
 
 from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
-from rollqp.three.contact import Contact, Loads
-from rollqp.three.grid import Grid
+from rollqp.operators.grid import Contact, Loads
+from rollqp.discretization.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import coupled_step, static_shift, steady, transient
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
-from rollqp.three.socp import ClarabelMethod, CvxpyMethod, OsqpMethod
+from rollqp.methods.socp import ClarabelMethod, CvxpyMethod, OsqpMethod
 
 FN, MU = 1000.0, 0.3
 A_CURV = 1 / 60

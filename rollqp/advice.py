@@ -34,6 +34,9 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from .influence import get_model
+from .methods import METHOD_NAMES
+from .methods import capabilities
 
 __all__ = ["Plan", "fast_path", "duration", "dense_memory", "dense_seconds", "cholesky_seconds", "alternation_note",
            "DENSE_MEMORY_LIMIT", "DENSE_SECONDS_LIMIT"]
@@ -103,14 +106,12 @@ def matrix_free_alternative(scene, same_method: bool = True) -> str | None:
     or no matrix-free method solves what the scene poses. ``same_method``: it must also solve the same kinds
     of step as the scene's method (the coupled one possibly by the N–T alternation) — Newton for Newton, not
     Newton for the QP route, whose point is to be another route."""
-    from .influence import get_model
-    from .methods import METHOD_NAMES, capabilities
     if not get_model(scene.contact.model).matrix_free:
         return None
     own = scene.method_capabilities.solves - {"coupled"}
     for name in METHOD_NAMES:
         caps = capabilities(name)
-        if not (caps.matrix_free and _needs(scene) <= caps.solves and caps.dimension == 2):
+        if not (caps.matrix_free and _needs(scene) <= caps.solves and 2 in caps.dimensions):
             continue
         if not same_method or caps.solves - {"coupled"} == own:
             return name
@@ -162,7 +163,6 @@ def estimate_note(scene) -> str | None:
 def alternation_note(scene) -> str | None:
     """Before a coupled run whose method solves it by the N–T alternation (two solves per outer iteration,
     ten or more outer iterations a step) while a registered method solves the coupled step directly: which."""
-    from .methods import METHOD_NAMES, capabilities
     caps = scene.method_capabilities
     if scene.coupling_level != "full" or "coupled" in caps.solves:
         return None

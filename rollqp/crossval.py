@@ -25,6 +25,11 @@ import numpy as np
 from .errors import RollqpError
 from .methods import CROSS_CHECK_METHODS, REFERENCE_METHOD
 from .stepfile import StepFile, export_step, solve_stored
+from .methods import available_methods
+from .problem import classify
+from .methods import capabilities
+from .march import march
+from .scene import scene_from_dict
 
 
 @dataclass
@@ -79,8 +84,6 @@ def report(scene, step: int | None = None, methods=None, tolerance: float = 1e-1
     one ``outer (normal+tangential)`` for the alternations and Newton's own count; ``—``
     where the solver does not report them (DAQP, HiGHS through qpsolvers).
     """
-    from .methods import available_methods
-    from .problem import classify
     sf = scene if isinstance(scene, StepFile) else export_step(scene, 1 if step is None else step)
     names = list(methods) if methods is not None else available_methods()
     if REFERENCE_METHOD in names:
@@ -133,11 +136,8 @@ def solve_step_file(sf: StepFile, name: str, tolerance: float = 1e-10):
     are rollqp's of that same discrete steady problem (``extras["marched"]`` is then True;
     ``iterations`` counts every solve of the march).
     """
-    from .methods import capabilities
     if sf.step_type != "steady" or "steady" in capabilities(name).solves:
         return solve_stored(sf, name, tolerance=tolerance)
-    from .march import march
-    from .scene import scene_from_dict
     if not isinstance(sf.scene, dict) or not sf.scene:
         raise RollqpError(f"step {sf.step} is a steady rolling step, which {name} reaches by marching the "
                           "scene; the step file holds no scene to march")

@@ -31,6 +31,8 @@ from __future__ import annotations
 import numpy as np
 
 from .fields import FORCE, STRESS, Field, register
+from .friction import largest
+from .errors import InputError
 
 __all__ = ["friction_power", "dissipation", "friction_work", "step_length", "elastic_energy", "load_work", "balance",
            "steady_identity", "power", "grid_dissipation", "grid_frictional_power", "grid_elastic_energy",
@@ -133,7 +135,6 @@ def load_work(rows) -> np.ndarray:
 
 def _mu(scene) -> bool:
     """Friction somewhere (a Coulomb μ > 0 or a law of :mod:`rollqp.friction` that is not zero)."""
-    from .friction import largest
     return largest(scene.contact.friction) > 0
 
 
@@ -175,7 +176,6 @@ def steady_identity(res: dict, k: int, direction: int) -> float:
 def power(res: dict, speed: float) -> np.ndarray:
     """Frictional power per unit axial length of each state at the rolling speed ``|V|`` (length/time):
     ``D·|V|`` (force·length/time per length); the density is ``friction_power·|V|``."""
-    from .errors import InputError
     if not (isinstance(speed, (int, float, np.floating)) and np.isfinite(speed) and speed >= 0):
         raise InputError("speed", f"must be a finite number >= 0 (|V|, length/time), got {speed!r}")
     if "dissipation" not in res:
@@ -209,7 +209,7 @@ def grid_elastic_energy(rec, contact) -> float:
 
 def elastic_energy_of(ops, p, t) -> float:
     """:func:`grid_elastic_energy` of tractions ``p`` (n,) and ``t`` (2, n) with the operators ``ops``
-    (:class:`~rollqp.three.operators.ContactOperators`)."""
+    (:class:`~rollqp.influence.grid.ContactOperators`)."""
     p = np.asarray(p, dtype=float).ravel()
     t = np.asarray(t, dtype=float).ravel()
     if not np.any(p) and not np.any(t):

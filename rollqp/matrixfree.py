@@ -24,6 +24,7 @@ import numpy as np
 
 from .errors import InputError
 from .influence.operator import Operator
+from .influence import get_model
 
 if TYPE_CHECKING:  # annotations only: scipy.sparse is imported at first use (`import rollqp` stays free of it)
     from scipy import sparse
@@ -66,7 +67,6 @@ def mode(scene, capabilities=None) -> str:
 
 def _model(scene):
     """The scene's influence model (:class:`rollqp.influence.Model`)."""
-    from .influence import get_model
     return get_model(scene.contact.model)
 
 
@@ -247,5 +247,4 @@ def steady_operators(ops):
 def build(scene, strip):
     """``(A_nn, A_tt, A_tn, A_nt, h, info)`` of a matrix-free scene: its influence model's FFT operators
     (:attr:`Model.operators <rollqp.influence.Model.operators>`; the half-space's: eq. 25–30)."""
-    from .influence import get_model
     return get_model(scene.contact.model).operators(scene, strip)

@@ -43,7 +43,7 @@ from .profiles import DEFECT_SHAPES, MAX_POINTS, Defect, Flat
 from .validate import choice, finite_real, positive_real, real_sequence, suggestion
 
 __all__ = ["Lateral", "Surface", "Defect3D", "Flat3D", "BodyShape", "Shape", "parse_body",
-           "PROFILE_KINDS", "INTERPOLATIONS"]
+           "PROFILE_KINDS", "INTERPOLATIONS", "register_feature"]
 
 INTERPOLATIONS = ("spline", "linear")
 #: Largest surface table (points).
@@ -184,6 +184,25 @@ class Flat3D:
 
 
 PROFILE_KINDS = ("lateral", "surface", "defect", "flat")
+#: Features registered from outside (:func:`register_feature`): kind → (keys, parse).
+_FEATURES: dict = {}
+
+
+def register_feature(kind: str, keys: tuple, parse) -> None:
+    """Make ``{ kind = "<kind>", … }`` a feature of a 3D body's ``profile``: ``parse(key, item, radius)``
+    returns an object with ``kind``, ``material`` (it rolls through with the body), ``height(x, y)`` (length
+    units, added to the body's surface) and ``to_dict()``; ``keys``: the table's keys besides ``kind``.
+
+    Raises
+    ------
+    InputError
+        ``kind`` is a built-in kind or registered already.
+    """
+    if not isinstance(kind, str) or kind in PROFILE_KINDS or kind in _FEATURES:
+        raise InputError("kind", f"must be a new profile kind (taken: {', '.join(PROFILE_KINDS + tuple(_FEATURES))}), "
+                                 f"got {kind!r}")
+    _FEATURES[kind] = (tuple(keys), parse)
+    _KEYS[kind] = tuple(keys)
 _KEYS = {"lateral": ("y", "z", "interpolation"), "surface": ("x", "y", "z", "interpolation"),
          "defect": ("x", "y", "depth", "length", "width", "shape", "frame"), "flat": ("x", "length", "frame")}
 
@@ -315,9 +334,10 @@ def parse_body(table: dict, key: str) -> BodyShape:
     for i, item in enumerate(items):
         k = f"{key}.profile" if len(items) == 1 else f"{key}.profile[{i}]"
         kind = item.get("kind")
-        if not isinstance(kind, str) or kind not in PROFILE_KINDS:
-            raise InputError(f"{k}.kind", f"must be one of {', '.join(map(repr, PROFILE_KINDS))} in a 3D scene, got "
-                                          f"{kind!r}{suggestion(kind, PROFILE_KINDS)}")
+        kinds = PROFILE_KINDS + tuple(_FEATURES)
+        if not isinstance(kind, str) or kind not in kinds:
+            raise InputError(f"{k}.kind", f"must be one of {', '.join(map(repr, kinds))} in a 3D scene, got "
+                                          f"{kind!r}{suggestion(kind, kinds)}")
         for name in item:
             if name != "kind" and name not in _KEYS[kind]:
                 raise InputError(f"{k}.{name}", f"unknown key for a {kind} profile{suggestion(name, _KEYS[kind])} "
@@ -344,6 +364,9 @@ def parse_body(table: dict, key: str) -> BodyShape:
     for k, kind, item in feats:
         if kind == "flat" and (rx is None or math.isinf(rx) or rx < 0):
             raise InputError(f"{k}.kind", "a flat is cut into the rolling radius: the body needs a finite radius > 0")
+        if kind in _FEATURES:
+            out.append(_FEATURES[kind][1](k, {n: v for n, v in item.items() if n != "kind"}, rx))
+            continue
         out.append(_defect(k, item) if kind == "defect" else _flat(k, item, rx))
     return BodyShape(rx, ry, base, tuple(out))
 

@@ -5,6 +5,8 @@ import numpy as np
 
 from . import closedforms as cf
 from .units import unit_names
+from .influence import get_model
+from .kinematics import plan
 
 
 def rms_in_contact(x, a, err):
@@ -24,7 +26,6 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     within 0.1 % of steady from 2.6 a_H).
     """
     out = []
-    from .influence import get_model
     if scene.coupling_level != "off" or not get_model(scene.contact.model).halfspace_field:
         return out
     x, a, p0, R = res["x"], float(res["a_H"]), float(res["p0"]), float(res["R"])
@@ -68,7 +69,6 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
 def _rolled_tail(scene, need: float):
     """``(distance, mask, direction)``: how far the last steps of a load path rolled without stopping or
     reversing (up to ``need``), which states they are, and their direction (:mod:`rollqp.kinematics`)."""
-    from .kinematics import plan
     pl = plan(scene)
     d, k, dist = pl.final_direction, pl.d.size - 1, 0.0
     mask = np.zeros(pl.d.size, dtype=bool)
@@ -178,7 +178,6 @@ def _start_rows(res: dict) -> list[tuple[str, str]]:
 def _model_rows(res: dict, scene) -> list[tuple[str, str]]:
     """The influence model's own rows (:attr:`Model.report <rollqp.influence.Model.report>`; the BEM's: assembly
     cost, the geometric coupling and the asymmetry of F·A, docs/bem.md)."""
-    from .influence import get_model
     rows = get_model(scene.contact.model).report
     return [] if rows is None else rows(_meta(res).get("model", {}))
 

@@ -37,15 +37,9 @@ __all__ = ["Recorder", "restore", "newton_of", "VERSION"]
 
 def newton_of(meth):
     """The :class:`~rollqp.methods.newton.NewtonMethod` that solves ``meth``'s uncoupled halves (through the
-    compositions that wrap it: N–T alternation, friction fixed point, continuation), or ``None``."""
-    from .methods.newton import NewtonMethod
-    for _ in range(8):
-        if isinstance(meth, NewtonMethod):
-            return meth
-        meth = vars(meth).get("inner") if hasattr(meth, "__dict__") else None
-        if meth is None:
-            return None
-    return None
+    compositions that wrap it: N–T alternation, friction fixed point, continuation), or ``None``: what the
+    method's record declares (``capabilities.carries_state``) and its ``carrier()`` gives."""
+    return meth.carrier() if meth.capabilities.carries_state else None
 
 
 def _runs(idx) -> list:

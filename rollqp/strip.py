@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .discretization import Discretization
 from .errors import InputError
 
 ELEMENTS = ("constant", "linear", "quadratic")
@@ -112,6 +113,11 @@ class Strip:
     def n(self) -> int:
         """Number of nodes."""
         return int(self.x.size)
+
+    def record(self) -> Discretization:
+        """The strip as a :class:`~rollqp.discretization.Discretization`: the nodes ``x`` (one coordinate),
+        their weights, one traction component, fields of shape ``(n,)``."""
+        return Discretization(self.x[None, :], self.weights, 1, (self.n,))
 
     @property
     def element_length(self) -> float:

@@ -2,7 +2,7 @@ r"""Subsurface stresses in three dimensions: exact Boussinesq–Cerruti integral
 
 Body A is the half-space ``z > 0`` (z into A, as everywhere in rollqp's 3D), loaded on its surface by
 the pressure ``p ≥ 0`` and the tangential tractions ``(p_x, p_y)`` on A, constant on each rectangular
-element of the grid (:mod:`rollqp.three.grid`, eq. 3D.9). The stresses are Love's potentials
+element of the grid (:mod:`rollqp.discretization.grid`, eq. 3D.9). The stresses are Love's potentials
 (Love 1929; Johnson, *Contact Mechanics*, 1985, §3.1, eq. 3.2–3.7) of those loads: every component is a
 sum of third and fourth derivatives of ``W = ∫∫ Ω dξ dη``, ``Ω = z ln(ρ + z) − ρ``, and over a rectangle
 each such derivative is the corner sum (docs/stresses.md §9)
@@ -92,7 +92,7 @@ def stress_components(grid, x, y, z, pn, px, py, nu: float) -> np.ndarray:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
+    grid : rollqp.discretization.grid.Grid
     x, y, z : array_like
         Points (broadcast together; z > 0, the depth into the body).
     pn, px, py : array_like
@@ -109,7 +109,7 @@ def stress_components(grid, x, y, z, pn, px, py, nu: float) -> np.ndarray:
 
     Examples
     --------
-    >>> from rollqp.three.grid import Grid
+    >>> from rollqp.discretization.grid import Grid
     >>> g = Grid.centred(1, 1, 0.5, 0.5)                     # a unit square under unit pressure
     >>> s = stress_components(g, 0.0, 0.0, 1e-6, [[1.0]], [[0.0]], [[0.0]], 0.3)
     >>> bool(abs(s[2, 0] + 1.0) < 1e-5)                      # σzz = −p just below the surface
@@ -310,8 +310,8 @@ def _state(arrays, step: int):
 
 
 def result_grid(arrays, scene=None):
-    """The :class:`~rollqp.three.grid.Grid` of a 3D result's element centres ``x``, ``y`` (uniform)."""
-    from .three.grid import Grid
+    """The :class:`~rollqp.discretization.grid.Grid` of a 3D result's element centres ``x``, ``y`` (uniform)."""
+    from .discretization.grid import Grid
     x, y = (np.asarray(arrays[k], dtype=float) for k in ("x", "y"))
     sizes = []
     for key, c in (("x", x), ("y", y)):
@@ -320,8 +320,13 @@ def result_grid(arrays, scene=None):
             if not (np.all(d > 0) and np.ptp(d) <= 1e-9 * max(abs(d[0]), 1e-300) + 1e-12 * np.max(np.abs(c))):
                 raise InputError("RESULT.npz", f"key {key!r} must hold the uniformly spaced element centres of a grid")
             sizes.append(float(np.mean(d)))
-        elif scene is not None:
-            sizes.append(float(getattr(scene.grid, "d" + key)))
+        elif scene is not None:  # one element along this axis: its size is the scene's, if its grid is this one
+            sg = scene.grid
+            mine = getattr(sg, key)
+            if mine.size != 1 or not abs(float(mine[0]) - float(c[0])) <= 1e-9 * (abs(float(c[0])) + getattr(sg, "d" + key)):
+                raise InputError("RESULT.npz", f"key {key!r} is not the grid of the scene stored in the file "
+                                               f"({mine.size} elements along {key}): a corrupt or edited file")
+            sizes.append(float(getattr(sg, "d" + key)))
         else:
             raise InputError("RESULT.npz", f"one element along {key}: its size comes from the scene")
     dx, dy = sizes
@@ -362,6 +367,15 @@ def _scale(arrays) -> float:
     return a
 
 
+def _finite(s) -> None:
+    """The stresses (and so their invariants, whose squares are within the range then) are finite: else the
+    tractions are beyond the floating-point range, a one-line error, never NaN peaks."""
+    s = np.asarray(s)
+    if not (np.all(np.isfinite(s)) and np.max(np.abs(s), initial=0.0) < 1e150):
+        raise InputError("result", "the stresses of these tractions are not finite (or beyond 1e150): the file's "
+                                   "tractions are out of range")
+
+
 def _body_nu(scene, body: str):
     if body not in ("A", "B"):
         raise InputError("body", f"must be 'A' or 'B', got {body!r}")
@@ -393,9 +407,11 @@ def stresses3d(result, step: int, plane=None, line=None, depths=None, body: str 
     nu, sign = _body_nu(scene, body)
     sec = section(grid, _scale(arrays), plane, line, depths, along)
     pts = sec.points()
-    s = stress_components(grid, *pts, arrays["pn"][k], sign * np.asarray(arrays["px"][k]),
-                          sign * np.asarray(arrays["py"][k]), nu)
-    values = {n: v.reshape(pts[0].shape) for n, v in invariants(s).items()}
+    with np.errstate(all="ignore"):
+        s = stress_components(grid, *pts, arrays["pn"][k], sign * np.asarray(arrays["px"][k]),
+                              sign * np.asarray(arrays["py"][k]), nu)
+        _finite(s)
+        values = {n: v.reshape(pts[0].shape) for n, v in invariants(s).items()}
     return StressField3D(sec, values, body, k, float(arrays["q"][k]), _maxima(values, pts))
 
 
@@ -424,10 +440,13 @@ def stress_history3d(result, plane=None, line=None, depths=None, body: str = "A"
     per = max(1, (1 << 22) // max(1, pts[0].size * 6))
     for b in range(0, ks.size, per):
         sel = ks[b:b + per]
-        s = stress_components(grid, *pts, np.asarray(arrays["pn"])[sel], sign * np.asarray(arrays["px"])[sel],
-                              sign * np.asarray(arrays["py"])[sel], nu)
+        with np.errstate(all="ignore"):
+            s = stress_components(grid, *pts, np.asarray(arrays["pn"])[sel], sign * np.asarray(arrays["px"])[sel],
+                                  sign * np.asarray(arrays["py"])[sel], nu)
+        _finite(s)
         for r in range(sel.size):
-            inv = invariants(s[r])
+            with np.errstate(all="ignore"):
+                inv = invariants(s[r])
             for name, (v, x, y, z) in _maxima({n: inv[n] for n in PEAKS}, [c.ravel() for c in pts]).items():
                 peaks[name][b + r] = (v, x, y, z)
     overall = {}

@@ -20,6 +20,8 @@ import numpy as np
 
 from .errors import InputError
 from .fields import Field, register
+from .subsurface import _source
+from .strip import Strip
 
 __all__ = ["wear_rate", "grid_wear_rate", "profile"]
 
@@ -77,8 +79,6 @@ def profile(result, body: str = "A", coefficient=None, resolution: int = 4):
         Surface coordinate (length, the material's position at q = 0, modulo 2πR) and the
         worn depth there (length).
     """
-    from .subsurface import _source
-    from .strip import Strip
     arrays, scene = _source(result)
     if body not in ("A", "B"):
         raise InputError("body", f"must be 'A' or 'B', got {body!r}")

@@ -12,13 +12,13 @@ import contact3d_cases
 from rollqp import load_scene
 from rollqp.energy import elastic_energy_of, grid_balance
 from rollqp.errors import InputError
-from rollqp.three.contact import Contact, Loads
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.grid import Grid
+from rollqp.operators.grid import Contact, Loads
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.discretization.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import steady
-from rollqp.three.materials import Materials
-from rollqp.three.operators import ContactOperators
+from rollqp.materials import Materials
+from rollqp.influence.grid import ContactOperators
 from rollqp.three.run import run
 
 

@@ -63,8 +63,8 @@ class LinearFriction:
     def largest(self) -> float:
         return self.mu + abs(self.slope) * self.reach
 
-    def coefficient(self, x_hat, q_hat, direction):
-        return self.mu + self.slope * np.asarray(x_hat, dtype=float)
+    def coefficient(self, points, q_hat, direction):
+        return self.mu + self.slope * np.asarray(points, dtype=float)[0]
 
     def check_strip(self, half_width_hat, q_end_hat, direction):
         """It varies everywhere: it meets every strip."""
@@ -89,6 +89,42 @@ def case_friction_law():
 
 def test_a_friction_law_from_outside():
     _fresh("case_friction_law")
+
+
+#: A short 3D run: the braked circle of ``cattaneo-3d`` on a 16 × 16 grid, rolled 2 a.
+SHORT_3D = {"discretization.elements": [16, 16], "discretization.distance": 2.0}
+
+
+def case_friction_law_both_dimensions():
+    """The same law object, registered once, runs a 2D and a 3D scene: on the grid it is read at the element
+    centres (``points[0]`` = x/a), equal to the built-in table over x, and the 3D tractions sit in its discs."""
+    from rollqp.friction import register
+    register("linear-in-x", LinearFriction)
+    law = {"law": "linear-in-x", "mu": 0.3, "slope": 0.02, "reach": 1.25}
+    two = rollqp.run(rollqp.load_scene("cattaneo-carter").replace(**SHORT, **{"contact.friction": law}))
+    assert two.arrays()["residual"].max() <= 1e-9
+    scene = rollqp.load_scene("cattaneo-3d").replace(**SHORT_3D)
+    mine = scene.replace(**{"contact.friction": law})
+    table = scene.replace(**{"contact.friction": {"law": "table", "x": [-1.25, 1.25], "values": [0.275, 0.325],
+                                                  "frame": "fixed"}})
+    assert mine.contact.friction.kind == "spatial" and mine.mu == 0.325   # its reference: the largest value
+    a, b = rollqp.run(mine).arrays(), rollqp.run(table).arrays()
+    # the same μ at every element up to the table's interpolation round-off (1e-16): the same transient to
+    # the solver's tolerance 1e-10 (each step converged to rollqp's residual 1e-10 from the same start)
+    for k in ("pn", "px", "py"):
+        assert np.max(np.abs(a[k] - b[k])) / float(a["p0"]) <= 1e-9, k
+    # on the grid: |t_i| <= μ(x_i) p_i, with equality where an element slips (state 2), to 1e-8 p0
+    # (the residual tolerance 1e-10 on the nondimensional projection, with margin)
+    mu = 0.3 + 0.02 * a["x"][None, :] / float(a["a"]) + 0.0 * a["y"][:, None]
+    t, p, state = np.hypot(a["px"][-1], a["py"][-1]), a["pn"][-1], a["state"][-1]
+    assert t.shape == mu.shape == p.shape, (t.shape, mu.shape, p.shape)
+    assert np.all(t <= mu * np.maximum(p, 0) + 1e-8 * float(a["p0"]))
+    slip = state == 2
+    assert slip.any() and np.max(np.abs(t[slip] - mu[slip] * p[slip])) <= 1e-8 * float(a["p0"])
+
+
+def test_a_friction_law_in_both_dimensions():
+    _fresh("case_friction_law_both_dimensions")
 
 
 # ------------------------------------------------------------------------------ a profile feature
@@ -181,6 +217,81 @@ def test_an_influence_model_from_outside():
     _fresh("case_influence_model")
 
 
+def case_influence_model_3d():
+    """A 3D influence model registered from outside: ``build(grid, materials)`` gives the contact's operators
+    (here the Boussinesq–Cerruti ones, built by a contributor from the public kernels), and a 3D scene's
+    ``contact.model`` runs it; the other dimension's scenes do not accept it."""
+    from rollqp.errors import InputError
+    from rollqp.influence import Model, register_model
+    from rollqp.influence.grid import ContactOperators
+    built = []
+
+    def build(grid, materials):
+        built.append(grid.n)
+        return ContactOperators(grid, materials)
+
+    register_model(Model("cerruti-copy", build, "the 3D half-space, built by a contributor",
+                         dimensions=frozenset({3})))
+    scene = rollqp.load_scene("cattaneo-3d").replace(**SHORT_3D)
+    a = rollqp.run(scene.replace(**{"contact.model": "cerruti-copy"})).arrays()
+    b = rollqp.run(scene).arrays()
+    assert built == [256], "the scene's contact is built by the registered model, once"
+    for k in ("pn", "px", "py", "Fx", "approach"):
+        assert np.array_equal(a[k], b[k]), f"the same operators: the same numbers ({k})"
+    with pytest.raises(InputError, match="contact.model"):   # a 3D model is no 2D scene's
+        rollqp.load_scene("cattaneo-carter").replace(**{"contact.model": "cerruti-copy"})
+
+
+def test_a_3d_influence_model_from_outside():
+    _fresh("case_influence_model_3d")
+
+
+@dataclass(frozen=True)
+class Bell:
+    """A contributor's feature over (x, y): a cosine bell of ``depth`` on a circle of ``diameter`` at
+    ``(x0, y0)``, fixed in the contact (it does not roll through)."""
+
+    depth: float
+    diameter: float
+    x0: float = 0.0
+    y0: float = 0.0
+    kind: ClassVar[str] = "bell"
+    material: ClassVar[bool] = False
+
+    def height(self, x, y):
+        r = 2.0 * np.hypot(np.asarray(x, dtype=float) - self.x0, np.asarray(y, dtype=float) - self.y0) / self.diameter
+        return np.where(r < 1.0, self.depth * 0.5 * (1.0 + np.cos(np.pi * np.minimum(r, 1.0))), 0.0)
+
+    def to_dict(self):
+        return {"kind": "bell", "depth": self.depth, "diameter": self.diameter, "x0": self.x0, "y0": self.y0}
+
+
+def case_profile_feature_3d():
+    """A profile feature with a height over (x, y), registered once: a 3D body's ``profile`` takes it, and it
+    gives the built-in circular cosine defect's numbers (the same heights, written independently)."""
+    from rollqp.profiles3d import register_feature
+
+    def parse(key, item, radius):
+        return Bell(**item)
+
+    register_feature("bell", ("depth", "diameter", "x0", "y0"), parse)
+    scene = rollqp.load_scene("cattaneo-3d").replace(**SHORT_3D)
+    body = {"radius": 30.0, "radius_y": 30.0, "E": 210000.0, "nu": 0.25}
+    mine = scene.replace(**{"bodies.A": {**body, "profile": {"kind": "bell", "depth": 2e-4, "diameter": 0.4,
+                                                             "x0": 0.1}}})
+    ref = scene.replace(**{"bodies.A": {**body, "profile": {"kind": "defect", "x": 0.1, "y": 0.0, "depth": 2e-4,
+                                                            "length": 0.4, "width": 0.4, "frame": "contact"}}})
+    a, b = rollqp.run(mine).arrays(), rollqp.run(ref).arrays()
+    assert not np.array_equal(a["pn"][-1], rollqp.run(scene).arrays()["pn"][-1]), "the bell changes the pressure"
+    # the same heights to round-off (1e-19 mm): the same steps to the solver's tolerance 1e-10
+    for k in ("pn", "px", "py"):
+        assert np.max(np.abs(a[k] - b[k])) / float(a["p0"]) <= 1e-9, k
+
+
+def test_a_3d_profile_feature_from_outside():
+    _fresh("case_profile_feature_3d")
+
+
 # ------------------------------------------------------------------------------ a method
 class Halves:
     """Newton on the normal and tangential halves only (no coupled, no steady problem): the registry
@@ -237,8 +348,8 @@ def test_the_capabilities_are_checked():
     with pytest.raises(rollqp.InputError, match="capabilities.solves"):
         Capabilities(solves=frozenset({"normal", "sideways"}))
     three = Halves()
-    three.capabilities = dataclasses.replace(Halves.capabilities, dimension=3, traction_components=2,
+    three.capabilities = dataclasses.replace(Halves.capabilities, dimensions=frozenset({3}), traction_components=2,
                                              friction_set="disc")
     with pytest.raises(rollqp.InputError, match="solver.method.*3D steps"):
         compose(three, coupled=False)
-    assert compose(Halves(), coupled=False).capabilities.dimension == 2
+    assert compose(Halves(), coupled=False).capabilities.dimensions == {2}

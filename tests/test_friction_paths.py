@@ -54,7 +54,7 @@ def test_reversal_brings_the_material_patch_back():
             assert np.array_equal(mu[j], mu[k]), (q[k], np.max(np.abs(mu[j] - mu[k])))
     law = sc.contact.friction
     x_hat = a["x"] / sc.a_H
-    np.testing.assert_array_equal(mu[-1], law.coefficient(x_hat, 0.0, sc.load.direction))
+    np.testing.assert_array_equal(mu[-1], law.coefficient(x_hat[None, :], 0.0, sc.load.direction))
 
 
 @pytest.mark.parametrize("method", ["qp-osqp", pytest.param("qp-clarabel", marks=pytest.mark.slow)])

@@ -137,3 +137,42 @@ def test_the_cycle_check_finds_a_cycle():
     """The same check on a small graph with a cycle and a self-contained part."""
     assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
     assert _cycles({"a": {"b"}, "b": set()}) == []
+
+
+def _units():
+    """The contract's floors (lists of its entries) and each module's entry (the longest that holds it)."""
+    import tomllib
+    layers = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]["layers"]
+    floors = [[e.strip() for e in floor.replace("|", ":").split(":")] for floor in layers]
+    entries = sorted((e for f in floors for e in f), key=len, reverse=True)
+
+    def unit(module):
+        rest = module[len("rollqp."):]
+        return next((e for e in entries if rest == e or rest.startswith(e + ".")), None)
+    return floors, unit
+
+
+def test_no_sibling_on_a_floor_hides_a_mutual_import():
+    """``:`` lets the modules of one floor import each other; none does both ways (a loop between two
+    packages would hide behind the floor), and every rollqp module sits on a floor."""
+    modules = _modules()
+    floors, unit = _units()
+    arrows = set()
+    for name, path in modules.items():
+        for target in _imports(name, path, modules):
+            a, b = unit(name), unit(target)
+            if a is not None and b is not None and a != b:
+                arrows.add((a, b))
+    mutual = [(a, b) for f in floors for i, a in enumerate(f) for b in f[i + 1:] if (a, b) in arrows and (b, a) in arrows]
+    assert mutual == [], f"siblings importing each other: {mutual}"
+    entries = [e for f in floors for e in f]
+    containers = {m for m in modules if any(e.startswith(m[len("rollqp."):] + ".") for e in entries)}  # rollqp.three
+    unplaced = sorted({m for m in modules if m != "rollqp" and m not in containers and unit(m) is None})
+    assert unplaced == [], f"modules on no floor of the contract: {unplaced}"
+
+
+def test_at_most_two_arrows_back_up():
+    """The contract's ignored imports are the only arrows running up a floor: at most two, each named."""
+    import tomllib
+    contract = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]
+    assert len(contract.get("ignore_imports", [])) <= 2

@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 
 from rollqp.methods import REFERENCE_METHOD, scene_method_3d
-from rollqp.three.contact import Contact, Loads
-from rollqp.three.grid import Grid
+from rollqp.operators.grid import Contact, Loads
+from rollqp.discretization.grid import Grid
 from rollqp.three.march import coupled_step
-from rollqp.three.problem import element_states
-from rollqp.three.materials import Materials
-from rollqp.three.scene import Solver3D
+from rollqp.problem.grid import element_states
+from rollqp.materials import Materials
+from rollqp.scene.grid import Solver3D
 
 DATA = Path(__file__).resolve().parent / "data" / "contact3d" / "spence35.ref_out"
 

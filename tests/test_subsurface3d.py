@@ -11,10 +11,10 @@ from rollqp.closedforms.hertz3d import hamilton_normal, huber_axis, sliding_axis
 from rollqp.errors import InputError
 from rollqp.subsurface3d import (COMPONENTS, invariants, parse_depths, parse_line, parse_plane, point_load,
                                  stress_components)
-from rollqp.three.contact import Contact
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.grid import Grid
-from rollqp.three.materials import Materials
+from rollqp.operators.grid import Contact
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.discretization.grid import Grid
+from rollqp.materials import Materials
 
 from pathlib import Path
 
@@ -249,3 +249,29 @@ def test_history_and_body_b(result3d):
     # the surface limit σxz → ∓p_x, to O(dz/dx) ≈ 1e-5 of p_x (the field of the neighbours' tractions)
     assert abs(A["sxz"][0, 0] + px) < 1e-4 * abs(px) and abs(B["sxz"][0, 0] - px) < 1e-4 * abs(px)
     assert abs(A["szz"][0, 0] - B["szz"][0, 0]) < 1e-4 * float(a["p0"])
+
+
+@pytest.mark.parametrize("change, words", [("pn", "not finite"), ("x", "uniformly spaced"), ("y", "not the grid"),
+                                           ("a", "'a'")])
+def test_command_refuses_a_changed_3d_file_in_one_line(result3d, tmp_path, capsys, change, words):
+    """A file whose tractions overflow the kernels, whose centres are not a uniform grid, whose one row is not
+    the scene's grid, or whose semi-axis is not positive: one line naming RESULT.npz, exit 2 (never NaN peaks)."""
+    from rollqp import cli
+    with np.load(result3d, allow_pickle=False) as f:
+        z = {k: f[k] for k in f.files}
+    if change == "pn":
+        z["pn"] = z["pn"].copy()
+        z["pn"][1, 5, 5] = 1e300
+    elif change == "x":
+        z["x"] = z["x"].copy()
+        z["x"][3] += 0.1 * (z["x"][1] - z["x"][0])
+    elif change == "y":
+        for k in [k for k, v in z.items() if np.ndim(v) == 3]:   # every field on the grid
+            z[k] = z[k][:, :1]
+        z["y"] = z["y"][:1]
+    else:
+        z["a"] = np.asarray(-1.0)
+    np.savez(tmp_path / "bad.npz", **z)
+    assert cli.main(["stresses", str(tmp_path / "bad.npz"), "--step", "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("rollqp: error: RESULT.npz:") and words in err[0], err

@@ -9,7 +9,7 @@ import pytest
 
 from rollqp import load_scene
 from rollqp.errors import InputError
-from rollqp.three.geometry import Body, curvatures
+from rollqp.profiles.surface import Body, curvatures
 from rollqp.three.hertz import hertz
 from rollqp.three.post import hertz_field_errors
 from rollqp.three.run import run

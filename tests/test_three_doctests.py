@@ -1,4 +1,4 @@
-"""The ``Examples`` of rollqp.three's public docstrings run as written."""
+"""The ``Examples`` of the three-dimensional modules' public docstrings run as written."""
 from __future__ import annotations
 
 import doctest
@@ -6,12 +6,13 @@ import importlib
 
 import pytest
 
-MODULES = ["grid", "materials", "influence", "operator", "operators", "geometry", "hertz", "closedforms", "gnm",
-           "contact", "loads"]
+MODULES = ["discretization", "discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
+           "profiles.surface", "three.hertz", "three.closedforms", "methods.newton.disc", "operators.grid",
+           "three.loads"]
 
 
 @pytest.mark.parametrize("name", MODULES)
 def test_docstring_examples(name):
-    module = importlib.import_module(f"rollqp.three.{name}")
+    module = importlib.import_module(f"rollqp.{name}")
     result = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
-    assert result.failed == 0 and result.attempted > 0, f"rollqp.three.{name}: {result}"
+    assert result.failed == 0 and result.attempted > 0, f"rollqp.{name}: {result}"

@@ -374,7 +374,7 @@ def physics_violations(res, scene) -> dict:
     stored element states against those of the stored p, t, s (the number that differ), stick elements' slip
     (in mu p0/E*) and slipping elements' slip not opposite their traction (the largest
     |t/|t| + s/|s|| where both are resolved)."""
-    from rollqp.three.problem import Scales, element_states
+    from rollqp.problem.grid import Scales, element_states
     a = res
     K1 = len(a["q"])
     area = float((a["x"][1] - a["x"][0]) * (a["y"][1] - a["y"][0])) if a["x"].size > 1 and a["y"].size > 1 else \

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from rollqp.errors import InputError
-from rollqp.three.geometry import Body, QuadraticProfile, curvatures
-from rollqp.three.grid import ASPECT_RANGE, Grid
+from rollqp.profiles.surface import Body, QuadraticProfile, curvatures
+from rollqp.discretization.grid import ASPECT_RANGE, Grid
 from rollqp.three.hertz import curvature_ratio, curvatures_for_ratio, hertz
-from rollqp.three.materials import Materials
+from rollqp.materials import Materials
 
 
 def test_circle_is_hertz_of_a_sphere():

@@ -9,11 +9,11 @@ import pytest
 from scipy import integrate
 
 from rollqp.errors import InputError
-from rollqp.three.grid import Grid
-from rollqp.three.influence import kernels, point_load, rectangle_integrals
-from rollqp.three.materials import Materials
-from rollqp.three.operator import BlockToeplitz
-from rollqp.three.operators import ContactOperators
+from rollqp.discretization.grid import Grid
+from rollqp.influence.cerruti import kernels, point_load, rectangle_integrals
+from rollqp.materials import Materials
+from rollqp.influence.blocktoeplitz import BlockToeplitz
+from rollqp.influence.grid import ContactOperators
 
 STEEL_ALU = Materials.from_young(210e3, 0.28, 70e3, 0.33)   # dissimilar: K ≠ 0
 INTEGRANDS = {"r": lambda x, y: 1 / math.hypot(x, y), "xx": lambda x, y: x * x / math.hypot(x, y) ** 3,
@@ -135,6 +135,6 @@ def test_bad_materials_name_the_key(kw, key):
 def test_operator_refuses_a_dense_block_beyond_its_budget(monkeypatch):
     g = Grid.centred(30, 30, 1.0, 1.0)
     op = ContactOperators(g, Materials.from_young(1.0, 0.3, 1.0, 0.3)).Att
-    monkeypatch.setattr("rollqp.three.operator.DENSE_MAX", 1000)
+    monkeypatch.setattr("rollqp.influence.blocktoeplitz.DENSE_MAX", 1000)
     with pytest.raises(InputError, match="FFT products"):
         op.dense()

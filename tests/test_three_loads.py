@@ -232,7 +232,7 @@ def test_a_load_path_round_trips_and_plain_scenes_are_unchanged():
     """The keys survive to_dict / replace; a scene without them marches as before (the same records)."""
     s = braked(**{"load.rolled": REVERSE, "load.normal_history": {"kind": "ramp", "start": 1.0, "end": 1.2,
                                                                     "over": 2.0}})
-    again = rollqp.three.scene.scene_from_dict(s.to_dict())
+    again = rollqp.scene.grid.scene_from_dict(s.to_dict())
     assert again == s and again.load.rolled.to_dict() == REVERSE | {"q": [0.0, 3.0, 4.0, 10.0],
                                                                      "value": [0.0, 3.0, 3.0, -3.0]}
     plain = braked(12, **{"discretization.distance": 1.0})

@@ -93,7 +93,11 @@ BAD = [
     ("unknown method", lambda d: d.setdefault("solver", {}).update(method="socp-mosek"), "solver.method:",
      "must be one of"),
     ("dimension 4", lambda d: d["contact"].update(dimension=4), "contact.dimension:", "2, 3"),
-    ("a friction law", lambda d: d["contact"].update(friction={"kind": "falling"}), "contact.friction:", "> 0"),
+    ("a friction law without its name", lambda d: d["contact"].update(friction={"kind": "falling"}),
+     "contact.friction.law:", "must be one of"),
+    ("a slip-velocity law", lambda d: d["contact"].update(friction={"law": "exponential", "static": 0.3, "kinetic": 0.2,
+                                                                      "velocity": 1.0, "rolling_speed": 1000.0}),
+     "contact.friction.law:", "only 2D scenes"),
     ("force and creepage along x", lambda d: d["load"].update(tangential=0.3), "load.creepage.longitudinal:",
      "at most one"),
     ("beyond the sliding limit", lambda d: (d["load"].update(tangential=0.8, lateral=0.7, start="braked"),
@@ -132,12 +136,12 @@ def test_a_cone_method_that_cannot_do_the_step_is_refused_by_its_record():
     """qp-osqp's 3D record solves the normal QP only; the refusal lists the methods whose records
     declare tangential steps on the friction disc, and every one of those is such a record."""
     caps = capabilities("qp-osqp", 3)
-    assert caps.dimension == 3 and "tangential" not in caps.solves
+    assert caps.dimensions == {3} and "tangential" not in caps.solves
     names = cone_methods()
     assert "newton" in names and "socp-clarabel" in names and "qp-osqp" not in names
     for name in names:
         c = capabilities(name, 3)
-        assert c.dimension == 3 and c.traction_components == 2 and c.friction_set == "disc"
+        assert c.dimensions == {3} and c.traction_components == 2 and c.friction_set == "disc"
         assert {"normal", "tangential"} <= c.solves
     assert set(names) <= set(available_methods(3))
 
@@ -146,7 +150,7 @@ def test_the_registry_names_the_instances():
     m = get_method("socp-clarabel", 3, tolerance=1e-9)
     assert m.name == "socp-clarabel" and m.tolerance == 1e-9
     assert method_class("newton", 3) is not method_class("newton", 2)
-    assert method_class("newton", 3).capabilities.dimension == 3
+    assert method_class("newton", 3).capabilities.dimensions == {3}
 
 
 def _leaves(d, prefix=()):

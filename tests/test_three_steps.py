@@ -6,13 +6,14 @@ import numpy as np
 import pytest
 
 from rollqp.errors import InputError, SolverError
-from rollqp.three.contact import Contact, Loads
+from rollqp.operators.grid import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import coupled_step, static_shift, steady, transient
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
-from rollqp.three.problem import SLIP, STICK, Scales, TangentialStep
-from rollqp.three.socp import ClarabelMethod, CvxpyMethod, OsqpMethod, raw_solution
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
+from rollqp.problem.grid import SLIP, STICK, Scales, TangentialStep
+from rollqp.methods import compose_3d
+from rollqp.methods.socp import ClarabelMethod, CvxpyMethod, OsqpMethod, raw_solution
 
 #: Agreement asked of two routes: both are solved to a residual of 1e-10 (Newton stops at
 #: ‖Φ‖∞ ≤ 1e-10·min(1, r), the refined conic answers below it); on these grids the residual's
@@ -130,6 +131,10 @@ def test_osqp_refuses_a_cone_in_one_line(contact, pressure):
     with pytest.raises(InputError) as err:
         OsqpMethod().solve(prob)
     msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("solver.method:") and "tangential" in msg
+    with pytest.raises(InputError) as err:   # the registry refuses it before any step, naming the methods that can
+        compose_3d(OsqpMethod())
+    msg = str(err.value)
     assert "\n" not in msg and msg.startswith("solver.method:")
     assert all(name in msg for name in ("newton", "qp-clarabel", "socp-clarabel", "qp-cvxpy", "socp-scs"))
 
@@ -217,7 +222,7 @@ def test_newton_reports_failure_with_the_residual(contact, pressure):
 def test_scales_are_hertz():
     c = elliptic()
     e = c.ellipse
-    assert c.scales == Scales(length=np.sqrt(e.a * e.b), stress=e.p0, modulus=STEEL.Estar)
+    assert c.scales == Scales(length=np.sqrt(e.a * e.b), stress=e.p0, modulus=STEEL.Estar, dimension=3)
 
 
 def test_the_2d_normal_machinery_solves_the_3d_normal_step(contact, pressure):

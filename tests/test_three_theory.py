@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rollqp.three.materials import Materials
+from rollqp.materials import Materials
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = ROOT / "docs" / "theory3d.md"

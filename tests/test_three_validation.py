@@ -8,11 +8,11 @@ import pytest
 
 import contact3d_cases
 from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_coefficients
-from rollqp.three.contact import Contact, Loads
+from rollqp.operators.grid import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import static_shift, steady
-from rollqp.three.materials import Materials
-from rollqp.three.gnm import NewtonMethod
+from rollqp.materials import Materials
+from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
 
 FN, MU = 1000.0, 0.3

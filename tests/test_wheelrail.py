@@ -15,7 +15,7 @@ from rollqp.errors import InputError
 from rollqp.methods import get_method
 from rollqp.scene import load_scene
 from rollqp.three.hertz import hertz
-from rollqp.three.materials import Materials
+from rollqp.materials import Materials
 from rollqp.wheelrail.benchmark import POSITIONS, read_reference
 from rollqp.wheelrail.profiles import Profile, read_profile, resolve_file
 from rollqp.wheelrail.run import crossval, solve_scene

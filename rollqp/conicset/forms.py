@@ -1,6 +1,6 @@
 r"""A 3D step's conic program as plain arrays, and rollqp's residual computed from them.
 
-:class:`ProgramData` is :class:`rollqp.three.forms.ConicForm` (eq. 3D.22/3D.20) written out:
+:class:`ProgramData` is :class:`rollqp.problem.conic.ConicForm` (eq. 3D.22/3D.20) written out:
 ``min ½xᵀHx + qᵀx`` s.t. ``a x = b`` and ``x ∈ K`` — ``x ≥ 0`` (normal) or one cone
 ``(bound_i, x_i, x_{nv+i}) ∈ Q³`` per element (tangential). With ``slip_scale = obj/â`` the
 gradient of the Lagrangian is the step's own gap or slip (docs/theory3d.md §5):
@@ -69,7 +69,7 @@ class ProgramData:
 
 
 def from_form(form, area_hat: float) -> ProgramData:
-    """From a :class:`~rollqp.three.forms.ConicForm` with a symmetric operator (no skew part) and the
+    """From a :class:`~rollqp.problem.conic.ConicForm` with a symmetric operator (no skew part) and the
     element area ``â`` in units of ``c²``."""
     if form.skew is not None:
         raise ValueError("a form with a skew part is a sequence of programs, not one (docs/theory3d.md §6)")

@@ -3,7 +3,7 @@ r"""The conic test set: 3D steps of the built-in scenes, marched by Newton, cert
 Each problem is one step of a built-in scene (``cattaneo-3d``: a circle braked and rolled;
 ``kalker-elliptic``: an a/b = 0.5 ellipse with ξ, η and spin; ``kalker-circular`` with pure spin;
 dissimilar bodies: aluminium on steel, docs/validation3d.md §7), marched with rollqp's Newton method
-(:class:`~rollqp.three.gnm.NewtonMethod`, tolerance :data:`NEWTON_TOLERANCE`) and posed as
+(:class:`~rollqp.methods.newton.disc.NewtonMethod`, tolerance :data:`NEWTON_TOLERANCE`) and posed as
 
 * a **tangential SOCP** (eq. 3D.20, the pressure fixed) or a **normal QP** (eq. 3D.22, the shear
   fixed) — :mod:`~rollqp.conicset.forms`, written as CBF (:mod:`~rollqp.conicset.cbf`) and as
@@ -26,9 +26,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..scene import load_scene
-from ..three.contact import Contact, Loads
-from ..three.forms import normal_form, tangential_form
-from ..three.gnm import NewtonMethod
+from ..operators.grid import Contact, Loads
+from ..problem.conic import normal_form, tangential_form
+from ..methods.newton.disc import NewtonMethod
 from ..three.march import coupled_step, normal, static_shift
 from . import cbf, fclib
 from .forms import ProgramData, from_form, objective, residual

@@ -39,6 +39,7 @@ from typing import Protocol, runtime_checkable
 from ..errors import InputError
 from ..validate import suggestion
 from .laws import FRAMES, MAX_FRICTION, VELOCITY_FORMS, Coulomb, Patch, SlipVelocity, Table
+from ..validate import number
 
 __all__ = ["LAWS", "FrictionLaw", "register", "parse_friction", "as_law", "Coulomb", "Patch", "Table",
            "SlipVelocity", "MAX_FRICTION", "FRAMES", "VELOCITY_FORMS", "law_kind", "reference", "largest"]
@@ -57,7 +58,9 @@ class FrictionLaw(Protocol):
         Its name, the table's ``law`` key.
     kind : {"constant", "spatial", "slip"}
         ``"constant"``: ``mu``, one number (the step problems' fast path). ``"spatial"``: also
-        ``coefficient(x_hat, q_hat, direction) -> (n,) array`` (``μ`` at the nodes, ``a_H`` units) and
+        ``coefficient(points, q_hat, direction) -> (n,) array`` (``μ`` at the ``points`` of the
+        discretization, shape ``(d, n)``: ``x̂`` on a strip, ``(x̂, ŷ)`` on a grid, in the contact's length
+        unit — ``a_H`` on a strip, ``c = √(ab)`` on a grid) and
         ``check_strip(half_width_hat, q_end_hat, direction)`` (the scene's check that it meets the
         strip). ``"slip"``: also ``steady(v) -> (μ, dμ/dv)`` of the slip velocity, ``rolling_speed``,
         ``memory`` and ``weight(dq_hat)`` (:class:`~.bound.SlipBound`), and for the selection of a step's
@@ -124,7 +127,6 @@ def parse_friction(value) -> FrictionLaw:
     if isinstance(value, FrictionLaw) and dataclasses.is_dataclass(value):
         value = {f.name: getattr(value, f.name) for f in dataclasses.fields(value)}
     if not isinstance(value, dict):
-        from ..validate import number
         return Coulomb(number(KEY, value, f">= 0 (and <= {MAX_FRICTION:g}), or a table [contact.friction] with law = "
                                           f"{', '.join(map(repr, LAWS))}", lambda x: 0 <= x <= MAX_FRICTION))
     name = value.get("law")

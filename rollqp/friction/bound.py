@@ -135,7 +135,7 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
     if kind == "constant":
         return law.mu, None  # the number itself (a plain float): the constant-coefficient code path
     if kind == "spatial":
-        return law.coefficient(x_hat, q_hat, direction), None
+        return law.coefficient(x_hat[None, :], q_hat, direction), None   # the strip's points, (1, n)
     static = law.steady(0.0)[0]
     if law.memory == 0.0:
         return float(static), SlipBound(law, steady=bool(steady))

@@ -107,9 +107,11 @@ class _Spatial:
         """Where the nodes ``x̂`` are in the law's own coordinate (``a_H`` units) at ``q̂``."""
         return x_hat - direction * q_hat if self.frame == "material" else x_hat
 
-    def coefficient(self, x_hat, q_hat, direction) -> np.ndarray:
-        """``μ`` at the nodes ``x̂`` (``a_H`` units) at the rolled distance ``q̂``."""
-        return self.profile(self.positions(np.asarray(x_hat, dtype=float), q_hat, direction))
+    def coefficient(self, points, q_hat, direction) -> np.ndarray:
+        """``μ`` at the ``points`` (shape ``(d, n)``: the rolling coordinate ``x̂`` first, then ``ŷ`` on a
+        grid; length units of the contact) at the rolled distance ``q̂``: a law along x, the same on every
+        line of a grid."""
+        return self.profile(self.positions(np.asarray(points, dtype=float)[0], q_hat, direction))
 
     def span(self):
         """``(lo, hi)``: the part of the law's coordinate where μ differs from the outside value."""

@@ -53,3 +53,4 @@ def build_influence(model: str, strip, **kw) -> Influence:
 
 register_model(builtin.HALFSPACE)
 register_model(builtin.BEM)
+register_model(builtin.HALFSPACE_3D)

@@ -9,8 +9,12 @@ import math
 import time
 
 from ..errors import InputError
+from .grid import ContactOperators
 from .halfspace import halfspace_influence
 from .model import Model
+from .halfspace import undeformed_gap
+from .toeplitz import halfspace_operators
+from .toeplitz import positive_definite_threshold
 
 __all__ = ["HALFSPACE", "BEM", "MIN_BEM_ELEMENT_RATIO"]
 
@@ -28,8 +32,6 @@ def halfspace_operators_of(scene, strip):
     (:func:`~rollqp.influence.toeplitz.positive_definite_threshold`), else an
     :class:`InputError` on ``contact.reference_distance`` as on the dense path.
     """
-    from .halfspace import undeformed_gap
-    from .toeplitz import halfspace_operators, positive_definite_threshold
     t0 = time.perf_counter()
     coupling = scene.coupling_level
     d_ref = scene.reference_distance_value
@@ -103,6 +105,9 @@ def bem_rows(m: dict) -> list[tuple[str, str]]:
 
 HALFSPACE = Model("halfspace", halfspace_of, "elastic half-spaces (docs/formulation.md §3)",
                   keys=("contact.reference_distance", "contact.coupling"), operators=halfspace_operators_of)
+#: Boussinesq–Cerruti on the rectangles of a grid (three dimensions, docs/theory3d.md §3–4).
+HALFSPACE_3D = Model("halfspace", ContactOperators, "elastic half-spaces, Boussinesq–Cerruti on rectangles "
+                     "(docs/theory3d.md §3)", dimensions=frozenset({3}))
 BEM = Model("bem", bem_of, "true roller geometry on rigid shafts by BEM (docs/bem.md)",
             keys=("contact.bem_outer_elements", "contact.bem_inner_elements", "contact.coupling",
                   "bodies.A.shaft_radius", "bodies.B.shaft_radius"),

@@ -86,6 +86,7 @@ from ..validate import positive_real
 from .kernels import (FAR_FIELD, GAUSS_POINTS, assemble_elements, element_offsets,  # noqa: F401 - re-exported
                       lattice_offsets, log_moments, sgn_moments)
 from .operator import asymmetry
+from .toeplitz import positive_definite_threshold
 
 __all__ = [
     "Influence",
@@ -407,7 +408,6 @@ def _check_by_threshold(strip, d_ref, L):
     docs/matrix-free.md). That ``B`` is positive definite is verified by Cholesky on every uniform
     mesh up to :data:`CHOLESKY_MAX` nodes (this module) and on each element type at the largest of
     them in the tests; ``λ_min/λ_max`` is not computed (``nan``)."""
-    from .toeplitz import positive_definite_threshold
     d_min = positive_definite_threshold(strip)
     if not (np.isfinite(d_min) and d_ref > d_min):
         raise _indefinite(d_ref, L, float("nan"), d_min)

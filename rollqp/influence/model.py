@@ -61,6 +61,11 @@ class Model:
     memo : bool
         ``build`` takes the keyword ``memo``: the :class:`~rollqp.influence.memo.Memo` of the scene's
         operators, where it keeps what depends on the geometry alone (the BEM's roller compliances).
+    dimensions : frozenset of int
+        The scenes it models: 2 (a strip: ``build(scene, strip)``) and/or 3 (a grid of rectangles:
+        ``build(grid, materials)`` returns the contact's operators, ``A_nn``, ``A_tt`` and for dissimilar
+        bodies ``A_nt``, ``A_tn``, with their ``shifted`` and ``steady`` copies, as
+        :class:`~rollqp.influence.grid.ContactOperators` does). One name may hold one model per dimension.
     """
 
     name: str
@@ -73,6 +78,13 @@ class Model:
     halfspace_field: bool = True
     report: Callable | None = None
     memo: bool = False
+    dimensions: frozenset = frozenset({2})
+
+    def __post_init__(self):
+        dims = frozenset(self.dimensions)
+        if not dims or not dims <= {2, 3}:
+            raise InputError("model.dimensions", f"must be a non-empty subset of {{2, 3}}, got {sorted(dims)}")
+        object.__setattr__(self, "dimensions", dims)
 
     @property
     def matrix_free(self) -> bool:
@@ -80,8 +92,8 @@ class Model:
         return self.operators is not None
 
 
-#: name → :class:`Model`, in the order registered.
-_MODELS: dict[str, Model] = {}
+#: (name, dimension) → :class:`Model`, in the order registered.
+_MODELS: dict[tuple, Model] = {}
 
 
 def register(model: Model) -> Model:
@@ -94,21 +106,26 @@ def register(model: Model) -> Model:
     """
     if not isinstance(model, Model):
         raise InputError("model", f"must be a rollqp.influence.Model, got {type(model).__name__}")
-    if model.name in _MODELS:
-        raise InputError("model.name", f"{model.name!r} is registered already (models: {', '.join(_MODELS)})")
-    _MODELS[model.name] = model
+    taken = [d for d in sorted(model.dimensions) if (model.name, d) in _MODELS]
+    if taken:
+        raise InputError("model.name", f"{model.name!r} is registered already for {taken[0]}D scenes "
+                                       f"(models: {', '.join(names(taken[0]))})")
+    for d in sorted(model.dimensions):
+        _MODELS[(model.name, d)] = model
     return model
 
 
-def names() -> tuple[str, ...]:
-    """The registered models' names."""
-    return tuple(_MODELS)
+def names(dimension: int = 2) -> tuple[str, ...]:
+    """The names of the registered models of ``dimension``'s scenes."""
+    return tuple(n for n, d in _MODELS if d == dimension)
 
 
-def get(name, key: str = "contact.model") -> Model:
-    """The model ``name``; an :class:`InputError` on ``key`` naming the registered ones if there is none."""
-    model = _MODELS.get(name) if isinstance(name, str) else None
+def get(name, key: str = "contact.model", dimension: int = 2) -> Model:
+    """The model ``name`` of ``dimension``'s scenes; an :class:`InputError` on ``key`` naming the registered
+    ones if there is none."""
+    model = _MODELS.get((name, dimension)) if isinstance(name, str) else None
     if model is None:
-        raise InputError(key, f"must be one of {', '.join(map(repr, _MODELS))}, got {name!r}"
-                              + suggestion(name, _MODELS))
+        known = names(dimension)
+        raise InputError(key, f"must be one of {', '.join(map(repr, known))}, got {name!r}"
+                              + suggestion(name, known))
     return model

@@ -35,6 +35,7 @@ from numpy.lib.stride_tricks import as_strided
 from ..errors import InputError
 from .kernels import assemble_elements, element_offsets, lattice_offsets, log_moments, sgn_moments
 from .operator import Operator
+from ..strip import Strip
 
 __all__ = ["kernel_moments", "elementwise", "generators", "assemble", "ToeplitzOperator", "log_operator", "sgn_operator",
            "halfspace_operators", "positive_definite_threshold"]
@@ -295,7 +296,6 @@ def log_operator(strip, d_ref: float, scale: float = 1.0, name: str = "influence
 def _coarse_log(strip, ne: int, d_ref: float, scale: float, name: str):
     """``(coarse strip, its log operator)``: the same kernel on ``ne`` elements of the same zone
     (a coarse model of the same problem, for the cold start of :mod:`rollqp.methods.krylov`)."""
-    from ..strip import Strip
     coarse = Strip(float(strip.half_width), int(ne), strip.element)
     return coarse, log_operator(coarse, d_ref, scale, name)
 

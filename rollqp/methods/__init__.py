@@ -16,7 +16,7 @@ its meaning across dimensions — ``newton`` is rollqp's generalized Newton meth
 convex programs on that external solver — and each dimension has its own table of classes:
 
 ========================  ==========================================================
-``newton``                generalized Newton on the disc projection (:mod:`rollqp.three.gnm`)
+``newton``                generalized Newton on the disc projection (:mod:`rollqp.methods.newton.disc`)
 ``qp-clarabel``           Clarabel: the normal QP and the tangential SOCP (one cone per element)
 ``socp-clarabel``         the same (the name says the cone)
 ``qp-cvxpy``              cvxpy's statement of the QP and the SOCP, solved by Clarabel
@@ -55,46 +55,128 @@ Examples
 from __future__ import annotations
 
 import importlib
+from dataclasses import dataclass
 
 from ..errors import InputError, MissingBackendError
+from .alternation import Alternation
 from .base import (FRICTION_KINDS, KINDS, Capabilities, Method, check_kind,  # noqa: F401 - the protocol, re-exported
                    check_options)
+from .continuation import SlipContinuation
+from .fixedpoint import BoundFixedPoint
+from .fastsim import FastsimMethod
+from .krylov import KrylovNewton
+from .newton import NewtonMethod
+from .newton.disc import NewtonMethod as _DiscNewton
+from .nt_newton import AlternationNewton
+from .qp_clarabel import ClarabelQP
+from .qp_osqp import OsqpQP
+from .socp import ClarabelMethod, CvxpyMethod, OsqpMethod, ScsMethod
 
-# name -> (module, class, pip extra that provides it or None)
-_REGISTRY = {
-    "qp-clarabel": ("rollqp.methods.qp_clarabel", "ClarabelQP", None),
-    "qp-osqp": ("rollqp.methods.qp_osqp", "OsqpQP", None),
-    "qp-cvxpy": ("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"),
-    "newton": ("rollqp.methods.newton", "NewtonMethod", None),
-    "nt-newton": ("rollqp.methods.nt_newton", "AlternationNewton", None),
-    "mf-newton": ("rollqp.methods.krylov", "KrylovNewton", None),
+
+@dataclass(frozen=True)
+class Optional:
+    """A method class in a module that needs an optional package: imported on first use, its
+    ``dimensions`` declared here (so that the table is read without importing it)."""
+
+    module: str
+    attr: str
+    extra: str
+    dimensions: frozenset = frozenset({2})
+
+    def load(self) -> type:
+        """The class (its module's attribute: a missing solver package is its MissingBackendError)."""
+        return getattr(importlib.import_module(self.module), self.attr)
+
+
+#: The one method table: name -> the classes (or optional modules) under that name, at most one per
+#: dimension; each class's ``capabilities.dimensions`` says which scenes it runs.
+_TABLE: dict[str, tuple] = {
+    "qp-clarabel": (ClarabelQP, ClarabelMethod),
+    "qp-osqp": (OsqpQP, OsqpMethod),
+    "qp-cvxpy": (Optional("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"), CvxpyMethod),
+    "newton": (NewtonMethod, _DiscNewton),
+    "nt-newton": (AlternationNewton,),
+    "mf-newton": (KrylovNewton,),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
-    **{f"qps-{s}": ("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers")
+    **{f"qps-{s}": (Optional("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers"),)
        for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
+    "socp-clarabel": (ClarabelMethod,),
+    "socp-cvxpy": (CvxpyMethod,),
+    "socp-scs": (ScsMethod,),
+    "fastsim": (FastsimMethod,),
 }
 
-# name -> (module, class, extra) of the methods of three-dimensional scenes (rollqp.three)
-_REGISTRY_3D = {
-    "newton": ("rollqp.three.gnm", "NewtonMethod", None),
-    "qp-clarabel": ("rollqp.three.socp", "ClarabelMethod", None),
-    "socp-clarabel": ("rollqp.three.socp", "ClarabelMethod", None),
-    "qp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
-    "socp-cvxpy": ("rollqp.three.socp", "CvxpyMethod", "cvxpy"),
-    "socp-scs": ("rollqp.three.socp", "ScsMethod", "cvxpy"),
-    "qp-osqp": ("rollqp.three.socp", "OsqpMethod", None),
-    "fastsim": ("rollqp.methods.fastsim", "FastsimMethod", None),
-}
-_TABLES = {2: _REGISTRY, 3: _REGISTRY_3D}
+
+def _dimensions(entry) -> frozenset:
+    return entry.dimensions if isinstance(entry, Optional) else entry.capabilities.dimensions
+
+
+def _table(dimension: int) -> tuple:
+    return tuple(name for name, entries in _TABLE.items() if any(dimension in _dimensions(e) for e in entries))
+
+
+@dataclass(frozen=True)
+class MethodRecord:
+    """A method name resolved for scenes of one dimension: made once, when a scene is validated
+    (:func:`resolve`), and carried from there (``scene.solver.method.record``) to :meth:`make`.
+
+    ``entry`` is the class, or the :class:`Optional` module that holds it; :attr:`cls` imports an optional
+    one (a missing package is a :class:`MissingBackendError` naming the pip extra).
+    """
+
+    name: str
+    dimension: int
+    entry: object
+
+    @property
+    def cls(self) -> type:
+        entry = self.entry
+        if isinstance(entry, Optional):
+            try:
+                return entry.load()
+            except ModuleNotFoundError as exc:
+                raise MissingBackendError(f"method {self.name!r} needs the package {exc.name!r} "
+                                          f"(pip install 'rollqp[{entry.extra}]')") from exc
+        return entry
+
+    @property
+    def capabilities(self) -> Capabilities:
+        """What the class declares; for a method whose package is missing, a record that solves nothing."""
+        try:
+            return self.cls.capabilities
+        except MissingBackendError:
+            return Capabilities(dimensions=frozenset({self.dimension}))
+
+    def make(self, settings, **options) -> Method:
+        """The method configured from a scene's solver settings (``Cls.from_settings``), named by the registry."""
+        method = self.cls.from_settings(settings, **options)
+        if method.name != self.name:
+            method.name = self.name
+        return method
+
+
+class MethodName(str):
+    """A scene's ``solver.method`` once validated: the name (what the scene file holds, a ``str``) that
+    carries its :class:`MethodRecord` (``.record``), so that nothing resolves it again."""
+
+    def __new__(cls, record: MethodRecord):
+        self = super().__new__(cls, record.name)
+        self.record = record
+        return self
+
+    def __reduce__(self):
+        return (MethodName, (self.record,))
+
 
 #: The methods of two-dimensional scenes.
-METHOD_NAMES = tuple(_REGISTRY)
+METHOD_NAMES = _table(2)
 #: The methods of three-dimensional scenes (``[contact] dimension = 3``).
-METHOD_NAMES_3D = tuple(_REGISTRY_3D)
+METHOD_NAMES_3D = _table(3)
 #: Every name a scene's ``solver.method`` (or ``--method``) may hold, of either dimension.
-SCENE_METHOD_NAMES = METHOD_NAMES + tuple(k for k in _REGISTRY_3D if k not in _REGISTRY)
+SCENE_METHOD_NAMES = METHOD_NAMES + tuple(k for k in METHOD_NAMES_3D if k not in METHOD_NAMES)
 #: The methods that pose convex QPs (each half of a step one QP; coupled steps by the N–T
 #: alternation): for listings and benchmarks. What a method can do is its ``capabilities``.
-QP_METHODS = tuple(k for k in _REGISTRY if k.startswith(("qp-", "qps-")))
+QP_METHODS = tuple(k for k in METHOD_NAMES if k.startswith(("qp-", "qps-")))
 #: The method of a scene without ``solver.method``.
 DEFAULT_METHOD = "newton"
 #: The reference method: step files are marched with it, and the cross-validation and the step checker
@@ -118,32 +200,91 @@ def register(name: str, cls: type, extra: str | None = None) -> None:
     """Register a method class under ``name`` (a scene's ``solver.method``, :func:`get_method`).
 
     ``cls`` follows the protocol of :mod:`rollqp.methods.base`: ``name``, a class attribute
-    ``capabilities`` (:class:`Capabilities`), ``from_settings``, ``setup`` and ``solve``. It goes into
-    the table of the dimension its record declares (``capabilities.dimension``). ``extra``: the pip
-    extra that installs what it needs, named when its import fails.
+    ``capabilities`` (:class:`Capabilities`), ``from_settings``, ``setup`` and ``solve``. It runs the
+    scenes of the dimensions its record declares (``capabilities.dimensions``); a name may hold one class
+    per dimension. ``extra``: the pip extra that installs what it needs (named in the listings).
 
     Raises
     ------
     InputError
-        ``name`` is already registered for that dimension, or ``cls`` declares no :class:`Capabilities`.
+        ``name`` is already registered for one of those dimensions, or ``cls`` declares no :class:`Capabilities`.
     """
     declared = next((vars(k)["capabilities"] for k in cls.__mro__ if "capabilities" in vars(k)), None)
     if not isinstance(declared, Capabilities):
         raise InputError("cls", f"a method class declares its Capabilities as the class attribute "
                                 f"'capabilities' ({cls!r} does not)")
-    table = _TABLES.get(declared.dimension)
-    if table is None:
-        raise InputError("cls", f"capabilities.dimension must be one of {sorted(_TABLES)}, got {declared.dimension!r}")
-    if not isinstance(name, str) or not name or name in table:
-        raise InputError("name", f"must be a new method name (registered: {', '.join(table)}), got {name!r}")
-    table[name] = (cls, None, extra)
+    taken = _TABLE.get(name, ())
+    if not isinstance(name, str) or not name or any(_dimensions(e) & declared.dimensions for e in taken):
+        names = ", ".join(n for d in sorted(declared.dimensions) for n in _table(d))
+        raise InputError("name", f"must be a new method name (registered: {names}), got {name!r}")
+    _TABLE[name] = taken + (cls,)
     _refresh_names()
 
 
 def _refresh_names() -> None:
     global METHOD_NAMES, METHOD_NAMES_3D, SCENE_METHOD_NAMES
-    METHOD_NAMES, METHOD_NAMES_3D = tuple(_REGISTRY), tuple(_REGISTRY_3D)
-    SCENE_METHOD_NAMES = METHOD_NAMES + tuple(k for k in _REGISTRY_3D if k not in _REGISTRY)
+    METHOD_NAMES, METHOD_NAMES_3D = _table(2), _table(3)
+    SCENE_METHOD_NAMES = METHOD_NAMES + tuple(k for k in METHOD_NAMES_3D if k not in METHOD_NAMES)
+
+
+def _unknown(name, key: str):
+    names = SCENE_METHOD_NAMES
+    import difflib
+    close = difflib.get_close_matches(name, list(names), n=1) if isinstance(name, str) else []
+    hint = f"; did you mean {close[0]!r}?" if close else ""
+    return InputError(key, f"must be one of {', '.join(map(repr, names))}, got {name!r}{hint}")
+
+
+def record(name, dimension: int = 2, key: str = "solver.method") -> MethodRecord:
+    """The record of method ``name`` for scenes of ``dimension``, without making it or importing an
+    optional package. A name registered for the other dimension only gives that dimension's record (its
+    :class:`Capabilities` then refuse the scene: :func:`resolve`, :func:`compose`); a validated scene's
+    ``solver.method`` carries its record already (:class:`MethodName`).
+
+    Raises
+    ------
+    InputError
+        ``key`` for an unknown name, or a ``dimension`` that is neither 2 nor 3.
+    """
+    if isinstance(name, MethodName) and name.record.dimension == dimension:
+        return name.record
+    if not isinstance(name, str) or name not in _TABLE:
+        raise _unknown(name, key)
+    if dimension not in (2, 3):
+        raise InputError("contact.dimension", f"must be one of [2, 3], got {dimension!r}")
+    entries = _TABLE[name]
+    entry = next((e for e in entries if dimension in _dimensions(e)), entries[0])
+    own = dimension if dimension in _dimensions(entry) else min(_dimensions(entry))
+    return MethodRecord(str(name), own, entry)
+
+
+def resolve(name, dimension: int, key: str = "solver.method") -> MethodName:
+    """``name`` validated for a scene of ``dimension``: the :class:`MethodName` carrying its record (the
+    scene's check, before any work; the one place a scene's method name becomes a class).
+
+    The record must declare ``dimension`` (a 2D-only method on a 3D scene and the reverse are refused
+    here, naming the methods of that dimension), and a 3D method must solve tangential steps on the
+    friction disc (:func:`compose_3d`); a method whose package is missing passes (running it names the
+    pip extra).
+    """
+    if isinstance(name, MethodName) and name.record.dimension == dimension:
+        return name
+    rec = record(name, dimension, key)
+    try:
+        caps = rec.cls.capabilities
+    except MissingBackendError:
+        return MethodName(rec)
+    if dimension not in caps.dimensions:
+        own = ", ".join(_RUNNABLE[dimension]())
+        raise InputError(key, f"method {rec.name!r} solves {_dims(caps)}D steps (its capabilities); a {dimension}D "
+                              f"scene needs one of {own}")
+    if dimension == 3:
+        _require_cones(rec.name, caps, key)
+    return MethodName(rec)
+
+
+def _dims(caps) -> str:
+    return "/".join(str(d) for d in sorted(caps.dimensions))
 
 
 def capabilities(name: str, dimension: int = 2) -> Capabilities:
@@ -156,18 +297,15 @@ def capabilities(name: str, dimension: int = 2) -> Capabilities:
     InputError
         ``solver.method`` for an unknown name.
     """
-    try:
-        return method_class(name, dimension).capabilities
-    except MissingBackendError:
-        return Capabilities(dimension=dimension)
+    return record(name, dimension).capabilities
 
 
 def available_methods(dimension: int = 2) -> list[str]:
     """Names of the methods of ``dimension`` whose modules import on this installation."""
     out = []
-    for name in _TABLES[dimension]:
+    for name in _table(dimension):
         try:
-            method_class(name, dimension)
+            record(name, dimension).cls
         except (MissingBackendError, InputError):
             continue
         out.append(name)
@@ -175,35 +313,17 @@ def available_methods(dimension: int = 2) -> list[str]:
 
 
 def check_name(name, key: str = "solver.method", dimension: int | None = None) -> str:
-    """``name`` if it is a registered method, else an :class:`InputError` on ``key`` listing them.
-
-    With ``dimension``, the method's record must declare that dimension (a 2D-only method on a 3D
-    scene and the reverse are refused here, through :class:`Capabilities`, naming the methods of
-    that dimension); a method whose package is missing passes (running it names the pip extra).
-    """
-    names = SCENE_METHOD_NAMES
-    if not isinstance(name, str) or name not in names:
-        import difflib
-        close = difflib.get_close_matches(name, list(names), n=1) if isinstance(name, str) else []
-        hint = f"; did you mean {close[0]!r}?" if close else ""
-        raise InputError(key, f"must be one of {', '.join(map(repr, names))}, got {name!r}{hint}")
+    """``name`` if it is a registered method, else an :class:`InputError` on ``key`` listing them; with
+    ``dimension``, :func:`resolve` (the name with its record)."""
     if dimension is not None:
-        try:
-            declared = method_class(name, dimension).capabilities.dimension
-        except MissingBackendError:
-            return name
-        if declared != dimension:
-            own = ", ".join(_RUNNABLE[dimension]())
-            raise InputError(key, f"method {name!r} solves {declared}D steps (its capabilities); a {dimension}D "
-                                  f"scene needs one of {own}")
+        return resolve(name, dimension, key)
+    if not isinstance(name, str) or name not in _TABLE:
+        raise _unknown(name, key)
     return name
 
 
 def method_class(name: str, dimension: int = 2) -> type:
-    """The class of method ``name`` for scenes of ``dimension``, importing its module on first use.
-
-    A name registered for the other dimension only resolves to that class: its
-    :class:`Capabilities` then refuse the scene (:func:`compose`, :func:`compose_3d`).
+    """The class of method ``name`` for scenes of ``dimension`` (:func:`record`'s ``cls``).
 
     Raises
     ------
@@ -212,21 +332,7 @@ def method_class(name: str, dimension: int = 2) -> type:
     MissingBackendError
         The method's package is not installed (the message names the pip extra).
     """
-    check_name(name)
-    if dimension not in _TABLES:
-        raise InputError("contact.dimension", f"must be one of {sorted(_TABLES)}, got {dimension!r}")
-    table = _TABLES[dimension]
-    if name not in table:
-        table = next(t for t in _TABLES.values() if name in t)
-    module, cls, extra = table[name]
-    if isinstance(module, type):  # registered as a class (register)
-        return module
-    try:
-        mod = importlib.import_module(module)
-    except ModuleNotFoundError as exc:
-        hint = f" (pip install 'rollqp[{extra}]')" if extra else ""
-        raise MissingBackendError(f"method {name!r} needs the package {exc.name!r}{hint}") from exc
-    return getattr(mod, cls)
+    return record(name, dimension).cls
 
 
 def get_method(name: str, dimension: int = 2, **settings) -> Method:
@@ -246,7 +352,8 @@ def get_method(name: str, dimension: int = 2, **settings) -> Method:
 
 
 def scene_method(settings, coupled: bool = False, friction: str = "constant", **options) -> Method:
-    """The method a scene runs with: ``settings.method`` built from the scene's solver settings.
+    """The method a scene runs with: ``settings.method`` (its record: :func:`record`) built from the
+    scene's solver settings.
 
     Parameters
     ----------
@@ -261,7 +368,7 @@ def scene_method(settings, coupled: bool = False, friction: str = "constant", **
     **options
         Method-specific settings (an unknown one is an :class:`InputError`).
     """
-    method = method_class(settings.method).from_settings(settings, **options)
+    method = record(settings.method, 2).make(settings, **options)
     return compose(method, coupled, max_outer=settings.max_iterations, friction=friction)
 
 
@@ -277,8 +384,8 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
     scene up front, naming the alternatives.
     """
     caps = method.capabilities
-    if caps.dimension != 2:
-        raise InputError("solver.method", f"method {method.name!r} solves {caps.dimension}D steps (its capabilities); "
+    if 2 not in caps.dimensions:
+        raise InputError("solver.method", f"method {method.name!r} solves {_dims(caps)}D steps (its capabilities); "
                                           "a scene is a two-dimensional rolling contact")
     if coupled and "coupled" in caps.solves and friction not in caps.coupled_friction:
         raise InputError("solver.method", f"method {method.name!r} solves coupled steps with "
@@ -286,27 +393,21 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
                                           f"{friction} friction law on a coupled scene use "
                                           "'nt-newton' (Newton halves in the N–T alternation) or a qp-* method")
     if friction == "slip":
-        from .continuation import SlipContinuation
         if not caps.slip_dependent:
-            from .fixedpoint import BoundFixedPoint
             method = BoundFixedPoint(method)
         method = SlipContinuation(method)
     if coupled and "coupled" not in caps.solves:
         if not {"normal", "tangential"} <= caps.solves:
             raise InputError("solver.method", f"method {method.name!r} solves neither coupled steps nor both "
                                               "halves of them")
-        from .alternation import Alternation
         return Alternation(method, max_outer=max_outer, limit=caps.coupled_limit)
     return method
 
 
 def scene_method_3d(settings, **options) -> Method:
-    """The method a three-dimensional scene runs with: ``settings.method`` from the 3D table, built from
-    the scene's solver settings and checked by :func:`compose_3d`."""
-    method = method_class(settings.method, 3).from_settings(settings, **options)
-    if method.name != settings.method:
-        method.name = settings.method
-    return compose_3d(method)
+    """The method a three-dimensional scene runs with: ``settings.method``'s record for dimension 3, built
+    from the scene's solver settings and checked by :func:`compose_3d`."""
+    return compose_3d(record(settings.method, 3).make(settings, **options))
 
 
 def compose_3d(method: Method) -> Method:
@@ -317,8 +418,8 @@ def compose_3d(method: Method) -> Method:
     method's own halves: every 3D method is composed so.)
     """
     caps = method.capabilities
-    if caps.dimension != 3:
-        raise InputError("solver.method", f"method {method.name!r} solves {caps.dimension}D steps (its capabilities); "
+    if 3 not in caps.dimensions:
+        raise InputError("solver.method", f"method {method.name!r} solves {_dims(caps)}D steps (its capabilities); "
                                           f"a 3D scene needs one of {', '.join(cone_methods())}")
     _require_cones(method.name, caps)
     return method
@@ -332,23 +433,16 @@ def _require_cones(name: str, caps: Capabilities, key: str = "solver.method") ->
 
 
 def require_3d(name, key: str = "solver.method") -> str:
-    """Check, through its record, that method ``name`` runs a 3D scene (the scene's check, before any work):
-    :func:`check_name` for dimension 3, then the cones of :func:`compose_3d`."""
-    check_name(name, key, dimension=3)
-    try:
-        caps = method_class(name, 3).capabilities
-    except MissingBackendError:
-        return name
-    _require_cones(name, caps, key)
-    return name
+    """:func:`resolve` for dimension 3 (the 3D scene's check of ``solver.method``, before any work)."""
+    return resolve(name, 3, key)
 
 
 def cone_methods() -> tuple:
     """The installed 3D methods that solve tangential steps on the friction disc (their records say so)."""
     out = []
-    for name in _REGISTRY_3D:
+    for name in _table(3):
         try:
-            caps = method_class(name, 3).capabilities
+            caps = record(name, 3).cls.capabilities
         except MissingBackendError:
             continue
         if {"normal", "tangential"} <= caps.solves and caps.friction_set == "disc":
@@ -357,7 +451,7 @@ def cone_methods() -> tuple:
 
 
 #: The methods that run a scene of each dimension (named in the refusals).
-_RUNNABLE = {2: lambda: tuple(_REGISTRY), 3: cone_methods}
+_RUNNABLE = {2: lambda: _table(2), 3: cone_methods}
 
 
 def matrix_free(name: str) -> bool:

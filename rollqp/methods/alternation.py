@@ -118,6 +118,10 @@ class Alternation:
         for a method that declares :attr:`~rollqp.methods.base.Capabilities.predicting`."""
         return self.inner.kkt_caches()
 
+    def carrier(self):
+        """The inner method's (called only where the capabilities declare ``carries_state``)."""
+        return self.inner.carrier()
+
     def setup(self, operators) -> None:
         """A new scene: the inner method's set-up (and the one-sweep mode off)."""
         self._single = False

@@ -53,8 +53,8 @@ class Capabilities:
     True
     >>> capabilities("mf-newton").matrix_free, capabilities("qp-osqp").matrix_free
     (True, False)
-    >>> Capabilities(solves=frozenset({"normal", "tangential"})).dimension
-    2
+    >>> sorted(Capabilities(solves=frozenset({"normal", "tangential"})).dimensions)
+    [2]
     """
 
     #: The problem kinds it solves (:data:`KINDS`).
@@ -83,10 +83,13 @@ class Capabilities:
     accelerated_start: bool = False
     #: That start's quasi-Newton phase is used (False: Anderson alone).
     quasi_newton: bool = False
-    #: The problems' dimension: 2 (a strip of nodes along x) or 3 (a grid of surface elements).
-    dimension: int = 2
+    #: The problems' dimensions it solves: 2 (a strip of nodes along x), 3 (a grid of surface elements).
+    dimensions: frozenset = frozenset({2})
     #: Tangential traction components per node: 1 in 2D, 2 in 3D.
     traction_components: int = 1
+    #: It keeps factorizations from one step to the next that a journaled march records and a resumed march
+    #: rebuilds (:mod:`rollqp.solverstate`): ``method.carrier()`` is the object that keeps them.
+    carries_state: bool = False
     #: The friction set ``|t| <= μ p`` of a node: ``"interval"`` (2D), ``"disc"`` (3D, a second-order cone).
     friction_set: str = "interval"
 
@@ -97,6 +100,9 @@ class Capabilities:
         if self.operator not in ("exact", "symmetrized"):
             raise InputError("capabilities.operator", f"must be 'exact' or 'symmetrized', got {self.operator!r}")
         object.__setattr__(self, "solves", frozenset(self.solves))
+        object.__setattr__(self, "dimensions", frozenset(self.dimensions))
+        if not self.dimensions or not self.dimensions <= {2, 3}:
+            raise InputError("capabilities.dimensions", f"must be a non-empty subset of {{2, 3}}, got {sorted(self.dimensions)}")
         object.__setattr__(self, "coupled_friction", frozenset(self.coupled_friction))
 
 

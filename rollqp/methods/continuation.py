@@ -91,6 +91,10 @@ class SlipContinuation:
             raise AttributeError(name)
         return getattr(self.inner, name)
 
+    def carrier(self):
+        """The inner method's (called only where the capabilities declare ``carries_state``)."""
+        return self.inner.carrier()
+
     def setup(self, operators) -> None:
         self.inner.setup(operators)
 

@@ -28,10 +28,10 @@ ellipse ``∫∫(x_ℓ − x) = 8a²b/3`` gives ``F_x = −G ab C_{11} ξ`` and 
 ``−G (ab)^{3/2} C_{23} φ`` of ``F_y`` (the discrete sums on the grid reproduce them to the grid's
 quadrature error). At large creepage every element slips and the force is ``μ F_N`` (saturation).
 Between, it is an approximation: its error against the exact solution of the same discrete problem
-(:mod:`rollqp.three.gnm`) is measured in docs/performance.md ("FASTSIM").
+(:mod:`rollqp.methods.newton.disc`) is measured in docs/performance.md ("FASTSIM").
 
 **The pressure** is the scene's own (the normal step, solved exactly by Newton's method,
-:mod:`rollqp.three.gnm`: Kalker's FASTSIM takes the parabolic pressure of his simplified normal theory;
+:mod:`rollqp.methods.newton.disc`: Kalker's FASTSIM takes the parabolic pressure of his simplified normal theory;
 here the saturation uses the same pressure as the exact method it is compared with). Prescribed forces
 (``Fx``, ``Fy``) are met by solving for the creepages (``scipy.optimize.root`` from the linear theory).
 
@@ -60,7 +60,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from ..three.closedforms import kalker_linear
-from ..three.gnm import NewtonMethod
+from .newton.disc import NewtonMethod
 from .base import Capabilities, check_options
 
 __all__ = ["FastsimMethod", "flexibilities", "fastsim_traction"]
@@ -140,7 +140,7 @@ class FastsimMethod:
     #: (:func:`rollqp.three.advice.refusal`).
     steady_only = True
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
-                                dimension=3, traction_components=2, friction_set="disc")
+                                dimensions=frozenset({3}), traction_components=2, friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int | None = None):
         self.tolerance = float(tolerance)
@@ -185,7 +185,7 @@ class FastsimMethod:
             xi, eta = self._creepages(problem, traction, e, m)
         t = traction(xi, eta)
         sol = problem.solution(t, None if problem.xi is not None else xi, None if problem.eta is not None else eta,
-                               method=self.name, iterations=1, info={"time": time.perf_counter() - t0,
+                               method=self.name, iterations=1, extras={"time": time.perf_counter() - t0,
                                                                       "flexibilities": L})
         return sol
 

@@ -75,6 +75,10 @@ class BoundFixedPoint:
         self.tolerance = inner.tolerance
         self.limit = float(inner.capabilities.residual_limit or inner.tolerance)
 
+    def carrier(self):
+        """The inner method's (called only where the capabilities declare ``carries_state``)."""
+        return self.inner.carrier()
+
     def setup(self, operators) -> None:
         self.inner.setup(operators)
 

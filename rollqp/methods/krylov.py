@@ -36,6 +36,7 @@ import scipy.sparse.linalg as spla
 
 from ..errors import InputError, SolverError
 from .base import Capabilities, check_kind, check_options
+from ..problem import NormalStep
 
 __all__ = ["KrylovNewton"]
 
@@ -289,7 +290,6 @@ class KrylovNewton:
         sub = KrylovNewton(tolerance=max(self.tolerance, 1e-8), max_iterations=self.max_iterations,
                            preconditioner=self.preconditioner)
         try:
-            from ..problem import NormalStep
             sol = sub.solve(NormalStep(A=Ac, f=coarse.weights, h=hc, P=pb.P, delta=pb.delta, scales=pb.scales))
         except SolverError:
             return np.ones(pb.n, dtype=bool)

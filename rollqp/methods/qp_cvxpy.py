@@ -19,6 +19,7 @@ import numpy as np
 from ._qp import QPMethod, constraint_rows
 from .qp_clarabel import ClarabelQP, clarabel_settings
 from .qp_osqp import OsqpQP
+from ..errors import InputError
 
 if importlib.util.find_spec("cvxpy") is None:  # not installed: the registry names the extra to install
     raise ModuleNotFoundError("No module named 'cvxpy'", name="cvxpy")
@@ -51,7 +52,6 @@ class CvxpyQP(QPMethod):
     def __init__(self, tolerance=1e-10, residual_limit=None, max_iterations=None, operator="exact",
                  solver="OSQP", **options):
         if solver not in ("OSQP", "CLARABEL"):
-            from ..errors import InputError
             raise InputError("solver", f"cvxpy backend solver must be 'OSQP' or 'CLARABEL', got {solver!r}")
         self.native_options = OsqpQP.native_options if solver == "OSQP" else ClarabelQP.native_options
         super().__init__(tolerance, residual_limit, max_iterations, operator, **options)

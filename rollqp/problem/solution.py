@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..friction.projection import residual as projection_residual
 from .scales import Scales
 
 __all__ = ["SEPARATION", "STICK", "SLIP", "friction_residual", "Residuals", "StepSolution", "classify", "compare"]
@@ -21,32 +22,28 @@ def friction_residual(t, s, bound, minus_bound=None, out=None):
     nondimensional ``t̂, ŝ, b̂``; the Newton method with ``r ŝ`` in place of ``ŝ`` (eq. 56, 63).
     ``minus_bound``: ``−b`` if the caller keeps it; ``out``: the array to write it into.
     """
-    if minus_bound is None:
-        minus_bound = -bound
-    # np.maximum/np.minimum rather than np.clip: the same numbers (``b >= 0``), without np.clip's
-    # Python-level dispatch (half the time on a step's vectors, and Newton evaluates it a few times an iteration)
-    if out is None:
-        return t - np.maximum(np.minimum(t - s, bound), minus_bound)
-    u = np.minimum(t - s, bound)
-    return np.subtract(t, np.maximum(u, minus_bound, out=u), out=out)  # the same operations, in place
+    return projection_residual(t, s, bound, minus_bound, out)   # the ball of radius b, k = 1 (rollqp.friction.projection)
 
 
 @dataclass
 class Residuals:
-    """rollqp's own nondimensional residuals of a step (max norms; see module docstring)."""
+    """rollqp's own nondimensional residuals of a step (max norms; see module docstring; on a
+    grid, eq. 3D.29): ``load_tangential`` is the tangential load equation (along x on a grid), ``load_lateral`` the
+    lateral one (along y; a grid's second traction component, zero on a strip)."""
 
     signorini: float = 0.0
     friction: float = 0.0
     load_normal: float = 0.0
     load_tangential: float = 0.0
+    load_lateral: float = 0.0
 
     @property
     def max(self) -> float:
         """The largest residual; NaN if any is NaN (so that no limit check can pass it)."""
-        a, b, c, d = self.signorini, self.friction, self.load_normal, self.load_tangential
-        total = a + b + c + d  # NaN if any is (the residuals are >= 0: no inf − inf)
-        # (builtin max on four floats: np.max costs 10× as much, and it is read for every solve)
-        return float(max(a, b, c, d)) if total == total else float("nan")
+        a, b, c, d, e = self.signorini, self.friction, self.load_normal, self.load_tangential, self.load_lateral
+        total = a + b + c + d + e  # NaN if any is (the residuals are >= 0: no inf − inf)
+        # (builtin max on five floats: np.max costs 10× as much, and it is read for every solve)
+        return float(max(a, b, c, d, e)) if total == total else float("nan")
 
     def __or__(self, other: "Residuals") -> "Residuals":
         a = np.asarray(dataclasses.astuple(self), dtype=float)
@@ -59,7 +56,8 @@ class StepSolution:
     """The unknowns of one step, how they were obtained, and rollqp's residuals.
 
     Absent parts are ``None`` (``g``/``delta`` for a tangential step, ``t``/``s``/``xi`` for
-    a normal one). The statistics every method may report are typed fields (qpsolvers'
+    a normal one). ``t`` and ``s`` have one row per traction component: shape ``(n,)`` on a strip,
+    ``(2, n)`` (x and y) on a grid, whose lateral creepage is ``eta``. The statistics every method may report are typed fields (qpsolvers'
     ``Solution`` style): ``iterations`` counts the method's own iterations; ``time`` is the wall
     time of the solve in rollqp (``solver_time`` the external solver's own, if any);
     ``backtracks`` the Armijo step reductions (Newton); ``outer``, ``inner_normal`` and
@@ -86,6 +84,8 @@ class StepSolution:
     delta: float | None = None
     xi: float | None = None
     residuals: Residuals = field(default_factory=Residuals)
+    #: The lateral creepage of a grid's step (its second load unknown; ``xi`` the longitudinal one).
+    eta: float | None = None
     method: str = ""
     status: str = "solved"
     iterations: int = 0

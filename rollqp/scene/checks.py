@@ -25,6 +25,14 @@ from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, CO
                      OPERATOR_MODES, STARTS,
                      Body, Contact, Discretization, Load, SolverSettings)
 from ..validate import choice, integer, number, string
+from ..units import UNIT_SYSTEMS
+from ..profiles import parse_profile
+from ..friction import parse_friction
+from ..kinematics import plan
+from ..profiles import check_cover
+from ..advice import fast_path
+from ..matrixfree import check_scene
+from ..matrixfree import memory_estimate
 
 #: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
 MAX_FRICTION = 1e6
@@ -37,7 +45,6 @@ NAME_PATTERN = re.compile(r"^[^\W_][\w .+()-]{0,99}$")
 # =========================================================================== names
 def check_units(key: str, v: Any) -> str:
     """The declared unit system (:data:`rollqp.units.UNIT_SYSTEMS`), or ``""`` for none."""
-    from ..units import UNIT_SYSTEMS
     if isinstance(v, str) and (v == "" or v in UNIT_SYSTEMS):  # a list or table is no name (and not hashable)
         return v
     raise InputError(key, f"must be one of {', '.join(map(repr, UNIT_SYSTEMS))} (the units the scene's numbers "
@@ -73,7 +80,6 @@ def check_body(key: str, b: Any) -> Body:
     wear = b.wear
     if wear is not None:  # Archard's k/H (docs/stresses.md §6)
         wear = number(f"{key}.wear", wear, ">= 0 (k/H in 1/stress) or absent", lambda x: x >= 0)
-    from ..profiles import parse_profile
     profile = parse_profile(b.profile, f"{key}.profile", radius)
     return Body(radius, E, nu, shaft, None if profile.is_circle else profile, wear)
 
@@ -81,7 +87,6 @@ def check_body(key: str, b: Any) -> Body:
 def check_contact(c: Any) -> Contact:
     if not isinstance(c, Contact):
         raise InputError("contact", f"must be a Contact, got {c!r}")
-    from ..friction import parse_friction
     mu = parse_friction(c.friction)  # a law (Coulomb's is also its number)
     model = get_model(c.model).name
     coupling = choice("contact.coupling", c.coupling, COUPLINGS)
@@ -173,8 +178,6 @@ def check_kinematics(scene) -> None:
     """``load.rolled``: every step's ``|Δq|`` within the step limits (``discretization.step``'s range, the
     convective-local CFL bound), and each body's profile against the strip and the run
     (:func:`rollqp.profiles.check_cover`)."""
-    from ..kinematics import plan
-    from ..profiles import check_cover
     pl = plan(scene)
     if pl.rolled and pl.dq.size > 1:
         disc = scene.discretization
@@ -353,8 +356,6 @@ def check_work(scene) -> None:
     matrices, or the matrix-free work space) within the memory this process may use (:func:`memory_limits`) —
     refused before any work, with what they would need. A run's states go to its result file as they come
     (:mod:`rollqp.journal`); a run that keeps them in memory is checked by :func:`check_result_memory`."""
-    from ..advice import fast_path
-    from ..matrixfree import check_scene, memory_estimate
     if fast_path(scene).note is not None:
         return  # it runs matrix-free (rollqp.advice): the scene it runs as is checked when it is built
     n, K = scene.n_nodes, scene.n_steps
@@ -371,7 +372,6 @@ def _result_bytes(n: int, states: int) -> float:
 def check_result_memory(scene, keep_every: int = 1) -> None:
     """A run that keeps its states in memory (:func:`rollqp.run` without ``out``) can hold them: the kept states
     (every ``keep_every``-th) and the operators within the memory this process may use."""
-    from ..matrixfree import check_scene, memory_estimate
     n, K = scene.n_nodes, scene.n_steps
     dense = check_scene(scene, MAX_NODES, scene.method_capabilities) == "dense"
     kept = -(-(K + 1) // keep_every) + 1
@@ -499,7 +499,6 @@ def check_friction(scene) -> None:
     if law.kind == "spatial":  # (rollqp.friction.FrictionLaw: a spatial law checks that it meets the strip)
         q = scene.q_end / scene.a_H
         if scene.load.rolled is not None:  # a load path: the range of q it covers (stops, reversals)
-            from ..kinematics import plan
             qs = plan(scene).q / scene.a_H
             q = (float(qs.min()), float(qs.max()))
         law.check_strip(scene.half_width / scene.a_H, q, scene.load.direction)

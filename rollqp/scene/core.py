@@ -18,13 +18,14 @@ from . import checks
 from .derived import Derived
 from .plain import plain, scene_to_dict, scene_to_toml
 from .schema import Body, Contact, Discretization, Load, SolverSettings
+from ..profiles import parse_profile
 
 __all__ = ["Scene", "SceneBase", "scene_from_dict"]
 
 
 class SceneBase:
     """What every scene is, whatever its dimension: ``dimension`` (a scene file's ``[contact]
-    dimension``: 2, this package's :class:`Scene`; 3, :class:`rollqp.three.scene.Scene3D`), and the
+    dimension``: 2, this package's :class:`Scene`; 3, :class:`rollqp.scene.grid.Scene3D`), and the
     interface the command line and a run read — ``name``, ``source``, ``solver``, ``n_steps``,
     ``to_dict()``, ``to_toml()``, ``replace(**changes)``."""
 
@@ -173,7 +174,6 @@ def _table(d: dict, key: str, cls: type) -> dict:
 
 def _body(d: Any, key: str, source: str) -> Body:
     """``[bodies.X]``, its ``profile`` read with the scene file's folder (:func:`rollqp.profiles.parse_profile`)."""
-    from ..profiles import parse_profile
     t = _table(d, key, Body)
     if "profile" in t:
         folder = os.path.dirname(os.path.abspath(source)) if os.path.isfile(source) else None

@@ -13,7 +13,10 @@ import math
 import numpy as np
 
 from ..errors import InputError
+from ..methods import record
 from .schema import BETA_ZERO
+from ..closedforms import hertz_half_width
+from ..closedforms import hertz_peak_pressure
 
 __all__ = ["Derived"]
 
@@ -39,8 +42,7 @@ class Derived:
     def method_capabilities(self):
         """What the scene's ``solver.method`` declares (:class:`~rollqp.methods.base.Capabilities`, asked of the
         method registry by name): whether it needs the influence matrix, what it solves."""
-        from ..methods import capabilities
-        return capabilities(self.solver.method)
+        return record(self.solver.method).capabilities
 
     @property
     def bem_mesh(self) -> tuple[int, int]:
@@ -82,13 +84,11 @@ class Derived:
     @functools.cached_property
     def a_H(self) -> float:
         """Hertz half-width for the reference load P̄: a_H = sqrt(4 P̄ R / (π E*))."""
-        from ..closedforms import hertz_half_width
         return hertz_half_width(self.load.normal, self.R, self.Estar)
 
     @functools.cached_property
     def p0(self) -> float:
         """Hertz peak pressure for P̄: p0 = 2 P̄ / (π a_H) = a_H E* / (2R)."""
-        from ..closedforms import hertz_peak_pressure
         return hertz_peak_pressure(self.load.normal, self.a_H)
 
     @property

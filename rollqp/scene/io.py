@@ -27,6 +27,16 @@ from .checks import safe_name
 from .core import Scene, SceneBase
 from .core import scene_from_dict as scene_from_dict_2d
 from .plain import part_dict, plain, scene_to_dict, scene_to_toml  # noqa: F401 - re-exported
+from .schema import Body
+from .schema import Contact
+from .schema import Discretization
+from .schema import Load
+from .schema import SolverSettings
+from .grid import Body3D
+from .grid import Contact3D
+from .grid import Discretization3D
+from .grid import Load3D
+from .grid import Solver3D
 
 __all__ = ["load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes", "scene_to_dict", "scene_to_toml"]
 
@@ -38,7 +48,7 @@ def _parse_3d(d: dict, source: str, default_name: str):
     if isinstance(d.get("contact"), dict) and d["contact"].get("kind") == "wheel-rail":
         from ..wheelrail.scene import scene_from_dict as wheel_rail  # a wheelset on its track (docs/wheel-rail.md)
         return wheel_rail(d, source=source, default_name=default_name)
-    from ..three.scene import scene_from_dict as parse  # imported on first use: import rollqp stays light
+    from .grid import scene_from_dict as parse  # imported on first use: import rollqp stays light
     return parse(d, source=source, default_name=default_name)
 
 
@@ -48,7 +58,7 @@ _PARSERS = {2: scene_from_dict_2d, 3: _parse_3d}
 
 def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene"):
     """Build and validate a scene from its nested dict, of the dimension its ``[contact] dimension``
-    names (default 2: :class:`~rollqp.scene.Scene`; 3: :class:`~rollqp.three.scene.Scene3D`).
+    names (default 2: :class:`~rollqp.scene.Scene`; 3: :class:`~rollqp.scene.grid.Scene3D`).
 
     Raises
     ------
@@ -76,11 +86,9 @@ def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene")
 def _table_keys(dimension: int) -> dict:
     """``{table: key names}`` of the scene tables of ``dimension`` (their dataclass fields)."""
     if dimension == 2:
-        from .schema import Body, Contact, Discretization, Load, SolverSettings
         classes = {"bodies": Body, "contact": Contact, "load": Load, "discretization": Discretization,
                    "solver": SolverSettings}
     else:
-        from ..three.scene import Body3D, Contact3D, Discretization3D, Load3D, Solver3D
         classes = {"bodies": Body3D, "contact": Contact3D, "load": Load3D, "discretization": Discretization3D,
                    "solver": Solver3D}
     return {t: {f.name for f in dataclasses.fields(c)} for t, c in classes.items()}

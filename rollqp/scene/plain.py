@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import MissingBackendError
 from ..histories import History
+from ..profiles import Profile
 
 __all__ = ["part_dict", "plain", "scene_to_dict", "scene_to_toml"]
 
@@ -26,7 +27,6 @@ def part_dict(obj) -> dict:
 
 def plain(v: Any) -> Any:
     """Plain (TOML/JSON) form of a value: histories and parts become dicts."""
-    from ..profiles import Profile
     if isinstance(v, Profile):
         return v.to_dict()
     if isinstance(v, History) or dataclasses.is_dataclass(v) and not isinstance(v, type):

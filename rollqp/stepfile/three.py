@@ -125,18 +125,18 @@ class StepFile3D:
         return bool(np.any(self.A_nt) or np.any(self.A_tn))
 
     def scales(self):
-        from ..three.problem import Scales
-        return Scales(self.length, self.stress, self.modulus)
+        from ..problem.grid import Scales
+        return Scales(self.length, self.stress, self.modulus, dimension=3)
 
     def normal(self, t):
         """The normal step (eq. 3D.14) at the traction ``t`` (its gap ``A_nt t``)."""
-        from ..three.problem import NormalStep
+        from ..problem.grid import NormalStep
         off = self.A_nt @ np.asarray(t, dtype=float).ravel() if self.coupled else None
         return NormalStep(DenseOperator(self.A_nn, self.n), self.area, self.h, FN=self.FN, offset=off, scales=self.scales())
 
     def tangential(self, p):
         """The tangential step (eq. 3D.15) at the pressure ``p`` (bound ``μp⁺``, history ``c + A_tn p``)."""
-        from ..three.problem import TangentialStep
+        from ..problem.grid import TangentialStep
         p = np.asarray(p, dtype=float)
         c = self.c + (self.A_tn @ p).reshape(2, -1) if self.coupled else self.c
         return TangentialStep(DenseOperator(self.B, self.n), self.area, self.mu * np.maximum(p, 0.0), self.x, self.y, c,
@@ -144,8 +144,8 @@ class StepFile3D:
                               scales=self.scales())
 
     def forms(self) -> dict:
-        """Both halves as conic programs (:mod:`rollqp.three.forms`) at rollqp's solution of the other half."""
-        from ..three.forms import normal_form, tangential_form
+        """Both halves as conic programs (:mod:`rollqp.problem.conic`) at rollqp's solution of the other half."""
+        from ..problem.conic import normal_form, tangential_form
         return {"normal": normal_form(self.normal(self.ref_t)), "tangential": tangential_form(self.tangential(self.ref_p))}
 
     def form_arrays(self) -> dict:
@@ -271,7 +271,7 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     method = method or REFERENCE_METHOD
     prepared = prepare(scene, method)
     scene, meth, contact = prepared
-    if getattr(contact, "law", None) is not None or np.ndim(getattr(contact, "mu", 0.0)) != 0:
+    if contact.law.kind != "constant":   # a law along the surface: μ differs from element to element
         raise InputError("contact.friction", "a 3D step file holds one constant coefficient of friction; this "
                                              "scene's friction law cannot be exported")
     prev: StepRecord | None = None
@@ -437,13 +437,13 @@ def check_step_3d(step, solution, tol: float = 1e-8) -> Check3D:
     g = npb.gap(p, delta)
     sig = np.abs(np.minimum(p / sc.stress, g / sc.displacement))
     s = tpb.slip(t, xi, eta)
-    from ..three.problem import disc_projection
+    from ..problem.grid import disc_projection
     th, sh, bh = t / sc.stress, s / sc.slip, tpb.bound / sc.stress
     r = th - disc_projection(th - sh, bh)
     fric = np.hypot(r[0], r[1])
     nres, tres = npb.residuals(p, delta, g), tpb.residuals(t, xi, eta, s)
     residuals = {"signorini": float(sig.max()), "friction": float(fric.max()), "load_normal": nres.load_normal,
-                 "load_x": tres.load_x, "load_y": tres.load_y}
+                 "load_x": tres.load_tangential, "load_y": tres.load_lateral}
     failed, where = {}, {}
     for cond, per in (("signorini", sig), ("friction", fric)):
         idx = np.flatnonzero(per > tol)
@@ -463,7 +463,7 @@ def check_step_3d(step, solution, tol: float = 1e-8) -> Check3D:
 def clarabel_json_3d(arrays: dict, half: str) -> dict:
     """One half's program (``q_frozen``) in the JSON that ``clarabel.load_from_file`` reads: the load rows
     (zero cone), then ``x ≥ 0`` (normal, nonnegative cone) or one ``(b̂_i, t̂_x,i, t̂_y,i) ∈ Q³`` per element
-    (tangential), the rows of :mod:`rollqp.three.socp`; rollqp's tolerances for 1e-10."""
+    (tangential), the rows of :mod:`rollqp.methods.socp`; rollqp's tolerances for 1e-10."""
     import scipy.sparse as sp
     g = lambda k: arrays[f"{half}_socp_{k}"]  # noqa: E731
     H, q, a, b = g("H"), g("q_frozen"), g("a"), g("b")
@@ -488,7 +488,7 @@ def clarabel_json_3d(arrays: dict, half: str) -> dict:
         M.sort_indices()
         return {"m": int(M.shape[0]), "n": int(M.shape[1]), "colptr": M.indptr.tolist(), "rowval": M.indices.tolist(),
                 "nzval": M.data.tolist()}
-    gap = 1e-13      # as rollqp's Clarabel (rollqp.three.socp): at 1e-14 it stops "AlmostSolved"
+    gap = 1e-13      # as rollqp's Clarabel (rollqp.methods.socp): at 1e-14 it stops "AlmostSolved"
     settings = {"max_iter": 200, "tol_gap_abs": gap, "tol_gap_rel": gap, "tol_feas": gap, "tol_ktratio": gap,
                 "presolve_enable": False, "verbose": False}
     return {"P": csc(sp.triu(sp.csc_matrix(H))), "q": q.tolist(), "A": csc(A), "b": rhs.tolist(), "cones": cones,

@@ -1,20 +1,16 @@
-r"""Three dimensions: Kalker's rolling contact problem, every step posed as a convex program
-(QP, SOCP) on external solvers and as nonsmooth equations for rollqp's generalized Newton method
-(docs/theory3d.md, docs/validation3d.md).
+r"""Three dimensions: what of Kalker's rolling contact problem is not yet written once for both
+dimensions (docs/theory3d.md, docs/validation3d.md).
 
-The package is layered like the 2D one; each layer imports only from the ones above it:
-
-* base: :mod:`.grid` (the uniform grid of the potential contact area);
-* physics: :mod:`.materials` (combined constants ``G, ν, K``), :mod:`.influence` (Boussinesq–Cerruti
-  coefficients of rectangles), :mod:`.geometry` (radii, curvatures, the undeformed distance),
-  :mod:`.hertz` and :mod:`.closedforms` (Hertz, Cattaneo–Mindlin, Kalker's creep coefficients);
-* operators: :mod:`.operator` (block-Toeplitz products by FFT, dense blocks), :mod:`.operators`
-  (the influence operators of one contact, shifted and steady ones);
-* problems: :mod:`.problem` (step problems, solutions, rollqp's residuals), :mod:`.forms` (their
-  QP and SOCP forms), :mod:`.contact` (one contact, built once; it makes the step problems);
-* methods: :mod:`.gnm` (generalized Newton), :mod:`.socp` (Clarabel, OSQP, cvxpy);
-* problems in time: :mod:`.march` (static shift, steady rolling, transient, N–T alternation);
-* post-processing: :mod:`.post` (errors against Hertz and Cattaneo, creep coefficients).
+The grid, its step problems, operators and methods live beside their 2D siblings:
+:mod:`rollqp.discretization.grid` (the grid), :mod:`rollqp.materials` (combined constants),
+:mod:`rollqp.influence.cerruti` and :mod:`rollqp.influence.grid` (Boussinesq–Cerruti on rectangles,
+block-Toeplitz operators of :mod:`rollqp.influence.blocktoeplitz`), :mod:`rollqp.profiles.surface`
+(radii and curvatures), :mod:`rollqp.problem.grid` and :mod:`rollqp.problem.conic` (step problems and
+their conic forms), :mod:`rollqp.operators.grid` (one contact, built once), :mod:`rollqp.methods.newton.disc`,
+:mod:`rollqp.methods.socp`, :mod:`rollqp.methods.refine`, :mod:`rollqp.methods.chord` (the methods) and
+:mod:`rollqp.scene.grid` (the scene). Here remain the closed forms (:mod:`.hertz`, :mod:`.closedforms`),
+the march and run (:mod:`.march`, :mod:`.run`, :mod:`.result`, :mod:`.fields`), the summary, advice,
+cross-check and post-processing (:mod:`.report`, :mod:`.advice`, :mod:`.crosscheck`, :mod:`.post`).
 
 Nothing here is imported by ``import rollqp``.
 """

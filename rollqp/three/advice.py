@@ -20,7 +20,7 @@ elements, and ``β`` the interior point's factorizations (about 20 of order ``2m
 A rolling start by a method that cannot solve the steady problem marches to it (:data:`MARCH_LENGTHS`
 contact lengths of ``dx`` steps). :func:`notes` prints the estimate when it exceeds :data:`NOTE_SECONDS`;
 :func:`refusal` refuses before any work a run whose estimate exceeds :data:`REFUSE_SECONDS`, or whose
-dense Hessian would not fit :data:`~rollqp.three.operator.DENSE_MAX`, naming what runs instead.
+dense Hessian would not fit :data:`~rollqp.influence.blocktoeplitz.DENSE_MAX`, naming what runs instead.
 """
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ import numpy as np
 
 from ..advice import duration
 from ..errors import InputError
-from .operator import DENSE_MAX
+from ..influence.blocktoeplitz import DENSE_MAX
 
 __all__ = ["notes", "refusal", "conic_step_seconds", "conic_run", "yardstick", "NOTE_SECONDS", "REFUSE_SECONDS",
            "QUADRATIC", "CUBIC", "MARCH_LENGTHS"]

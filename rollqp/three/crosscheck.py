@@ -6,7 +6,7 @@ A run keeps the records of the steps ``0``, ``K/2`` and ``K`` (:class:`SpotObser
 the methods of :data:`rollqp.methods.CROSS_CHECK_METHODS_3D` other than the one that ran: Newton's
 run is checked by Clarabel's QP and SOCP, a conic run by Newton. Differences are from the run's own
 solution, in ``p0`` (pressure) and ``μp0`` (traction); the conic solver's raw answer (before its
-active-set refinement, :mod:`rollqp.three.refine`) is compared too, and every residual is rollqp's.
+active-set refinement, :mod:`rollqp.methods.refine`) is compared too, and every residual is rollqp's.
 
 **A steady state** (state 0 of a rolling start) is the fixed point of the march: one rolling step of
 ``Δq = dx`` from it, at its loads, must return it (docs/theory3d.md §6). That one step is a

@@ -13,7 +13,7 @@ and the same history objects (:mod:`rollqp.histories`):
   ``Δq_k = q_k − q_{k−1}`` is positive rolls by ``Δq_k`` in ``load.direction``; a negative one is a reversal
   (the material flows the other way, eq. 3D.16 with ``−d``); a zero one is a stop, a static shift step under
   the loads of ``τ_k`` (eq. 3D.16 at ``Δq = c``, the shift kind of :meth:`Contact.tangential_step
-  <rollqp.three.contact.Contact.tangential_step>`). The Δq may vary from step to step.
+  <rollqp.operators.grid.Contact.tangential_step>`). The Δq may vary from step to step.
 
 The loads (``tangential``, ``lateral``, the creepages and ``normal_history``) are histories of τ, so "roll,
 stop, cycle Fx at rest, roll back" is one scene. ``load.tangential`` stays ``Fx/(μ·FN_ref)`` with
@@ -33,7 +33,7 @@ from ..errors import SolverError
 from ..kinematics import plan
 from .loads import has_load_path, normal_force, start_force
 from .march import StepRecord, _record, _states, _warm_of, coupled_step, normal, transient
-from .problem import SEPARATION
+from ..problem.grid import SEPARATION
 
 __all__ = ["out_of_contact", "rolling_steps", "posed_force", "SHIFTED_KEPT"]
 
@@ -59,7 +59,7 @@ def out_of_contact(contact, k: int, phase: str, q: float, loads) -> StepRecord:
 
 class _Shifted:
     """The shifted operators of the distinct step sizes met (:meth:`ContactOperators.shifted
-    <rollqp.three.operators.ContactOperators.shifted>` keeps one per offset): a Δq within 1e-12 of one met
+    <rollqp.influence.grid.ContactOperators.shifted>` keeps one per offset): a Δq within 1e-12 of one met
     before (a table's Δq differ by round-off) reuses it, and at most :data:`SHIFTED_KEPT` are kept."""
 
     def __init__(self, contact):

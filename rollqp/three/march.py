@@ -24,8 +24,8 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from .advice import MARCH_LENGTHS
-from .contact import Loads
-from .problem import SEPARATION, SLIP, STICK, disc_projection, element_states
+from ..operators.grid import Loads
+from ..problem.grid import SEPARATION, SLIP, STICK, disc_projection, element_states
 
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
@@ -74,7 +74,7 @@ class StepRecord:
 
 def normal(contact, method, FN: float, t=None, warm=None):
     """The normal step (eq. 3D.14) solved by ``method``, from ``warm`` or the Hertz pressure
-    (:meth:`~rollqp.three.contact.Contact.hertz_start`)."""
+    (:meth:`~rollqp.operators.grid.Contact.hertz_start`)."""
     return method.solve(contact.normal_step(FN, t), warm if warm is not None else contact.hertz_start(FN))
 
 
@@ -116,13 +116,13 @@ def _frictionless(contact, kind, nsol, loads, previous, dq, direction):
     free = Loads(xi=0.0 if loads.xi is None else loads.xi, eta=0.0 if loads.eta is None else loads.eta,
                  phi=loads.phi)
     prob = contact.tangential_step(kind, nsol.p, free, previous, dq, direction)
-    return prob.solution(np.zeros((2, contact.grid.n)), method="frictionless", info={"status": "frictionless"})
+    return prob.solution(np.zeros((2, contact.grid.n)), method="frictionless", extras={"status": "frictionless"})
 
 
 def _warm_of(rec):
     """``(normal, tangential)``: the warm start of the step after a resumed state ``rec``, the numbers the
     step that computed it hands to the next (pressure and approach; tractions and creepages)."""
-    from .problem import Residuals, StepSolution
+    from ..problem.grid import Residuals, StepSolution
     return (StepSolution(residuals=Residuals(), p=rec.p, g=rec.g, delta=rec.delta),
             StepSolution(residuals=Residuals(), t=rec.t, s=rec.s, xi=rec.xi, eta=rec.eta))
 
@@ -136,14 +136,14 @@ def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_stat
                       info={"sweeps": sweeps, "normal": nsol.info, "tangential": tsol.info})
 
 
-def _states(contact, p, t, s):
-    """0 separation, 1 stick, 2 slip (:func:`~rollqp.three.problem.element_states`). At ``μ = 0`` (bound
+def _states(contact, p, t, s, q=0.0):
+    """0 separation, 1 stick, 2 slip (:func:`~rollqp.problem.grid.element_states`). At ``μ = 0`` (bound
     zero) as in 2D (:func:`rollqp.problem.solution.classify`): an element in contact (``p > 0``) slips
     where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it."""
     if contact.mu == 0:
         moving = np.hypot(*(np.asarray(s, dtype=float).reshape(2, -1) / contact.scales.slip)) > 1e-7
         return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
-    return element_states(np.asarray(t), np.asarray(s), contact.mu * np.maximum(p, 0.0), contact.scales)
+    return element_states(np.asarray(t), np.asarray(s), contact.bound(p, q), contact.scales)
 
 
 def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, phi: float = 0.0, steps: int = 1,
@@ -181,7 +181,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
     when a step changes the tractions by less than the method's tolerance (``info["marched"]`` steps).
 
     ``accelerate``: ``"chord"`` (similar bodies; default) Newton's method on the march map
-    (:mod:`rollqp.three.chord`, eq. 3D.24), every iterate evaluated by the method; ``"anderson"`` the
+    (:mod:`rollqp.methods.chord`, eq. 3D.24), every iterate evaluated by the method; ``"anderson"`` the
     march accelerated by Anderson's method with ``memory`` differences (default :data:`ANDERSON_MEMORY`;
     0: the plain march; dissimilar bodies always). ``pressure``: the normal solution to use (similar
     bodies; solved here if ``None``). ``tick(j, expected)``: called after each step of the march (``expected``: the
@@ -208,9 +208,9 @@ def _expected_march(contact) -> int:
 
 
 def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure=None, tick=None):
-    """The fixed point of the march by Newton's method on the march map (:func:`rollqp.three.chord.chord_step`),
+    """The fixed point of the march by Newton's method on the march map (:func:`rollqp.methods.chord.chord_step`),
     a march step wherever a Newton iterate does not reduce the change by :data:`NEWTON_DECREASE`."""
-    from .chord import chord_step
+    from ..methods.chord import chord_step
     nsol = pressure or normal(contact, method, FN)
     dx, n = contact.grid.dx, contact.grid.n
     shifted = contact.ops.shifted("tt", -direction * dx)
@@ -218,7 +218,7 @@ def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure
     base = np.zeros((2, n)) if start is None else np.asarray(start.t, dtype=float)
     x, best, warm = base, None, None       # best: (change, x, G(x)) of the last accepted base point
     limit = int(np.ceil(MAX_MARCH_DISTANCE * contact.scales.length / dx))
-    bound = contact.mu * np.maximum(nsol.p, 0.0)
+    bound = contact.bound(nsol.p)
     expected = _expected_march(contact)
     for k in range(1, limit + 1):
         if tick is not None and k > 1:
@@ -330,6 +330,6 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                                       warm=warm, pressure=fixed)
         except SolverError as exc:
             raise exc.with_step(k) from None
-        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s))
+        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q))
         yield rec
         prev, warm = rec, (ns, ts)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .contact import Loads
+from ..operators.grid import Loads
 from .march import normal, steady
 
 __all__ = ["semi_axes", "hertz_errors", "hertz_field_errors", "creep_matrix", "cattaneo_errors"]

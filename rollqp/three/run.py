@@ -32,7 +32,7 @@ from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
-from .contact import Contact
+from ..operators.grid import Contact
 from .loadpath import out_of_contact, rolling_steps
 from .loads import start_force
 from .patch import moving_profile
@@ -55,8 +55,8 @@ def prepare(scene, method=None):
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
     meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
-    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.mu,
-                      profile=None if scene.shape.hertzian else scene.shape.at(0.0))
+    contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
+                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
         contact.move = moving_profile(contact, scene.shape, scene.load.direction)
     meth.setup(contact)
@@ -308,7 +308,7 @@ def _versions() -> tuple:
 
 def _raw_distance(meta: dict, rec: StepRecord, contact) -> bool:
     """A conic method's raw answers (the solver's own, before the active-set refinement,
-    :mod:`rollqp.three.refine`) against the refined ones the run keeps: the largest distance over the
+    :mod:`rollqp.methods.refine`) against the refined ones the run keeps: the largest distance over the
     run in ``meta["raw_distance"]`` (``dp`` in p0, ``dt`` in μp0, ``steps`` compared); nothing for a
     method without a raw answer (Newton). True if it was updated."""
     sc = contact.scales

@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from ..errors import InputError
-from ..three.contact import Loads
+from ..operators.grid import Loads
 from ..three.crosscheck import AGREEMENT
 from ..three.march import coupled_step
 from .solve import solve_wheel

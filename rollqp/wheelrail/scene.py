@@ -150,7 +150,7 @@ class WheelRailScene(SceneBase):
         return tuple(out)
 
     def materials(self):
-        from ..three.materials import Materials
+        from ..materials import Materials
         w = self.data["wheelset"]
         E = {b: w.get(f"{b}_E") if w.get(f"{b}_E") is not None else w.get("E") for b in ("wheel", "rail")}
         nu = {b: w.get(f"{b}_nu") if w.get(f"{b}_nu") is not None else w.get("nu") for b in ("wheel", "rail")}

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..three.grid import Grid, MAX_ELEMENTS
+from ..discretization.grid import Grid, MAX_ELEMENTS
 
 __all__ = ["Patch", "search", "touch", "MARGIN"]
 

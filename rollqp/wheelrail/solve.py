@@ -31,9 +31,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..three.contact import Contact, Loads
+from ..operators.grid import Contact, Loads
 from ..three.march import steady
-from ..three.problem import NormalStep
+from ..problem.grid import NormalStep
 from .search import search
 
 __all__ = ["PatchResult", "WheelResult", "solve_wheel", "LOAD_TOLERANCE", "Z_TOLERANCE"]
@@ -49,7 +49,7 @@ COARSE = 2.0
 
 
 class _Gap:
-    """``h(x, y)`` of a patch on its own grid (the seam :class:`~rollqp.three.contact.Contact` takes)."""
+    """``h(x, y)`` of a patch on its own grid (the seam :class:`~rollqp.operators.grid.Contact` takes)."""
 
     def __init__(self, grid, gap):
         self.grid, self.gap = grid, np.asarray(gap, dtype=float)

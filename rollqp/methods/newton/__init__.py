@@ -132,7 +132,7 @@ class NewtonMethod:
     #: F⁻¹ sym(F A)); steps whose friction bound depends on the slip too (:mod:`.slip`), but coupled
     #: steps with a constant coefficient only.
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "coupled", "steady"}), slip_dependent=True,
-                                coupled_friction=frozenset({"constant"}))
+                                coupled_friction=frozenset({"constant"}), carries_state=True)
     #: Coupled steps: reuse the LU of the coupled Jacobian across iterations and steps
     #: (:class:`~.linear.CoupledFactors`); ``False`` solves a new reduced system every iteration
     #: (:func:`~.linear.direct_coupled_direction`, the reference the tests compare with).
@@ -172,6 +172,10 @@ class NewtonMethod:
         check_options(cls.name, options, ("rho", "sigma"))
         return cls(tolerance=settings.tolerance, max_iterations=settings.max_iterations,
                    r=settings.augmentation, **options)
+
+    def carrier(self):
+        """Itself: it keeps the reduced systems' factors across steps (``capabilities.carries_state``)."""
+        return self
 
     def setup(self, operators) -> None:
         """A new scene: drop the scaled systems and factorizations of the previous one."""

@@ -19,6 +19,7 @@ from . import linear
 from .common import ALPHA_MIN, not_converged
 from .linear import coupled_vectors
 from .ncp import coupled_cases, coupled_phi
+from ..alternation import sweep
 
 
 __all__ = ["solve_coupled"]
@@ -41,7 +42,6 @@ class _Coupled:
 
     def _start(self, warm):
         """Step 1: the previous step's state, else one N–T sweep of the halves (normal with ``t = 0``)."""
-        from ..alternation import sweep
         pb, S, n, sc = self.pb, self.S, self.n, self.pb.scales
         start = "warm"
         if (warm is not None and warm.p is not None and warm.t is not None and np.shape(warm.p) == (n,)
@@ -143,7 +143,6 @@ class _Coupled:
 
     def sweep(self):
         """One N–T sweep from ``z`` (the fallback when Armijo fails); returns the new ``z``."""
-        from ..alternation import sweep
         pb, S, n, sc, z = self.pb, self.S, self.n, self.pb.scales, self.z
         warm = StepSolution(p=z[:n] * sc.stress, t=z[n:2 * n] * sc.stress,
                             delta=z[S.iP] * sc.displacement if S.iP is not None else pb.delta,

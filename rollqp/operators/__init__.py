@@ -18,12 +18,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import matrixfree
-from .errors import InputError
-from .influence import Memo, get_model
-from .influence.operator import Operator, asymmetry
-from .problem import CoupledStep, FrictionBound, NormalStep, Scales, TangentialStep, _check_sliding_limit
-from .strip import RowSparse, Strip
+from .. import matrixfree
+from ..errors import InputError
+from ..influence import Memo, get_model
+from ..influence.operator import Operator, asymmetry
+from ..problem import CoupledStep, FrictionBound, NormalStep, Scales, TangentialStep, _check_sliding_limit
+from ..strip import RowSparse, Strip
+from ..profiles import Profile
+from ..friction import largest
+from ..friction.bound import step_coefficient
 
 __all__ = ["SceneOperators"]
 
@@ -131,7 +134,6 @@ class SceneOperators:
         sc = self.scene
         if sc.A.profile is None and sc.B.profile is None:
             return self.h
-        from .profiles import Profile
         x, shift = self.strip.x, sc.load.direction * float(q)
         h = 0.0
         for body in (sc.A, sc.B):
@@ -185,13 +187,11 @@ class SceneOperators:
     @property
     def frictionless(self) -> bool:
         """``μ = 0`` everywhere, whatever the slip (the law's largest value is 0)."""
-        from .friction import largest
         return largest(self.friction) == 0.0
 
     def step_friction(self, q=0.0, dq=None, previous=None, steady=False):
         """``(mu, law)`` of a step at the rolled distance ``q`` (:func:`rollqp.friction.bound.step_coefficient`):
         the number ``μ`` and ``None`` for Coulomb (the constant bound's path)."""
-        from .friction.bound import step_coefficient
         sc, a = self.scene, self.scales.length
         return step_coefficient(self.friction, self.strip.x / a, q / a, sc.load.direction,
                                 dq_hat=None if dq is None else dq / a, previous=previous, steady=steady)

@@ -2,7 +2,7 @@ r"""The influence operators of one contact, built once per grid and materials (d
 
 :class:`ContactOperators` holds ``A_nn`` (1 × 1), ``A_tt`` (2 × 2), and for dissimilar bodies the
 couplings ``A_nt`` (1 × 2: gap due to shear) and ``A_tn`` (2 × 1: tangential displacement due
-to pressure), as :class:`~rollqp.three.operator.BlockToeplitz` operators, and derives on first
+to pressure), as :class:`~rollqp.influence.blocktoeplitz.BlockToeplitz` operators, and derives on first
 use (kept) the operators of a rolling step:
 
 * the displacements at the previous position of the particles, ``x − d·Δq`` (eq. 3D.16): the
@@ -19,8 +19,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .influence import kernels
-from .operator import BlockToeplitz
+from .cerruti import kernels
+from .blocktoeplitz import BlockToeplitz
 
 __all__ = ["ContactOperators"]
 
@@ -42,13 +42,13 @@ class ContactOperators:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
-    materials : rollqp.three.materials.Materials
+    grid : rollqp.discretization.grid.Grid
+    materials : rollqp.materials.Materials
 
     Examples
     --------
-    >>> from rollqp.three.grid import Grid
-    >>> from rollqp.three.materials import Materials
+    >>> from rollqp.discretization.grid import Grid
+    >>> from rollqp.materials import Materials
     >>> ops = ContactOperators(Grid.centred(8, 8, 1.0, 1.0), Materials.from_young(210e3, 0.3, 210e3, 0.3))
     >>> ops.Ann.shape, ops.Att.shape, ops.coupled
     ((64, 64), (128, 128), False)

@@ -3,7 +3,7 @@ r"""Block-Toeplitz influence operators on the grid: products by 2D FFT, dense bl
 
 On the uniform grid the influence coefficient between elements ``I`` and ``J`` depends only on
 ``(i_I − i_J, j_I − j_J)``, so a product ``u = A t`` is a 2D discrete convolution of the traction
-field with the kernel array of :func:`rollqp.three.influence.kernels`:
+field with the kernel array of :func:`rollqp.influence.cerruti.kernels`:
 
 .. math::
     u_{j,i} = \sum_{j',i'} K[j − j' + n_y − 1,\ i − i' + n_x − 1]\; t_{j',i'}          \qquad (3D.13)
@@ -37,7 +37,7 @@ class BlockToeplitz:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
+    grid : rollqp.discretization.grid.Grid
     blocks : list of list of ndarray or None
         ``blocks[a][b]``: the kernel (shape ``(2ny − 1, 2nx − 1)``) from input component ``b`` to
         output component ``a``; ``None`` for a zero block.
@@ -46,9 +46,9 @@ class BlockToeplitz:
 
     Examples
     --------
-    >>> from rollqp.three.grid import Grid
-    >>> from rollqp.three.materials import Materials
-    >>> from rollqp.three.influence import kernels
+    >>> from rollqp.discretization.grid import Grid
+    >>> from rollqp.materials import Materials
+    >>> from rollqp.influence.cerruti import kernels
     >>> g = Grid.centred(6, 5, 1.0, 1.0)
     >>> k = kernels(g, Materials.from_shear(1.0, 0.3, 1.0, 0.3))
     >>> A = BlockToeplitz(g, [[k["nn"]]], "Ann")

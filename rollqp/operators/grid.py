@@ -1,9 +1,9 @@
 r"""One 3D contact, built once: geometry, materials, grid, operators, scales (docs/theory3d.md §2–4).
 
 :class:`Contact` is what every step of a 3D problem shares — the analog of the 2D project's
-scene operators: the grid and its :class:`~rollqp.three.operators.ContactOperators`, the
+scene operators: the grid and its :class:`~rollqp.influence.grid.ContactOperators`, the
 undeformed distance on the grid, the Hertz ellipse of the nominal load and the scales of the
-residuals — and it makes the step problems of :mod:`rollqp.three.problem`:
+residuals — and it makes the step problems of :mod:`rollqp.problem.grid`:
 
 * :meth:`Contact.normal_step` (eq. 3D.14), with the shear's gap ``A_nt t`` for dissimilar bodies;
 * :meth:`Contact.tangential_step` of a *shift* (eq. 3D.16 with no offset, ``Δq`` the length unit
@@ -18,11 +18,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .geometry import QuadraticProfile
-from .grid import Grid
-from .hertz import hertz
-from .operators import ContactOperators
-from .problem import NormalStep, Residuals, Scales, StepSolution, TangentialStep
+from ..friction import as_law
+from ..profiles.surface import QuadraticProfile
+from ..discretization.grid import Grid
+from ..three.hertz import hertz
+from ..influence import DEFAULT_MODEL, get_model
+from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
 __all__ = ["Contact", "Loads"]
 
@@ -30,13 +31,15 @@ __all__ = ["Contact", "Loads"]
 @dataclass(frozen=True)
 class Loads:
     """The tangential loading of a step: ``Fx`` or ``xi``, ``Fy`` or ``eta`` (exactly one of each
-    pair), and the spin ``phi`` (1/length). Forces on body A, creepages of A relative to B."""
+    pair), and the spin ``phi`` (1/length). Forces on body A, creepages of A relative to B; ``q`` the
+    rolled distance of the step (length units: where a friction law along the surface is read)."""
 
     Fx: float | None = None
     xi: float | None = None
     Fy: float | None = None
     eta: float | None = None
     phi: float = 0.0
+    q: float = 0.0
 
 
 #: Below this coefficient of friction the tangential steps measure tractions in (mu / MU_REFERENCE) p0 instead of
@@ -51,46 +54,53 @@ class Contact:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
-    materials : rollqp.three.materials.Materials
+    grid : rollqp.discretization.grid.Grid
+    materials : rollqp.materials.Materials
     curvatures : (float, float)
         ``(A, B)`` of eq. 3D.3 (for the Hertz ellipse and the default profile).
     FN : float
         The nominal normal force: the Hertz ellipse and the scales.
-    mu : float
-        Coulomb's coefficient of friction (``>= 0``).
+    mu : float or FrictionLaw
+        Coulomb's coefficient of friction (``>= 0``), or a friction law along the surface
+        (:class:`rollqp.friction.FrictionLaw` of kind ``"constant"`` or ``"spatial"``: ``μ`` at the grid's
+        points, read at each step's rolled distance, :meth:`coefficient`). ``mu`` is then its reference.
     profile : callable, optional
         ``h(x, y)``, the undeformed distance; default ``A x² + B y²`` (the seam for
         non-Hertzian profiles).
+    model : str
+        The influence model (``contact.model``) of 3D scenes that builds the operators from the grid and
+        the materials (:func:`rollqp.influence.get_model`; default the Boussinesq–Cerruti half-space).
 
     Examples
     --------
-    >>> from rollqp.three.materials import Materials
+    >>> from rollqp.materials import Materials
     >>> c = Contact.hertzian(Materials.from_young(210e3, 0.25, 210e3, 0.25), (1 / 60, 1 / 60), 1000.0, 0.3,
     ...                      elements=(20, 20))
     >>> round(c.ellipse.a, 4), c.grid.nx, c.ops.coupled
     (0.5857, 20, False)
     """
 
-    def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None):
-        try:
-            coefficient = float(mu) if not isinstance(mu, (bool, str)) else math.nan
-        except (TypeError, ValueError):
-            coefficient = math.nan
-        if not (math.isfinite(coefficient) and coefficient >= 0):   # Coulomb's constant μ only (no laws in 3D yet)
-            raise InputError("contact.friction", f"must be a finite number >= 0, got {mu!r}")
-        self.grid, self.materials, self.mu = grid, materials, coefficient
+    def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None,
+                 model: str = DEFAULT_MODEL):
+        # a scene's law as it is, a number checked once here (as_law)
+        law = as_law(mu)
+        if law.kind not in ("constant", "spatial"):
+            raise InputError("contact.friction", f"a 3D contact takes a law of kind 'constant' or 'spatial' (μ at the "
+                                                 f"grid's points); law {law.law!r} is of kind {law.kind!r}")
+        self.law = law
+        self.grid, self.materials, self.mu = grid, materials, law.mu if law.kind == "constant" else float(law.reference)
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
         self.profile = profile if profile is not None else QuadraticProfile(*curvatures)
-        self.scales = Scales.hertz(self.ellipse)
+        self.scales = Scales.ellipse(self.ellipse)
         # the tangential steps' units: tractions in p0, and in (mu / MU_REFERENCE) p0 where friction is smaller, so
         # that a method's tolerance stays a fraction of mu p0 (at mu = 1e-6 a tolerance in p0 would allow tractions
         # beyond mu p by 1e-4 mu p0)
-        f = min(1.0, coefficient / MU_REFERENCE) if coefficient > 0 else 1.0
+        f = min(1.0, self.mu / MU_REFERENCE) if self.mu > 0 else 1.0
         self.tangential_scales = self.scales if f == 1.0 else Scales(self.scales.length, self.scales.stress * f,
-                                                                     self.scales.modulus)
-        self.ops = ContactOperators(grid, materials)
+                                                                     self.scales.modulus, dimension=3)
+        self.ops = get_model(model, "contact.model", dimension=3).build(grid, materials)
         self.x, self.y = grid.centres()
+        self.record = grid.record()   # the points, weights and components a law or a field reads
         h = np.asarray(self.profile(self.x, self.y), dtype=float)
         if h.shape != (grid.n,) or not np.all(np.isfinite(h)):
             raise InputError("profile", f"h(x, y) must give finite values of shape ({grid.n},)")
@@ -143,9 +153,26 @@ class Contact:
                     c = c - (ops.Atn if off == 0 else ops.shifted("tn", off)) @ pp
         else:
             raise InputError("kind", f"must be 'shift', 'rolling' or 'steady', got {kind!r}")
-        bound = self.mu * np.maximum(p, 0.0)
+        bound = self.bound(p, loads.q, direction)
         return TangentialStep(B, g.area, bound, self.x, self.y, c.reshape(2, g.n), dq, Fx=loads.Fx, xi=loads.xi,
                               Fy=loads.Fy, eta=loads.eta, phi=loads.phi, scales=self.tangential_scales)
+
+    def coefficient(self, q: float = 0.0, direction: int = -1):
+        """``μ`` at the grid's points at the rolled distance ``q``: the number ``mu`` for a constant law, else
+        the law's ``coefficient`` at the element centres ``(x, y)/a`` (``a`` the Hertz semi-axis along x,
+        the unit of the scene's distances) and ``q/a`` (:class:`rollqp.friction.FrictionLaw`)."""
+        if self.law.kind == "constant":
+            return self.mu
+        a = self.ellipse.a
+        mu = np.asarray(self.law.coefficient(self.record.points / a, float(q) / a, direction), dtype=float)
+        if mu.shape != (self.grid.n,) or not np.all(np.isfinite(mu) & (mu >= 0)):
+            raise InputError("contact.friction", f"law {self.law.law!r} must give a finite μ >= 0 at each of the "
+                                                 f"{self.grid.n} elements, got shape {mu.shape}")
+        return mu
+
+    def bound(self, p, q: float = 0.0, direction: int = -1) -> np.ndarray:
+        """The traction bound ``μ p⁺`` of the pressure ``p`` at the rolled distance ``q`` (eq. 3D.18)."""
+        return self.coefficient(q, direction) * np.maximum(p, 0.0)
 
     def hertz_start(self, FN: float):
         """The Hertz pressure and approach of ``FN`` as a start for an iterative normal solve: the

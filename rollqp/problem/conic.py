@@ -86,7 +86,7 @@ def _split(FA):
 
 
 def normal_form(problem, elements=None) -> ConicForm:
-    """The QP of eq. 3D.22 for a :class:`~rollqp.three.problem.NormalStep` (dense ``Â``), over
+    """The QP of eq. 3D.22 for a :class:`~rollqp.problem.grid.NormalStep` (dense ``Â``), over
     ``elements`` (default: every element of the grid; the others are held at ``p = 0``)."""
     sc = problem.scales
     V = np.arange(problem.n) if elements is None else np.asarray(elements)
@@ -108,7 +108,7 @@ def normal_form(problem, elements=None) -> ConicForm:
 
 
 def tangential_form(problem, elements=None) -> ConicForm:
-    """The SOCP of eq. 3D.20 for a :class:`~rollqp.three.problem.TangentialStep` (dense ``Ŝ``)
+    """The SOCP of eq. 3D.20 for a :class:`~rollqp.problem.grid.TangentialStep` (dense ``Ŝ``)
     on ``elements`` (default: those with a positive bound)."""
     sc = problem.scales
     V = np.flatnonzero(problem.bound > 0) if elements is None else np.asarray(elements)

@@ -35,6 +35,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..friction.projection import project
+from .scales import Scales
+from .solution import Residuals, StepSolution
 from ..validate import positive as _positive, scalar
 
 __all__ = ["Scales", "Residuals", "StepSolution", "NormalStep", "TangentialStep", "disc_projection",
@@ -44,91 +47,11 @@ __all__ = ["Scales", "Residuals", "StepSolution", "NormalStep", "TangentialStep"
 SEPARATION, STICK, SLIP = 0, 1, 2
 
 
-@dataclass(frozen=True)
-class Scales:
-    """Units of the nondimensional form: ``length`` (``c = √(ab)``), ``stress`` (``p0``),
-    ``modulus`` (``E*``); all 1 leaves a problem in its own units."""
-
-    length: float = 1.0
-    stress: float = 1.0
-    modulus: float = 1.0
-
-    def __post_init__(self):
-        for name in ("length", "stress", "modulus"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise InputError(f"scales.{name}", f"must be a finite number > 0, got {v!r}")
-
-    @classmethod
-    def hertz(cls, ellipse) -> "Scales":
-        """From a :class:`~rollqp.three.hertz.HertzEllipse`: ``c = √(ab)``, ``p0``, ``E*``."""
-        return cls(length=ellipse.c, stress=ellipse.p0, modulus=ellipse.Estar)
-
-    @property
-    def displacement(self) -> float:
-        """``u0 = c p0/E*``: gaps, displacements, approach."""
-        return self.length * self.stress / self.modulus
-
-    @property
-    def slip(self) -> float:
-        """``p0/E*``: slips and creepages (spin: ``p0/(E* c)``)."""
-        return self.stress / self.modulus
-
-    @property
-    def force(self) -> float:
-        """``p0 c²``: forces."""
-        return self.stress * self.length ** 2
-
-
-@dataclass(frozen=True)
-class Residuals:
-    """rollqp's nondimensional residuals of a step solution (max-norms, eq. 3D.29)."""
-
-    signorini: float = 0.0
-    friction: float = 0.0
-    load_normal: float = 0.0
-    load_x: float = 0.0
-    load_y: float = 0.0
-
-    @property
-    def max(self) -> float:
-        """The largest, NaN if any is NaN."""
-        v = (self.signorini, self.friction, self.load_normal, self.load_x, self.load_y)
-        return float("nan") if any(math.isnan(x) for x in v) else max(v)
-
-
-@dataclass(frozen=True)
-class StepSolution:
-    """A solution of a normal (``p, g, delta``) or tangential (``t, s, xi, eta``) step.
-
-    ``t`` and ``s`` have shape ``(2, n)`` (x and y components), ``p`` and ``g`` ``(n,)``;
-    ``residuals`` are rollqp's (:class:`Residuals`), ``residual`` their maximum.
-    """
-
-    residuals: Residuals
-    p: np.ndarray | None = None
-    g: np.ndarray | None = None
-    delta: float | None = None
-    t: np.ndarray | None = None
-    s: np.ndarray | None = None
-    xi: float | None = None
-    eta: float | None = None
-    method: str = ""
-    iterations: int = 0
-    info: dict = field(default_factory=dict)
-
-    @property
-    def residual(self) -> float:
-        return self.residuals.max
-
-
 def disc_projection(z: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``Proj_{|·| ≤ b_i}(z_i)`` element by element (eq. 3D.19: Coulomb's law on the disc, the variational
-    inequality 3D.18, as a projection); ``z`` of shape ``(2, n)``, ``b ≥ 0``."""
-    norm = np.hypot(z[0], z[1])
-    outside = norm > b
-    k = np.divide(b, norm, out=np.ones_like(norm), where=outside)   # b/|z| only where it is < 1 (no overflow)
-    return z * k
+    inequality 3D.18, as a projection); ``z`` of shape ``(2, n)``, ``b ≥ 0``: the ball of radius ``b`` for
+    ``k = 2`` (:func:`rollqp.friction.projection.project`)."""
+    return project(z, b)
 
 
 def rigid_slip(xi: float, eta: float, phi: float, x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -162,7 +85,7 @@ class NormalStep:
 
     Parameters
     ----------
-    A : rollqp.three.operator.BlockToeplitz
+    A : rollqp.influence.blocktoeplitz.BlockToeplitz
         ``A_nn`` (1 × 1 blocks) on the grid of ``n`` elements.
     area : float
         Element area ``dx·dy``.
@@ -181,13 +104,16 @@ class NormalStep:
     FN: float | None = None
     delta: float | None = None
     offset: np.ndarray | None = None
-    scales: Scales = field(default_factory=Scales)
+    scales: Scales = field(default_factory=lambda: Scales(dimension=3))
     kind = "normal"
 
     def __post_init__(self):
         n = self.A.shape[1]
         if self.A.shape != (n, n):
             raise InputError("A", f"the normal operator must be square (1 × 1 blocks), got {self.A.shape}")
+        if not isinstance(self.scales, Scales) or self.scales.dimension != 3:
+            raise InputError("scales", "a grid's step takes Scales(..., dimension=3) (forces in p0 c²), got "
+                                       f"{self.scales!r}")
         object.__setattr__(self, "area", _number("area", self.area, positive=True))
         object.__setattr__(self, "h", _vector("h", self.h, n))
         if self.offset is not None:
@@ -230,7 +156,7 @@ class TangentialStep:
 
     Parameters
     ----------
-    B : rollqp.three.operator.BlockToeplitz
+    B : rollqp.influence.blocktoeplitz.BlockToeplitz
         The 2 × 2 slip operator: ``A_tt`` (shift, transient) or ``A_tt − A_tt(· − d Δx)``
         (steady rolling, eq. 3D.17).
     area : float
@@ -264,13 +190,16 @@ class TangentialStep:
     Fy: float | None = None
     eta: float | None = None
     phi: float = 0.0
-    scales: Scales = field(default_factory=Scales)
+    scales: Scales = field(default_factory=lambda: Scales(dimension=3))
     kind = "tangential"
 
     def __post_init__(self):
         n = self.B.shape[1] // 2
         if self.B.shape != (2 * n, 2 * n):
             raise InputError("B", f"the slip operator must be 2 × 2 blocks, got shape {self.B.shape}")
+        if not isinstance(self.scales, Scales) or self.scales.dimension != 3:
+            raise InputError("scales", "a grid's step takes Scales(..., dimension=3) (forces in p0 c²), got "
+                                       f"{self.scales!r}")
         object.__setattr__(self, "area", _number("area", self.area, positive=True))
         bound = _vector("bound", self.bound, n)
         if np.any(bound < 0):
@@ -324,7 +253,7 @@ class TangentialStep:
         fric = float(np.max(np.hypot(r[0], r[1])))
         lx = 0.0 if self.Fx is None else abs(self.area * float(np.sum(t[0])) - self.Fx) / sc.force
         ly = 0.0 if self.Fy is None else abs(self.area * float(np.sum(t[1])) - self.Fy) / sc.force
-        return Residuals(friction=fric, load_x=lx, load_y=ly)
+        return Residuals(friction=fric, load_tangential=lx, load_lateral=ly)
 
     def solution(self, t, xi=None, eta=None, Bt=None, **meta) -> StepSolution:
         """``(t, ξ, η)`` with its slip and rollqp's residuals."""

@@ -1,7 +1,7 @@
 r"""Generalized Newton method with line search for the 3D steps (docs/theory3d.md §7).
 
 The 2D project's GNMls (González & Abascal 2002 §4; Pang 1990) carried to the disc. In the
-nondimensional variables of :mod:`rollqp.three.problem` the steps are the nonsmooth equations
+nondimensional variables of :mod:`rollqp.problem.grid` the steps are the nonsmooth equations
 
 .. math::
     \Phi_N = \begin{bmatrix} \min(\hat p,\ r\hat g) \\ \hat a\sum\hat p − \hat F_N\end{bmatrix},
@@ -42,10 +42,10 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from .. import progress
-from ..errors import InputError, SolverError
-from ..methods.base import Capabilities, check_options
-from .problem import disc_projection
+from ... import progress
+from ...errors import InputError, SolverError
+from ..base import Capabilities, check_options
+from ...problem.grid import disc_projection
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 
@@ -109,7 +109,7 @@ class NewtonMethod:
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "newton-3d"
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
-                                dimension=3, traction_components=2, friction_set="disc")
+                                dimensions=frozenset({3}), traction_components=2, friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, r: float | None = None,
                  rho: float = 0.5, sigma: float = 1e-4, path: str = "auto"):
@@ -136,8 +136,8 @@ class NewtonMethod:
         """Nothing to build: the dense blocks are memoized by the operators themselves."""
 
     def solve(self, problem, warm=None):
-        """Solve a :class:`~rollqp.three.problem.NormalStep` or
-        :class:`~rollqp.three.problem.TangentialStep`; ``warm``: a previous solution."""
+        """Solve a :class:`~rollqp.problem.grid.NormalStep` or
+        :class:`~rollqp.problem.grid.TangentialStep`; ``warm``: a previous solution."""
         t0 = time.perf_counter()
         if problem.kind == "normal":
             sol = _solve_normal(self, problem, warm)
@@ -213,7 +213,7 @@ def _solve_normal(method, problem, warm):
     p = np.maximum(x[:n], 0.0) * sc.stress
     Ap = (A @ p)
     return problem.solution(p, x[n] * sc.displacement, Ap=Ap, method=method.name,
-                            iterations=info["directions"], info=info)
+                            iterations=info["directions"], extras=info)
 
 
 def _normal_direction(method, A, s, x, Kx, phi, r, hh, ah, free_delta):
@@ -285,7 +285,7 @@ def _solve_tangential(method, problem, warm):
     n, B = problem.n, problem.B
     V = np.flatnonzero(bh > 0)
     if V.size == 0:   # no contact: no traction (the sliding limit check rejects a nonzero force)
-        return problem.solution(np.zeros((2, n)), 0.0, 0.0, method=method.name, info={"contact": 0})
+        return problem.solution(np.zeros((2, n)), 0.0, 0.0, method=method.name, extras={"contact": 0})
     diag = k * B.diagonal()
     r = method.r if method.r is not None else 1.0 / float(np.mean(np.concatenate([diag[V], diag[n + V]])))
     if warm is not None and warm.t is not None and np.shape(warm.t) == (2, n):
@@ -301,7 +301,7 @@ def _solve_tangential(method, problem, warm):
     t[:, V] = x[:2 * V.size].reshape(2, V.size) * sc.stress
     crp = {j: x[2 * V.size + i] * sc.slip for i, j in enumerate(free)}
     sol = problem.solution(t, crp.get(0), crp.get(1), method=method.name, iterations=info["directions"],
-                           info={**info, "contact": int(V.size)})
+                           extras={**info, "contact": int(V.size)})
     # ‖Φ‖∞ ≤ tol·min(1, r) bounds the residual on the same products; the fresh FFT product of
     # problem.solution can differ by round-off times the condition: 100× is the 2D QPs' residual_limit
     if not sol.residual <= 100 * method.tolerance:

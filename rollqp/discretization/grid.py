@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import Discretization
 from ..errors import InputError
 from ..validate import positive, scalar
 
@@ -142,6 +143,11 @@ class Grid:
         """``(X, Y)``: the centre coordinates of every element, flattened (``(n,)`` each)."""
         X, Y = np.meshgrid(self.x, self.y)
         return X.ravel(), Y.ravel()
+
+    def record(self) -> Discretization:
+        """The grid as a :class:`~rollqp.discretization.Discretization`: the element centres ``(x, y)``, the
+        element area as every weight, two traction components, fields of shape ``(ny, nx)``."""
+        return Discretization(np.stack(self.centres()), np.full(self.n, self.area), 2, self.shape)
 
     def field(self, v) -> np.ndarray:
         """A flattened field ``(n,)`` (or ``(k, n)``) as ``(ny, nx)`` (or ``(k, ny, nx)``)."""

@@ -33,8 +33,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from .errors import InputError
-from .validate import choice, finite_real, positive_real, real_sequence, suggestion
+from ..errors import InputError
+from ..validate import choice, finite_real, positive_real, real_sequence, suggestion
+from ..npzfile import read_npz
+from ..npzfile import real_array
 
 __all__ = ["Profile", "Feature", "Table", "Flat", "Defect", "FEATURE_KINDS", "register", "parse_profile",
            "circle_height", "DEFECT_SHAPES"]
@@ -392,7 +394,6 @@ def read_profile_file(name: Any, key: str, folder=None) -> tuple[np.ndarray, np.
     if size > MAX_FILE_BYTES:
         raise InputError(key, f"{name!r} is larger than {MAX_FILE_BYTES >> 20} MiB")
     if path.suffix.lower() == ".npz":
-        from .npzfile import read_npz, real_array
         z = read_npz(path, key)
         n = np.asarray(z.get("x", np.zeros(0))).size
         return real_array(z, "x", (n,), key), real_array(z, "h", (n,), key)

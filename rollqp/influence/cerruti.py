@@ -32,7 +32,7 @@ corner sum ``F(X₊,Y₊) − F(X₋,Y₊) − F(X₊,Y₋) + F(X₋,Y₋)`` of 
 (and ``X ↔ Y`` for ``Y²/ρ³``, ``Y/ρ²``). The coefficients depend on ``X_c, Y_c`` only: on the
 uniform grid they form a block-Toeplitz matrix, stored as one kernel array of shape
 ``(2ny − 1, 2nx − 1)`` per component (:func:`kernels`; products by FFT in
-:mod:`rollqp.three.operator`). A kernel may be evaluated with an offset ``(ox, oy)`` added to
+:mod:`rollqp.influence.blocktoeplitz`). A kernel may be evaluated with an offset ``(ox, oy)`` added to
 ``(X_c, Y_c)``: the displacement at ``x_I + ox`` of the tractions on the grid, which the
 transient needs where a particle was one step earlier (eq. 3D.16).
 """
@@ -111,8 +111,8 @@ def kernels(grid, materials, offset=(0.0, 0.0), components=None) -> dict:
 
     Parameters
     ----------
-    grid : rollqp.three.grid.Grid
-    materials : rollqp.three.materials.Materials
+    grid : rollqp.discretization.grid.Grid
+    materials : rollqp.materials.Materials
     offset : (float, float)
         ``(ox, oy)`` added to the observation point: the kernel gives the displacement at
         ``x_I + ox, y_I + oy`` (0 for the current displacements).

@@ -2,7 +2,7 @@ r"""The 3D steps on external conic solvers: Clarabel natively, OSQP (normal step
 (docs/theory3d.md §5–6).
 
 Each backend poses the normal step as the QP of eq. 3D.22 and the tangential step as the SOCP
-of eq. 3D.20 (:mod:`rollqp.three.forms`), maps the answer back (pressures, tractions, and the
+of eq. 3D.20 (:mod:`rollqp.problem.conic`), maps the answer back (pressures, tractions, and the
 load rows' multipliers as the approach and the creepages, eq. 3D.21) and evaluates it with
 rollqp's own residuals on the step problem. On top of the solver:
 
@@ -12,7 +12,7 @@ rollqp's own residuals on the step problem. On top of the solver:
   the skew part at the previous iterate (docs/formulation.md §8); a splitting that does not
   contract is a :class:`~rollqp.errors.SolverError` (the steady operator: its skew part dominates;
   the SOCP route reaches the steady state by marching, :mod:`rollqp.three.steady`);
-* **active-set refinement** (:mod:`rollqp.three.refine`): an interior point method ends with every
+* **active-set refinement** (:mod:`rollqp.methods.refine`): an interior point method ends with every
   complementary pair small but not zero, so elements at the edge of the contact or of the stick area
   are off by about ``√gap``. The answer is refined by the conic program's own KKT system on the
   active set the solver identified (eq. 3D.23: Newton iterations on smooth equations, the active set
@@ -34,9 +34,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError, MissingBackendError, SolverError
-from ..methods.base import Capabilities, check_options
+from .base import Capabilities, check_options
 from ..threads import threads
-from .forms import normal_form, tangential_form
+from ..problem.conic import normal_form, tangential_form
 from .refine import active_set_refine
 
 __all__ = ["ConicMethod", "ClarabelMethod", "OsqpMethod", "CvxpyMethod", "ScsMethod", "raw_solution"]
@@ -67,7 +67,7 @@ class ConicMethod:
     name = "conic"
     #: ``time.perf_counter()`` at which Clarabel stops its iterations (a cross-check's time budget); None: none.
     deadline = None
-    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimension=3, traction_components=2,
+    capabilities = Capabilities(solves=frozenset({"normal", "tangential"}), dimensions=frozenset({3}), traction_components=2,
                                 friction_set="disc")
 
     def __init__(self, tolerance: float = 1e-10, refine: bool = True, max_iterations: int | None = None,
@@ -93,10 +93,9 @@ class ConicMethod:
 
     def solve(self, problem, warm=None):
         """Solve a normal or tangential step (eq. 3D.22/3D.20); rollqp's residuals decide."""
-        if problem.kind not in self.capabilities.solves:
-            from ..methods import cone_methods
-            raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step "
-                                              f"(methods that can: {', '.join(cone_methods())})")
+        if problem.kind not in self.capabilities.solves:   # a scene is refused up front by the registry, naming the methods that can
+            raise InputError("solver.method", f"{self.name} cannot solve a {problem.kind} step (it solves: "
+                                              f"{', '.join(sorted(self.capabilities.solves))}; its capabilities)")
         t0 = time.perf_counter()
         elements = predicted_contact(problem, warm) if problem.kind == "normal" else None
         sol, info = self._solve_on(problem, elements)
@@ -143,13 +142,13 @@ class ConicMethod:
         return x, y, info
 
     def _refined(self, problem, sol):
-        """:func:`~rollqp.three.refine.active_set_refine` of the solver's answer, kept if rollqp's
+        """:func:`~rollqp.methods.refine.active_set_refine` of the solver's answer, kept if rollqp's
         residual drops; the raw answer and its residual in ``info``."""
         raw = {"raw_residual": sol.residual, "raw": _unknowns(sol)}
         ref = active_set_refine(problem, sol)
         if ref is not None and ref.residual < sol.residual:
             info = {**sol.info, **raw, "refined": True, "refine_iterations": ref.iterations}
-            return type(sol)(**{**ref.__dict__, "method": self.name, "iterations": sol.iterations, "info": info})
+            return type(sol)(**{**ref.__dict__, "method": self.name, "iterations": sol.iterations, "extras": info})
         sol.info.update(raw, refined=False)
         return sol
 
@@ -213,13 +212,13 @@ def _solution(problem, form, x, y, name, info):
         p = np.zeros(problem.n)
         p[form.elements] = np.maximum(np.asarray(x), 0.0) * sc.stress
         delta = problem.delta if problem.delta is not None else -float(unknowns[0]) * sc.displacement
-        return problem.solution(p, delta, method=name, iterations=info.get("iterations", 0), info=info)
+        return problem.solution(p, delta, method=name, iterations=info.get("iterations", 0), extras=info)
     nv = form.elements.size
     t = np.zeros((2, problem.n))
     t[:, form.elements] = np.asarray(x).reshape(2, nv) * sc.stress
     crp = dict(zip(form.rows, unknowns * sc.slip))
     return problem.solution(t, crp.get("Fx"), crp.get("Fy"), method=name,
-                            iterations=info.get("iterations", 0), info=info)
+                            iterations=info.get("iterations", 0), extras=info)
 
 
 def _clarabel_settings(tolerance, max_iterations):
@@ -306,7 +305,7 @@ class OsqpMethod(ConicMethod):
 
     name = "osqp"
     #: No cones: the friction disc cannot be posed, so it solves the normal QP only.
-    capabilities = Capabilities(solves=frozenset({"normal"}), dimension=3, traction_components=2,
+    capabilities = Capabilities(solves=frozenset({"normal"}), dimensions=frozenset({3}), traction_components=2,
                                 friction_set="interval")
 
     def _solve_form(self, form, q):

@@ -49,7 +49,7 @@ def chord_step(problem, solution, shifted, x):
     """The Newton iterate ``x_new`` of eq. 3D.24 (tractions ``(2, n)``, scene units), or None if the
     system is singular.
 
-    ``problem``: the rolling step ``G`` solved at ``x`` (:class:`~rollqp.three.problem.TangentialStep`,
+    ``problem``: the rolling step ``G`` solved at ``x`` (:class:`~rollqp.problem.grid.TangentialStep`,
     ``B = A_tt``, ``Δq = dx``); ``solution`` its conic answer ``z = G(x)``; ``shifted``: the operator
     ``A_tt(· − d dx)`` of its history vector; ``x``: the previous tractions ``(2, n)``.
     """

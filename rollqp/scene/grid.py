@@ -21,7 +21,7 @@ the spin ``creepage.spin`` (1/length) defaults to 0. Each value is a number or a
 Checked before any work, each failure an :class:`~rollqp.errors.InputError` naming the key and the
 allowed range: radii nonzero (``< 0`` concave, ``inf`` straight), a concentrated contact (the summed
 curvature positive in both directions, eq. 3D.3), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
-element aspect ratio ``dx/dy`` in :data:`rollqp.three.grid.ASPECT_RANGE`, the forces below the sliding
+element aspect ratio ``dx/dy`` in :data:`rollqp.discretization.grid.ASPECT_RANGE`, the forces below the sliding
 limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
 (:func:`rollqp.methods.require_3d`).
@@ -37,21 +37,24 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import InputError
+from ..friction import parse_friction
 from ..histories import Constant, History, parse_history
-from ..influence import DEFAULT_MODEL
+from ..influence import DEFAULT_MODEL, get_model
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
-from ..scene.checks import MAX_FRICTION, check_scene_name, check_units
-from ..scene.core import SceneBase
+from .checks import check_scene_name, check_units
+from .core import SceneBase
+from .plain import plain
 from ..validate import choice, integer, number, string, suggestion
-from .contact import Loads
-from .geometry import Body, curvatures
-from .contact import MU_REFERENCE
-from .grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
-from .hertz import hertz
-from .loads import check_load_path, has_load_path
-from .materials import Materials
-from .patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
+from ..operators.grid import MU_REFERENCE, Loads
+from ..profiles.surface import Body, curvatures
+from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
+from ..three.hertz import hertz
+from ..three.loads import check_load_path, has_load_path
+from ..materials import Materials
+from ..three.patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
+from ..methods import REFERENCE_METHOD
+from ..methods import scene_method_3d
 
 __all__ = ["Scene3D", "Body3D", "Contact3D", "Creepage3D", "Load3D", "Discretization3D", "Solver3D",
            "scene_from_dict", "MAX_STEPS", "MAX_RESULT_BYTES"]
@@ -94,7 +97,8 @@ class Contact3D:
 
     @property
     def mu(self) -> float:
-        return float(self.friction)
+        """Coulomb's coefficient, or a law's reference ``μ`` (``load.tangential = Fx/(μ FN)``)."""
+        return float(self.friction.reference)
 
 
 @dataclass(frozen=True)
@@ -164,14 +168,14 @@ def _body(key, b: Body3D) -> Body3D:
 
 
 def _contact(c: Contact3D) -> Contact3D:
-    if isinstance(c.friction, dict):
-        raise InputError("contact.friction", "a 3D scene takes Coulomb's coefficient (a number > 0); friction laws "
-                                             "(docs/friction.md) are two-dimensional")
-    mu = number("contact.friction", c.friction, f"in [0, {MAX_FRICTION:g}] (Coulomb's coefficient; 0: frictionless)",
-                lambda x: 0 <= x <= MAX_FRICTION)
+    law = parse_friction(c.friction)   # a number is Coulomb's coefficient; a table a law: checked once, here
+    if law.kind == "slip":
+        raise InputError("contact.friction.law", f"a 3D scene takes Coulomb's coefficient or a law along the "
+                                                 f"surface (kind 'constant' or 'spatial'); {law.law!r} depends on "
+                                                 "the slip velocity, which only 2D scenes take")
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-    return Contact3D(mu, 3, choice("contact.model", c.model, (DEFAULT_MODEL,)))
+    return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name)
 
 
 def _history(v, key):
@@ -318,7 +322,6 @@ class Scene3D(SceneBase):
         None for two paraboloids."""
         if self.shape.hertzian:
             return None
-        from ..methods import REFERENCE_METHOD, scene_method_3d
         A, B = self.shape.curvatures()
         guess = (A, B) if A > 0 and B > 0 else None
         return computed_patch(self.shape.at(0.0), self.grid, self.materials, self.load.normal,
@@ -332,7 +335,7 @@ class Scene3D(SceneBase):
 
     @functools.cached_property
     def grid(self) -> Grid:
-        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.three.grid.Grid.for_ellipse>`),
+        """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.discretization.grid.Grid.for_ellipse>`),
         or on ``extent`` (:func:`rollqp.three.patch.extent_grid`)."""
         d = self.discretization
         if d.extent is not None:
@@ -395,7 +398,7 @@ class Scene3D(SceneBase):
         val = lambda h: None if h is None else float(h(s))  # noqa: E731
         Fx, Fy = val(ld.tangential), val(ld.lateral)
         return Loads(Fx=None if Fx is None else Fx * cap, xi=val(cr.longitudinal),
-                     Fy=None if Fy is None else Fy * cap, eta=val(cr.lateral), phi=float(cr.spin(s)))
+                     Fy=None if Fy is None else Fy * cap, eta=val(cr.lateral), phi=float(cr.spin(s)), q=float(q))
 
     # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
@@ -414,7 +417,7 @@ class Scene3D(SceneBase):
         return {"name": self.name, "description": self.description, **({"units": self.units} if self.units else {}),
                 "bodies": {k: {f: v for f, v in dataclasses.asdict(b).items() if v is not None}
                            for k, b in (("A", self.A), ("B", self.B))},
-                "contact": {"dimension": 3, "friction": self.contact.friction, "model": self.contact.model},
+                "contact": {"dimension": 3, "friction": plain(self.contact.friction), "model": self.contact.model},
                 "load": loads,
                 "discretization": {**disc, "step": d.step, "distance": d.distance},
                 "solver": solver}
@@ -604,7 +607,7 @@ def _check_creepages(scene) -> None:
         # tolerance a step stops at zero tractions, however wrong (a creepage of 1e-3 under FN = 1e30)
         mu = scene.mu
         if mu > 0:
-            unit = e.p0 * min(1.0, mu / MU_REFERENCE)          # the tangential steps' stress unit (rollqp.three.contact)
+            unit = e.p0 * min(1.0, mu / MU_REFERENCE)          # the tangential steps' stress unit (rollqp.operators.grid)
             lowest = float(np.min(v[v > 0], initial=np.inf)) * scene.materials.Estar / unit
             if lowest < MEANINGFUL * scene.solver.tolerance:
                 raise InputError(f"load.creepage.{key}", f"{what} = {float(np.min(v[v > 0])):.4g} sets tractions of "
