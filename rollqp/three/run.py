@@ -249,10 +249,28 @@ def check_states(scene, contact, source) -> None:
                 bad = [f"state {int(k[i])}: its forces are not those of its pressure and tractions"]
             elif not np.array_equal(_states(contact, p[i], t[i], sl[i]), np.asarray(b["state"][i]).ravel()):
                 bad = [f"state {int(k[i])}: its element states are not those of its pressure, traction and slip"]
+            else:
+                bad = _law(contact, p[i], t[i], sl[i], np.asarray(b["state"][i]).ravel(), tunit, int(k[i]))
         if bad:
             where = bad[0] if bad[0].startswith("state") else f"a state of the file: {bad[0]}"
             raise InputError("--resume", f"{where}: the file was changed or is corrupt")
         seen += m
+
+
+def _law(contact, p, t, s, states, tunit, k) -> list:
+    """Coulomb's law at a stored state (to :data:`RESUME_TOL`): a sticking element does not slip (``|s|`` in the
+    tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``[]``, or what is wrong."""
+    slip_unit = tunit / contact.materials.Estar
+    sn = np.hypot(s[0], s[1])
+    stick, slipping = states == 1, (states == 2) & (sn > 0)
+    if np.any(sn[stick] > RESUME_TOL * slip_unit):
+        return [f"state {k}: a sticking element slips"]
+    b = contact.mu * np.maximum(p, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.hypot(t[0] + b * s[0] / sn, t[1] + b * s[1] / sn)
+    if np.any(r[slipping] > RESUME_TOL * tunit):
+        return [f"state {k}: a slipping element's traction is not opposite its slip"]
+    return []
 
 
 def _array_blocks(arrays, names, rows: int = 256):
@@ -364,8 +382,9 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     tail = state = None
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
+        resumed_record(scene, contact, tail)            # the grid and the rolled distances: this scene's
+        check_states(scene, contact, source)            # every state consistent, before any is solved from
         state = check_resumed(scene, prepared, tail)
-        check_states(scene, contact, source)
     result = new_result(scene, contact, meth.name, out=out, keep_every=keep)
     records = _noted(result.meta, march(scene, prepared=prepared, resume=tail, verify=False, state=state,
                                         start_progress=start_progress), contact)
