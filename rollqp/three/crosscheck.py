@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import RollqpError
+from .loadpath import posed_force
 from .march import coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
@@ -57,7 +58,7 @@ class SpotObserver:
 
     def __call__(self, rec, contact) -> None:
         self.contact = contact
-        if rec.k in self.steps:
+        if rec.k in self.steps and rec.FN > 0:      # out of contact (FN = 0) nothing is solved
             before = rec.info.get("before") if rec.k == 0 else (self._last.p, self._last.t)
             self.kept[rec.k] = (rec, before)
         self._last = rec
@@ -137,6 +138,9 @@ class CrossCheck:
 
 def _pose(scene, contact, rec, before):
     """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
+    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.three.loadpath)
+        kind, _, dq, _, loads = rec.info["pose"]
+        return kind, loads, before, dq
     if rec.phase == "steady":
         return "rolling", scene.loads_at(0.0), (rec.p, rec.t), contact.grid.dx
     if rec.phase == "shift":
@@ -210,8 +214,8 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
                         out.estimate = max(out.estimate or 0.0, est)
                         continue
                     t1 = time.perf_counter()
-                    nsol, tsol, _ = coupled_step(contact, method, scene.load.normal, kind, loads, previous, dq,
-                                                 scene.load.direction)
+                    FN, direction = posed_force(scene, rec)
+                    nsol, tsol, _ = coupled_step(contact, method, FN, kind, loads, previous, dq, direction)
                     measured = (time.perf_counter() - t1, m)
                     done[key] = (k, nsol, tsol)
                 else:

@@ -33,8 +33,10 @@ from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
 from ..operators.grid import Contact
+from .loadpath import out_of_contact, rolling_steps
+from .loads import start_force
 from .patch import moving_profile
-from .march import StepRecord, static_shift, steady, transient
+from .march import StepRecord, static_shift, steady
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
 
@@ -63,14 +65,16 @@ def prepare(scene, method=None):
 
 def _start(scene, meth, contact, tick=None) -> StepRecord:
     """State 0: the braked start's last static shift step, or the steady rolling state."""
-    ld = scene.load
+    ld, FN = scene.load, start_force(scene)     # FN(0): load.normal without a normal history
+    if FN <= 0.0:           # a normal history that starts at 0: out of contact
+        return out_of_contact(contact, 0, ld.start, 0.0, scene.loads_at(0.0))
     if ld.start == "rolling":
-        return steady(contact, meth, ld.normal, scene.loads_at(0.0), direction=ld.direction, tick=tick)
+        return steady(contact, meth, FN, scene.loads_at(0.0), direction=ld.direction, tick=tick)
     loads = scene.loads_at(0.0)
     if loads.xi is not None or loads.eta is not None:
         raise InputError("load.start", "a braked start shifts the bodies by the tangential forces: prescribe "
                                        "load.tangential and load.lateral (or start = \"rolling\")")
-    last = static_shift(contact, meth, ld.normal, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps, tick=tick)[-1]
+    last = static_shift(contact, meth, FN, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps, tick=tick)[-1]
     return dataclasses.replace(last, k=0)   # the shift steps are numbered within the start; it is state 0
 
 
@@ -101,8 +105,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
         except SolverError as err:
             raise (err.with_step(0) if err.step is None else err) from err
         first = 1
-    records = transient(contact, meth, scene.load.normal, scene.loads_at, scene.dq, scene.n_steps,
-                        scene.load.direction, start=start, first=first)
+    records = rolling_steps(scene, contact, meth, start, first)
     head = next(records)
     if resume is None:
         yield head
@@ -163,8 +166,7 @@ def check_resumed(scene, prepared, arrays: dict) -> StepRecord:
             again = _start(scene, meth, contact)
         elif steps.size >= 2 and int(steps[-2]) == k - 1:
             before = resumed_record(scene, contact, arrays, -2)
-            again = list(transient(contact, meth, scene.load.normal, scene.loads_at, scene.dq, k,
-                                   scene.load.direction, start=before, first=k))[-1]
+            again = list(rolling_steps(scene, contact, meth, before, k, last=k))[-1]
         else:
             raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
                                          "which it needs to be continued")
