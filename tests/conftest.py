@@ -233,6 +233,10 @@ class Delegate:
     def solve(self, problem, warm=None):
         return self.inner.solve(problem, warm=warm)
 
+    def carrier(self):
+        """The inner method's (a composition: called only where the capabilities declare ``carries_state``)."""
+        return self.inner.carrier()
+
 
 def scene_method_of(scene, name=None):
     """The method ``name`` (default the scene's) built from ``scene``'s solver settings, not composed."""

@@ -173,7 +173,7 @@ def grid_extent(extent, zone, element_size, elements):
         counts = [round((hi - lo) / d) for (lo, hi), d in zip(out, size)]
     else:
         key = "discretization.elements"
-        counts = list(elements) if elements is not None else [40, 40]
+        counts = list(_pair_of(key, elements, "element counts along x and y")) if elements is not None else [40, 40]
     for i, n in enumerate(counts):
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 4 <= n <= 10_000:
             raise InputError(key, f"gives {n!r} elements along {'xy'[i]}: must be 4 to 10000")
