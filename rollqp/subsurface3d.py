@@ -32,7 +32,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy import arcsinh, arctan, log, pi, sqrt  # noqa: F401  (the generated kernels' functions)
 
+from .discretization.grid import Grid
 from .errors import InputError
+from .result import load_result, save_npz
+from .scene import load_scene
+from .subsurface import _step
 
 __all__ = ["COMPONENTS", "QUANTITIES", "stress_components", "point_load", "invariants", "Section", "section",
            "StressField3D", "stresses3d", "stress_history3d", "save_field3d", "plot_field3d", "summary_rows3d",
@@ -305,13 +309,11 @@ def _maxima(values: dict, pts) -> dict:
 
 
 def _state(arrays, step: int):
-    from .subsurface import _step
     return _step(step, len(arrays["q"]))
 
 
 def result_grid(arrays, scene=None):
     """The :class:`~rollqp.discretization.grid.Grid` of a 3D result's element centres ``x``, ``y`` (uniform)."""
-    from .discretization.grid import Grid
     x, y = (np.asarray(arrays[k], dtype=float) for k in ("x", "y"))
     sizes = []
     for key, c in (("x", x), ("y", y)):
@@ -335,8 +337,6 @@ def result_grid(arrays, scene=None):
 
 def source3d(result) -> tuple[dict, object]:
     """``(arrays, scene)`` of a 3D result (a ``load_result`` dict, a path, or an object with ``arrays()``)."""
-    from .result import load_result
-    from .scene import load_scene
     if isinstance(result, dict):
         arrays = result
     elif hasattr(result, "arrays"):
@@ -460,7 +460,6 @@ def stress_history3d(result, plane=None, line=None, depths=None, body: str = "A"
 def save_field3d(sf: StressField3D, path) -> str:
     """Write a :class:`StressField3D` to a ``.npz``: the points ``x, y, z`` (nz, n_along), every quantity, the
     maxima ``max_<name> = [value, x, y, z]``, ``step``, ``q``, ``body``, ``section``; atomically."""
-    from .result import save_npz
     x, y, z = sf.section.points()
     arrays = {"x": x, "y": y, "z": z, "step": np.asarray(sf.step), "q": np.asarray(sf.q), "body": np.asarray(sf.body),
               "section": np.asarray(sf.section.label)}

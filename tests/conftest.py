@@ -230,12 +230,12 @@ class Delegate:
     def setup(self, operators):
         self.inner.setup(operators)
 
-    def carrier(self):
-        """The inner method's (called where the capabilities it copies declare ``carries_state``)."""
-        return self.inner.carrier()
-
     def solve(self, problem, warm=None):
         return self.inner.solve(problem, warm=warm)
+
+    def carrier(self):
+        """The inner method's (a composition: called only where the capabilities declare ``carries_state``)."""
+        return self.inner.carrier()
 
 
 def scene_method_of(scene, name=None):

@@ -120,6 +120,20 @@ def test_a_defect_rolls_through_the_contact():
     assert len(moved) >= 3 and moved[-1] < moved[0]      # the separated spot travels towards −x
 
 
+def test_a_feature_that_pushes_the_contact_off_the_grid_stops_the_run_naming_the_key():
+    """A flat-bottomed dent deeper than the approach (0.03 mm against 0.011) and 0.9 mm wide carries the load on
+    its rim, which reaches the grid's outer elements as it passes: the run stops at that step with a one-line
+    error naming the grid's key, the completed states kept in ``err.partial``."""
+    d = _base("cattaneo-3d")
+    d["discretization"].update(elements=[12, 12], distance=2.0)
+    d["bodies"]["A"]["profile"] = {"kind": "defect", "x": 0.9, "y": 0.0, "depth": 0.03, "length": 0.9, "width": 0.9,
+                                   "shape": "flat"}
+    s = scene_from_dict(d)                      # at q = 0 the dent is outside the contact: the scene is fine
+    with pytest.raises(InputError, match=r"^discretization.zone: at rolling step \d+ the contact reaches") as err:
+        rollqp.run(s)
+    assert "\n" not in str(err.value) and len(err.value.partial) >= 2
+
+
 # ------------------------------------------------------------------- bad input
 BAD = [
     ("lateral and radius_y", lambda d: d["bodies"]["A"].update(profile={"kind": "lateral", "y": [-1, 0, 1],

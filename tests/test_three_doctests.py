@@ -7,7 +7,8 @@ import importlib
 import pytest
 
 MODULES = ["discretization", "discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
-           "profiles.surface", "three.hertz", "three.closedforms", "methods.newton.disc", "operators.grid"]
+           "profiles.surface", "three.hertz", "three.closedforms", "methods.newton.disc", "operators.grid",
+           "three.loads"]
 
 
 @pytest.mark.parametrize("name", MODULES)

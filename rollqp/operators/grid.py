@@ -12,7 +12,6 @@ residuals — and it makes the step problems of :mod:`rollqp.problem.grid`:
 """
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -170,11 +169,6 @@ class Contact:
             raise InputError("contact.friction", f"law {self.law.law!r} must give a finite μ >= 0 at each of the "
                                                  f"{self.grid.n} elements, got shape {mu.shape}")
         return mu
-
-    def posed(self, loads: Loads) -> Loads:
-        """``loads`` as a step is posed from them: the rolled distance ``q`` kept only where the friction law
-        reads it (a law along the surface); two steps of equal posed loads and history are the same problem."""
-        return loads if self.law.kind != "constant" else dataclasses.replace(loads, q=0.0)
 
     def bound(self, p, q: float = 0.0, direction: int = -1) -> np.ndarray:
         """The traction bound ``μ p⁺`` of the pressure ``p`` at the rolled distance ``q`` (eq. 3D.18)."""

@@ -9,7 +9,7 @@ normal force and rolling in x with creepages or tangential forces::
     [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace")
     [load]                  normal (FN), tangential (Fx/(μFN)), lateral (Fy/(μFN)),
                             creepage = { longitudinal = ξ, lateral = η, spin = φ },
-                            start, direction, start_steps
+                            start, direction, start_steps, normal_history, rolled
     [discretization]        elements = [nx, ny], zone = [zx, zy], step (Δq/Δx), distance (/a)
     [solver]                method, tolerance, max_iterations, augmentation
 
@@ -50,6 +50,7 @@ from ..operators.grid import MU_REFERENCE, Loads
 from ..profiles.surface import Body, curvatures
 from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
 from ..three.hertz import hertz
+from ..three.loads import check_load_path, has_load_path
 from ..materials import Materials
 from ..three.patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
 from ..methods import REFERENCE_METHOD
@@ -115,7 +116,8 @@ class Load3D:
     """The normal force ``normal`` (FN, a force), the tangential forces as histories of q/a —
     ``tangential`` = Fx/(μFN), ``lateral`` = Fy/(μFN) — or the creepages (:class:`Creepage3D`), the
     ``start`` (``"braked"``: static shift to the initial forces, then rolling; ``"rolling"``: the
-    steady state), the material's ``direction`` d = ±1 and the braked start's ``start_steps``."""
+    steady state), the material's ``direction`` d = ±1 and the braked start's ``start_steps``; the load path
+    (:mod:`rollqp.three.loads`): ``normal_history`` (FN(τ)/``normal``) and ``rolled`` (q(τ)/a, None: τ = q)."""
 
     normal: float
     tangential: History | None = None
@@ -124,6 +126,8 @@ class Load3D:
     start: str = "braked"
     direction: int = -1
     start_steps: int = 1
+    normal_history: History = Constant(1.0)
+    rolled: History | None = None
 
 
 @dataclass(frozen=True)
@@ -197,7 +201,9 @@ def _load(ld: Load3D) -> Load3D:
         raise InputError("load.direction", f"must be -1 or +1, got {direction!r}")
     return Load3D(number("load.normal", ld.normal, "> 0 (the normal force FN)", lambda x: x > 0), fx, fy, cr,
                   choice("load.start", ld.start, STARTS), int(direction),
-                  integer("load.start_steps", ld.start_steps, ">= 1 (and <= 10000)", lambda n: 1 <= n <= 10_000))
+                  integer("load.start_steps", ld.start_steps, ">= 1 (and <= 10000)", lambda n: 1 <= n <= 10_000),
+                  parse_history(ld.normal_history, "load.normal_history", constant_default=1.0),
+                  _history(ld.rolled, "load.rolled"))
 
 
 def _pair(key, v, what, check) -> tuple:
@@ -354,9 +360,27 @@ class Scene3D(SceneBase):
         return int(r) if abs(r - ratio) <= 1e-9 * max(ratio, 1.0) else int(math.ceil(ratio))
 
     @property
-    def q_steps(self) -> np.ndarray:
-        """Rolled distances ``k·Δq``, ``k = 0 … K``."""
+    def time_steps(self) -> np.ndarray:
+        """The time-like parameter ``τ_k = k·Δq``, ``k = 0 … K`` (length units): the argument of the load
+        histories (the rolled distance itself without ``load.rolled``)."""
         return np.arange(self.n_steps + 1) * self.dq
+
+    @property
+    def q_steps(self) -> np.ndarray:
+        """Rolled distances ``q_k``, ``k = 0 … K``: ``k·Δq``, or ``q(τ_k)`` with ``load.rolled``
+        (:mod:`rollqp.kinematics`)."""
+        return self.rolled_distance(self.time_steps)
+
+    def rolled_distance(self, tau):
+        """``q(τ) = a·rolled(τ/a)`` (length units); ``τ`` itself without ``load.rolled``."""
+        if self.load.rolled is None:
+            return np.asarray(tau, dtype=float)
+        return self.ellipse.a * np.asarray(self.load.rolled(np.asarray(tau, dtype=float) / self.ellipse.a), dtype=float)
+
+    @property
+    def element_length(self) -> float:
+        """The element length along the rolling direction, ``dx`` (:func:`rollqp.kinematics.plan`'s unit)."""
+        return self.grid.dx
 
     def contact_elements(self) -> int:
         """The elements whose centres lie inside the Hertz ellipse: about those in contact (the size of
@@ -383,7 +407,9 @@ class Scene3D(SceneBase):
         loads = {"normal": ld.normal, **_opt("tangential", ld.tangential), **_opt("lateral", ld.lateral),
                  "creepage": {**_opt("longitudinal", ld.creepage.longitudinal),
                               **_opt("lateral", ld.creepage.lateral), "spin": _plain(ld.creepage.spin)},
-                 "start": ld.start, "direction": ld.direction, "start_steps": ld.start_steps}
+                 "start": ld.start, "direction": ld.direction, "start_steps": ld.start_steps,
+                 **({} if ld.normal_history == Constant(1.0) else {"normal_history": _plain(ld.normal_history)}),
+                 **_opt("rolled", ld.rolled)}
         solver = {k.name: getattr(self.solver, k.name) for k in fields(self.solver)
                   if getattr(self.solver, k.name) is not None}
         disc = {"elements": d.elements, "zone": d.zone, "extent": d.extent, "element_size": d.element_size}
@@ -459,7 +485,10 @@ def _check_whole(scene) -> None:
         check_patch(scene.patch, "discretization.extent" if scene.discretization.extent is not None
                     else "discretization.zone")
     _check_work(scene)
-    _check_sliding_limit(scene)
+    if has_load_path(scene):
+        check_load_path(scene)      # the sliding limit of the current load among them
+    else:
+        _check_sliding_limit(scene)
     _check_creepages(scene)
 
 
@@ -531,8 +560,8 @@ def _check_sliding_limit(scene) -> None:
     ld = scene.load
     if ld.tangential is None and ld.lateral is None:
         return
-    s_end = float(scene.q_steps[-1]) / scene.ellipse.a
-    s = scene.q_steps / scene.ellipse.a
+    s_end = float(scene.time_steps[-1]) / scene.ellipse.a
+    s = scene.time_steps / scene.ellipse.a
     for h in (ld.tangential, ld.lateral):
         if h is not None:
             s = np.union1d(s, h.critical_points(s_end))
@@ -559,13 +588,13 @@ def _check_creepages(scene) -> None:
     """Prescribed creepages: ``|ξ|, |η| <= MAX_CREEPAGE`` and ``|φ|·max(a, b) <= MAX_CREEPAGE`` at every step
     (and the histories' breakpoints)."""
     cr, e = scene.load.creepage, scene.ellipse
-    s_end = float(scene.q_steps[-1]) / e.a
+    s_end = float(scene.time_steps[-1]) / e.a
     arm = max(e.a, e.b)
     for h, key, scale, what in ((cr.longitudinal, "longitudinal", 1.0, "|xi|"), (cr.lateral, "lateral", 1.0, "|eta|"),
                                 (cr.spin, "spin", arm, "|phi|·max(a, b)")):
         if h is None:
             continue
-        s = np.union1d(scene.q_steps / e.a, h.critical_points(s_end))
+        s = np.union1d(scene.time_steps / e.a, h.critical_points(s_end))
         v = np.abs(h(s) * np.ones_like(s)) * scale
         k = int(np.argmax(v))
         if not v[k] <= MAX_CREEPAGE:

@@ -261,6 +261,7 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     :class:`StepFile3D`."""
     from ..methods import REFERENCE_METHOD
     from ..three.march import StepRecord
+    from ..three.loads import start_force
     from ..three.run import march, prepare
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene {scene.name!r}, got {k!r}")
@@ -290,6 +291,12 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     else:
         kind, loads, previous, dq = "rolling", scene.loads_at(rec.q), (prev.p, prev.t), scene.dq
         B, Atn = ops.Att, (ops.Atn if ops.coupled else None)
+    FN = start_force(scene) if k == 0 else ld.normal
+    if "pose" in rec.info:          # a load path's step (rollqp.three.loadpath): its load, Δq, direction, loads
+        kind, FN, dq, direction, loads = rec.info["pose"]
+    if rec.FN == 0:
+        raise InputError("--step", f"step {k} of {scene.name!r} is out of contact (load.normal_history is 0 there): "
+                                   "nothing is solved, there is no step to export")
     tp = contact.tangential_step(kind, rec.p, loads, previous, dq, direction)
     c = tp.c - (Atn @ rec.p).reshape(2, -1) if Atn is not None else tp.c
     n = g.n
@@ -301,7 +308,7 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
         x=contact.x.copy(), y=contact.y.copy(), nx=g.nx, ny=g.ny, area=g.area, A_nn=ops.Ann.dense(),
         B=B.dense(), A_nt=ops.Ant.dense() if ops.coupled else np.zeros((n, 2 * n)),
         A_tn=Atn.dense() if Atn is not None else np.zeros((2 * n, n)), h=contact.h.copy(), c=c, dq=tp.dq,
-        mu=contact.mu, phi=tp.phi, FN=ld.normal, Fx=tp.Fx, xi=tp.xi, Fy=tp.Fy, eta=tp.eta, length=sc.length,
+        mu=contact.mu, phi=tp.phi, FN=FN, Fx=tp.Fx, xi=tp.xi, Fy=tp.Fy, eta=tp.eta, length=sc.length,
         stress=sc.stress, modulus=sc.modulus, prev_p=pp, prev_t=pt,
         prev_delta=float("nan") if prev is None else float(prev.delta), ref_p=np.asarray(rec.p, float),
         ref_t=np.asarray(rec.t, float).reshape(2, n), ref_delta=float(rec.delta), ref_xi=float(rec.xi),

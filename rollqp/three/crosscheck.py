@@ -18,11 +18,12 @@ steady state itself only by marching (``solver.method = "qp-clarabel"`` on a rol
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..errors import RollqpError
+from .loadpath import posed_force
 from .march import coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
@@ -57,7 +58,7 @@ class SpotObserver:
 
     def __call__(self, rec, contact) -> None:
         self.contact = contact
-        if rec.k in self.steps:
+        if rec.k in self.steps and rec.FN > 0:      # out of contact (FN = 0) nothing is solved
             before = rec.info.get("before") if rec.k == 0 else (self._last.p, self._last.t)
             self.kept[rec.k] = (rec, before)
         self._last = rec
@@ -137,6 +138,9 @@ class CrossCheck:
 
 def _pose(scene, contact, rec, before):
     """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
+    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.three.loadpath)
+        kind, _, dq, _, loads = rec.info["pose"]
+        return kind, loads, before, dq
     if rec.phase == "steady":
         return "rolling", scene.loads_at(0.0), (rec.p, rec.t), contact.grid.dx
     if rec.phase == "shift":
@@ -159,9 +163,13 @@ def _compare(row, contact, rec, nsol, tsol) -> dict:
     return {k: float(v) for k, v in d.items()}
 
 
-def _key(kind, loads, previous, dq) -> tuple:
-    """The data a step is posed from, as bytes: two steps with equal keys are the same problem."""
+def _key(kind, loads, previous, dq, constant_friction: bool = True) -> tuple:
+    """The data a step is posed from, as bytes: two steps with equal keys are the same problem. The rolled
+    distance ``loads.q`` is part of the data only where the friction law is read along the surface (a
+    constant coefficient poses the same step at every ``q``)."""
     prev = b"" if previous is None else np.asarray(previous[0]).tobytes() + np.asarray(previous[1]).tobytes()
+    if constant_friction:
+        loads = replace(loads, q=0.0)
     return kind, repr(loads), None if dq is None else float(dq), prev
 
 
@@ -200,7 +208,7 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
             for k in order:
                 rec, before = kept[k]
                 kind, loads, previous, dq = _pose(scene, contact, rec, before)
-                key = _key(kind, contact.posed(loads), previous, dq)
+                key = _key(kind, loads, previous, dq, contact.law.kind == "constant")
                 if key not in done:
                     m = max(int(np.sum(rec.p > 0)), 1)
                     # the estimate: the model's before the first conic step, then that step's own time
@@ -210,8 +218,8 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
                         out.estimate = max(out.estimate or 0.0, est)
                         continue
                     t1 = time.perf_counter()
-                    nsol, tsol, _ = coupled_step(contact, method, scene.load.normal, kind, loads, previous, dq,
-                                                 scene.load.direction)
+                    FN, direction = posed_force(scene, rec)
+                    nsol, tsol, _ = coupled_step(contact, method, FN, kind, loads, previous, dq, direction)
                     measured = (time.perf_counter() - t1, m)
                     done[key] = (k, nsol, tsol)
                 else:

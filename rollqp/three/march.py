@@ -331,5 +331,7 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
         except SolverError as exc:
             raise exc.with_step(k) from None
         rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q))
+        if move is not None and hasattr(move, "check"):
+            move.check(ns.p, k)
         yield rec
         prev, warm = rec, (ns, ts)

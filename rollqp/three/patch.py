@@ -173,7 +173,7 @@ def grid_extent(extent, zone, element_size, elements):
         counts = [round((hi - lo) / d) for (lo, hi), d in zip(out, size)]
     else:
         key = "discretization.elements"
-        counts = list(elements) if elements is not None else [40, 40]
+        counts = list(_pair_of(key, elements, "element counts along x and y")) if elements is not None else [40, 40]
     for i, n in enumerate(counts):
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or not 4 <= n <= 10_000:
             raise InputError(key, f"gives {n!r} elements along {'xy'[i]}: must be 4 to 10000")
@@ -200,13 +200,26 @@ def extent_grid(extent, elements, element_size):
 
 
 # =========================================================================== a profile that rolls through
-def moving_profile(contact, shape, direction: int):
+def moving_profile(contact, shape, direction: int, key: str = "discretization.zone"):
     """``move(q)``: sets ``contact.h`` to the undeformed distance after the rolled distance ``q`` (a material
     feature at ``s`` is then at ``x = s + d·q``, ``d = direction``), the hook the march calls before each
-    rolling step of a scene whose profile moves (:attr:`rollqp.profiles3d.Shape.moves`)."""
+    rolling step of a scene whose profile moves (:attr:`rollqp.profiles3d.Shape.moves`); ``move.check(p, k)``
+    after the step: the contact keeps off the grid's outermost rows and columns, else an
+    :class:`InputError` naming ``key`` and the step (the scene's check, :func:`check_patch`, at every step)."""
+    g = contact.grid
+
     def move(q: float) -> None:
         h = np.asarray(shape(contact.x, contact.y, direction * float(q)), dtype=float)
         if not np.all(np.isfinite(h)):
             raise InputError("profile", f"the undeformed distance at q = {q!r} is not finite")
         contact.h = h
+
+    def check(p, k: int) -> None:
+        on = g.field(np.asarray(p) > 0)
+        if on[:, 0].any() or on[:, -1].any() or on[0].any() or on[-1].any():
+            raise InputError(key, f"at rolling step {k} the contact reaches the grid's outer rows or columns (a "
+                                  "profile feature rolling through widened it): the grid must cover it with a row "
+                                  "of elements to spare; widen it")
+
+    move.check = check
     return move

@@ -23,6 +23,7 @@ import numpy as np
 from ..report import time_row
 from ..units import unit_names
 from .closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
+from .loads import start_ellipse
 from .post import hertz_field_errors
 
 __all__ = ["summary", "closed_form_errors", "stick_fraction", "LINEAR_SLIP_FRACTION"]
@@ -52,7 +53,9 @@ def stick_fraction(state) -> tuple[int, int, int]:
 
 def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
     """``(name, text)`` for every comparison that applies (module docstring)."""
-    e = scene.ellipse
+    e = start_ellipse(scene)            # Hertz at the starting state's load (a normal history's FN(0))
+    if e is None:
+        return [("contact (start)", "out of contact (FN(0) = 0): no closed form for state 0")]
     if not scene.shape.hertzian:       # a profile: no closed form; a, b, p0 are the scales (docs/scenes.md)
         on = np.asarray(res["pn"][0]) > 0
         area = float(on.sum()) * float(np.diff(res["x"][:2])[0]) * float(np.diff(res["y"][:2])[0])
@@ -71,7 +74,7 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
 
 def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
     """The braked start of a circle pressed, then shifted along x (Cattaneo–Mindlin, eq. 3D.6–3D.7)."""
-    e, m, mu = scene.ellipse, scene.materials, scene.mu
+    e, m, mu = start_ellipse(scene), scene.materials, scene.mu
     FN, Fx = float(res["FN"][0]), float(res["Fx"][0])
     if mu == 0:
         return []
@@ -89,7 +92,7 @@ def _cattaneo_rows(res, scene, X, Y) -> list[tuple[str, str]]:
 
 
 def _kalker_rows(res, scene) -> list[tuple[str, str]]:
-    e, m = scene.ellipse, scene.materials
+    e, m = start_ellipse(scene), scene.materials
     if scene.mu == 0:
         return [("error: kalker", "not compared (mu = 0: no stick, no creep force)")]
     C = kalker_linear(e.a / e.b, m.nu)

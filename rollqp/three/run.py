@@ -33,8 +33,10 @@ from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
 from ..operators.grid import Contact
+from .loadpath import out_of_contact, rolling_steps
+from .loads import start_force
 from .patch import moving_profile
-from .march import StepRecord, static_shift, steady, transient
+from .march import StepRecord, static_shift, steady
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
 
@@ -56,21 +58,25 @@ def prepare(scene, method=None):
     contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
                       profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
-        contact.move = moving_profile(contact, scene.shape, scene.load.direction)
+        contact.move = moving_profile(contact, scene.shape, scene.load.direction,
+                                      "discretization.extent" if scene.discretization.extent is not None
+                                      else "discretization.zone")
     meth.setup(contact)
     return scene, meth, contact
 
 
 def _start(scene, meth, contact, tick=None) -> StepRecord:
     """State 0: the braked start's last static shift step, or the steady rolling state."""
-    ld = scene.load
+    ld, FN = scene.load, start_force(scene)     # FN(0): load.normal without a normal history
+    if FN <= 0.0:           # a normal history that starts at 0: out of contact
+        return out_of_contact(contact, 0, ld.start, 0.0, scene.loads_at(0.0))
     if ld.start == "rolling":
-        return steady(contact, meth, ld.normal, scene.loads_at(0.0), direction=ld.direction, tick=tick)
+        return steady(contact, meth, FN, scene.loads_at(0.0), direction=ld.direction, tick=tick)
     loads = scene.loads_at(0.0)
     if loads.xi is not None or loads.eta is not None:
         raise InputError("load.start", "a braked start shifts the bodies by the tangential forces: prescribe "
                                        "load.tangential and load.lateral (or start = \"rolling\")")
-    last = static_shift(contact, meth, ld.normal, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps, tick=tick)[-1]
+    last = static_shift(contact, meth, FN, loads.Fx, loads.Fy, loads.phi, steps=ld.start_steps, tick=tick)[-1]
     return dataclasses.replace(last, k=0)   # the shift steps are numbered within the start; it is state 0
 
 
@@ -101,8 +107,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
         except SolverError as err:
             raise (err.with_step(0) if err.step is None else err) from err
         first = 1
-    records = transient(contact, meth, scene.load.normal, scene.loads_at, scene.dq, scene.n_steps,
-                        scene.load.direction, start=start, first=first)
+    records = rolling_steps(scene, contact, meth, start, first)
     head = next(records)
     if resume is None:
         yield head
@@ -163,8 +168,7 @@ def check_resumed(scene, prepared, arrays: dict) -> StepRecord:
             again = _start(scene, meth, contact)
         elif steps.size >= 2 and int(steps[-2]) == k - 1:
             before = resumed_record(scene, contact, arrays, -2)
-            again = list(transient(contact, meth, scene.load.normal, scene.loads_at, scene.dq, k,
-                                   scene.load.direction, start=before, first=k))[-1]
+            again = list(rolling_steps(scene, contact, meth, before, k, last=k))[-1]
         else:
             raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
                                          "which it needs to be continued")
@@ -249,10 +253,28 @@ def check_states(scene, contact, source) -> None:
                 bad = [f"state {int(k[i])}: its forces are not those of its pressure and tractions"]
             elif not np.array_equal(_states(contact, p[i], t[i], sl[i]), np.asarray(b["state"][i]).ravel()):
                 bad = [f"state {int(k[i])}: its element states are not those of its pressure, traction and slip"]
+            else:
+                bad = _law(contact, p[i], t[i], sl[i], np.asarray(b["state"][i]).ravel(), tunit, int(k[i]))
         if bad:
             where = bad[0] if bad[0].startswith("state") else f"a state of the file: {bad[0]}"
             raise InputError("--resume", f"{where}: the file was changed or is corrupt")
         seen += m
+
+
+def _law(contact, p, t, s, states, tunit, k) -> list:
+    """Coulomb's law at a stored state (to :data:`RESUME_TOL`): a sticking element does not slip (``|s|`` in the
+    tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``[]``, or what is wrong."""
+    slip_unit = tunit / contact.materials.Estar
+    sn = np.hypot(s[0], s[1])
+    stick, slipping = states == 1, (states == 2) & (sn > 0)
+    if np.any(sn[stick] > RESUME_TOL * slip_unit):
+        return [f"state {k}: a sticking element slips"]
+    b = contact.mu * np.maximum(p, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.hypot(t[0] + b * s[0] / sn, t[1] + b * s[1] / sn)
+    if np.any(r[slipping] > RESUME_TOL * tunit):
+        return [f"state {k}: a slipping element's traction is not opposite its slip"]
+    return []
 
 
 def _array_blocks(arrays, names, rows: int = 256):
@@ -364,8 +386,9 @@ def run(scene, method=None, progress=None, resume=None, observe=None, out=None, 
     tail = state = None
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
+        resumed_record(scene, contact, tail)            # the grid and the rolled distances: this scene's
+        check_states(scene, contact, source)            # every state consistent, before any is solved from
         state = check_resumed(scene, prepared, tail)
-        check_states(scene, contact, source)
     result = new_result(scene, contact, meth.name, out=out, keep_every=keep)
     records = _noted(result.meta, march(scene, prepared=prepared, resume=tail, verify=False, state=state,
                                         start_progress=start_progress), contact)
