@@ -25,6 +25,7 @@ the run marches (:func:`rollqp.three.march.transient` itself for a scene without
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -99,8 +100,12 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
     fixed = None                          # (FN, normal solution) of similar bodies, reused while FN holds
     for k in range(int(first), last + 1):
         t0 = time.perf_counter()
-        FN, d, ld = float(fn[k]), int(pl.d[k]), scene.loads_at(float(pl.tau[k]))
-        q = float(pl.q[k])
+        q, d0 = float(pl.q[k]), scene.load.direction
+        d = int(pl.d[k]) or d0              # a stop (Δq = 0) is a shift step: its direction only places μ
+        # the loads of τ_k, with the rolled distance q_k where a friction law is read (its material frame puts
+        # a point s at x = s + d0·q_k, the law reads d·q: q·d0·d, so that a reversal's d = −d0 reads the same)
+        ld = dataclasses.replace(scene.loads_at(float(pl.tau[k])), q=q * d0 * d)
+        FN = float(fn[k])
         if move is not None:
             move(q)
         if FN <= 0.0:
@@ -116,8 +121,9 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
         previous = (prev.p, prev.t)
         if prev.FN != FN:       # the last step's tractions may lie outside this load's discs: a cold start
             warm = None
-        phase = "shift" if d == 0 else "rolling"       # a stop: a static shift step under the loads of τ_k
-        dq = None if d == 0 else shifted.snap(float(pl.dq[k]))
+        stop = pl.d[k] == 0
+        phase = "shift" if stop else "rolling"       # a stop: a static shift step under the loads of τ_k
+        dq = None if stop else shifted.snap(float(pl.dq[k]))
         try:
             ns, ts, sw = coupled_step(contact, method, FN, phase, ld, previous, dq, d, warm=warm, pressure=pressure)
         except SolverError as exc:
@@ -139,5 +145,5 @@ def posed_force(scene, rec) -> tuple[float, int]:
     (``rec.info["pose"]``), else the starting state's ``FN(0)`` or ``load.normal``, and ``load.direction``."""
     pose = rec.info.get("pose")
     if pose is not None:
-        return pose[1], pose[3] if pose[3] != 0 else scene.load.direction
+        return pose[1], pose[3]
     return (start_force(scene) if rec.k == 0 else float(scene.load.normal)), scene.load.direction
