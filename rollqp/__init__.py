@@ -50,7 +50,8 @@ def _scene(scene):
 def run(scene, method=None, progress=None, resume=None, observe=None, **options):
     """Run a scene's transient and return its result: :func:`rollqp.march.run` for a 2D scene,
     :func:`rollqp.three.run.run` for a 3D one (``[contact] dimension = 3``), with the same arguments
-    (``out``, ``keep_every``, and the 2D run's ``geometry``, as keywords).
+    (``out``, ``keep_every``, and the 2D run's ``geometry``, as keywords); a wheel–rail scene
+    (``[contact] kind = "wheel-rail"``) is solved by :func:`rollqp.wheelrail.run.run`.
 
     Examples
     --------
@@ -61,6 +62,14 @@ def run(scene, method=None, progress=None, resume=None, observe=None, **options)
     """
     scene = _scene(scene)
     with _threads.limited():  # every BLAS pool at $ROLLQP_THREADS (default 1) for the run (rollqp.threads)
+        if getattr(scene, "family", None) == "wheel-rail":   # one state per wheel: no march (rollqp.wheelrail)
+            from .wheelrail.run import run as run_wheel_rail
+            if method is not None:
+                if not isinstance(method, str):
+                    raise InputError("method", "a wheel-rail scene takes a method name (e.g. 'newton'), "
+                                               f"got {type(method).__name__}")
+                scene = scene.replace(**{"solver.method": method})
+            return run_wheel_rail(scene, progress=progress, resume=resume, observe=observe, **options)
         if scene.dimension == 3:
             from .three.run import run as run_3d
             return run_3d(scene, method, progress, resume, observe, **options)
@@ -71,6 +80,8 @@ def march(scene, method=None, **options):
     """The transient as a stream of step records: :func:`rollqp.march.march` for a 2D scene,
     :func:`rollqp.three.run.march` for a 3D one (``prepared``, ``resume`` as keywords)."""
     scene = _scene(scene)
+    if getattr(scene, "family", None) == "wheel-rail":
+        raise InputError("scene", "a wheel-rail scene is one state per wheel, not a march: use rollqp.run")
     if scene.dimension == 3:
         from .three.run import march as march_3d
         return march_3d(scene, method, **options)

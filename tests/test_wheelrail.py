@@ -272,3 +272,17 @@ def test_smoothed_profiles_in_a_scene():
     (a,) = solve_scene(base)
     (b,) = solve_scene(base.replace(**{"wheelset.wheel_smooth": 1.0, "wheelset.rail_smooth": 1.0}))
     assert abs(a.patches[0].FN - b.patches[0].FN) < 100.0 and abs(a.patches[0].y_rail - b.patches[0].y_rail) < 0.2
+
+
+def test_python_api_runs_a_wheel_rail_scene_with_its_method():
+    """rollqp.run takes a wheel–rail scene as the command line does (its own runner, the method by name);
+    rollqp.march refuses it in one line (one state per wheel, nothing to march)."""
+    import rollqp
+    scene = load_scene("wheel-rail").replace(**{"wheelset.side": "right"})
+    res = rollqp.run(scene, method="newton")
+    arrays = res.arrays()
+    assert arrays["patch_FN"].size >= 1 and np.all(arrays["patch_FN"] > 0)
+    with pytest.raises(InputError, match=r"^scene: .*rollqp\.run"):
+        rollqp.march(scene)
+    with pytest.raises(InputError, match=r"^solver\.method"):
+        rollqp.run(scene, method="qp-osqp")
