@@ -249,9 +249,11 @@ STARTS = {"braked": ("cattaneo-3d", {}), "rolling": ("kalker-circular", {}),
 
 def _cases():
     """Newton on every start in the fast suite; the conic methods on the similar bodies' starts, and on the
-    dissimilar ones in the slow suite (the march to a dissimilar steady state takes 10-80 s on 2 cores)."""
+    dissimilar ones in the slow suite (the march to a dissimilar steady state takes 10-80 s on 2 cores). Every
+    3D method that marches is here: ``fastsim`` solves one steady state (nothing to resume) and ``qp-osqp``
+    is refused on a 3D scene."""
     for start in sorted(STARTS):
-        for method in ("newton", "socp-clarabel", "socp-cvxpy", "socp-scs", "qp-clarabel"):
+        for method in ("newton", "socp-clarabel", "socp-cvxpy", "socp-scs", "qp-clarabel", "qp-cvxpy"):
             for k in (0, 3):
                 slow = method != "newton" and ("dissimilar" in start or method != "socp-clarabel")
                 yield pytest.param(start, method, k, marks=[pytest.mark.slow] if slow else [])
@@ -263,7 +265,7 @@ def test_a_journal_resume_is_the_uninterrupted_run_bit_for_bit(tmp_path, start, 
     the next steps set out as in a run that never stopped (the first rolling step from nothing, every later one
     from the state before; a conic solver object scaled from its matrices alone), so every array but the wall
     times is the uninterrupted run's, bit for bit."""
-    if method in ("socp-cvxpy", "socp-scs"):
+    if method in ("socp-cvxpy", "socp-scs", "qp-cvxpy"):
         pytest.importorskip("cvxpy")
     name, changes = STARTS[start]
     scene = coarse(name, **changes)
