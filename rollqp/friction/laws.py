@@ -107,11 +107,26 @@ class _Spatial:
         """Where the nodes ``x̂`` are in the law's own coordinate (``a_H`` units) at ``q̂``."""
         return x_hat - direction * q_hat if self.frame == "material" else x_hat
 
+    #: The keys that make a law vary along y (a grid's second coordinate; a strip has none).
+    y_keys = ()
+
+    def varies_in_y(self) -> str | None:
+        """The first key set that makes ``μ`` depend on ``ŷ`` (only a 3D contact has it), else None."""
+        return next((k for k in self.y_keys if getattr(self, k) is not None), None)
+
     def coefficient(self, points, q_hat, direction) -> np.ndarray:
         """``μ`` at the ``points`` (shape ``(d, n)``: the rolling coordinate ``x̂`` first, then ``ŷ`` on a
-        grid; length units of the contact) at the rolled distance ``q̂``: a law along x, the same on every
-        line of a grid."""
-        return self.profile(self.positions(np.asarray(points, dtype=float)[0], q_hat, direction))
+        grid; length units of the contact) at the rolled distance ``q̂``. The material frame moves ``x̂``
+        only; a law without y keys is the same on every line of a grid."""
+        pts = np.asarray(points, dtype=float)
+        xs = self.positions(pts[0], q_hat, direction)
+        key = self.varies_in_y()
+        if key is None:
+            return self.profile(xs)
+        if pts.ndim != 2 or pts.shape[0] < 2:
+            raise InputError(f"{KEY}.{key}", "makes μ vary along y, which only a 3D contact has (a 2D strip's "
+                                             "laws vary along x only)")
+        return self.surface(xs, pts[1])
 
     def span(self):
         """``(lo, hi)``: the part of the law's coordinate where μ differs from the outside value."""
@@ -139,7 +154,8 @@ class _Spatial:
 
 @dataclass(frozen=True)
 class Patch(_Spatial):
-    """``μ = inside`` on ``[start, end]`` (``a_H`` units), ``mu`` elsewhere."""
+    """``μ = inside`` on ``[start, end]`` (``a_H`` units), ``mu`` elsewhere; on a 3D contact also bounded in
+    y by ``[y_start, y_end]`` (``a_H`` units; either omitted: unbounded on that side, both: every y)."""
 
     mu: float
     inside: float
@@ -147,6 +163,9 @@ class Patch(_Spatial):
     end: float
     frame: str = "fixed"
     law: str = "patch"
+    y_start: float | None = None
+    y_end: float | None = None
+    y_keys = ("y_start", "y_end")
 
     def __post_init__(self):
         object.__setattr__(self, "mu", _mu("mu", self.mu))
@@ -155,6 +174,14 @@ class Patch(_Spatial):
         e = number(f"{KEY}.end", self.end, f"> start = {s!r} (a_H units)", lambda x: x > s)
         object.__setattr__(self, "start", s)
         object.__setattr__(self, "end", e)
+        if self.y_start is not None:
+            object.__setattr__(self, "y_start", number(f"{KEY}.y_start", self.y_start, "finite (a_H units)",
+                                                       lambda x: True))
+        if self.y_end is not None:
+            lo = self.y_start
+            object.__setattr__(self, "y_end", number(
+                f"{KEY}.y_end", self.y_end, "finite (a_H units)" if lo is None else f"> y_start = {lo!r} (a_H units)",
+                lambda x: lo is None or x > lo))
         self._check_frame()
 
     reference = property(lambda self: self.mu, doc="The outside value (``load.tangential = Q/(μ P̄)``).")
@@ -163,37 +190,97 @@ class Patch(_Spatial):
     def profile(self, xi):
         return np.where((xi >= self.start) & (xi <= self.end), self.inside, self.mu)
 
+    def surface(self, xi, yi):
+        """``μ(x̂, ŷ)``: ``inside`` on the rectangle ``[start, end] × [y_start, y_end]``."""
+        inside = (xi >= self.start) & (xi <= self.end)
+        if self.y_start is not None:
+            inside &= yi >= self.y_start
+        if self.y_end is not None:
+            inside &= yi <= self.y_end
+        return np.where(inside, self.inside, self.mu)
+
     def span(self):
         return self.start, self.end
 
 
 @dataclass(frozen=True)
 class Table(_Spatial):
-    """``μ(x)`` interpolated linearly in the table ``(x, values)`` (``a_H`` units), constant beyond its ends."""
+    """``μ(x)`` interpolated linearly in the table ``(x, values)`` (``a_H`` units), constant beyond its ends.
+
+    On a 3D contact, ``y`` (``a_H`` units, increasing) makes ``values`` a table of rows along y (``len(y)``
+    rows of ``len(x)`` entries): ``μ(x, y)`` bilinear in it, constant beyond its ends. Without ``y`` a
+    table is ``μ(x)``, the same at every y.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = Table(x=(-1.0, 1.0), values=((0.1, 0.3), (0.2, 0.4)), y=(0.0, 1.0))
+    >>> t.coefficient(np.array([[0.0, 0.0, 5.0], [0.5, -3.0, 2.0]]), 0.0, -1)
+    array([0.25, 0.2 , 0.4 ])
+    """
 
     x: tuple
     values: tuple
     frame: str = "fixed"
     law: str = "table"
+    y: tuple | None = None
+    y_keys = ("y",)
 
     def __post_init__(self):
         x = real_sequence(f"{KEY}.x", self.x, 100_000)
-        v = real_sequence(f"{KEY}.values", self.values, 100_000)
-        if len(x) < 2 or len(v) != len(x):
-            raise InputError(f"{KEY}.values", f"must have as many entries as {KEY}.x (at least 2), got {len(v)} and {len(x)}")
+        if len(x) < 2:
+            raise InputError(f"{KEY}.x", f"must have at least 2 entries, got {len(x)}")
         if any(b <= a for a, b in zip(x, x[1:])):
             raise InputError(f"{KEY}.x", "must be strictly increasing")
-        for i, m in enumerate(v):
-            _mu(f"values[{i}]", m)
+        if self.y is None:
+            v = real_sequence(f"{KEY}.values", self.values, 100_000)
+            if len(v) != len(x):
+                raise InputError(f"{KEY}.values", f"must have as many entries as {KEY}.x (at least 2), got {len(v)} "
+                                                  f"and {len(x)}")
+            for i, m in enumerate(v):
+                _mu(f"values[{i}]", m)
+        else:
+            y = real_sequence(f"{KEY}.y", self.y, 100_000)
+            if len(y) < 2 or any(b <= a for a, b in zip(y, y[1:])):
+                raise InputError(f"{KEY}.y", f"must be strictly increasing with at least 2 entries, got {list(y)!r}")
+            rows = self.values
+            if isinstance(rows, (str, bytes)) or not hasattr(rows, "__len__") or len(rows) != len(y):
+                n = len(rows) if hasattr(rows, "__len__") else rows
+                raise InputError(f"{KEY}.values", f"with {KEY}.y must be {len(y)} rows (one per y), got {n!r}")
+            v = []
+            for j, row in enumerate(rows):
+                r = real_sequence(f"{KEY}.values[{j}]", row, 100_000)
+                if len(r) != len(x):
+                    raise InputError(f"{KEY}.values[{j}]", f"must have {len(x)} entries (one per x), got {len(r)}")
+                for i, m in enumerate(r):
+                    _mu(f"values[{j}][{i}]", m)
+                v.append(r)
+            v = tuple(v)
+            object.__setattr__(self, "y", y)
         object.__setattr__(self, "x", x)
         object.__setattr__(self, "values", v)
         self._check_frame()
 
-    reference = property(lambda self: max(self.values), doc="The largest tabulated value.")
-    largest = property(lambda self: max(self.values))
+    def _all(self):
+        return self.values if self.y is None else tuple(m for row in self.values for m in row)
+
+    reference = property(lambda self: max(self._all()), doc="The largest tabulated value.")
+    largest = property(lambda self: max(self._all()))
 
     def profile(self, xi):
         return np.interp(xi, self.x, self.values)
+
+    def surface(self, xi, yi):
+        """``μ(x̂, ŷ)`` bilinear in the table: linear along x on each row, then along y between rows
+        (``lo + w (hi − lo)``: equal rows give the row's ``μ(x)`` exactly)."""
+        rows = np.array([np.interp(xi, self.x, r) for r in self.values])
+        y = np.asarray(self.y)
+        yc = np.clip(yi, y[0], y[-1])
+        j = np.clip(np.searchsorted(y, yc, side="right") - 1, 0, len(y) - 2)
+        w = (yc - y[j]) / (y[j + 1] - y[j])
+        k = np.arange(np.size(xi))
+        lo, hi = rows[j, k], rows[j + 1, k]
+        return lo + w * (hi - lo)
 
     def span(self):
         return self.x[0], self.x[-1]

@@ -496,6 +496,10 @@ def check_convective_step(scene) -> None:
 def check_friction(scene) -> None:
     """A friction law varying along the surface meets the strip during the run (:mod:`rollqp.friction`)."""
     law = scene.contact.friction
+    key = law.varies_in_y() if hasattr(law, "varies_in_y") else None
+    if key is not None:
+        raise InputError(f"contact.friction.{key}", "makes μ vary along y, which only a 3D scene has (a 2D "
+                                                    "scene's laws vary along x only: leave it out)")
     if law.kind == "spatial":  # (rollqp.friction.FrictionLaw: a spatial law checks that it meets the strip)
         q = scene.q_end / scene.a_H
         if scene.load.rolled is not None:  # a load path: the range of q it covers (stops, reversals)
