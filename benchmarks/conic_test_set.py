@@ -109,7 +109,8 @@ def main(argv=None) -> int:
     ap.add_argument("--small", action="store_true", help="the small set of the tests (seconds)")
     ap.add_argument("--only", help="comma-separated case names (" + ", ".join(generate.CASES) + ")")
     ap.add_argument("--run", action="store_true", help="run the solvers and write the report")
-    ap.add_argument("--solver", help="comma-separated solver routes (" + ", ".join(runner.SOLVERS + runner.FC_SOLVERS) + ")")
+    ap.add_argument("--solver",
+                    help="comma-separated solver routes (" + ", ".join(runner.SOLVERS + runner.FC_SOLVERS) + ")")
     ap.add_argument("--settings", help="comma-separated: default, high")
     ap.add_argument("--summarize", action="store_true", help="the report of the last run, again")
     ap.add_argument("--epigraph", metavar="NAME", help="Clarabel on one written program: epigraph against P = H")

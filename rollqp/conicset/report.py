@@ -130,6 +130,7 @@ def report(answers, catalogue, machine: str = "") -> str:
     if fc:
         out += ["## FCLib problems: the SOCP fixed point (each SOCP by Clarabel or SCS, tolerances 1e-10)", "",
                 "max|r − r*| in p0 from the certified solution; merit: the natural-map residual "
-                "‖r − Proj_C(r − û)‖₂ from W, q, μ; within 1e-6: converged, and distance and merit at most 1e-6.",
+                "‖r − Proj_C(r − û)‖₂ from W, q, μ; within 1e-6: converged, and distance and merit at "
+                "most 1e-6.",
                 "", _fclib(fc, catalogue), ""]
     return "\n".join(out)

@@ -73,7 +73,8 @@ def available(solver: str) -> bool:
     """Whether the solver (and cvxpy, for a ``cvxpy-`` route; h5py, for a ``socp-fp-`` route) imports."""
     import importlib
     name = solver.removeprefix("cvxpy-").removeprefix("socp-fp-")
-    mods = [name] + (["cvxpy"] if solver.startswith("cvxpy-") else []) + (["h5py"] if solver.startswith("socp-fp-") else [])
+    mods = [name] + (["cvxpy"] if solver.startswith("cvxpy-") else []) \
+        + (["h5py"] if solver.startswith("socp-fp-") else [])
     try:
         for m in mods:
             importlib.import_module(m)
