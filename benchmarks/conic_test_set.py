@@ -16,9 +16,11 @@ writes the set to ``DIR`` (default ``conic-test-set``)::
     DIR/problems.json, problems.md   the catalogue
 
 and with ``--run`` runs every installed conic solver (Clarabel, SCS, ECOS, CVXOPT; natively on the CBF
-file and through cvxpy) at default and high-accuracy settings: ``DIR/results/report.md`` (qpbenchmark's
-style: success rate, shifted geometric mean of time, accuracy against the certified solutions) and
-``DIR/results/answers.jsonl`` (every solve). Needs the extra ``conicbench``.
+file and through cvxpy) at default and high-accuracy settings, and the FCLib problems by the SOCP fixed
+point (``socp-fp-clarabel``, ``socp-fp-scs``: rollqp.conicset.fcsocp): ``DIR/results/report.md``
+(qpbenchmark's style: success rate, shifted geometric mean of time, accuracy against the certified
+solutions), ``DIR/results/answers.jsonl`` and ``answers-fclib.jsonl`` (every solve). Needs the extra
+``conicbench``.
 """
 from __future__ import annotations
 
@@ -107,7 +109,8 @@ def main(argv=None) -> int:
     ap.add_argument("--small", action="store_true", help="the small set of the tests (seconds)")
     ap.add_argument("--only", help="comma-separated case names (" + ", ".join(generate.CASES) + ")")
     ap.add_argument("--run", action="store_true", help="run the solvers and write the report")
-    ap.add_argument("--solver", help="comma-separated solver routes (" + ", ".join(runner.SOLVERS) + ")")
+    ap.add_argument("--solver",
+                    help="comma-separated solver routes (" + ", ".join(runner.SOLVERS + runner.FC_SOLVERS) + ")")
     ap.add_argument("--settings", help="comma-separated: default, high")
     ap.add_argument("--summarize", action="store_true", help="the report of the last run, again")
     ap.add_argument("--epigraph", metavar="NAME", help="Clarabel on one written program: epigraph against P = H")
@@ -118,21 +121,32 @@ def main(argv=None) -> int:
         return 0
     if args.summarize:
         catalogue = json.loads((out / "problems.json").read_text(encoding="utf-8"))
-        lines = (out / "results" / "answers.jsonl").read_text(encoding="utf-8").splitlines()
+        lines = []
+        for log in ("answers.jsonl", "answers-fclib.jsonl"):
+            if (out / "results" / log).exists():
+                lines += (out / "results" / log).read_text(encoding="utf-8").splitlines()
         _report(out, [runner.Answer(**json.loads(s)) for s in lines if s.strip()], catalogue)
         return 0
     catalogue = _generate(args)
     if args.run:
-        solvers = args.solver.split(",") if args.solver else None
+        wanted = args.solver.split(",") if args.solver else list(runner.SOLVERS + runner.FC_SOLVERS)
+        unknown = [s for s in wanted if s not in runner.SOLVERS + runner.FC_SOLVERS]
+        if unknown:
+            print(f"unknown solver route(s) {', '.join(unknown)}; known: "
+                  f"{', '.join(runner.SOLVERS + runner.FC_SOLVERS)}")
+            return 2
         settings = tuple(args.settings.split(",")) if args.settings else runner.SETTINGS
-        missing = [s for s in (solvers or runner.SOLVERS) if not runner.available(s)]
+        missing = [s for s in wanted if not runner.available(s)]
         if missing:
             print(f"not installed, skipped: {', '.join(missing)} (pip install -e '.[conicbench]')")
 
         def said(a):
-            print(f"  {a.problem:30s} {a.solver:15s} {a.settings:8s} {'ok' if a.ok else a.status[:24]:24s} "
+            print(f"  {a.problem:30s} {a.solver:16s} {a.settings:8s} {'ok' if a.ok else a.status[:24]:24s} "
                   f"|x − x*| {a.dx:.1e}  residual {a.residual:.1e}  {a.time:.3f} s", flush=True)
-        answers = runner.run_set(out, solvers, settings, progress=said)
+        conic = [s for s in wanted if s in runner.SOLVERS and runner.available(s)]
+        fc = [s for s in wanted if s in runner.FC_SOLVERS and runner.available(s)]
+        answers = runner.run_set(out, conic, settings, progress=said) if conic else []
+        answers += runner.run_fclib(out, fc, progress=said) if fc else []
         _report(out, answers, catalogue)
     return 0
 

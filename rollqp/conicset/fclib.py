@@ -82,8 +82,9 @@ def write(path, W, q, mu, r=None, u=None, title="", description="", math_info=""
             sol.create_dataset("r", data=np.asarray(r, dtype=float))
 
 
-def read(path) -> dict:
-    """``{"W": csc, "q", "mu", "spacedim", "u", "r" (or None), "title"}`` of an FCLib local problem."""
+def read(path, solution: bool = True) -> dict:
+    """``{"W": csc, "q", "mu", "spacedim", "u", "r" (or None), "title"}`` of an FCLib local problem
+    (``solution=False``: the problem only, ``/solution`` not read)."""
     h5py = _h5py()
     with h5py.File(path, "r") as f:
         loc = f["fclib_local"]
@@ -94,7 +95,7 @@ def read(path) -> dict:
         W = sp.csc_matrix((g["x"][:], g["i"][:], g["p"][:]), shape=(m, n))
         out = {"W": W, "q": loc["vectors/q"][:], "mu": loc["vectors/mu"][:], "spacedim": int(loc["spacedim"][0]),
                "u": None, "r": None, "title": loc["info/title"][()].decode() if "info/title" in loc else ""}
-        if "solution" in f:
+        if solution and "solution" in f:
             out["u"], out["r"] = f["solution/u"][:], f["solution/r"][:]
     return out
 

@@ -99,8 +99,22 @@ def _times(answers, settings, solvers, catalogue):
     return "\n".join(rows)
 
 
+def _fclib(answers, catalogue):
+    rows = ["| problem | contacts | route | converged | fixed-point it. | solver it. | time [s] | max\\|r − r*\\| | "
+            "merit | rollqp residual | within 1e-6 |", "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for a in sorted(answers, key=lambda a: (catalogue.get(a.problem, {}).get("n", 0), a.problem, a.solver)):
+        good = a.ok and a.dx <= WITHIN and a.merit <= WITHIN
+        rows.append(f"| `{a.problem}` | {catalogue.get(a.problem, {}).get('contacts', '')} | {a.solver} | "
+                    f"{'yes' if a.ok else 'no: ' + a.status} | {a.iterations} | {a.inner} | {a.time:.2f} | "
+                    f"{a.dx:.1e} | {a.merit:.1e} | {a.residual:.1e} | {'yes' if good else 'no'} |")
+    return "\n".join(rows)
+
+
 def report(answers, catalogue, machine: str = "") -> str:
-    """The Markdown report of a run (module docstring)."""
+    """The Markdown report of a run (module docstring); the FCLib problems' answers (the SOCP fixed
+    point) in their own table."""
+    fc = [a for a in answers if catalogue.get(a.problem, {}).get("kind") == "fc"]
+    answers = [a for a in answers if catalogue.get(a.problem, {}).get("kind") != "fc"]
     solvers = list(dict.fromkeys(a.solver for a in answers))
     settings = list(dict.fromkeys(a.settings for a in answers))
     n = len({a.problem for a in answers})
@@ -113,4 +127,10 @@ def report(answers, catalogue, machine: str = "") -> str:
         out += [f"## Distance from the certified solution, {st} settings (max|x − x*| in p0; ✗: the solver's "
                 f"status is not solved)", "", _per_problem(answers, st, solvers, catalogue), ""]
         out += [f"Median wall time [s], {st} settings:", "", _times(answers, st, solvers, catalogue), ""]
+    if fc:
+        out += ["## FCLib problems: the SOCP fixed point (each SOCP by Clarabel or SCS, tolerances 1e-10)", "",
+                "max|r − r*| in p0 from the certified solution; merit: the natural-map residual "
+                "‖r − Proj_C(r − û)‖₂ from W, q, μ; within 1e-6: converged, and distance and merit at "
+                "most 1e-6.",
+                "", _fclib(fc, catalogue), ""]
     return "\n".join(out)

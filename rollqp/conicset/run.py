@@ -27,11 +27,11 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from . import cbf
+from . import cbf, fclib, fcsocp
 from .forms import ProgramData, residual
 
-__all__ = ["SOLVERS", "SETTINGS", "Answer", "available", "solve", "run_set", "HIGH_ACCURACY", "TIME_LIMIT",
-           "WITHIN"]
+__all__ = ["SOLVERS", "FC_SOLVERS", "SETTINGS", "Answer", "available", "solve", "run_set", "run_fclib",
+           "HIGH_ACCURACY", "TIME_LIMIT", "WITHIN"]
 
 #: qpbenchmark's high-accuracy tolerance, for every gap and feasibility tolerance of the ``high`` settings.
 HIGH_ACCURACY = 1e-9
@@ -43,12 +43,18 @@ WITHIN = 1e-6
 #: The solvers (``route-name``): native on the CBF file, cvxpy on the program's arrays.
 SOLVERS = ("clarabel", "scs", "ecos", "cvxopt", "cvxpy-clarabel", "cvxpy-scs", "cvxpy-ecos", "cvxpy-cvxopt")
 SETTINGS = ("default", "high")
+#: The routes for the FCLib problems: the SOCP fixed point (:mod:`~rollqp.conicset.fcsocp`), each SOCP by
+#: Clarabel or by SCS at high accuracy.
+FC_SOLVERS = ("socp-fp-clarabel", "socp-fp-scs")
 
 
 @dataclass
 class Answer:
     """One solve: ``ok`` the solver's own status says solved; ``dx`` ``max|x − x*|``; ``residual``
-    rollqp's; ``time`` wall seconds of the solver call (cvxpy: ``problem.solve``, its compilation included)."""
+    rollqp's; ``time`` wall seconds of the solver call (cvxpy: ``problem.solve``, its compilation included).
+    FCLib routes: ``dx`` is ``max|r − r*|`` (in ``p0``), ``iterations`` the fixed-point iterations, ``inner``
+    the conic solver's iterations summed over them and ``merit`` the natural-map residual
+    (:func:`~rollqp.conicset.fcsocp.merit`)."""
 
     problem: str
     solver: str
@@ -59,13 +65,16 @@ class Answer:
     residual: float
     time: float
     iterations: int
+    inner: int = 0
+    merit: float = float("nan")
 
 
 def available(solver: str) -> bool:
-    """Whether the solver (and cvxpy, for a ``cvxpy-`` route) imports."""
+    """Whether the solver (and cvxpy, for a ``cvxpy-`` route; h5py, for a ``socp-fp-`` route) imports."""
     import importlib
-    name = solver.removeprefix("cvxpy-")
-    mods = [name] + (["cvxpy"] if solver.startswith("cvxpy-") else [])
+    name = solver.removeprefix("cvxpy-").removeprefix("socp-fp-")
+    mods = [name] + (["cvxpy"] if solver.startswith("cvxpy-") else []) \
+        + (["h5py"] if solver.startswith("socp-fp-") else [])
     try:
         for m in mods:
             importlib.import_module(m)
@@ -246,4 +255,36 @@ def run_set(folder, solvers=None, settings=SETTINGS, only=None, progress=None) -
                     log.flush()
                     if progress:
                         progress(ans)
+    return out
+
+
+def run_fclib(folder, solvers=None, only=None, progress=None, limit: float = 4 * TIME_LIMIT) -> list[Answer]:
+    """Every FCLib problem under ``folder/fclib`` on the SOCP fixed point (``solvers``: :data:`FC_SOLVERS`,
+    default every available one), each read from its file alone, then scored against the file's certified
+    ``/solution`` and by the natural-map merit; answers written to ``folder/results/answers-fclib.jsonl``.
+    ``limit`` wall seconds per fixed point."""
+    folder = Path(folder)
+    solvers = [s for s in (solvers or FC_SOLVERS) if s in FC_SOLVERS and available(s)]
+    names = sorted(p.stem for p in (folder / "fclib").glob("*.hdf5"))
+    if only:
+        names = [n for n in names if n in only]
+    (folder / "results").mkdir(exist_ok=True)
+    out = []
+    with open(folder / "results" / "answers-fclib.jsonl", "w", encoding="utf-8") as log:
+        for name in names:
+            path = folder / "fclib" / f"{name}.hdf5"
+            d = fclib.read(path)
+            for solver in solvers:
+                a = fcsocp.solve_file(path, solver.removeprefix("socp-fp-"), limit=limit)
+                fin = bool(np.all(np.isfinite(a.r)))
+                ans = Answer(name, solver, "high", a.converged, a.status if a.converged else
+                             f"not converged: {a.status}, |ds| {a.ds:.1e}",
+                             float(np.max(np.abs(a.r - d["r"]))) if fin else float("inf"),
+                             fclib.residual(d["W"], d["q"], d["mu"], a.r) if fin else float("inf"), a.time,
+                             a.iterations, a.inner, fcsocp.merit(d["W"], d["q"], d["mu"], a.r) if fin else float("inf"))
+                out.append(ans)
+                log.write(json.dumps(asdict(ans)) + "\n")
+                log.flush()
+                if progress:
+                    progress(ans)
     return out
