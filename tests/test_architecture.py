@@ -164,3 +164,23 @@ def test_import_rollqp_loads_no_optional_or_heavy_module():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "", f"imported by `import rollqp`: {out.stdout.strip()}"
+
+
+def test_the_method_table_declares_the_dimensions_of_every_class_it_imports_on_first_use():
+    """The table names the classes that need scipy or a solver package by module, with their dimensions
+    declared (``import rollqp`` then loads neither): each declaration must be the class's own record."""
+    from rollqp.errors import MissingBackendError
+    from rollqp.methods import _TABLE, Optional
+    checked = 0
+    for name, entries in _TABLE.items():
+        for entry in entries:
+            if not isinstance(entry, Optional):
+                continue
+            try:
+                cls = entry.load()
+            except (ImportError, MissingBackendError):
+                assert entry.extra is not None, f"{name}: a core method class failed to import"
+                continue    # an optional package that is not installed
+            assert cls.capabilities.dimensions == entry.dimensions, (name, entry)
+            checked += 1
+    assert checked >= 12, checked   # the core entries at least: the check is not blind

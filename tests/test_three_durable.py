@@ -310,11 +310,13 @@ def test_a_second_ctrl_c_keeps_every_completed_3d_state(tmp_path, gap_ms):
     """Ctrl-C twice, the second 5–20 ms after the first: exit 130, one line naming the completed states, the file
     holding them and no journal left beside it (the second signal is ignored while the first one's states are
     written)."""
-    scene = coarse("cattaneo-3d", **{"discretization.distance": 40.0})
+    # long enough to be running when the signals come on a quiet machine (about 1 ms a step on 12 x 12: 1,850
+    # steps), the first progress line after 0.05 s of stepping
+    scene = coarse("cattaneo-3d", **{"discretization.distance": 400.0})
     (tmp_path / "scene.toml").write_text(scene.to_toml(), encoding="utf-8")
     proc = subprocess.Popen([sys.executable, "-m", "rollqp.cli", "run", "scene.toml", "--out", "r.npz"], cwd=tmp_path,
                             stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, preexec_fn=_default_sigint,
-                            env=dict(os.environ, OPENBLAS_NUM_THREADS="1", ROLLQP_PROGRESS_SECONDS="0.3"))
+                            env=dict(os.environ, OPENBLAS_NUM_THREADS="1", ROLLQP_PROGRESS_SECONDS="0.05"))
     line = proc.stderr.readline()
     while line and not line.startswith("rollqp: step "):
         line = proc.stderr.readline()

@@ -9,7 +9,7 @@ field with the kernel array of :func:`rollqp.influence.cerruti.kernels`:
     u_{j,i} = \sum_{j',i'} K[j − j' + n_y − 1,\ i − i' + n_x − 1]\; t_{j',i'}          \qquad (3D.13)
 
 computed exactly (no periodic wrap-around) by real FFTs of size ``L_y × L_x ≥ (2n_y − 1) ×
-(2n_x − 1)`` (``scipy.fft.next_fast_len``), the kernel's transform computed once per operator:
+(2n_x − 1)`` (``_fft().next_fast_len``), the kernel's transform computed once per operator:
 ``O(n log n)`` time and ``O(n)`` memory, so the matrix is never needed. A
 :class:`BlockToeplitz` maps ``m_in`` traction components to ``m_out`` displacement components
 (``A_nn``: 1 × 1; ``A_tt``: 2 × 2 with blocks ``xx, xy; yx, yy``; couplings 1 × 2 and 2 × 1);
@@ -21,9 +21,16 @@ vectors are the components' flattened fields one after the other (``[t_x, t_y]``
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft
 
 from ..errors import InputError
+
+
+def _fft():
+    """``scipy.fft``, imported on a grid's first product: ``import rollqp`` loads no scipy (a 2D half-space
+    scene never needs it)."""
+    import scipy.fft
+    return scipy.fft
+
 
 __all__ = ["BlockToeplitz", "DENSE_MAX"]
 
@@ -71,8 +78,8 @@ class BlockToeplitz:
                 if k is not None:
                     k.flags.writeable = False
         self.m_out, self.m_in = len(self.blocks), len(self.blocks[0])
-        self._fft_shape = (scipy.fft.next_fast_len(shape[0], real=True),
-                           scipy.fft.next_fast_len(shape[1], real=True))
+        self._fft_shape = (_fft().next_fast_len(shape[0], real=True),
+                           _fft().next_fast_len(shape[1], real=True))
         self._hat = None
         self._memo = {}
 
@@ -99,7 +106,7 @@ class BlockToeplitz:
     def _transforms(self):
         if self._hat is None:
             L = self._fft_shape
-            self._hat = [[None if k is None else scipy.fft.rfft2(k, s=L) for k in row] for row in self.blocks]
+            self._hat = [[None if k is None else _fft().rfft2(k, s=L) for k in row] for row in self.blocks]
         return self._hat
 
     def __matmul__(self, x) -> np.ndarray:
@@ -112,7 +119,7 @@ class BlockToeplitz:
             raise InputError(self.name, f"product with a vector of shape {x.shape}, expected ({self.m_in * g.n},)")
         L = self._fft_shape
         fields = x.reshape(self.m_in, g.ny, g.nx)
-        hats = [scipy.fft.rfft2(f, s=L) for f in fields]
+        hats = [_fft().rfft2(f, s=L) for f in fields]
         out = np.empty((self.m_out, g.ny, g.nx))
         for a, row in enumerate(self._transforms()):
             acc = None
@@ -122,7 +129,7 @@ class BlockToeplitz:
             if acc is None:
                 out[a] = 0.0
             else:
-                full = scipy.fft.irfft2(acc, s=L)
+                full = _fft().irfft2(acc, s=L)
                 out[a] = full[g.ny - 1:2 * g.ny - 1, g.nx - 1:2 * g.nx - 1]
         return out.ravel()
 

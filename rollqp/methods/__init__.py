@@ -63,24 +63,18 @@ from .base import (FRICTION_KINDS, KINDS, Capabilities, Method, check_kind,  # n
                    check_options)
 from .continuation import SlipContinuation
 from .fixedpoint import BoundFixedPoint
-from .fastsim import FastsimMethod
-from .krylov import KrylovNewton
-from .newton import NewtonMethod
-from .newton.disc import NewtonMethod as _DiscNewton
-from .nt_newton import AlternationNewton
-from .qp_clarabel import ClarabelQP
-from .qp_osqp import OsqpQP
-from .socp import ClarabelMethod, CvxpyMethod, OsqpMethod, ScsMethod
 
 
 @dataclass(frozen=True)
 class Optional:
-    """A method class in a module that needs an optional package: imported on first use, its
-    ``dimensions`` declared here (so that the table is read without importing it)."""
+    """A method class imported on first use, its ``dimensions`` declared here (so that the table is read
+    without importing it): a module that needs an optional package (``extra``, the pip extra that brings
+    it), or a core one that needs scipy or a solver package (``extra = None``: ``import rollqp`` loads
+    neither; ``tests/test_layers.py`` checks each declaration against the class's capabilities)."""
 
     module: str
     attr: str
-    extra: str
+    extra: str | None
     dimensions: frozenset = frozenset({2})
 
     def load(self) -> type:
@@ -90,20 +84,27 @@ class Optional:
 
 #: The one method table: name -> the classes (or optional modules) under that name, at most one per
 #: dimension; each class's ``capabilities.dimensions`` says which scenes it runs.
+_TWO, _THREE = frozenset({2}), frozenset({3})
+
+
+def _core(module: str, attr: str, dimensions: frozenset) -> Optional:
+    return Optional(f"rollqp.methods.{module}", attr, None, dimensions)
+
+
 _TABLE: dict[str, tuple] = {
-    "qp-clarabel": (ClarabelQP, ClarabelMethod),
-    "qp-osqp": (OsqpQP, OsqpMethod),
-    "qp-cvxpy": (Optional("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"), CvxpyMethod),
-    "newton": (NewtonMethod, _DiscNewton),
-    "nt-newton": (AlternationNewton,),
-    "mf-newton": (KrylovNewton,),
+    "qp-clarabel": (_core("qp_clarabel", "ClarabelQP", _TWO), _core("socp", "ClarabelMethod", _THREE)),
+    "qp-osqp": (_core("qp_osqp", "OsqpQP", _TWO), _core("socp", "OsqpMethod", _THREE)),
+    "qp-cvxpy": (Optional("rollqp.methods.qp_cvxpy", "CvxpyQP", "cvxpy"), _core("socp", "CvxpyMethod", _THREE)),
+    "newton": (_core("newton", "NewtonMethod", _TWO), _core("newton.disc", "NewtonMethod", _THREE)),
+    "nt-newton": (_core("nt_newton", "AlternationNewton", _TWO),),
+    "mf-newton": (_core("krylov", "KrylovNewton", _TWO),),
     # qpsolvers backends: the module's attribute qps_<solver> checks that the solver is installed
     **{f"qps-{s}": (Optional("rollqp.methods.qp_qpsolvers", f"qps_{s}", "qpsolvers"),)
        for s in ("daqp", "quadprog", "proxqp", "piqp", "highs")},
-    "socp-clarabel": (ClarabelMethod,),
-    "socp-cvxpy": (CvxpyMethod,),
-    "socp-scs": (ScsMethod,),
-    "fastsim": (FastsimMethod,),
+    "socp-clarabel": (_core("socp", "ClarabelMethod", _THREE),),
+    "socp-cvxpy": (_core("socp", "CvxpyMethod", _THREE),),
+    "socp-scs": (_core("socp", "ScsMethod", _THREE),),
+    "fastsim": (_core("fastsim", "FastsimMethod", _THREE),),
 }
 
 
@@ -135,6 +136,8 @@ class MethodRecord:
             try:
                 return entry.load()
             except ModuleNotFoundError as exc:
+                if entry.extra is None:
+                    raise
                 raise MissingBackendError(f"method {self.name!r} needs the package {exc.name!r} "
                                           f"(pip install 'rollqp[{entry.extra}]')") from exc
         return entry

@@ -22,8 +22,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.special import ellipe, ellipk
 
 from ..errors import InputError
 
@@ -34,6 +32,7 @@ _SERIES = 1e-3   # below: power series of (K−E)/m and (E/(1−m) − K)/m, err
 
 def _quotients(m: float) -> tuple[float, float, float, float]:
     """``(K, E, (K − E)/m, (E/(1 − m) − K)/m)`` at parameter ``m = 1 − g²``."""
+    from scipy.special import ellipe, ellipk   # scipy on first use: ``import rollqp`` loads none
     K, E = float(ellipk(m)), float(ellipe(m))
     if m < _SERIES:
         h = 0.5 * math.pi
@@ -66,6 +65,7 @@ def _ratio_to_g(y: float) -> float:
     lo = 1e-6
     if curvature_ratio(lo) > y:
         raise InputError("curvatures", f"curvature ratio {y:.3g} is beyond an ellipse with b/a = 1e-6")
+    from scipy.optimize import brentq
     return brentq(lambda g: curvature_ratio(g) - y, lo, 1.0, xtol=1e-15, rtol=4 * np.finfo(float).eps)
 
 
