@@ -133,6 +133,15 @@ def _parser():
 LOG_EVERY = 5.0
 
 
+def _log_every() -> float:
+    """Seconds between progress lines: ``$ROLLQP_PROGRESS_SECONDS``, or :data:`LOG_EVERY` when unset or
+    not a number."""
+    try:
+        return float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
+    except ValueError:
+        return LOG_EVERY
+
+
 def _progress(quiet):
     """A progress callback and its closer: a tqdm bar on a terminal (after 2 s, if tqdm is
     installed), a line every :data:`LOG_EVERY` seconds otherwise (logs and batch jobs)."""
@@ -154,10 +163,7 @@ def _progress(quiet):
             return cb, lambda: bar.get("b") and bar["b"].close()
     t0 = time.perf_counter()
     last = [t0]
-    try:
-        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
-    except ValueError:
-        every = LOG_EVERY
+    every = _log_every()
 
     def line(k, K):
         now = time.perf_counter()
@@ -174,10 +180,7 @@ def _iteration_lines():
     step (the Newton iterations of a large grid's steady step, with the residual), and from a minute on
     the remaining time estimated from the residual's last decrease."""
     from .progress import remaining_iterations
-    try:
-        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
-    except ValueError:
-        every = LOG_EVERY
+    every = _log_every()
     state = {"last": 0.0, "res": []}
 
     def listen(what, it, res, seconds, target):
@@ -542,10 +545,7 @@ def start_progress():
     :data:`ANNOUNCE_SECONDS`; then a line every ``ROLLQP_PROGRESS_SECONDS`` (default :data:`LOG_EVERY`)."""
     t0 = time.perf_counter()
     state = {"last": t0, "said": False}
-    try:
-        every = float(os.environ.get("ROLLQP_PROGRESS_SECONDS", LOG_EVERY))
-    except ValueError:
-        every = LOG_EVERY
+    every = _log_every()
 
     def tick(j, expected):
         now = time.perf_counter()
