@@ -28,6 +28,27 @@ _STRINGS = ("format", "kind", "step_type", "ref_method", "scene")
 STEP_TYPES = ("rolling", "static-shift", "steady")
 
 
+
+def write_step_files(path, arrays: dict, native: bool, clarabel_json, cvxpy_script) -> list[str]:
+    """Write a step file's ``.npz`` and (``native``) ``STEM.normal.clarabel.json``,
+    ``STEM.tangential.clarabel.json`` and ``STEM.cvxpy.py`` beside it, from the dimension's writers
+    ``clarabel_json(arrays, half)`` and ``cvxpy_script(npz_name)``; return the paths (both dimensions)."""
+    from ..result import save_npz
+    path = save_npz(path, arrays, "step file")
+    written = [path]
+    if native:
+        stem = path[:-4]
+        for half in ("normal", "tangential"):
+            name = f"{stem}.{half}.clarabel.json"
+            with open(name, "w", encoding="utf-8") as fh:
+                json.dump(clarabel_json(arrays, half), fh)
+            written.append(name)
+        name = f"{stem}.cvxpy.py"
+        with open(name, "w", encoding="utf-8") as fh:
+            fh.write(cvxpy_script(os.path.basename(path)))
+        written.append(name)
+    return written
+
 @dataclass
 class StepFile:
     """One step of a scene with rollqp's solution of it (module docstring; ``docs/stepfiles.md``).
@@ -153,22 +174,7 @@ class StepFile:
         ``load_from_file`` format, the ``q_frozen`` QPs) and ``STEP.cvxpy.py`` (rebuilds both
         halves from the ``.npz`` and solves them; writes ``STEP.cvxpy-solution.npz``).
         """
-        from ..result import save_npz
-        arrays = self.arrays()
-        path = save_npz(path, arrays, "step file")
-        written = [path]
-        if native:
-            stem = path[:-4]
-            for half in ("normal", "tangential"):
-                name = f"{stem}.{half}.clarabel.json"
-                with open(name, "w", encoding="utf-8") as fh:
-                    json.dump(clarabel_json(arrays, half), fh)
-                written.append(name)
-            name = f"{stem}.cvxpy.py"
-            with open(name, "w", encoding="utf-8") as fh:
-                fh.write(cvxpy_script(os.path.basename(path)))
-            written.append(name)
-        return written
+        return write_step_files(path, self.arrays(), native, clarabel_json, cvxpy_script)
 
     @classmethod
     def load(cls, path, arg: str = "STEP.npz") -> "StepFile":

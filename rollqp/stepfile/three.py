@@ -32,6 +32,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..npzfile import read_npz, real_array, real_scalar, text_value
+from .file import write_step_files
 
 __all__ = ["FORMAT_3D", "MAX_ELEMENTS_3D", "StepFile3D", "export_step_3d", "check_step_3d", "Check3D",
            "load_solution_3d", "DenseOperator"]
@@ -181,22 +182,7 @@ class StepFile3D:
     def save(self, path, native: bool = True) -> list[str]:
         """Write the ``.npz`` and (``native``) ``STEM.normal.clarabel.json``, ``STEM.tangential.clarabel.json``
         (``clarabel.load_from_file``'s format) and ``STEM.cvxpy.py``; return the paths."""
-        from ..result import save_npz
-        arrays = self.arrays()
-        path = save_npz(path, arrays, "step file")
-        written = [path]
-        if native:
-            stem = path[:-4]
-            for half in ("normal", "tangential"):
-                name = f"{stem}.{half}.clarabel.json"
-                with open(name, "w", encoding="utf-8") as fh:
-                    json.dump(clarabel_json_3d(arrays, half), fh)
-                written.append(name)
-            name = f"{stem}.cvxpy.py"
-            with open(name, "w", encoding="utf-8") as fh:
-                fh.write(cvxpy_script_3d(os.path.basename(path)))
-            written.append(name)
-        return written
+        return write_step_files(path, self.arrays(), native, clarabel_json_3d, cvxpy_script_3d)
 
     @classmethod
     def load(cls, path, arg: str = "STEP.npz", z: dict | None = None) -> "StepFile3D":
