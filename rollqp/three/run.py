@@ -27,6 +27,7 @@ from ..atomic import stop_once
 from ..errors import InputError, SolverError
 from ..fields import fields_for
 from ..march import RESUME_TOL, _keep_every, _last_index, drive
+from ..friction import law_kind
 from ..methods import compose_3d, scene_method_3d
 from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
@@ -54,7 +55,9 @@ def prepare(scene, method=None):
                                               f"{scene.dimension}D (rollqp.run runs either)")
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
-    meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
+    kind = law_kind(scene.contact.friction)
+    meth = (scene_method_3d(scene.solver, friction=kind) if method is None or isinstance(method, str)
+            else compose_3d(method, friction=kind))
     contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
                       profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
