@@ -158,6 +158,28 @@ class SlipContinuation:
         return sol
 
 
+    def _selected(self, problem, warm, kappa):
+        t0 = time.perf_counter()
+        frozen = frozen_coefficients(problem, warm)
+        start = self.inner.solve(problem.replace(mu=frozen, law=None), warm=warm)
+        sc = problem.scales
+        x0 = start.t / sc.stress
+        if problem.Q is not None:
+            x0 = np.append(x0, start.xi / sc.slip)
+        path = FrozenBoundPath(problem, frozen)
+        try:
+            u, stats = follow(path, x0)
+        except PathStop as err:  # the method's own solution, saying that it was not selected
+            sol = self.inner.solve(problem, warm=warm)
+            sol.info.update(path={"stopped": err.message, "lam": err.lam}, steepness=kappa)
+            return sol
+        end = path.solution(u)
+        sol = self.inner.solve(problem.derived(law=problem.law.homotopy(frozen, 1.0)), warm=end)
+        sol.info.update(path=stats, steepness=kappa)
+        sol.time = time.perf_counter() - t0
+        return sol
+
+
 #: The smallest step in ``λ`` of the grid's path (:func:`follow_grid`): below it the path has met a fold.
 MIN_LAMBDA_STEP = 1.0 / 1024
 #: A step of the grid's path is halved when it changes the tractions by more than this many times the step before
@@ -200,24 +222,3 @@ def _warn_unselected(err):
     """Say that a step's solution could not be selected: uniqueness fails there (docs/friction.md)."""
     warnings.warn(f"falling friction: {err.message}; the method's own solution is returned", RuntimeWarning,
                   stacklevel=3)
-
-    def _selected(self, problem, warm, kappa):
-        t0 = time.perf_counter()
-        frozen = frozen_coefficients(problem, warm)
-        start = self.inner.solve(problem.replace(mu=frozen, law=None), warm=warm)
-        sc = problem.scales
-        x0 = start.t / sc.stress
-        if problem.Q is not None:
-            x0 = np.append(x0, start.xi / sc.slip)
-        path = FrozenBoundPath(problem, frozen)
-        try:
-            u, stats = follow(path, x0)
-        except PathStop as err:  # the method's own solution, saying that it was not selected
-            sol = self.inner.solve(problem, warm=warm)
-            sol.info.update(path={"stopped": err.message, "lam": err.lam}, steepness=kappa)
-            return sol
-        end = path.solution(u)
-        sol = self.inner.solve(problem.derived(law=problem.law.homotopy(frozen, 1.0)), warm=end)
-        sol.info.update(path=stats, steepness=kappa)
-        sol.time = time.perf_counter() - t0
-        return sol
