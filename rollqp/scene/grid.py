@@ -384,7 +384,7 @@ class Scene3D(TwoBodyScene):
 
     def contact_elements(self) -> int:
         """The elements whose centres lie inside the Hertz ellipse: about those in contact (the size of
-        a step's conic program, which :mod:`rollqp.three.advice` estimates from)."""
+        a step's conic program, which :mod:`rollqp.advice.grid` estimates from)."""
         e, g = self.ellipse, self.grid
         X, Y = np.meshgrid(g.x / e.a, g.y / e.b)
         return int(np.sum(X * X + Y * Y < 1))
