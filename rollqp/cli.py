@@ -681,7 +681,7 @@ def cmd_crossval(args) -> int:
 
 
 def cmd_extrapolate(args) -> int:
-    """``rollqp extrapolate SCENE [--grids N1,N2,N3]`` (:func:`rollqp.three.extrapolate.extrapolate`)."""
+    """``rollqp extrapolate SCENE [--grids N1,N2,N3]`` (:func:`rollqp.extrapolate.extrapolate`)."""
     from .errors import InputError
     from .scene import load_scene
     scene = load_scene(args.scene)
@@ -694,7 +694,7 @@ def cmd_extrapolate(args) -> int:
             raise InputError("--grids", f"must be three integers N1,N2,N3, got {args.grids!r}") from None
         if any(g < 1 or g > 2000 for g in grids):
             raise InputError("--grids", f"each count must be in [1, 2000], got {args.grids!r}")
-    from .three.extrapolate import extrapolate
+    from .extrapolate import extrapolate
     print(extrapolate(scene, grids))
     return 0
 

@@ -104,7 +104,7 @@ def test_crossval_step_choice_still_checks(kept):
 
 # ------------------------------------------------------------------------------- extrapolation
 def test_richardson_recovers_a_power_law_and_its_order():
-    from rollqp.three.extrapolate import richardson
+    from rollqp.extrapolate import richardson
     for p in (0.7, 1.0, 2.0):
         e = richardson([3.0 + 0.4 * h ** p for h in (0.2, 0.1, 0.05)], 2.0)
         assert e.order == pytest.approx(p, rel=1e-9) and e.value == pytest.approx(3.0, rel=1e-12)
