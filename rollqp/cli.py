@@ -797,7 +797,8 @@ def cmd_sweep(args) -> int:
 def _sweep_3d(scene, args) -> int:
     from .sweep.three import sweep_3d
     out = args.out or default_output(scene.name, "-sweep.zarr")
-    _, summary = sweep_3d(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    _, summary = _sweep_signals(lambda: sweep_3d(scene, args.vary, out, scheduler=args.scheduler,
+                                                 workers=args.workers, quiet=args.quiet))
     if not args.quiet:
         print(f"rollqp sweep of {scene.name} (3D): {out}")
         print(summary.table())
@@ -812,8 +813,12 @@ def _creep_3d(scene, args) -> int:
                          "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
     out = args.out or default_output(scene.name, "-creep.zarr")
     _check_plot(args.plot)
-    curve = creep_curve_3d(scene, args.creepage or "longitudinal", args.values or "1e-4:2e-3:12", out,
-                           scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    curve = _sweep_signals(lambda: creep_curve_3d(scene, args.creepage or "longitudinal",
+                                                  args.values or "1e-4:2e-3:12", out, scheduler=args.scheduler,
+                                                  workers=args.workers, quiet=args.quiet))
+    if curve.FN is None:       # interrupted: the points done are saved in the store
+        print(curve.summary.table())
+        return _sweep_exit(curve.summary)
     if args.plot:
         curve.plot(args.plot)
     if not args.quiet:
