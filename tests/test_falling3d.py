@@ -217,3 +217,22 @@ def test_no_warning_where_the_path_is_followed():
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
         _run(_transient(0.0, distance=0.5), "newton")
+
+
+def test_a_run_without_memory_resumes_to_the_same_result():
+    scene = _transient(0.0, distance=1.0)
+    a = rollqp.run(scene).arrays()
+    part = {k: (v[:4] if np.ndim(v) and k not in ("x", "y") else v) for k, v in a.items()}
+    b = rollqp.run(scene, resume=part).arrays()
+    assert b["q"].shape == a["q"].shape
+    # the resumed state solved again from the state before it (the same computation): bit for bit
+    assert np.array_equal(b["px"], a["px"]) and np.array_equal(b["state"], a["state"])
+
+
+def test_a_run_with_memory_refuses_to_resume_in_one_line():
+    scene = _transient(0.3, distance=1.0)
+    a = rollqp.run(scene).arrays()
+    part = {k: (v[:4] if np.ndim(v) and k not in ("x", "y") else v) for k, v in a.items()}
+    with pytest.raises(InputError) as err:
+        rollqp.run(scene, resume=part)
+    assert str(err.value).startswith("--resume:") and "memory" in str(err.value) and "\n" not in str(err.value)

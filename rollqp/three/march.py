@@ -152,6 +152,8 @@ def _states(contact, p, t, s, q=0.0, mu=None):
     if contact.mu == 0:
         moving = np.hypot(*(np.asarray(s, dtype=float).reshape(2, -1) / contact.scales.slip)) > 1e-7
         return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
+    if mu is None and contact.law.kind == "slip":   # a stored state: the law at its own slip (without memory)
+        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float).reshape(2, -1), contact=np.asarray(p) > 0)
     bound = contact.bound(p, q) if mu is None else np.asarray(mu) * np.maximum(p, 0.0)
     return element_states(np.asarray(t), np.asarray(s), bound, contact.scales)
 
