@@ -102,7 +102,7 @@ class Family:
     ``export_step(scene, k, method)`` the step file of step ``k``; ``sweep(scene, args)`` and
     ``creep_curve(scene, args)`` run those commands and return the exit code; ``refuse(scene, allow_long)``
     raises an InputError, before any work, for a run that cannot finish in reasonable time or memory (3D conic
-    runs: :func:`rollqp.three.advice.refusal`; None: every run starts); ``memory_policy()`` how freed memory
+    runs: :func:`rollqp.advice.grid.refusal`; None: every run starts); ``memory_policy()`` how freed memory
     goes back to the system (:mod:`rollqp.cli.run`; None: kept for the next allocation).
 
     Each part is named as data, ``"module:attribute"``, and imported when a command first uses it (so that a
@@ -144,9 +144,9 @@ FAMILIES = {
               export_step="rollqp.stepfile:export_step", sweep="rollqp.cli.sweep:sweep_2d",
               creep_curve="rollqp.cli.creep_curve:creep_2d", memory_policy="rollqp.cli.run:give_back_freed_memory"),
     3: Family({"crossval", "export-step", "sweep", "creep-curve", "extrapolate"},
-              run="rollqp.three.run:run", summary="rollqp.three.report:summary", plot="rollqp.plot.three:three_figure",
+              run="rollqp.three.run:run", summary="rollqp.report.grid:summary", plot="rollqp.plot.three:three_figure",
               advise="rollqp.cli.run:advise_3d", spot="rollqp.cli.crossval:spot_3d", check="rollqp.cli.crossval:check_3d",
-              crossval="rollqp.cli.crossval:crossval_3d", refuse="rollqp.three.advice:refusal",
+              crossval="rollqp.cli.crossval:crossval_3d", refuse="rollqp.advice.grid:refusal",
               export_step="rollqp.stepfile.three:export_step_3d", sweep="rollqp.cli.sweep:sweep_3d",
               creep_curve="rollqp.cli.creep_curve:creep_3d"),
     "wheel-rail": Family({"crossval"},

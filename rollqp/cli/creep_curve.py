@@ -53,8 +53,12 @@ def creep_3d(scene, args) -> int:
                          "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
     out = args.out or default_output(scene.name, "-creep.zarr")
     check_plot(args.plot)
-    curve = creep_curve_3d(scene, args.creepage or "longitudinal", args.values or "1e-4:2e-3:12", out,
-                           scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    curve = sweep_signals(lambda: creep_curve_3d(scene, args.creepage or "longitudinal",
+                                                 args.values or "1e-4:2e-3:12", out, scheduler=args.scheduler,
+                                                 workers=args.workers, quiet=args.quiet))
+    if curve.FN is None:       # interrupted: the points done are saved in the store
+        print(curve.summary.table())
+        return sweep_exit(curve.summary)
     if args.plot:
         curve.plot(args.plot)
     if not args.quiet:

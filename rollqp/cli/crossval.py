@@ -4,12 +4,12 @@ steps again by other methods (docs/stepfiles.md)."""
 from __future__ import annotations
 
 from ..crossval import SPOT_MAX_NODES, SPOT_METHODS, report, spot_check
+from ..crossval.grid import SpotObserver, cross_check, spot_steps
+from ..crossval.grid import crossval as crossval_steps
 from ..errors import InputError
 from ..methods import SCENE_METHOD_NAMES
 from ..scene import load_scene
 from ..stepfile import StepFile, from_record
-from ..three.crosscheck import SpotObserver, cross_check, spot_steps
-from ..three.crosscheck import crossval as crossval_steps
 from .common import family, takes
 
 
@@ -43,7 +43,7 @@ def crossval_2d(scene, step, methods) -> int:
 
 def crossval_3d(scene, step, methods) -> int:
     """``rollqp crossval`` of a 3D scene: every step (or ``--step K``) of its run solved again by the SOCP
-    backends and Newton (:func:`rollqp.three.crosscheck.crossval`); exit 1 if they disagree."""
+    backends and Newton (:func:`rollqp.crossval.grid.crossval`); exit 1 if they disagree."""
     check = crossval_steps(scene, step, methods, tolerance=scene.solver.tolerance)
     print(check.table())
     print(str(check))
@@ -80,7 +80,7 @@ def check_2d(keep, scene, budget=None) -> str:
 
 def spot_3d(args, scene):
     """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check (by default
-    solved again as far as the run's own time plus :data:`~rollqp.three.crosscheck.SLACK` allows, the last
+    solved again as far as the run's own time plus :data:`~rollqp.crossval.grid.SLACK` allows, the last
     first; all three with ``--cross-check``)."""
     if args.quiet or args.cross_check is False:
         return {}, None
@@ -89,6 +89,6 @@ def spot_3d(args, scene):
 
 
 def check_3d(observer, scene, budget=None) -> str:
-    """The 3D cross-check (:func:`rollqp.three.crosscheck.cross_check` of the observed steps, within ``budget``
+    """The 3D cross-check (:func:`rollqp.crossval.grid.cross_check` of the observed steps, within ``budget``
     seconds)."""
     return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance, budget=budget))

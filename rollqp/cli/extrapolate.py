@@ -1,10 +1,10 @@
 """``rollqp extrapolate SCENE [--grids N1,N2,N3]``: a 3D steady state's creep forces on three grids,
-extrapolated with an error estimate (:func:`rollqp.three.extrapolate.extrapolate`; docs/performance.md)."""
+extrapolated with an error estimate (:func:`rollqp.extrapolate.extrapolate`; docs/performance.md)."""
 from __future__ import annotations
 
 from ..errors import InputError
 from ..scene import load_scene
-from ..three.extrapolate import extrapolate
+from ..extrapolate import extrapolate
 from .common import takes
 
 

@@ -13,14 +13,14 @@ import time
 from contextlib import nullcontext
 
 from ..advice import alternation_note, estimate_note, fast_path
+from ..advice.grid import notes
 from ..errors import InputError
 from ..journal import Journal, journal_path
 from ..methods import SCENE_METHOD_NAMES, method_class
 from ..progress import listening
 from ..result import OutputLock, check_output, resume_source
 from ..scene import load_scene, scene_from_dict
-from ..three.advice import notes
-from ..three.crosscheck import SLACK
+from ..crossval.grid import SLACK
 from .common import (EXIT_INTERRUPTED, EXIT_TERMINATED, EXIT_WRITE, Terminated, check_plot, default_output, family,
                      on_sigterm)
 from .reporting import estimate_progress, iteration_lines, progress, start_progress
@@ -213,6 +213,6 @@ def advise_2d(scene) -> None:
 
 
 def advise_3d(scene) -> None:
-    """Before a 3D run: its estimated time and memory, and what runs faster (:mod:`rollqp.three.advice`)."""
+    """Before a 3D run: its estimated time and memory, and what runs faster (:mod:`rollqp.advice.grid`)."""
     for note in notes(scene):
         print(f"rollqp: {note}", file=sys.stderr, flush=True)

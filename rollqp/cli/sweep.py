@@ -36,7 +36,8 @@ def sweep_2d(scene, args) -> int:
 
 def sweep_3d(scene, args) -> int:
     out = args.out or default_output(scene.name, "-sweep.zarr")
-    _, summary = sweep_grid(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    _, summary = sweep_signals(lambda: sweep_grid(scene, args.vary, out, scheduler=args.scheduler,
+                                                  workers=args.workers, quiet=args.quiet))
     if not args.quiet:
         print(f"rollqp sweep of {scene.name} (3D): {out}")
         print(summary.table())
