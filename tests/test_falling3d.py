@@ -236,3 +236,79 @@ def test_a_run_with_memory_refuses_to_resume_in_one_line():
     with pytest.raises(InputError) as err:
         rollqp.run(scene, resume=part)
     assert str(err.value).startswith("--resume:") and "memory" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_the_uniqueness_factor_and_its_eigenvalue():
+    """``κ_u`` of a step from the slip operator's largest eigenvalue (power iteration, kept with the operator)
+    against the dense eigenvalue problem; below 1 Newton from rest and from the last state find one solution."""
+    from rollqp.methods.continuation import uniqueness_factor
+    from rollqp.problem.grid import StepSolution
+    from rollqp.three.march import normal
+    scene = _transient(0.0, velocity=4000.0, distance=1.0)
+    recs, contact = _run(scene, "newton")
+    prev = recs[-2]
+    ns = normal(contact, NewtonMethod(1e-12), scene.load.normal)
+    prob = contact.tangential_step("rolling", ns.p, scene.loads_at(recs[-1].q), (prev.p, prev.t), scene.dq,
+                                   scene.load.direction)
+    kappa = uniqueness_factor(prob)
+    dense = prob.B.dense(np.arange(prob.n), np.arange(prob.n))
+    lam = float(np.max(np.linalg.eigvalsh(0.5 * (dense + dense.T))))
+    exact = prob.law.steepness * float(np.max(prob.p)) * lam / prob.dq
+    assert abs(kappa - exact) <= 0.02 * exact, (kappa, exact)    # 30 power iterations: measured within 1 %
+    assert kappa < 1
+    newton = NewtonMethod(tolerance=1e-12)
+    a = newton.solve(prob, StepSolution(t=prev.t, s=prev.s, xi=prev.xi, eta=prev.eta))
+    b = newton.solve(prob, None)
+    assert (a.info.get("fixed_point") is None) and np.max(np.abs(a.t - b.t)) <= 1e-9 * 0.32 * contact.scales.stress
+
+
+def test_a_path_that_turns_back_is_reported():
+    """Where the path from the frozen bound cannot pass a λ (a fold: the step has another solution beyond it) the
+    method's own solution is returned with the path's report, and a RuntimeWarning says so."""
+    from rollqp.errors import SolverError
+    from rollqp.methods.continuation import MIN_LAMBDA_STEP
+
+    class FoldAtHalf(NewtonMethod):
+        def solve(self, problem, warm=None):
+            law = getattr(problem, "law", None)
+            if law is not None and law.on_path and law.blend > 0.5:
+                raise SolverError("no solution past the fold", method=self.name)
+            return super().solve(problem, warm)
+
+    scene = _transient(0.0, distance=0.5)
+    method = SlipContinuation(NewtonMethod(tolerance=1e-12), path_solver=FoldAtHalf(tolerance=1e-12))
+    with pytest.warns(RuntimeWarning, match="turns back near λ = 0.5"):
+        recs, _ = _run(scene, method)
+    path = recs[-1].info["tangential"]["path"]
+    assert 0.5 - MIN_LAMBDA_STEP <= path["lam"] <= 0.5 and "fold" in path["stopped"]
+    assert recs[-1].residual <= 1e-10
+
+
+def test_the_newton_matrix_is_the_derivative_of_its_equations():
+    """eq. 3D.26s: the dense Newton matrix of a step with a falling law (partial slip, the forces prescribed) against
+    central differences of Φ_T, at a point off the solution (so that the slip rows have |s| > 0)."""
+    from rollqp.methods.newton.disc import tangential_rows
+    from rollqp.three.march import normal
+    scene = _transient(0.3)
+    recs, contact = _run(scene, "newton")
+    prev = recs[-2]
+    ns = normal(contact, NewtonMethod(1e-12), scene.load.normal)
+    prob = contact.tangential_step("rolling", ns.p, scene.loads_at(recs[-1].q), (prev.p, prev.t, prev.mu), scene.dq,
+                                   scene.load.direction)
+    phi, x, J = tangential_rows(prob, prev.t, (prev.xi, prev.eta))
+    x = x + 1e-3 * np.random.default_rng(0).standard_normal(x.size)
+    phi, _, J = tangential_rows(prob, _traction(prob, x), (x[-2] * prob.scales.slip, x[-1] * prob.scales.slip))
+    h = 1e-7
+    fd = np.column_stack([(phi(x + h * e) - phi(x - h * e)) / (2 * h) for e in np.eye(x.size)])
+    # central differences to O(h²) and round-off/h ~ 1e-9 (measured 9e-10 on a like step, where the ∂μ/∂|s| term
+    # itself reached 6e-2: leaving it out fails this by far)
+    assert np.max(np.abs(J - fd)) <= 1e-7 * np.max(np.abs(J)), np.max(np.abs(J - fd))
+    assert np.any(prob.law.dmu(recs[-1].s)) and (recs[-1].state == 2).any()
+
+
+def _traction(prob, x):
+    """The traction ``(2, n)`` of the scaled contact tractions at the start of ``x`` (:func:`tangential_rows`)."""
+    V = np.flatnonzero(prob.bound > 0)
+    t = np.zeros((2, prob.n))
+    t[:, V] = x[:2 * V.size].reshape(2, V.size) * prob.scales.stress
+    return t
