@@ -159,11 +159,14 @@ def test_the_selected_solution_is_every_methods_and_the_path_is_reported():
 def test_a_long_memory_holds_the_static_value():
     """With the memory length far beyond the run (L = 1e6 a) the coefficient barely moves from μ_s: the run is
     Coulomb's at μ_s to the memory's weight 1 − w = Δq/(L + Δq)."""
-    falling = _run(_transient(1e6), "newton")[0]
+    falling, contact = _run(_transient(1e6), "newton")
     coulomb = _run(_transient(1e6).replace(**{"contact.friction": 0.32}), "newton")[0]
+    unit = 0.32 * contact.scales.stress
     for x, y in zip(falling, coulomb):
-        assert np.max(np.abs(x.mu - 0.32)) <= 0.12 * 1e-5      # Δμ (1 − w) per step, steps of Δq < 0.2 a
-        assert abs(x.Fx - y.Fx) <= 1e-6 * abs(y.Fx) + 1e-12
+        # measured: μ within 9.6e-9 of μ_s, the tractions within 1.0e-8 μ_s p0 of Coulomb's (Δμ (1 − w) = 0.12
+        # Δq/L ≈ 1e-8 per step of Δq ≈ 0.1 a, accumulated over a few steps where the material stays in slip)
+        assert np.max(np.abs(x.mu - 0.32)) <= 1e-7
+        assert np.max(np.abs(x.t - y.t)) <= 1e-7 * unit
 
 
 def test_the_memory_is_carried_with_the_material():
