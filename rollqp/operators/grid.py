@@ -21,7 +21,7 @@ from ..errors import InputError
 from ..friction import as_law
 from ..profiles.surface import QuadraticProfile
 from ..discretization.grid import Grid
-from ..three.hertz import hertz
+from ..closedforms.hertz_ellipse import hertz
 from ..influence import DEFAULT_MODEL, get_model
 from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
