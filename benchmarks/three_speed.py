@@ -275,7 +275,7 @@ def section_precision(quick):
     """Force error against CPU time on the circle at ξ = 1e-3 (partial slip): Newton on 20 … 160 elements,
     FASTSIM on the same grids, the extrapolation from three grids; the reference is Richardson's extrapolation
     from 75, 150 and 300 elements (its own estimate printed). Draws docs/figures/perf-3d-work-precision.png."""
-    from rollqp.three.extrapolate import richardson
+    from rollqp.extrapolate import richardson
     ref_grids = (40, 80, 160) if quick else (75, 150, 300)
     ref_vals = [_steady_run(n)[0] for n in ref_grids]
     ref = richardson(ref_vals, 2.0)

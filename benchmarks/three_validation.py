@@ -30,7 +30,7 @@ from rollqp.three.hertz import curvatures_for_ratio, hertz
 from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
-from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
+from rollqp.report.grid import cattaneo_errors, creep_matrix, hertz_errors
 from rollqp.methods.socp import ClarabelMethod, CvxpyMethod, OsqpMethod
 
 FN, MU = 1000.0, 0.3

@@ -333,7 +333,7 @@ class Family:
     sweep: Callable | None = None
     creep_curve: Callable | None = None
     #: ``refuse(scene, allow_long)``: raise an InputError, before any work, for a run that cannot finish in
-    #: reasonable time or memory (3D conic runs: :func:`rollqp.three.advice.refusal`).
+    #: reasonable time or memory (3D conic runs: :func:`rollqp.advice.grid.refusal`).
     refuse: Callable = lambda scene, allow_long: None
     #: How freed memory goes back to the system (glibc): the dense 2D runs give arrays of 1 MiB and more back at
     #: once (:func:`_give_back_freed_memory`, their peak memory); by default (None) the runs keep them for the
@@ -356,8 +356,8 @@ def _family_2d() -> Family:
 
 def _family_3d() -> Family:
     from .plot.three import three_figure
-    from .three.advice import notes, refusal
-    from .three.report import summary
+    from .advice.grid import notes, refusal
+    from .report.grid import summary
     from .three.run import run
 
     def advise(scene):
@@ -475,7 +475,7 @@ def cmd_run(args) -> int:
         print(fam.summary(res, scene, scene.solver.method, wall, peaks))  # the method that ran: from res's meta
         if keep:
             t1 = time.perf_counter()
-            from .three.crosscheck import SLACK  # the default: at most the run's own time plus SLACK seconds
+            from .crossval.grid import SLACK  # the default: at most the run's own time plus SLACK seconds
             head, *failures = fam.check(keep, scene, None if args.cross_check else wall + SLACK).splitlines()
             print(f"  cross-check   {head} ({time.perf_counter() - t1:.2f} s)")
             for line in failures:  # each in full, on a line of its own
@@ -493,9 +493,9 @@ def _spot_lines(keep, scene, budget=None) -> str:
 
 def _spot_3d(args, scene):
     """``(observer or {}, observer or None)``: the 3D run keeps steps 0, K/2, K for its cross-check (by default
-    solved again as far as the run's own time plus :data:`~rollqp.three.crosscheck.SLACK` allows, the last
+    solved again as far as the run's own time plus :data:`~rollqp.crossval.grid.SLACK` allows, the last
     first; all three with ``--cross-check``)."""
-    from .three.crosscheck import SpotObserver, spot_steps
+    from .crossval.grid import SpotObserver, spot_steps
     if args.quiet or args.cross_check is False:
         return {}, None
     observer = SpotObserver(spot_steps(scene.n_steps))
@@ -511,8 +511,8 @@ def _crossval_2d(scene, step, methods) -> int:
 
 def _crossval_3d(scene, step, methods) -> int:
     """``rollqp crossval`` of a 3D scene: every step (or ``--step K``) of its run solved again by the SOCP
-    backends and Newton (:func:`rollqp.three.crosscheck.crossval`); exit 1 if they disagree."""
-    from .three.crosscheck import crossval
+    backends and Newton (:func:`rollqp.crossval.grid.crossval`); exit 1 if they disagree."""
+    from .crossval.grid import crossval
     check = crossval(scene, step, methods, tolerance=scene.solver.tolerance)
     print(check.table())
     print(str(check))
@@ -520,7 +520,7 @@ def _crossval_3d(scene, step, methods) -> int:
 
 
 def _check_3d(observer, scene, budget=None) -> str:
-    from .three.crosscheck import cross_check
+    from .crossval.grid import cross_check
     return str(cross_check(scene, observer, scene.solver.method, tolerance=scene.solver.tolerance, budget=budget))
 
 
@@ -681,7 +681,7 @@ def cmd_crossval(args) -> int:
 
 
 def cmd_extrapolate(args) -> int:
-    """``rollqp extrapolate SCENE [--grids N1,N2,N3]`` (:func:`rollqp.three.extrapolate.extrapolate`)."""
+    """``rollqp extrapolate SCENE [--grids N1,N2,N3]`` (:func:`rollqp.extrapolate.extrapolate`)."""
     from .errors import InputError
     from .scene import load_scene
     scene = load_scene(args.scene)
@@ -694,7 +694,7 @@ def cmd_extrapolate(args) -> int:
             raise InputError("--grids", f"must be three integers N1,N2,N3, got {args.grids!r}") from None
         if any(g < 1 or g > 2000 for g in grids):
             raise InputError("--grids", f"each count must be in [1, 2000], got {args.grids!r}")
-    from .three.extrapolate import extrapolate
+    from .extrapolate import extrapolate
     print(extrapolate(scene, grids))
     return 0
 
@@ -797,7 +797,8 @@ def cmd_sweep(args) -> int:
 def _sweep_3d(scene, args) -> int:
     from .sweep.three import sweep_3d
     out = args.out or default_output(scene.name, "-sweep.zarr")
-    _, summary = sweep_3d(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    _, summary = _sweep_signals(lambda: sweep_3d(scene, args.vary, out, scheduler=args.scheduler,
+                                                 workers=args.workers, quiet=args.quiet))
     if not args.quiet:
         print(f"rollqp sweep of {scene.name} (3D): {out}")
         print(summary.table())
@@ -812,8 +813,12 @@ def _creep_3d(scene, args) -> int:
                          "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
     out = args.out or default_output(scene.name, "-creep.zarr")
     _check_plot(args.plot)
-    curve = creep_curve_3d(scene, args.creepage or "longitudinal", args.values or "1e-4:2e-3:12", out,
-                           scheduler=args.scheduler, workers=args.workers, quiet=args.quiet)
+    curve = _sweep_signals(lambda: creep_curve_3d(scene, args.creepage or "longitudinal",
+                                                  args.values or "1e-4:2e-3:12", out, scheduler=args.scheduler,
+                                                  workers=args.workers, quiet=args.quiet))
+    if curve.FN is None:       # interrupted: the points done are saved in the store
+        print(curve.summary.table())
+        return _sweep_exit(curve.summary)
     if args.plot:
         curve.plot(args.plot)
     if not args.quiet:

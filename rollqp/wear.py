@@ -20,7 +20,9 @@ import numpy as np
 
 from .errors import InputError
 from .fields import Field, register
+from .result import load_result
 from .subsurface import _source
+from .subsurface3d import source3d
 from .strip import Strip
 
 __all__ = ["wear_rate", "grid_wear_rate", "profile"]
@@ -62,60 +64,110 @@ for _b in ("A", "B"):
 
 
 def profile(result, body: str = "A", coefficient=None, resolution: int = 4):
-    """Worn depth along roller ``body``'s surface after the whole run.
+    """Worn depth along roller ``body``'s surface after the whole run, in either dimension.
+
+    A material point of the surface moves through the contact in the direction ``d`` by ``|Δq|`` per rolling
+    step: at state ``k`` the point of surface coordinate ``σ`` (its position at ``q = 0``) is at
+    ``x = σ + Σ_j d_j |Δq_j|`` (``d_j`` the step's direction: ``load.direction``, reversed where ``load.rolled``
+    falls). Its worn depth is ``h(σ) = Σ_k rate_k(x_k(σ))·|Δq_k|`` over the rolling steps (not the starting state
+    nor a stop), the rate interpolated along x by the discretization's own traction shape: the strip's shape
+    functions in 2D, the grid's piecewise constant elements in 3D, where every row of elements (each ``y``)
+    is a material line of its own. The sum is the trapezoid-free discrete form of
+    ``h = (k/H) ∫ p |s| dq`` along the material line (docs/stresses.md §6, §10).
 
     Parameters
     ----------
     result : Result, dict (``load_result``) or path
+        A 2D or 3D result.
     body : {"A", "B"}
     coefficient : float or None
         k/H; None: the scene's ``bodies.<body>.wear`` (the result's ``wear_rate_<body>`` is used).
     resolution : int
-        Surface points per node spacing.
+        Surface points per node spacing (2D) or element length ``dx`` (3D).
 
     Returns
     -------
     (sigma, depth) : ndarrays
-        Surface coordinate (length, the material's position at q = 0, modulo 2πR) and the
-        worn depth there (length).
+        Surface coordinate (length, the material's position at q = 0, modulo 2πR) and the worn depth there
+        (length): ``depth`` has the shape of ``sigma`` in 2D and ``(ny, sigma.size)`` in 3D (rows at the
+        result's ``y``).
+
+    >>> import rollqp
+    >>> s = rollqp.load_scene("cattaneo-3d").replace(**{"discretization.elements": [12, 12],
+    ...                                              "discretization.distance": 1.0, "bodies.A.wear": 1e-9})
+    >>> sigma, h = profile(rollqp.run(s))
+    >>> h.shape == (12, sigma.size) and bool(h.max() > 0)
+    True
     """
-    arrays, scene = _source(result)
     if body not in ("A", "B"):
         raise InputError("body", f"must be 'A' or 'B', got {body!r}")
     if isinstance(resolution, bool) or not isinstance(resolution, (int, np.integer)) or not 1 <= resolution <= 100:
         raise InputError("resolution", f"must be a whole number in [1, 100] (surface points per node spacing), "
                                        f"got {resolution!r}")
-    mat = getattr(scene, body)
+    arrays, scene, along, lo, hi, spacing, centred = _material_axis(result)
     key = f"wear_rate_{body}"
+    p0 = float(np.asarray(arrays["p0"]).reshape(-1)[0]) if "p0" in arrays else float(scene.p0)
     if coefficient is None and key not in arrays:
         raise InputError("coefficient", f"give k/H: the scene has no bodies.{body}.wear and the result no {key!r}")
     if coefficient is not None and (isinstance(coefficient, bool) or not isinstance(coefficient, (int, float, np.integer, np.floating))
-                                    or not 0 <= coefficient <= 1.0 / scene.p0):
-        raise InputError("coefficient", f"must be a number in [0, 1/p0 = {1.0 / scene.p0:.6g}] (k/H in 1/stress: "
+                                    or not 0 <= coefficient <= 1.0 / p0):
+        raise InputError("coefficient", f"must be a number in [0, 1/p0 = {1.0 / p0:.6g}] (k/H in 1/stress: "
                                         f"Archard's k·p0/H is at most 1), got {coefficient!r}")
-    d = scene.discretization
-    strip = Strip(scene.half_width, d.elements, d.element)
     q = np.asarray(arrays["q"], dtype=float)
-    # the material's signed travel: Σ d_k Δq_k (per-step directions of load.rolled, else load.direction)
-    d = np.asarray(arrays["direction"], dtype=float) if "direction" in arrays else \
-        np.full(q.size, float(scene.load.direction))
     dqs = np.abs(np.diff(q, prepend=q[0]))                  # |Δq_k|: q falls when load.rolled reverses
-    travel = np.cumsum(d * dqs)
-    rate = (coefficient * np.asarray(arrays["pn"]) * np.abs(arrays["slip"])) if coefficient is not None \
-        else np.asarray(arrays[key])
-    L, h = scene.half_width, strip.spacing / resolution
+    if "direction" in arrays:                               # 2D: the per-step directions of load.rolled
+        d = np.asarray(arrays["direction"], dtype=float)
+    else:                                                   # q(τ) itself falls on a reversal
+        d = float(scene.load.direction) * np.sign(np.diff(q, prepend=q[0]))
+    travel = np.cumsum(d * dqs)                             # the material's signed travel Σ d_k |Δq_k|
+    if coefficient is not None:
+        slip = np.abs(arrays["slip"]) if "slip" in arrays else np.hypot(arrays["sx"], arrays["sy"])
+        rate = coefficient * np.asarray(arrays["pn"], dtype=float) * slip
+    else:
+        rate = np.asarray(arrays[key], dtype=float)
+    h = spacing / resolution
     reach = np.abs(travel).max()
-    sigma = np.arange(-L - reach, L + reach + h / 2, h)
-    depth = np.zeros_like(sigma)
+    sigma = np.arange(lo - reach, hi + reach + h / 2, h) + (h / 2 if centred else 0.0)
+    depth = np.zeros(rate.shape[1:-1] + sigma.shape)
     for k in np.flatnonzero((dqs > 0) & (d != 0)):            # rolling steps (not the start, not stops)
         x = sigma + travel[k]                                   # where each material point is at q_k
-        inside = np.abs(x) <= L
-        depth[inside] += strip.traction_matrix(x[inside]) @ rate[k] * dqs[k]
-    circ = 2 * np.pi * mat.radius
-    if sigma.max() - sigma.min() > circ:  # more than one turn: fold the surface onto one circumference
+        inside = (x >= lo) & (x <= hi)
+        depth[..., inside] += rate[k] @ along(x[inside]).T * dqs[k]
+    circ = 2 * np.pi * float(getattr(scene, body).radius)
+    if np.isfinite(circ) and sigma.max() - sigma.min() > circ:  # more than one turn: fold onto one circumference
         s = np.mod(sigma, circ)
         grid = np.arange(0.0, circ, h)
-        folded = np.zeros_like(grid)
-        np.add.at(folded, np.minimum((s / h).astype(int), grid.size - 1), depth)
+        folded = np.zeros(depth.shape[:-1] + grid.shape)
+        idx = np.minimum((s / h).astype(int), grid.size - 1)
+        for j in np.ndindex(*depth.shape[:-1]):
+            np.add.at(folded[j], idx, depth[j])
         return grid, folded
     return sigma, depth
+
+
+def _material_axis(result):
+    """``(arrays, scene, along, lo, hi, spacing, centred)``: a result's arrays and scene, the interpolation
+    ``along(x)`` (m, n) of its values along the rolling axis at points ``x`` in ``[lo, hi]``, its node spacing, and
+    whether the surface points sit at the centres of the ``resolution`` parts of an element (3D: the grid's
+    piecewise constant elements, so that a travel of whole elements gives each element ``resolution`` points and
+    the worn volume is the rates' sum exactly) rather than on the nodes (2D)."""
+    arrays = result if isinstance(result, dict) else dict(result.arrays()) if hasattr(result, "arrays") \
+        else load_result(result, "result")
+    if "px" in arrays:                                      # a 3D result: the grid's elements
+        arrays, scene = source3d(arrays)
+        x = np.asarray(arrays["x"], dtype=float)
+        dx = float(x[1] - x[0]) if x.size > 1 else float(scene.grid.dx)
+        lo, hi = float(x[0]) - dx / 2, float(x[-1]) + dx / 2
+
+        def along(pts):
+            idx = np.minimum(((pts - lo) / dx).astype(int), x.size - 1)
+            m = np.zeros((pts.size, x.size))
+            m[np.arange(pts.size), idx] = 1.0
+            return m
+        return arrays, scene, along, lo, hi, dx, True
+    if hasattr(result, "arrays"):
+        arrays["meta"] = result.meta
+    arrays, scene = _source(arrays)
+    d = scene.discretization
+    strip = Strip(scene.half_width, d.elements, d.element)
+    return arrays, scene, strip.traction_matrix, -scene.half_width, scene.half_width, strip.spacing, False

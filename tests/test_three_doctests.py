@@ -8,7 +8,7 @@ import pytest
 
 MODULES = ["discretization", "discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
            "profiles.surface", "three.hertz", "three.closedforms", "methods.newton.disc", "operators.grid",
-           "three.loads"]
+           "three.loads", "methods.newton.capacitance"]
 
 
 @pytest.mark.parametrize("name", MODULES)

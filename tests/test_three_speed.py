@@ -1,5 +1,5 @@
 """What a 3D run costs and what it says about it: the conic cost model, the refusal before any work, the
-cross-check's time budget and its reuse of identical steps (rollqp.three.advice, rollqp.three.crosscheck).
+cross-check's time budget and its reuse of identical steps (rollqp.advice.grid, rollqp.crossval.grid).
 No test times anything: the budget tests use a budget of zero or a deadline already past."""
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import pytest
 
 from rollqp import cli, load_scene
 from rollqp.errors import InputError
-from rollqp.three import advice
-from rollqp.three.crosscheck import SpotObserver, cross_check, crossval
+from rollqp.advice import grid as advice
+from rollqp.crossval.grid import SpotObserver, cross_check, crossval
 from rollqp.three.run import run
 
 
@@ -104,7 +104,7 @@ def test_crossval_step_choice_still_checks(kept):
 
 # ------------------------------------------------------------------------------- extrapolation
 def test_richardson_recovers_a_power_law_and_its_order():
-    from rollqp.three.extrapolate import richardson
+    from rollqp.extrapolate import richardson
     for p in (0.7, 1.0, 2.0):
         e = richardson([3.0 + 0.4 * h ** p for h in (0.2, 0.1, 0.05)], 2.0)
         assert e.order == pytest.approx(p, rel=1e-9) and e.value == pytest.approx(3.0, rel=1e-12)

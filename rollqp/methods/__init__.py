@@ -191,7 +191,7 @@ COMPARE_METHODS = ("newton", "qp-clarabel")
 CROSS_CHECK_METHODS = ("qp-clarabel", "qp-osqp")
 #: The method :func:`rollqp.solve_step` poses one step with by default (a convex QP, interior point).
 STEP_METHOD = "qp-clarabel"
-#: The methods a 3D run is cross-checked with (:func:`rollqp.three.crosscheck.cross_check`): the conic
+#: The methods a 3D run is cross-checked with (:func:`rollqp.crossval.grid.cross_check`): the conic
 #: route (Clarabel, core dependency) and Newton; the one that ran the scene is left out.
 CROSS_CHECK_METHODS_3D = ("socp-clarabel", "newton")
 #: The methods ``rollqp crossval`` solves every step of a 3D scene with (those installed): rollqp's Newton

@@ -44,10 +44,9 @@ from ..influence import DEFAULT_MODEL, get_model
 from ..influence.layer import check_relative, parse_layer
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
-from .checks import check_scene_name, check_units
-from .core import SceneBase
+from .core import TwoBodyScene, check_top, table_keys
 from .plain import plain
-from ..validate import choice, integer, number, string, suggestion
+from ..validate import choice, integer, number
 from ..operators.grid import MU_REFERENCE, Loads
 from ..profiles.surface import Body, curvatures
 from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
@@ -248,7 +247,7 @@ def _solver(s: Solver3D) -> Solver3D:
 
 # =========================================================================== the scene
 @dataclass(frozen=True)
-class Scene3D(SceneBase):
+class Scene3D(TwoBodyScene):
     """A validated three-dimensional rolling-contact problem (module docstring; docs/scenes.md).
 
     The parts are checked key by key and the scene as a whole at construction; the derived
@@ -279,20 +278,21 @@ class Scene3D(SceneBase):
     source: str = field(default="<dict>", compare=False)
 
     dimension: ClassVar[int] = 3
+    _PARTS: ClassVar[tuple] = (("A", functools.partial(_body, "bodies.A")), ("B", functools.partial(_body, "bodies.B")),
+                               ("contact", _contact), ("load", _load), ("discretization", _discretization),
+                               ("solver", _solver))
 
-    def __post_init__(self):
-        put = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 - frozen dataclass
-        put("name", check_scene_name("name", self.name))
-        put("description", string("description", self.description))
-        put("A", _body("bodies.A", self.A))
-        put("B", _body("bodies.B", self.B))
-        put("contact", _contact(self.contact))
-        put("load", _load(self.load))
-        put("discretization", _discretization(self.discretization))
-        put("solver", _solver(self.solver))
-        put("units", check_units("units", self.units))
-        put("source", str(self.source))
+    def _check_whole(self) -> None:
         _check_whole(self)
+
+    @staticmethod
+    def _plain(value: Any) -> Any:
+        return _plain(value)
+
+    @classmethod
+    def from_dict(cls, d: Any, source: str = "<dict>", default_name: str = "scene") -> "Scene3D":
+        """:func:`scene_from_dict`."""
+        return scene_from_dict(d, source=source, default_name=default_name)
 
     # ------------------------------------------------------------------ derived
     @functools.cached_property
@@ -388,7 +388,7 @@ class Scene3D(SceneBase):
 
     def contact_elements(self) -> int:
         """The elements whose centres lie inside the Hertz ellipse: about those in contact (the size of
-        a step's conic program, which :mod:`rollqp.three.advice` estimates from)."""
+        a step's conic program, which :mod:`rollqp.advice.grid` estimates from)."""
         e, g = self.ellipse, self.grid
         X, Y = np.meshgrid(g.x / e.a, g.y / e.b)
         return int(np.sum(X * X + Y * Y < 1))
@@ -426,27 +426,6 @@ class Scene3D(SceneBase):
                 "load": loads,
                 "discretization": {**disc, "step": d.step, "distance": d.distance},
                 "solver": solver}
-
-    def to_toml(self) -> str:
-        """The scene as TOML text, defaults filled in; reading it back gives an equal scene."""
-        import tomli_w
-        return tomli_w.dumps(self.to_dict())
-
-    def replace(self, **changes: Any) -> "Scene3D":
-        """A new, validated scene with dotted keys changed (``scene.replace(**{"solver.method": "qp-clarabel"})``);
-        ``None`` removes an optional key."""
-        d = self.to_dict()
-        for dotted, value in changes.items():
-            node, parts = d, dotted.split(".")
-            for i, part in enumerate(parts[:-1]):
-                node = node.setdefault(part, {})
-                if not isinstance(node, dict):
-                    raise InputError(".".join(parts[:i + 1]), f"is not a table; cannot set {dotted}")
-            if value is None:
-                node.pop(parts[-1], None)
-            else:
-                node[parts[-1]] = _plain(value)
-        return scene_from_dict(d, source=self.source, default_name=self.name)
 
 
 def _plain(v):
@@ -626,36 +605,16 @@ def _check_creepages(scene) -> None:
 
 # =========================================================================== from a dict
 _TABLES = {"contact": Contact3D, "load": Load3D, "discretization": Discretization3D, "solver": Solver3D}
-_TOP = ("name", "description", "units", "bodies", "contact", "load", "discretization", "solver")
 
 
 def _table(d: Any, key: str, cls: type, also=()) -> dict:
-    if not isinstance(d, dict):
-        raise InputError(key, f"must be a table [{key}], got {d!r}")
-    names = [f.name for f in fields(cls)]
-    for k in d:
-        if k not in names:
-            raise InputError(f"{key}.{k}", f"unknown key{suggestion(k, names)} (allowed in [{key}] of a 3D scene: "
-                                           f"{', '.join(names)})")
-    required = [f.name for f in fields(cls)
-                if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING] + list(also)
-    missing = [k for k in required if k not in d]
-    if missing:
-        raise InputError(f"{key}.{missing[0]}", f"missing required key ([{key}] needs {', '.join(required)})")
-    return dict(d)
+    return table_keys(d, key, cls, also, where=f"[{key}] of a 3D scene", each_missing=True)
 
 
 def scene_from_dict(d: Any, source: str = "<dict>", default_name: str = "scene") -> Scene3D:
     """Build and validate a 3D scene from its nested dict (the parsed TOML); every invalid input is an
     :class:`InputError` naming the dotted key."""
-    if not isinstance(d, dict):
-        raise InputError("SCENE", f"must be a table of tables, got {type(d).__name__}")
-    for k in d:
-        if k not in _TOP:
-            raise InputError(k, f"unknown key{suggestion(k, _TOP)} (allowed at the top level: {', '.join(_TOP)})")
-    for k in ("bodies", "contact", "load"):
-        if k not in d:
-            raise InputError(k, f"missing required table [{k}]")
+    check_top(d)
     bodies = d["bodies"]
     if not isinstance(bodies, dict) or set(bodies) != {"A", "B"}:
         raise InputError("bodies", "must hold exactly the tables [bodies.A] and [bodies.B] (radius, radius_y, E, nu)")

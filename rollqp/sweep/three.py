@@ -9,6 +9,14 @@ swept keys are dimensions (their values the coordinates), ``step`` (the state in
 ``status`` (1 done, 2 failed), ``error`` and ``point_time``. Points with fewer states or another grid are
 padded with NaN (their own ``q``, ``x``, ``y`` then per point).
 
+The store is resumable as a 2D one is: while the sweep runs, each point is saved as it finishes
+(``POINTS/<i>.npz`` inside the store folder, written atomically, with ``MANIFEST`` naming the sweep by its
+fingerprint: the base scene and the swept values); the labelled Dataset replaces them when every point is
+done. A sweep that was killed (SIGKILL, Ctrl-C, SIGTERM) and is run again with the same scene and ``--vary``
+computes only the points not saved and writes the same Dataset (but for the points' wall times); a store
+of another sweep, or a folder that is no 3D sweep store, is refused naming ``--out``; a finished store of
+the same sweep is opened and nothing is computed. Failed points are not saved: a new run tries them again.
+
 ``rollqp creep-curve SCENE --creepage longitudinal|lateral|spin --values V`` is the preset of the steady
 creep-force curve: the scene in steady rolling (``load.start = "rolling"``, ``distance = 0``) at each
 prescribed creepage (the others as the scene gives them; a force along the swept axis is replaced by
@@ -23,14 +31,19 @@ the creepage), the forces ``Fx``, ``Fy`` and the spin moment ``Mz`` against it, 
 """
 from __future__ import annotations
 
+import hashlib
 import itertools
+import json
 import math
 import os
+import re
+import shutil
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..atomic import OutputLock, written
 from ..errors import InputError
 from .spec import Axis, MAX_POINTS, parse_values, parse_vary
 
@@ -41,6 +54,10 @@ CREEPAGES = {"longitudinal": ("load.creepage.longitudinal", "load.tangential", "
              "lateral": ("load.creepage.lateral", "load.lateral", "Fy"),
              "spin": ("load.creepage.spin", None, "Fy")}
 COMPONENTS = ("longitudinal", "lateral", "spin")
+#: Inside a 3D store being computed: the sweep's fingerprint (JSON) and the folder of the points done.
+MANIFEST, POINTS = "rollqp-sweep3d.json", "points"
+#: The Dataset's global attribute holding the sweep's fingerprint (the 2D stores' name).
+FINGERPRINT = "rollqp_sweep_fingerprint"
 
 
 def run_point_3d(scene: dict) -> dict:
@@ -68,10 +85,13 @@ class Summary3D:
     wall: float = 0.0
     point_times: list = field(default_factory=list)
     interrupted: bool = False
+    kept: int = 0
 
     def table(self) -> str:
         busy = sum(self.point_times)
-        rows = [f"  points        {self.done} done, {len(self.failed)} failed of {self.total}",
+        rows = [f"  points        {self.done} done, {len(self.failed)} failed of {self.total}"
+                + (f" ({self.kept} kept from the store, not recomputed)" if self.kept else "")
+                + (" (interrupted: run the same command again to compute the rest)" if self.interrupted else ""),
                 f"  wall time     {self.wall:.2f} s (points' own {busy:.2f} s: {busy / max(self.wall, 1e-9):.2f}x)"]
         rows += [f"  failed        point {i}: {e}" for i, e in self.failed[:5]]
         return "\n".join(rows)
@@ -91,6 +111,13 @@ def _points(base, axes):
     return out
 
 
+def fingerprint_3d(base, axes) -> str:
+    """SHA-256 of the base scene and the swept keys and values: what a store is the store of."""
+    text = json.dumps({"dimension": 3, "scene": base.to_dict(), "vary": [[a.key, list(a.values)] for a in axes]},
+                      sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def _check_out(out) -> str:
     path = os.fspath(out).rstrip("/")
     if not path.endswith(".zarr"):
@@ -98,16 +125,71 @@ def _check_out(out) -> str:
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder) or not os.access(folder, os.W_OK):
         raise InputError("--out", f"cannot write in folder {folder!r}")
-    if os.path.exists(path):
-        raise InputError("--out", f"{path!r} exists: a 3D sweep writes a new store (choose another --out)")
+    if os.path.exists(path) and not os.path.isdir(path):
+        raise InputError("--out", f"{path!r} exists and is not a zarr folder")
     return path
 
 
-def sweep_3d(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=True):
-    """Run a sweep of a 3D scene into the new zarr store ``out``; return ``(dataset, Summary3D)``
-    (module docstring). ``vary``: ``"KEY=VALUES"`` strings or :class:`~rollqp.sweep.spec.Axis` objects."""
+def _open_out(path, fp):
+    """``(finished dataset or None, {index: saved point})`` of the store ``path`` of the sweep ``fp`` (module
+    docstring); a new store is made (its manifest written). Refuses another sweep's store naming ``--out``."""
+    manifest = os.path.join(path, MANIFEST)
+    if os.path.isdir(path) and not os.path.exists(manifest):
+        import xarray as xr
+        try:
+            ds = xr.open_zarr(path, chunks=None)
+            theirs = ds.attrs.get(FINGERPRINT)
+        except Exception as exc:  # noqa: BLE001  (zarr raises several types for a folder that is no store)
+            raise InputError("--out", f"{path!r} exists and is not a rollqp sweep store ({type(exc).__name__})") from None
+        if theirs != fp:
+            raise InputError("--out", f"{path!r} holds a different sweep (another scene, dimension or other --vary "
+                                      f"values: fingerprint {str(theirs)[:12]} != {fp[:12]}); choose another --out")
+        return ds.load(), {}
+    if os.path.exists(manifest):
+        try:
+            with open(manifest, encoding="utf-8") as fh:
+                theirs = json.load(fh).get("fingerprint")
+        except (OSError, ValueError, AttributeError):
+            theirs = None
+        if theirs != fp:
+            raise InputError("--out", f"{path!r} holds a different 3D sweep being computed (fingerprint "
+                                      f"{str(theirs)[:12]} != {fp[:12]}); choose another --out")
+    else:
+        os.makedirs(os.path.join(path, POINTS), exist_ok=True)
+        with written(manifest, ".json") as (fh, _):
+            fh.write(json.dumps({"fingerprint": fp, "format": "rollqp 3D sweep points"}).encode())
+    os.makedirs(os.path.join(path, POINTS), exist_ok=True)
+    saved = {}
+    for name in os.listdir(os.path.join(path, POINTS)):
+        m = re.fullmatch(r"(\d{1,7})\.npz", name)
+        if m is None:
+            continue
+        try:
+            with np.load(os.path.join(path, POINTS, name), allow_pickle=False) as z:
+                arrays = {k: z[k] for k in z.files}
+        except (OSError, ValueError, EOFError):   # unreadable: computed again
+            continue
+        t = float(arrays.pop("_point_time", np.nan))
+        saved[int(m.group(1))] = {"arrays": arrays, "time": t}
+    return None, saved
+
+
+def _save_point(path, i, r) -> None:
+    """Save point ``i``'s arrays in the store being computed (atomic: a killed writer leaves no half file)."""
+    import io
+    buf = io.BytesIO()
+    np.savez(buf, _point_time=np.float64(r["time"]), **r["arrays"])
+    with written(os.path.join(path, POINTS, f"{i}.npz")) as (fh, _):
+        fh.write(buf.getvalue())
+
+
+def sweep_3d(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=True, on_point=None):
+    """Run a sweep of a 3D scene into the zarr store ``out`` (new, or the store of this sweep, continued);
+    return ``(dataset, Summary3D)`` (module docstring; ``dataset`` is None when interrupted).
+    ``vary``: ``"KEY=VALUES"`` strings or :class:`~rollqp.sweep.spec.Axis` objects; ``on_point(i, out)``
+    after point ``i`` is saved."""
     from ..scene import load_scene
-    from .executor import map_jobs
+    from .executor import close_client, connect, iter_jobs
     base = scene if hasattr(scene, "replace") else load_scene(scene)
     axes = parse_vary(vary) if vary and isinstance(next(iter(vary)), str) else tuple(vary)
     if not axes:
@@ -117,17 +199,45 @@ def sweep_3d(scene, vary, out, *, scheduler=None, workers=None, client=None, qui
         raise InputError("--vary", f"{size} points; at most {MAX_POINTS}")
     path = _check_out(out)
     points = _points(base, axes)
-    t0 = time.perf_counter()
-    results = map_jobs(run_point_3d, [(p,) for p in points], workers=workers, scheduler=scheduler, client=client)
-    summary = Summary3D(len(points), wall=time.perf_counter() - t0)
-    for i, r in enumerate(results):
-        summary.point_times.append(r["time"])
-        if "error" in r:
-            summary.failed.append((i, r["error"]))
-        else:
-            summary.done += 1
-    ds = dataset_3d(base, axes, results)
-    ds.to_zarr(path, mode="w-", zarr_format=2, consolidated=True)   # as the 2D stores (docs/sweeps.md)
+    fp = fingerprint_3d(base, axes)
+    with OutputLock(path):
+        finished, saved = _open_out(path, fp)
+        if finished is not None:
+            done = int((finished["status"].values == 1).sum())
+            return finished, Summary3D(len(points), kept=done)
+        summary = Summary3D(len(points), kept=len(saved))
+        todo = [i for i in range(len(points)) if i not in saved]
+        results = dict(saved)
+        t0 = time.perf_counter()
+        own = client is None and todo
+        client = (client or connect(scheduler, workers)) if todo else None
+        try:
+            for i, r in zip(todo, iter_jobs(run_point_3d, [(points[i],) for i in todo], client) if todo else ()):
+                results[i] = r
+                summary.point_times.append(r["time"])
+                if "error" in r:
+                    summary.failed.append((i, r["error"]))
+                else:
+                    summary.done += 1
+                    _save_point(path, i, r)
+                if on_point is not None:
+                    on_point(i, r)
+        except KeyboardInterrupt:
+            summary.interrupted = True
+            summary.wall = time.perf_counter() - t0
+            return None, summary
+        finally:
+            if own:
+                close_client(client)
+        summary.wall = time.perf_counter() - t0
+        ds = dataset_3d(base, axes, [results[i] for i in range(len(points))])
+        ds.attrs[FINGERPRINT] = fp
+        ds.to_zarr(path, mode="w", zarr_format=2, consolidated=True)   # as the 2D stores (docs/sweeps.md)
+        for leftover in (os.path.join(path, POINTS), os.path.join(path, MANIFEST)):   # only if zarr kept them
+            if os.path.isdir(leftover):
+                shutil.rmtree(leftover)
+            elif os.path.exists(leftover):
+                os.unlink(leftover)
     return ds, summary
 
 
@@ -336,6 +446,8 @@ def creep_curve_3d(scene, creepage: str = "longitudinal", values="1e-4:2e-3:12",
     ``client``, ``quiet``) and return the curve."""
     base, axis = creep_sweep_3d(scene, creepage, values)
     ds, summary = sweep_3d(base, (axis,), out, **run)
+    if ds is None:   # interrupted: the points done are saved in the store, run again for the rest
+        return CreepCurve3D(base, creepage, np.asarray(axis.values, dtype=float), None, None, None, None, summary)
     get = lambda k: np.asarray(ds[k].values[:, 0], dtype=float)  # noqa: E731  (state 0 of each point)
     return CreepCurve3D(base, creepage, np.asarray(axis.values, dtype=float), get("FN"), get("Fx"), get("Fy"),
                         get("Mz"), summary)

@@ -135,7 +135,7 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
                 raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
                       _states(contact, ns.p, ts.t, ts.s))
-        rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.three.crosscheck
+        rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.crossval.grid
         yield rec
         prev, warm = rec, (ns, ts)
 

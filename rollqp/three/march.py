@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, SolverError
-from .advice import MARCH_LENGTHS
+from ..advice.grid import MARCH_LENGTHS
 from ..operators.grid import Loads
 from ..problem.grid import SEPARATION, SLIP, STICK, disc_projection, element_states
 
@@ -202,7 +202,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
 
 
 def _expected_march(contact) -> int:
-    """The steps a march to the steady state usually takes (:data:`rollqp.three.advice.MARCH_LENGTHS` contact
+    """The steps a march to the steady state usually takes (:data:`rollqp.advice.grid.MARCH_LENGTHS` contact
     lengths of ``dx``), for its progress."""
     return int(MARCH_LENGTHS * 2 * contact.ellipse.a / contact.grid.dx) + 1
 

@@ -29,7 +29,8 @@ along the line (``K(x + αd) = Kx + α Kd``): one operator product per iteration
 ``‖Φ‖∞ ≤ tolerance·min(1, r)``, which bounds rollqp's residual (``r = 1``) by ``tolerance``.
 
 Linear algebra (``path``): ``"dense"`` gathers the operator's block on the contact elements
-and solves by LU (normal: Cholesky of ``Â_FF``); ``"krylov"`` never forms it: CG (normal) or
+and solves through its inverse, kept with the operator, by a capacitance matrix on the slipping
+elements (:mod:`.capacitance`; by LU where most elements slip; normal: Cholesky of ``Â_FF``); ``"krylov"`` never forms it: CG (normal) or
 GMRES (tangential) on FFT products, preconditioned by the elements' own 2 × 2 blocks.
 ``"auto"`` takes the dense path up to :data:`DENSE_UNKNOWNS` unknowns.
 """
@@ -46,6 +47,7 @@ from ... import progress
 from ...errors import InputError, SolverError
 from ..base import Capabilities, check_options
 from ...problem.grid import disc_projection
+from . import capacitance
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 
@@ -53,10 +55,13 @@ __all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
 #: on CONTACT's 48 × 44 steady case (2768 unknowns) a dense LU step takes 1.3 s, the GMRES step
 #: 0.07 s; at 500 unknowns (a 20 × 20 grid) they are even. Above this, FFT products and GMRES.
 DENSE_UNKNOWNS = 1200
-#: The same for a transient or shift step (the operator ``A_tt`` itself: GMRES converges in a few dozen
-#: products): measured on circles, CPU of a transient rolling step dense / Krylov: 2.4 / 9.0 ms at 160
-#: unknowns, 8.9 / 13.6 ms at 300, 36.6 / 17.4 ms at 632 (the same forces to 8 digits).
-TRANSIENT_DENSE_UNKNOWNS = 450
+#: The same for a transient or shift step (the operator ``A_tt`` itself). The dense path solves through the
+#: inverse of the contact block, computed once per contact set and shared by the march's steps
+#: (:mod:`.capacitance`); measured on circles (ξ, η, φ, 12 steps), CPU of a transient step dense / Krylov,
+#: median (the first step, which inverts the block): 1.9 (8.5) / 13.0 ms at 5 per semi-axis, 3.0 (26) /
+#: 17.8 ms at 10 (632 unknowns), 6.5 (59) / 20.8 ms at 12, 14.5 (163) / 25.1 ms at 15 (about 1420
+#: unknowns: the 12 steps even), 49 (634) / 50 ms at 20 (2544 unknowns).
+TRANSIENT_DENSE_UNKNOWNS = 1200
 #: Relative tolerance of the Krylov solves, against ‖Φ‖: an inexact Newton step of this
 #: accuracy keeps the local convergence superlinear (Eisenstat–Walker forcing ≤ 1e-2 ‖Φ‖).
 KRYLOV_FORCING = 1e-3
@@ -337,8 +342,18 @@ class _TangentialSystem:
             self.E[j * self.nv:(j + 1) * self.nv, i] = 1.0
         steady = str(getattr(problem.B, "name", "")).startswith("steady")   # the steady operator (eq. 3D.17)
         self.dense = method._use_dense(2 * self.nv + len(free), DENSE_UNKNOWNS if steady else TRANSIENT_DENSE_UNKNOWNS)
-        self.S = k * problem.B.memo(("dense", V.tobytes()), lambda: problem.B.dense(V, V)) if self.dense else None
+        self.S = k * self._block() if self.dense else None
         self._rS = None
+
+    def _block(self):
+        """The operator's dense block on the contact elements (kept with the operator)."""
+        B, V = self.problem.B, self.V
+        return B.memo(("dense", V.tobytes()), lambda: B.dense(V, V))
+
+    def _inverse(self):
+        """The inverse of :meth:`_block` (kept with the operator: a march's steps on one contact set
+        share it)."""
+        return self.problem.B.memo(("inverse", self.V.tobytes()), lambda: capacitance.inverse(self._block()))
 
     def split(self, x, Kx):
         m = 2 * self.nv
@@ -380,6 +395,34 @@ class _TangentialSystem:
         return self.k * (self.problem.B @ full.ravel()).reshape(2, n)[:, V].ravel()
 
     def _dense_step(self, mxx, mxy, myy, phi):
+        slip = np.flatnonzero((mxx != 1.0) | (mxy != 0.0) | (myy != 1.0))   # M_i = I: a sticking element
+        if 2 * slip.size <= capacitance.MAX_FRACTION * 2 * self.nv:
+            d = self._capacitance_step(slip, mxx, mxy, myy, phi)
+            if d is not None:
+                return d
+        return self._lu_step(mxx, mxy, myy, phi)
+
+    def _capacitance_step(self, slip, mxx, mxy, myy, phi):
+        """``J d = −Φ`` by eq. 3D.28a (the load rows bordered: ``d_t = X_0 + X_ζ dζ``); ``None`` where it is
+        singular (the LU step decides)."""
+        nv, r, nf = self.nv, self.r, len(self.free)
+        m = 2 * nv
+        rhs = -phi[:m]
+        if nf:
+            cols = [-r * np.concatenate([(mxx, mxy)[j], (mxy, myy)[j]]) for j in self.free]   # −J_tζ
+            rhs = np.column_stack([rhs] + cols)
+        X = capacitance.solve(self._inverse(), r * self.k, slip, mxx, mxy, myy, rhs)
+        if X is None or not np.all(np.isfinite(X)):
+            return None
+        if not nf:
+            return X
+        LX = self.ah * np.stack([X[j * nv:(j + 1) * nv].sum(axis=0) for j in self.free])   # (nf, 1 + nf)
+        if not np.linalg.cond(LX[:, 1:]) < 1e12:   # every element slipping: the load rows are singular
+            return None
+        dz = np.linalg.solve(LX[:, 1:], -phi[m:] - LX[:, 0])
+        return np.concatenate([X[:, 0] + X[:, 1:] @ dz, dz])
+
+    def _lu_step(self, mxx, mxy, myy, phi):
         nv, r, nf = self.nv, self.r, len(self.free)
         m = 2 * nv
         if self._rS is None:   # r·[Ŝ E] once per solve (the same numbers as forming it each iteration)

@@ -30,8 +30,8 @@ import math
 import time
 from dataclasses import dataclass, field
 
-from ..errors import InputError
-from .run import run
+from .errors import InputError
+from .three.run import run
 
 __all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "ORDER_RANGE"]
 
