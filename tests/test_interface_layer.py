@@ -7,23 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import layer_cases as lc
 import rollqp
-from rollqp.closedforms import brush_creep_ratio
 from rollqp.discretization.grid import Grid
 from rollqp.errors import InputError
 from rollqp.influence.grid import ContactOperators
 from rollqp.influence.layer import Layer, LayeredOperators, grid_kernel, parse_layer
 from rollqp.materials import Materials
-from rollqp.methods.newton.disc import NewtonMethod
-from rollqp.operators.grid import Contact, Loads
-from rollqp.three.hertz import hertz
-from rollqp.three.march import steady
-
-KAPPAS = (0.3, 1.0)
-
-
-def rate(errors, hs):
-    return float(np.log(abs(errors[0] / errors[-1])) / np.log(hs[0] / hs[-1]))
 
 
 def test_the_layer_adds_its_compliance_to_the_tangential_operators_only():
@@ -52,60 +42,25 @@ def test_the_layer_adds_its_compliance_to_the_tangential_operators_only():
     assert grid_kernel(g, c, (0.0, 0.0)).sum() == pytest.approx(c)
 
 
-def _brush_3d(n, eps=1e-4):
-    """A circle (E = 210 GPa, ν = 0.25, FN = 1 kN, R = 30 mm) under a layer 1/eps times as compliant as the
-    bodies' a/G, on n × n elements over 1.1·(a, b) (the leading edge at an element edge on the axis): F/(μFN)
-    against the brush's eq. B.1 at κ = 0.3 and 1."""
-    m = Materials.from_young(210e3, 0.25, 210e3, 0.25)
-    A, FN, mu = 1 / 60, 1000.0, 0.3
-    e = hertz(A, A, m.Estar, FN)
-    comp = e.a / m.G / eps
-    c = Contact(Grid.for_ellipse(e.a, e.b, (n, n), (1.1, 1.1)), m, (A, A), FN, mu,
-                layer={"thickness": comp, "shear_modulus": 1.0})
-    newton = NewtonMethod()
-    p = newton.solve(c.normal_step(FN))
-    errs = []
-    for kappa in KAPPAS:
-        xi = kappa * mu * e.p0 * comp / e.a
-        r = steady(c, newton, FN, Loads(xi=xi, eta=0.0), -1, pressure=p)
-        errs.append(r.Fx / (mu * FN) / brush_creep_ratio(xi, e.a, e.p0, mu, 1 / comp) - 1)
-    return np.array(errs), c.grid.dx
-
-
 def test_a_dominating_layer_is_the_brush_in_3d():
     """F/(μFN) against eq. B.1 on 11, 22, 44 elements across: measured errors 16.8 %, 6.0 %, 3.7 % (κ = 0.3) and
     7.1 %, 4.8 %, 2.9 % (κ = 1), order 1.1 and 0.65 — first order with the staircase scatter of the rows' leading
     edges (the first stuck element of a row carries k ξ dx, the brush k ξ times its distance from the edge). The
     bodies' own elasticity (1e-4 of the layer's) moves the ratio by about 1e-4 (measured: 1e-3 at 1e-3)."""
-    errs, hs = zip(*(_brush_3d(n) for n in (11, 22, 44)))
+    errs, hs = zip(*(lc.brush_3d(n) for n in (11, 22, 44)))
     errs = np.array(errs)
     assert np.all(errs > 0), errs          # the upwind first element over-counts: the discrete brush is stiffer
-    assert rate(errs[:, 0], hs) > 0.9 and rate(errs[:, 1], hs) > 0.55, errs
+    assert lc.order(errs[:, 0], hs) > 0.9 and lc.order(errs[:, 1], hs) > 0.55, errs
     assert np.all(errs[-1] < 0.04), errs
-
-
-def _strip(n, eps=1e-4):
-    base = rollqp.load_scene("cattaneo-carter").replace(**{
-        "load.start": "rolling", "discretization.distance": 0.0, "load.tangential": None, "load.creepage": 1e-6,
-        "discretization.elements": n, "discretization.element": "constant", "discretization.zone": 1.1})
-    comp = base.a_H / base.Estar / eps
-    mu = base.contact.mu
-    errs = []
-    for kappa in KAPPAS:
-        xi = kappa * mu * base.p0 * comp / base.a_H
-        s = base.replace(**{"contact.layer": {"thickness": comp, "shear_modulus": 1.0}, "load.creepage": xi})
-        Q = float(rollqp.run(s).arrays()["Q"][0])
-        errs.append(Q / (mu * base.load.normal) / brush_creep_ratio(xi, base.a_H, base.p0, mu, 1 / comp) - 1)
-    return np.array(errs), 2 * 1.1 * base.a_H / n
 
 
 def test_a_dominating_layer_is_the_brush_in_2d():
     """The same closed form on the strip (constant elements, 22, 44, 88 over ±1.1 a_H: the leading edge on a node):
     measured 4.85 %, 2.45 %, 1.21 % (κ = 0.3) and 3.88 %, 1.94 %, 0.97 % (κ = 1), order 1.0."""
-    errs, hs = zip(*(_strip(n) for n in (22, 44, 88)))
+    errs, hs = zip(*(lc.brush_strip(n) for n in (22, 44, 88)))
     errs = np.array(errs)
     assert np.all(errs > 0), errs
-    assert rate(errs[:, 0], hs) > 0.9 and rate(errs[:, 1], hs) > 0.9, errs
+    assert lc.order(errs[:, 0], hs) > 0.9 and lc.order(errs[:, 1], hs) > 0.9, errs
     assert np.all(errs[-1] < 0.015), errs
 
 

@@ -12,10 +12,7 @@ import numpy as np
 import pytest
 
 import contact3d_cases as cc
-from rollqp.methods.fastsim import FastsimMethod
-from rollqp.methods.newton.disc import NewtonMethod
-from rollqp.operators.grid import Loads
-from rollqp.three.march import steady
+import layer_cases as lc
 
 
 def test_the_deck_is_four_series_of_thirty_cases_with_contact_s_numbers():
@@ -51,24 +48,13 @@ def test_series_2_falling_friction_with_the_interface_layer(cases):
     assert all(o[3] <= 8 for o in ours)             # CONTACT: 2–5 outer iterations per case
 
 
-def _series_3():
-    d, ref = cc.deck(), cc.reference_forces()
-    idx = [i for i, c in enumerate(d) if c["series"] == 3]
-    c0 = d[idx[0]]
-    c = cc.tractcurv_contact(c0, c0["FKIN"], layer=False)
-    fs = FastsimMethod()
-    fs.setup(c)
-    p = NewtonMethod().solve(c.normal_step(c0["FN"]))
-    return [(ref[i][1], steady(c, fs, c0["FN"], Loads(xi=d[i]["CKSI"], eta=0.0), -1, pressure=p).Fx) for i in idx]
-
-
 def test_series_3_fastsim_against_rollqp_s_fastsim():
     """Series 3 (CONTACT's original FASTSIM, Coulomb μ = 0.33, parabolic traction bound B = 3) against rollqp's
     ``fastsim`` (Kalker's L1 of Table E.3, the exact pressure of the normal step). Not the same method: measured
     −2.1 % at CKSI 1e-5 (CONTACT's flexibility from its own C11, 2.2 % stiffer), +6.3 % at 8e-4 … −3.4 % at 3.2e-3
     (the parabolic pressure, 4/3 of Hertz's peak and zero slope at the edge, saturates later), both at μFN from
     CKSI 0.03 (within CONTACT's 4 digits)."""
-    pairs = np.array(_series_3())
+    pairs = np.array([r[1:] for r in lc.tractcurv_fastsim()])
     rel = pairs[:, 1] / pairs[:, 0] - 1
     assert abs(rel[0]) < 0.03 and np.max(np.abs(rel)) < 0.07, rel
     assert np.all(np.abs(rel[19:]) < 1e-4), rel            # CKSI >= 0.03: full sliding, μFN

@@ -202,8 +202,8 @@ def grid_kernel(grid, c: float, offset=(0.0, 0.0)) -> np.ndarray:
 
     >>> from rollqp.discretization.grid import Grid
     >>> k = grid_kernel(Grid.centred(3, 2, 1.0, 1.0), 2.0, (-1.0, 0.0))
-    >>> k.shape, float(k.sum()), [int(v) for v in np.argwhere(k)[0]]     # one element upstream along x
-    ((3, 5), 2.0, [1, 1])
+    >>> k.shape, float(k.sum()), [int(v) for v in np.argwhere(k)[0]]   # i − i' = 1: the element on the −x side
+    ((3, 5), 2.0, [1, 3])
     """
     ox, oy = (float(v) for v in offset)
 
