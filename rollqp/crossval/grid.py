@@ -134,7 +134,9 @@ class CrossCheck:
     def _nothing(self) -> str:
         if self.skipped:
             m, ks = next(iter(self.skipped.items()))
-            return (f"skipped: one {m} step takes about {self.estimate:.0f} s (estimate), beyond the budget of "
+            took = (f"one {m} step takes about {self.estimate:.0f} s (estimate)" if self.estimate is not None
+                    else f"a {m} step was stopped at the budget")   # a solve stopped mid-way: no estimate
+            return (f"skipped: {took}, beyond the budget of "
                     f"{self.budget:.1f} s (the run's own time plus {SLACK:g} s); --cross-check solves steps {', '.join(map(str, sorted(ks)))} again, "
                     "rollqp crossval every step")
         return "nothing to check"
