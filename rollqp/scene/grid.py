@@ -172,10 +172,6 @@ def _body(key, b: Body3D) -> Body3D:
 
 def _contact(c: Contact3D) -> Contact3D:
     law = parse_friction(c.friction)   # a number is Coulomb's coefficient; a table a law: checked once, here
-    if law.kind == "slip":
-        raise InputError("contact.friction.law", f"a 3D scene takes Coulomb's coefficient or a law along the "
-                                                 f"surface (kind 'constant' or 'spatial'); {law.law!r} depends on "
-                                                 "the slip velocity, which only 2D scenes take")
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
     return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name, parse_layer(c.layer))
@@ -470,6 +466,7 @@ def _check_whole(scene) -> None:
         check_patch(scene.patch, "discretization.extent" if scene.discretization.extent is not None
                     else "discretization.zone")
     _check_work(scene)
+    _check_memory(scene)
     if has_load_path(scene):
         check_load_path(scene)      # the sliding limit of the current load among them
     else:
@@ -538,6 +535,16 @@ def _check_work(scene) -> None:
         raise InputError("discretization.distance", f"the result of {K + 1} states of {scene.grid.n} elements would be "
                                                     f"{size / 2 ** 30:.3g} GiB, more than {MAX_RESULT_BYTES >> 30} GiB: "
                                                     "fewer steps or elements")
+
+
+def _check_memory(scene) -> None:
+    """A slip-velocity law's memory is carried with the material from step to step: the steady state of a rolling
+    start has no previous step to carry it from (as in 2D: docs/friction.md)."""
+    law = scene.contact.friction
+    if getattr(law, "kind", None) == "slip" and law.memory > 0 and scene.load.start == "rolling":
+        raise InputError("contact.friction.memory", f"= {law.memory!r} needs load.start = 'braked': a steady rolling "
+                                                    "start cannot carry the friction memory along the material "
+                                                    "(or set memory = 0)")
 
 
 def _check_sliding_limit(scene) -> None:
