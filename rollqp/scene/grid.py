@@ -6,7 +6,8 @@ normal force and rolling in x with creepages or tangential forces::
 
     name, description, units
     [bodies.A] [bodies.B]   radius, radius_y (> 0 convex, < 0 concave, or inf), E, nu
-    [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace")
+    [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace"),
+                            layer = { thickness = h, shear_modulus = G3 }
     [load]                  normal (FN), tangential (Fx/(μFN)), lateral (Fy/(μFN)),
                             creepage = { longitudinal = ξ, lateral = η, spin = φ },
                             start, direction, start_steps, normal_history, rolled
@@ -40,6 +41,7 @@ from ..errors import InputError
 from ..friction import parse_friction
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL, get_model
+from ..influence.layer import check_relative, parse_layer
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
 from .core import TwoBodyScene, check_top, table_keys
@@ -88,11 +90,13 @@ class Body3D:
 
 @dataclass(frozen=True)
 class Contact3D:
-    """``dimension = 3``; Coulomb's coefficient ``friction`` (a number > 0); ``model``: the half-space."""
+    """``dimension = 3``; Coulomb's coefficient ``friction`` (a number > 0); ``model``: the half-space; ``layer``: an
+    interface layer ``{ thickness, shear_modulus }`` (:mod:`rollqp.influence.layer`), None: none."""
 
     friction: float
     dimension: int = 3
     model: str = DEFAULT_MODEL
+    layer: Any = None
 
     @property
     def mu(self) -> float:
@@ -170,7 +174,7 @@ def _contact(c: Contact3D) -> Contact3D:
     law = parse_friction(c.friction)   # a number is Coulomb's coefficient; a table a law: checked once, here
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-    return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name)
+    return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name, parse_layer(c.layer))
 
 
 def _history(v, key):
@@ -413,7 +417,8 @@ class Scene3D(TwoBodyScene):
         return {"name": self.name, "description": self.description, **({"units": self.units} if self.units else {}),
                 "bodies": {k: {f: v for f, v in dataclasses.asdict(b).items() if v is not None}
                            for k, b in (("A", self.A), ("B", self.B))},
-                "contact": {"dimension": 3, "friction": plain(self.contact.friction), "model": self.contact.model},
+                "contact": {"dimension": 3, "friction": plain(self.contact.friction), "model": self.contact.model,
+                            **({} if self.contact.layer is None else {"layer": plain(self.contact.layer)})},
                 "load": loads,
                 "discretization": {**disc, "step": d.step, "distance": d.distance},
                 "solver": solver}
@@ -445,6 +450,7 @@ def _check_whole(scene) -> None:
                                                       "ellipse to scale discretization.zone by; give the grid in length "
                                                       "units, extent = [[x0, x1], [y0, y1]]")
     _check_ellipse(scene)
+    check_relative(scene.contact.layer, math.sqrt(scene.ellipse.a * scene.ellipse.b), scene.materials.Estar)
     for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):  # Archard's k·p0/H <= 1, as in 2D
         if body.wear is not None and not body.wear * scene.ellipse.p0 <= 1.0:
             raise InputError(f"{key}.wear", f"must be a number in [0, 1/p0 = {1.0 / scene.ellipse.p0:.6g}] (k/H in "
