@@ -1,4 +1,4 @@
-"""Slip-velocity friction laws on a 3D contact (docs/friction.md, "On the grid"; docs/validation3d.md §19): the
+"""Slip-velocity friction laws on a 3D contact (docs/friction.md, "On the grid"; docs/validation3d.md §20): the
 slip speed ``V|s|`` of each element's slip vector, Newton's pseudo-Jacobian with the ``∂μ/∂|s|`` term, the fixed
 point on the bound around the conic method, the memory carried with the material, the selection of a step's
 solution by the path from the frozen bound, and bad input in one line naming the key."""
@@ -75,7 +75,7 @@ def test_full_sliding_under_a_falling_law_converges_to_the_integral():
     slopes = np.log2(errors[0] / errors[2]) / 2
     print(f"|Fx/FN - exact| = {', '.join(f'{e:.3g}' for e in errors[:, 0])} (slope {slopes[0]:.2f}); "
           f"|Mz/(FN a) - exact| = {', '.join(f'{e:.3g}' for e in errors[:, 1])} (slope {slopes[1]:.2f})")
-    # measured (docs/validation3d.md §19): Fx 4.26e-5, 8.80e-6, 3.30e-6 (slope 1.85); Mz 7.97e-5, 1.39e-5,
+    # measured (docs/validation3d.md §20): Fx 4.26e-5, 8.80e-6, 3.30e-6 (slope 1.85); Mz 7.97e-5, 1.39e-5,
     # 4.70e-6 (slope 2.04). The midpoint rule on μ p is second order (Hertz's √ edge O(h^1.5)); the steady
     # slip's upwind difference adds a first-order part through the elastic slip, 1.4e-6 at 40 per a
     assert np.all(errors[1] < errors[0]) and np.all(errors[2] < errors[1]), errors

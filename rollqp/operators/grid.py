@@ -22,8 +22,9 @@ from ..friction import as_law
 from ..friction.bound import grid_coefficient
 from ..profiles.surface import QuadraticProfile
 from ..discretization.grid import Grid
-from ..three.hertz import hertz
+from ..closedforms.hertz_ellipse import hertz
 from ..influence import DEFAULT_MODEL, get_model
+from ..influence.layer import parse_layer, with_layer
 from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
 __all__ = ["Contact", "Loads"]
@@ -71,6 +72,9 @@ class Contact:
     model : str
         The influence model (``contact.model``) of 3D scenes that builds the operators from the grid and
         the materials (:func:`rollqp.influence.get_model`; default the Boussinesq–Cerruti half-space).
+    layer : rollqp.influence.layer.Layer or dict, optional
+        An interface layer between the bodies (``contact.layer``): its compliance ``h/G₃`` joins the tangential
+        operators (:mod:`rollqp.influence.layer`).
 
     Examples
     --------
@@ -82,7 +86,7 @@ class Contact:
     """
 
     def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None,
-                 model: str = DEFAULT_MODEL):
+                 model: str = DEFAULT_MODEL, layer=None):
         # a scene's law as it is, a number checked once here (as_law)
         law = as_law(mu)
         if law.kind not in ("constant", "spatial", "slip"):
@@ -99,7 +103,8 @@ class Contact:
         f = min(1.0, self.mu / MU_REFERENCE) if self.mu > 0 else 1.0
         self.tangential_scales = self.scales if f == 1.0 else Scales(self.scales.length, self.scales.stress * f,
                                                                      self.scales.modulus, dimension=3)
-        self.ops = get_model(model, "contact.model", dimension=3).build(grid, materials)
+        self.layer = parse_layer(layer)
+        self.ops = with_layer(get_model(model, "contact.model", dimension=3).build(grid, materials), self.layer)
         self.x, self.y = grid.centres()
         self.record = grid.record()   # the points, weights and components a law or a field reads
         h = np.asarray(self.profile(self.x, self.y), dtype=float)

@@ -34,9 +34,9 @@ from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
 from ..operators.grid import Contact
-from .loadpath import out_of_contact, rolling_steps
-from .loads import start_force
-from .patch import moving_profile
+from ..loadpath import out_of_contact, rolling_steps
+from ..loads import start_force
+from ..patch import moving_profile
 from .march import StepRecord, static_shift, steady
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
@@ -59,7 +59,8 @@ def prepare(scene, method=None):
     meth = (scene_method_3d(scene.solver, friction=kind) if method is None or isinstance(method, str)
             else compose_3d(method, friction=kind))
     contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
-                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
+                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model,
+                      layer=scene.contact.layer)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
         contact.move = moving_profile(contact, scene.shape, scene.load.direction,
                                       "discretization.extent" if scene.discretization.extent is not None
