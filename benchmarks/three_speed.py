@@ -155,26 +155,6 @@ def section_chord(quick):
                   "Anderson / chord", "max\\|Δt\\|/μp0"], rows)
 
 
-def _cpu(fn, repeats):
-    """(best CPU seconds of this process over ``repeats`` calls, the last result): CPU time, not wall time, so
-    that the other jobs of a shared machine weigh less (a job's CPU time still grows with the cache misses they
-    cause)."""
-    best, out = np.inf, None
-    for _ in range(repeats):
-        t0 = time.process_time()
-        out = fn()
-        best = min(best, time.process_time() - t0)
-    return best, out
-
-
-def _circle(per, nu=0.28):
-    """A circle of ``per`` elements per semi-axis (CONTACT's count): ``2·per + 2`` elements on zone
-    ``(per + 1)/per``, one row to spare on each side."""
-    zone = (per + 1) / per
-    return Contact.hertzian(Materials.from_young(210e3, nu, 210e3, nu), (1 / 60, 1 / 60), FN, MU,
-                            elements=(2 * per + 2, 2 * per + 2), zone=(zone, zone))
-
-
 #: CONTACT's figures on the same problems (circle, partial slip; single-threaded, whole-process CPU time),
 #: measured on another machine with CONTACT (not installed here) against the rollqp of that day (commit
 #: 1bdc107): the ratio rollqp / CONTACT of the steady run's whole process, and the transient rolling step of
@@ -213,8 +193,14 @@ distance = 0.0
 
 
 def _tree_env(tree):
+    """The environment of a process on the checkout ``tree``: single-threaded BLAS (as CONTACT was timed; the
+    older checkout does not pin its pools itself), and bytecode caches allowed, as an installed package has
+    them (an environment with ``PYTHONDONTWRITEBYTECODE`` compiles every module of every process again)."""
     env = dict(os.environ)
     env["PYTHONPATH"] = str(tree)
+    for key in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env[key] = "1"
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     return env
 
 
@@ -326,7 +312,8 @@ def section_startup(quick):
         best, wall = np.inf, np.inf
         for _ in range(3):
             r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-            subprocess.run(cmd, check=True, capture_output=True, cwd=folder)
+            subprocess.run(cmd, check=True, capture_output=True, cwd=folder,
+                           env=_tree_env(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
             r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
             best = min(best, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
             wall = min(wall, time.perf_counter() - t0)
