@@ -11,7 +11,7 @@ from rollqp import load_scene
 from rollqp.errors import InputError
 from rollqp.profiles.surface import Body, curvatures
 from rollqp.three.hertz import hertz
-from rollqp.three.post import hertz_field_errors
+from rollqp.report.grid import hertz_field_errors
 from rollqp.three.run import run
 
 INF = float("inf")

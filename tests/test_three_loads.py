@@ -270,7 +270,7 @@ def test_export_step_and_cross_check_pose_a_load_paths_steps():
     the run's own solution solves the exported step (rollqp's residuals at the solver tolerance) and the
     conic method agrees on the kept steps; an out-of-contact step is refused naming --step."""
     from rollqp.stepfile.three import export_step_3d
-    from rollqp.three.crosscheck import SpotObserver, cross_check
+    from rollqp.crossval.grid import SpotObserver, cross_check
     nh = {"kind": "table", "q": [0, 1, 1.2, 1.9, 2.2, 4], "value": [1.2, 1, 0, 0, 1, 1.2]}
     s = braked(12, **{"load.tangential": nh | {"value": [0.5 * v for v in nh["value"]]},
                       "load.rolled": {"kind": "table", "q": [0, 1, 2.5, 4], "value": [0, 1, 1, -0.5]},

@@ -12,7 +12,7 @@ import pytest
 from rollqp import cli, load_scene
 from rollqp.errors import InputError
 from rollqp.scene import builtin_scenes
-from rollqp.three.report import summary
+from rollqp.report.grid import summary
 from rollqp.three.run import run
 
 

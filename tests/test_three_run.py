@@ -13,9 +13,9 @@ import pytest
 from rollqp import cli, load_scene
 from rollqp.errors import InputError
 from rollqp.methods import CROSSVAL_METHODS_3D, available_methods
-from rollqp.three.crosscheck import AGREEMENT, crossval, spot_steps
+from rollqp.crossval.grid import AGREEMENT, crossval, spot_steps
 from rollqp.three.march import steady
-from rollqp.three.report import summary
+from rollqp.report.grid import summary
 from rollqp.three.run import prepare, run
 
 #: SPEC's keys of a 3D result file (docs/results.md, "Three dimensions"): the contract's (every other key is

@@ -1,5 +1,5 @@
 """What a 3D run costs and what it says about it: the conic cost model, the refusal before any work, the
-cross-check's time budget and its reuse of identical steps (rollqp.three.advice, rollqp.three.crosscheck).
+cross-check's time budget and its reuse of identical steps (rollqp.advice.grid, rollqp.crossval.grid).
 No test times anything: the budget tests use a budget of zero or a deadline already past."""
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import pytest
 
 from rollqp import cli, load_scene
 from rollqp.errors import InputError
-from rollqp.three import advice
-from rollqp.three.crosscheck import SpotObserver, cross_check, crossval
+from rollqp.advice import grid as advice
+from rollqp.crossval.grid import SpotObserver, cross_check, crossval
 from rollqp.three.run import run
 
 

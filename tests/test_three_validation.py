@@ -13,7 +13,7 @@ from rollqp.three.hertz import curvatures_for_ratio
 from rollqp.three.march import static_shift, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
-from rollqp.three.post import cattaneo_errors, creep_matrix, hertz_errors
+from rollqp.report.grid import cattaneo_errors, creep_matrix, hertz_errors
 
 FN, MU = 1000.0, 0.3
 

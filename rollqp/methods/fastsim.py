@@ -137,7 +137,7 @@ class FastsimMethod:
 
     name = "fastsim"
     #: It solves the steady state only: a run with rolling steps after it is refused before any work
-    #: (:func:`rollqp.three.advice.refusal`).
+    #: (:func:`rollqp.advice.grid.refusal`).
     steady_only = True
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
                                 dimensions=frozenset({3}), traction_components=2, friction_set="disc")

@@ -38,7 +38,7 @@ from ..errors import RollqpError
 from ..methods import REFERENCE_METHOD
 from ..units import unit_names
 from ..three.closedforms import cattaneo_stick_radius, cattaneo_traction, kalker_linear
-from ..three.report import LINEAR_SLIP_FRACTION, stick_fraction
+from ..report.grid import LINEAR_SLIP_FRACTION, stick_fraction
 from .style import REFERENCES, arrays, colors, finish, legend_below, meta, pyplot, scene_of, value_axis
 
 __all__ = ["three_figure", "field_figure", "three_kind", "creep_force_panel", "she_saturation", "KINDS_3D"]

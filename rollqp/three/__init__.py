@@ -10,7 +10,8 @@ their conic forms), :mod:`rollqp.operators.grid` (one contact, built once), :mod
 :mod:`rollqp.methods.socp`, :mod:`rollqp.methods.refine`, :mod:`rollqp.methods.chord` (the methods) and
 :mod:`rollqp.scene.grid` (the scene). Here remain the closed forms (:mod:`.hertz`, :mod:`.closedforms`),
 the march and run (:mod:`.march`, :mod:`.run`, :mod:`.result`, :mod:`.fields`), the summary, advice,
-cross-check and post-processing (:mod:`.report`, :mod:`.advice`, :mod:`.crosscheck`, :mod:`.post`).
+cross-check and post-processing beside their 2D siblings (:mod:`rollqp.report.grid`, :mod:`rollqp.advice.grid`,
+:mod:`rollqp.crossval.grid`).
 
 Nothing here is imported by ``import rollqp``.
 """

@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import SolverError
 from ..kinematics import plan
 from .loads import has_load_path, normal_force, start_force
-from .march import StepRecord, _record, _states, _warm_of, coupled_step, normal, transient
+from .march import StepRecord, _previous, _record, _states, _warm_of, coupled_step, normal, transient
 from ..problem.grid import SEPARATION
 
 __all__ = ["out_of_contact", "rolling_steps", "posed_force", "SHIFTED_KEPT"]
@@ -118,7 +118,7 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             if fixed is None or fixed[0] != FN or move is not None:
                 fixed = (FN, normal(contact, method, FN))
             pressure = fixed[1]
-        previous = (prev.p, prev.t)
+        previous = _previous(prev)
         if prev.FN != FN:       # the last step's tractions may lie outside this load's discs: a cold start
             warm = None
         stop = pl.d[k] == 0
@@ -134,8 +134,8 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             except SolverError as again:
                 raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
-                      _states(contact, ns.p, ts.t, ts.s))
-        rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.three.crosscheck
+                      _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
+        rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.crossval.grid
         yield rec
         prev, warm = rec, (ns, ts)
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..operators.grid import Loads
-from ..three.crosscheck import AGREEMENT
+from ..crossval.grid import AGREEMENT
 from ..three.march import coupled_step
 from .solve import solve_wheel
 from .track import Track

@@ -3,10 +3,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import closedforms as cf
-from .units import unit_names
-from .influence import get_model
-from .kinematics import plan
+from .. import closedforms as cf
+from ..units import unit_names
+from ..influence import get_model
+from ..kinematics import plan
 
 
 def rms_in_contact(x, a, err):

@@ -22,14 +22,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import RollqpError
-from .methods import CROSS_CHECK_METHODS, REFERENCE_METHOD
-from .stepfile import StepFile, export_step, solve_stored
-from .methods import available_methods
-from .problem import classify
-from .methods import capabilities
-from .march import march
-from .scene import scene_from_dict
+from ..errors import RollqpError
+from ..methods import CROSS_CHECK_METHODS, REFERENCE_METHOD
+from ..stepfile import StepFile, export_step, solve_stored
+from ..methods import available_methods
+from ..problem import classify
+from ..methods import capabilities
+from ..march import march
+from ..scene import scene_from_dict
 
 
 @dataclass

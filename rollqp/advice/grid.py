@@ -28,9 +28,10 @@ import time
 
 import numpy as np
 
-from ..advice import duration
+from . import duration
 from ..errors import InputError
 from ..influence.blocktoeplitz import DENSE_MAX
+from ..methods import capabilities, method_class
 
 __all__ = ["notes", "refusal", "conic_step_seconds", "conic_run", "yardstick", "NOTE_SECONDS", "REFUSE_SECONDS",
            "QUADRATIC", "CUBIC", "MARCH_LENGTHS"]
@@ -81,7 +82,6 @@ def conic_step_seconds(contact_elements: int, y: float | None = None) -> float:
 
 def conic_run(scene) -> tuple:
     """``(steps, seconds a step, seconds in all)`` of ``scene`` run by a conic method (estimate)."""
-    from ..methods import capabilities
     caps = capabilities(scene.solver.method, 3)
     n = scene.contact_elements()
     per = conic_step_seconds(n)
@@ -95,7 +95,6 @@ def conic_run(scene) -> tuple:
 
 def _conic(scene) -> bool:
     """Whether the scene's method needs the dense matrices (the conic backends; Newton works with FFT products)."""
-    from ..methods import capabilities
     return not capabilities(scene.solver.method, 3).matrix_free
 
 
@@ -113,7 +112,6 @@ def newton_steady_seconds(elements: int, y: float | None = None) -> float:
 
 
 def _newton_note(scene) -> list[str]:
-    from ..methods import capabilities
     n = scene.grid.nx * scene.grid.ny
     if n < NEWTON_NOTE_ELEMENTS or "steady" not in capabilities(scene.solver.method, 3).solves:
         return []
@@ -141,7 +139,6 @@ def refusal(scene, allow_long: bool = False) -> None:
     """Refuse, before any work, a conic run that cannot finish in reasonable time or memory (one
     :class:`~rollqp.errors.InputError` naming ``--method newton`` and a coarser grid); ``allow_long``
     lets a run above :data:`REFUSE_SECONDS` start (never one whose dense matrix does not fit)."""
-    from ..methods import method_class
     if getattr(method_class(scene.solver.method, 3), "steady_only", False) and (
             scene.n_steps > 0 or scene.load.start != "rolling"):
         raise InputError("solver.method", f"{scene.solver.method} solves the steady state of a rolling start only "

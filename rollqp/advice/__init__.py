@@ -34,9 +34,9 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from .influence import get_model
-from .methods import METHOD_NAMES
-from .methods import capabilities
+from ..influence import get_model
+from ..methods import METHOD_NAMES
+from ..methods import capabilities
 
 __all__ = ["Plan", "fast_path", "duration", "dense_memory", "dense_seconds", "cholesky_seconds", "alternation_note",
            "DENSE_MEMORY_LIMIT", "DENSE_SECONDS_LIMIT"]

@@ -22,14 +22,18 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..errors import RollqpError
-from .loadpath import posed_force
-from .march import coupled_step
+from ..advice.grid import conic_step_seconds
+from ..errors import InputError, RollqpError
+from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, get_method,
+                       method_class, require_3d)
+from ..three.run import run
+from ..three.loadpath import posed_force
+from ..three.march import coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
 
 #: The default cross-check of ``rollqp run`` may take the run's own wall time plus this many seconds: a
-#: conic step whose estimated cost (:func:`rollqp.three.advice.conic_step_seconds`) does not fit is not
+#: conic step whose estimated cost (:func:`rollqp.advice.grid.conic_step_seconds`) does not fit is not
 #: started, and one still running at the end is stopped. ``--cross-check`` solves the three steps whatever
 #: they cost.
 SLACK = 3.0
@@ -130,7 +134,9 @@ class CrossCheck:
     def _nothing(self) -> str:
         if self.skipped:
             m, ks = next(iter(self.skipped.items()))
-            return (f"skipped: one {m} step takes about {self.estimate:.0f} s (estimate), beyond the budget of "
+            took = (f"one {m} step takes about {self.estimate:.0f} s (estimate)" if self.estimate is not None
+                    else f"a {m} step was stopped at the budget")   # a solve stopped mid-way: no estimate
+            return (f"skipped: {took}, beyond the budget of "
                     f"{self.budget:.1f} s (the run's own time plus {SLACK:g} s); --cross-check solves steps {', '.join(map(str, sorted(ks)))} again, "
                     "rollqp crossval every step")
         return "nothing to check"
@@ -183,10 +189,8 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
     solution is that step's, compared with the run's own solution of it (``CrossCheck.same``).
 
     ``budget`` (seconds; None: none) bounds the wall time: the steps are taken the last first, a step
-    whose estimated conic cost (:func:`rollqp.three.advice.conic_step_seconds`) does not fit what is left
+    whose estimated conic cost (:func:`rollqp.advice.grid.conic_step_seconds`) does not fit what is left
     is not started, and a conic solve still running at the end is stopped (``CrossCheck.skipped``)."""
-    from ..methods import CROSS_CHECK_METHODS_3D, capabilities, get_method, method_class
-    from .advice import conic_step_seconds
     if methods is None:      # the other route: not the class that ran (socp-clarabel and qp-clarabel are one)
         methods = [m for m in CROSS_CHECK_METHODS_3D if method_class(m, 3) is not method_class(ran, 3)]
     names = [m for m in methods if m != ran]
@@ -248,9 +252,6 @@ def crossval(scene, step: int | None = None, methods=None, tolerance: float = 1e
     InputError
         ``--step`` outside ``0 … K``, or a method that cannot solve the scene's steps.
     """
-    from ..errors import InputError
-    from ..methods import CROSSVAL_METHODS_3D, available_methods, require_3d
-    from .run import run
     K = scene.n_steps
     if step is not None and not (isinstance(step, int) and 0 <= step <= K):
         raise InputError("--step", f"must be an integer in [0, {K}] ({scene.name!r} has {K} rolling steps), got "
