@@ -37,7 +37,7 @@ from harness import pin_threads, table
 
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
-from rollqp.three.hertz import curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
 from rollqp.three.march import normal, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
