@@ -71,7 +71,7 @@ def test_the_built_in_falling_friction_3d_is_series_2_without_memory(tmp_path):
     pytest.importorskip("zarr")
     from rollqp import load_scene
     from rollqp.sweep.three import creep_curve_3d
-    from rollqp.three.hertz import curvatures_for_ratio
+    from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
     scene = load_scene("falling-friction-3d")
     two = next(c for c in cc.deck() if c["series"] == 2)
     law = scene.contact.friction

@@ -27,7 +27,7 @@ from ..errors import InputError, RollqpError
 from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, get_method,
                        method_class, require_3d)
 from ..three.run import run
-from ..three.loadpath import posed_force
+from ..loadpath import posed_force
 from ..three.march import coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
@@ -144,7 +144,7 @@ class CrossCheck:
 
 def _pose(scene, contact, rec, before):
     """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
-    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.three.loadpath)
+    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.loadpath)
         kind, _, dq, _, loads = rec.info["pose"]
         return kind, loads, before, dq
     if rec.phase == "steady":
