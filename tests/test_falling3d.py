@@ -130,6 +130,19 @@ def test_newton_agrees_with_the_fixed_point_on_the_conic_method(memory):
     assert min(float(np.min(r.mu[r.state == 2])) for r in a[1:] if (r.state == 2).any()) < 0.32 - 1e-3
 
 
+def test_newton_agrees_with_the_fixed_point_on_cvxpy():
+    """The fixed point on the bound around socp-cvxpy (its conic solve at tolerances set from 1e-12) against Newton on
+    the transient with memory, each step on its own."""
+    pytest.importorskip("cvxpy")
+    from rollqp.methods.socp import CvxpyMethod
+    scene = _transient(0.3, distance=1.0)
+    a, contact = _run(scene, _newton())
+    b, _ = _run(scene, SlipContinuation(BoundFixedPoint(CvxpyMethod(tolerance=1e-12)), threshold=math.inf))
+    worst = max(float(np.max(np.abs(x.t - y.t))) for x, y in zip(a, b)) / (0.32 * contact.scales.stress)
+    print(f"cvxpy: max |t_newton - t_fixed point| = {worst:.2e} mu_s p0")
+    assert worst <= 1e-8, worst      # as with Clarabel: both at rollqp's residual 1e-10 or below
+
+
 def test_newton_agrees_with_the_fixed_point_in_steady_rolling():
     """Steady rolling (no memory): Newton's direct steady solve against the fixed point on the conic method
     marched to the steady state."""
