@@ -18,7 +18,7 @@ import numpy as np
 from rollqp.operators.grid import Contact, Loads
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.discretization.grid import Grid
-from rollqp.three.hertz import curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
 from rollqp.three.march import static_shift, steady, transient
 from rollqp.materials import Materials
 

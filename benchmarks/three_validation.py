@@ -25,10 +25,11 @@ import contact3d_cases
 import layer_cases
 from harness import pin_threads, table
 
-from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
+from rollqp.closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
+from rollqp.closedforms.kalker import kalker_linear
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
-from rollqp.three.hertz import curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
 from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod

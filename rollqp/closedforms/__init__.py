@@ -28,6 +28,10 @@ One module per closed form, each citing its source (its ``SOURCE``) and defining
 :mod:`.hertz`, :mod:`.cattaneo`, :mod:`.carter`, :mod:`.bentall_johnson`, :mod:`.mindlin`,
 :mod:`.rounded_punch`, :mod:`.lame`, :mod:`.mcewen`, :mod:`.brush`. Every function is importable from here as
 ``rollqp.closedforms.<name>``; :data:`SOURCES` maps each function's name to its citation.
+
+The 3D closed forms are modules of their own here, not imported with the package (``import rollqp`` stays
+light): :mod:`.hertz_ellipse` (the Hertz ellipse), :mod:`.kalker` (Kalker's linear theory, Table E.3),
+:mod:`.cattaneo3d` (Cattaneo–Mindlin on the circle) and :mod:`.hertz3d` (stresses below a circular contact).
 """
 from __future__ import annotations
 from __future__ import annotations

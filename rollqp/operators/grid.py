@@ -22,7 +22,7 @@ from ..friction import as_law
 from ..friction.bound import grid_coefficient
 from ..profiles.surface import QuadraticProfile
 from ..discretization.grid import Grid
-from ..three.hertz import hertz
+from ..closedforms.hertz_ellipse import hertz
 from ..influence import DEFAULT_MODEL, get_model
 from ..influence.layer import parse_layer, with_layer
 from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep

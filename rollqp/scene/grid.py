@@ -50,10 +50,10 @@ from ..validate import choice, integer, number
 from ..operators.grid import MU_REFERENCE, Loads
 from ..profiles.surface import Body, curvatures
 from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
-from ..three.hertz import hertz
-from ..three.loads import check_load_path, has_load_path
+from ..closedforms.hertz_ellipse import hertz
+from ..loads import check_load_path, has_load_path
 from ..materials import Materials
-from ..three.patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
+from ..patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
 from ..methods import REFERENCE_METHOD
 from ..methods import scene_method_3d
 
@@ -120,7 +120,7 @@ class Load3D:
     ``tangential`` = Fx/(μFN), ``lateral`` = Fy/(μFN) — or the creepages (:class:`Creepage3D`), the
     ``start`` (``"braked"``: static shift to the initial forces, then rolling; ``"rolling"``: the
     steady state), the material's ``direction`` d = ±1 and the braked start's ``start_steps``; the load path
-    (:mod:`rollqp.three.loads`): ``normal_history`` (FN(τ)/``normal``) and ``rolled`` (q(τ)/a, None: τ = q)."""
+    (:mod:`rollqp.loads`): ``normal_history`` (FN(τ)/``normal``) and ``rolled`` (q(τ)/a, None: τ = q)."""
 
     normal: float
     tangential: History | None = None
@@ -307,7 +307,7 @@ class Scene3D(TwoBodyScene):
     def curvatures(self) -> tuple[float, float]:
         """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.3); with a profile, its curvatures at the origin where
         both are positive, else the equivalent curvatures of the computed contact
-        (:func:`rollqp.three.patch.equivalent_curvatures`)."""
+        (:func:`rollqp.patch.equivalent_curvatures`)."""
         if self.shape.hertzian:
             return curvatures(Body(self.A.radius, self.A.radius_y, "A"), Body(self.B.radius, self.B.radius_y, "B"))
         A, B = self.shape.curvatures()
@@ -318,7 +318,7 @@ class Scene3D(TwoBodyScene):
 
     @functools.cached_property
     def patch(self):
-        """The contact the normal step finds for the profile at the reference load (:mod:`rollqp.three.patch`),
+        """The contact the normal step finds for the profile at the reference load (:mod:`rollqp.patch`),
         None for two paraboloids."""
         if self.shape.hertzian:
             return None
@@ -329,14 +329,14 @@ class Scene3D(TwoBodyScene):
 
     @functools.cached_property
     def ellipse(self):
-        """The Hertz ellipse of ``load.normal`` (a, b, p0, δ, E*: :class:`~rollqp.three.hertz.HertzEllipse`)."""
+        """The Hertz ellipse of ``load.normal`` (a, b, p0, δ, E*: :class:`~rollqp.closedforms.hertz_ellipse.HertzEllipse`)."""
         A, B = self.curvatures
         return hertz(A, B, self.materials.Estar, self.load.normal)
 
     @functools.cached_property
     def grid(self) -> Grid:
         """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.discretization.grid.Grid.for_ellipse>`),
-        or on ``extent`` (:func:`rollqp.three.patch.extent_grid`)."""
+        or on ``extent`` (:func:`rollqp.patch.extent_grid`)."""
         d = self.discretization
         if d.extent is not None:
             return extent_grid(d.extent, d.elements, d.element_size)

@@ -180,7 +180,7 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
                       _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
         rec.info.update(shift=tuple(shift), loads=loads, before=previous)
         out.append(rec)
-        previous, warm = (ns.p, ts.t), (ns, ts)
+        previous, warm = (ns.p, ts.t) if ts.mu is None else (ns.p, ts.t, ts.mu), (ns, ts)   # μ: a law's memory
         if tick is not None:
             tick(j, int(steps))
     return out

@@ -34,9 +34,9 @@ from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
 from ..operators.grid import Contact
-from .loadpath import out_of_contact, rolling_steps
-from .loads import start_force
-from .patch import moving_profile
+from ..loadpath import out_of_contact, rolling_steps
+from ..loads import start_force
+from ..patch import moving_profile
 from .march import StepRecord, static_shift, steady
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
