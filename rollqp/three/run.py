@@ -102,7 +102,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
     """
     scene, meth, contact = prepared = prepared if prepared is not None else prepare(scene, method)
     if resume is not None:
-        _resumable(scene)
+        _resumable(scene, resume if isinstance(resume, dict) else {})
         if state is None:
             state = check_resumed(scene, prepared, resume) if verify else resumed_record(scene, contact, resume)
         start, first = state, _last_index(resume) + 1
@@ -146,10 +146,12 @@ def resumed_record(scene, contact, arrays: dict, row: int = -1) -> StepRecord:
     t = np.stack([np.array(arrays[c][row], dtype=float).ravel() for c in ("px", "py")])
     s = np.stack([np.array(arrays[c][row], dtype=float).ravel() for c in ("sx", "sy")])
     xi, eta, phi = (float(v) for v in arrays["creepage"][row])
+    # a slip-velocity law's coefficient at the elements (field "mu"): the memory the next step starts from
+    mu = np.array(arrays["mu"][row], dtype=float).ravel() if "mu" in arrays and contact.law.kind == "slip" else None
     return StepRecord(k, "resumed", float(q[row]), p, np.zeros_like(p), t, s,
                       np.array(arrays["state"][row]).ravel(), float(arrays["FN"][row]), float(arrays["Fx"][row]),
                       float(arrays["Fy"][row]), float(arrays["Mz"][row]), xi, eta, phi,
-                      float(arrays["approach"][row]), 0, 0.0, float(arrays["residual"][row]))
+                      float(arrays["approach"][row]), 0, 0.0, float(arrays["residual"][row]), mu=mu)
 
 
 def check_resumed(scene, prepared, arrays: dict) -> StepRecord:
@@ -227,12 +229,11 @@ def check_states(scene, contact, source) -> None:
     :class:`InputError` on ``--resume``, before anything is run or written. (The last state is moreover solved
     again: :func:`check_resumed`.)"""
     from .march import _states
-    _resumable(scene)
     g, sc = contact.grid, contact.scales
     mu = float(contact.mu)
     tunit = (min(mu, 1.0) if mu > 0 else 1.0) * sc.stress
     force = sc.stress * g.area * g.n
-    names = ("pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "step")
+    names = ("pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "step", "mu")
     blocks = source.blocks(names) if isinstance(source, ResumeSource) else _array_blocks(source, names)
     seen = 0
     for b in blocks:
@@ -241,6 +242,8 @@ def check_states(scene, contact, source) -> None:
         t = np.stack([np.asarray(b["px"], dtype=float).reshape(m, -1), np.asarray(b["py"], dtype=float).reshape(m, -1)], 1)
         sl = np.stack([np.asarray(b["sx"], dtype=float).reshape(m, -1), np.asarray(b["sy"], dtype=float).reshape(m, -1)], 1)
         k = np.asarray(b["step"]) if "step" in b else np.arange(seen, seen + m)
+        _resumable(scene, b)
+        law_mu = np.asarray(b["mu"], dtype=float).reshape(m, -1) if "mu" in b and contact.law.kind == "slip" else None
         bad = []
         if not (np.all(np.isfinite(p)) and np.all(np.isfinite(t)) and np.all(np.isfinite(sl))):
             bad = ["its fields are not finite"]
@@ -257,37 +260,41 @@ def check_states(scene, contact, source) -> None:
                     and abs(Fy - float(b["Fy"][i])) <= 1e-12 * force
                     and abs(Mz - float(b["Mz"][i])) <= 1e-12 * force * sc.length):
                 bad = [f"state {int(k[i])}: its forces are not those of its pressure and tractions"]
-            elif not np.array_equal(_states(contact, p[i], t[i], sl[i]), np.asarray(b["state"][i]).ravel()):
+            elif not np.array_equal(_states(contact, p[i], t[i], sl[i], mu=None if law_mu is None else law_mu[i]),
+                                    np.asarray(b["state"][i]).ravel()):
                 bad = [f"state {int(k[i])}: its element states are not those of its pressure, traction and slip"]
             else:
-                bad = _law(contact, p[i], t[i], sl[i], np.asarray(b["state"][i]).ravel(), tunit, int(k[i]))
+                bad = _law(contact, p[i], t[i], sl[i], np.asarray(b["state"][i]).ravel(), tunit, int(k[i]),
+                           None if law_mu is None else law_mu[i])
         if bad:
             where = bad[0] if bad[0].startswith("state") else f"a state of the file: {bad[0]}"
             raise InputError("--resume", f"{where}: the file was changed or is corrupt")
         seen += m
 
 
-def _resumable(scene) -> None:
-    """A run with a friction memory is not resumed: its result file does not hold the coefficient the material
-    carries (a one-line :class:`InputError` on ``--resume``)."""
+def _resumable(scene, arrays) -> None:
+    """A run with a friction memory is resumed from the coefficient the material carries, the stored field ``mu``
+    of ``arrays``; without it, a one-line :class:`InputError` on ``--resume``."""
     law = scene.contact.friction
-    if getattr(law, "kind", None) == "slip" and law.memory > 0:
-        raise InputError("--resume", "a 3D run with a friction memory (contact.friction.memory > 0) cannot be "
-                                     "resumed: its result file does not hold the coefficient the material carries; "
+    if getattr(law, "kind", None) == "slip" and law.memory > 0 and "mu" not in arrays:
+        raise InputError("--resume", "a 3D run with a friction memory (contact.friction.memory > 0) resumes from the "
+                                     "stored friction coefficient, field 'mu', which the result file does not hold; "
                                      "run it again")
 
 
-def _law(contact, p, t, s, states, tunit, k) -> list:
+def _law(contact, p, t, s, states, tunit, k, mu=None) -> list:
     """Coulomb's law at a stored state (to :data:`RESUME_TOL`): a sticking element does not slip (``|s|`` in the
-    tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``[]``, or what is wrong."""
+    tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``[]``, or what is wrong.
+    ``mu``: a slip-velocity law's stored coefficient at the elements (else the law at the slip, or the number)."""
     slip_unit = tunit / contact.materials.Estar
     sn = np.hypot(s[0], s[1])
     stick, slipping = states == 1, (states == 2) & (sn > 0)
     if np.any(sn[stick] > RESUME_TOL * slip_unit):
         return [f"state {k}: a sticking element slips"]
-    mu = contact.mu
-    if contact.law.kind == "slip":   # a slip-velocity law (without memory: a run with one is not resumed) at the slip
-        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float), contact=np.asarray(p) > 0)
+    if mu is None:
+        mu = contact.mu
+        if contact.law.kind == "slip":   # a slip-velocity law without its stored coefficient: the law at the slip
+            mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float), contact=np.asarray(p) > 0)
     b = mu * np.maximum(p, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.hypot(t[0] + b * s[0] / sn, t[1] + b * s[1] / sn)
