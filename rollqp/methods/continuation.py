@@ -37,6 +37,12 @@ methods' own choice).
 QP and need not have one solution; the branch of a direct steady solve is chosen by its braked start
 (docs/friction.md, "Which steady state a rolling start returns").
 
+**On a grid** (two traction components, :mod:`rollqp.problem.grid`) the path is followed in ``λ`` by
+natural-parameter steps of Newton on the disc (:func:`follow_grid`), not by arclength: a path that turns back
+(a fold) stops there, and the run says so (``info["path"]``, a ``RuntimeWarning``). Each selected step reports
+:func:`uniqueness_factor` (``info["uniqueness"]``): below 1 the step with its creepages prescribed has one
+solution (docs/friction.md, "When a step's solution is unique").
+
 **Where the path stops.** A path that cannot be followed to ``λ = 1`` (it runs into gross sliding, or a
 corrector does not converge) leaves the step to the method's own solution (or its ``SolverError``), and
 says so: ``info["path"]`` is then ``{"stopped": message, "lam": λ reached}``.
