@@ -27,7 +27,7 @@ from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_l
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
 from rollqp.three.hertz import curvatures_for_ratio, hertz
-from rollqp.three.march import coupled_step, static_shift, steady, transient
+from rollqp.march.grid import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.report.grid import cattaneo_errors, creep_matrix, hertz_errors

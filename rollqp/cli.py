@@ -358,7 +358,7 @@ def _family_3d() -> Family:
     from .plot.three import three_figure
     from .advice.grid import notes, refusal
     from .report.grid import summary
-    from .three.run import run
+    from .march.grid import run
 
     def advise(scene):
         for note in notes(scene):

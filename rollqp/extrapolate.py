@@ -31,7 +31,7 @@ import time
 from dataclasses import dataclass, field
 
 from .errors import InputError
-from .three.run import run
+from .march.grid import run
 
 __all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "ORDER_RANGE"]
 

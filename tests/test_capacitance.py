@@ -9,7 +9,7 @@ from rollqp.materials import Materials
 from rollqp.methods.newton import capacitance
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.operators.grid import Contact, Loads
-from rollqp.three.march import static_shift, steady, transient
+from rollqp.march.grid import static_shift, steady, transient
 
 FN, MU = 1000.0, 0.3
 STEEL = Materials.from_young(210e3, 0.28, 210e3, 0.28)

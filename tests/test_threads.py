@@ -37,7 +37,7 @@ make = rollqp.cli.FAMILIES[3]      # the command's own lazy imports are kept: th
 rollqp.cli.FAMILIES[3] = lambda: dataclasses.replace(make(), run=recording(make().run))
 how = sys.argv[1]
 if how == "api":
-    import rollqp.three.run as r3
+    import rollqp.march.grid as r3
     r3.run = recording(r3.run)
     rollqp.run("kalker-elliptic")
     code = 0

@@ -10,7 +10,7 @@ from rollqp import cli, load_scene
 from rollqp.errors import InputError
 from rollqp.advice import grid as advice
 from rollqp.crossval.grid import SpotObserver, cross_check, crossval
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 
 def coarse(name, **changes):

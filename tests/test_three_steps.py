@@ -8,7 +8,7 @@ import pytest
 from rollqp.errors import InputError, SolverError
 from rollqp.operators.grid import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
-from rollqp.three.march import coupled_step, static_shift, steady, transient
+from rollqp.march.grid import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.problem.grid import SLIP, STICK, Scales, TangentialStep

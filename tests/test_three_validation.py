@@ -10,7 +10,7 @@ import contact3d_cases
 from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_coefficients
 from rollqp.operators.grid import Contact, Loads
 from rollqp.three.hertz import curvatures_for_ratio
-from rollqp.three.march import static_shift, steady
+from rollqp.march.grid import static_shift, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.report.grid import cattaneo_errors, creep_matrix, hertz_errors

@@ -26,9 +26,9 @@ from ..advice.grid import conic_step_seconds
 from ..errors import InputError, RollqpError
 from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, get_method,
                        method_class, require_3d)
-from ..three.run import run
-from ..three.loadpath import posed_force
-from ..three.march import coupled_step
+from ..march.grid import run
+from ..march.grid import posed_force
+from ..march.grid import coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
 
@@ -51,7 +51,7 @@ def spot_steps(K: int) -> list[int]:
 
 
 class SpotObserver:
-    """``observe(record, contact)`` for :func:`rollqp.three.run.run`: keeps the records of ``steps`` and
+    """``observe(record, contact)`` for :func:`rollqp.march.grid.run`: keeps the records of ``steps`` and
     the state before each (``kept[k] = (record, (p, t) before or None)``)."""
 
     def __init__(self, steps):
@@ -142,7 +142,7 @@ class CrossCheck:
 
 def _pose(scene, contact, rec, before):
     """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
-    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.three.loadpath)
+    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.march.grid)
         kind, _, dq, _, loads = rec.info["pose"]
         return kind, loads, before, dq
     if rec.phase == "steady":

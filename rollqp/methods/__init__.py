@@ -417,7 +417,7 @@ def compose_3d(method: Method) -> Method:
     """``method`` if its record can run a 3D scene: dimension 3, and tangential steps on the friction
     disc (a second-order cone per element); else an :class:`InputError` naming the methods that can.
 
-    (Dissimilar bodies run the normal–tangential alternation of :mod:`rollqp.three.march` with the
+    (Dissimilar bodies run the normal–tangential alternation of :mod:`rollqp.march.grid` with the
     method's own halves: every 3D method is composed so.)
     """
     caps = method.capabilities

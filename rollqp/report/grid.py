@@ -36,7 +36,7 @@ from ..units import unit_names
 from ..three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
 from ..three.loads import start_ellipse
 from ..operators.grid import Loads
-from ..three.march import normal, steady
+from ..march.grid import normal, steady
 
 __all__ = ["summary", "closed_form_errors", "stick_fraction", "LINEAR_SLIP_FRACTION", "semi_axes", "hertz_errors",
            "hertz_field_errors", "creep_matrix", "cattaneo_errors"]

@@ -8,10 +8,10 @@ block-Toeplitz operators of :mod:`rollqp.influence.blocktoeplitz`), :mod:`rollqp
 (radii and curvatures), :mod:`rollqp.problem.grid` and :mod:`rollqp.problem.conic` (step problems and
 their conic forms), :mod:`rollqp.operators.grid` (one contact, built once), :mod:`rollqp.methods.newton.disc`,
 :mod:`rollqp.methods.socp`, :mod:`rollqp.methods.refine`, :mod:`rollqp.methods.chord` (the methods) and
-:mod:`rollqp.scene.grid` (the scene). Here remain the closed forms (:mod:`.hertz`, :mod:`.closedforms`),
-the march and run (:mod:`.march`, :mod:`.run`, :mod:`.result`, :mod:`.fields`), the summary, advice,
-cross-check and post-processing beside their 2D siblings (:mod:`rollqp.report.grid`, :mod:`rollqp.advice.grid`,
-:mod:`rollqp.crossval.grid`).
+:mod:`rollqp.scene.grid` (the scene), :mod:`rollqp.march.grid` (the march and run), :mod:`rollqp.report.grid`,
+:mod:`rollqp.advice.grid` and :mod:`rollqp.crossval.grid` (the summary, advice and cross-check). Here remain the
+closed forms (:mod:`.hertz`, :mod:`.closedforms`) and the scene's load and profile helpers (:mod:`.loads`,
+:mod:`.patch`).
 
 Nothing here is imported by ``import rollqp``.
 """
