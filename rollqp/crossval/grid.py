@@ -24,11 +24,9 @@ import numpy as np
 
 from ..advice.grid import conic_step_seconds
 from ..errors import InputError, RollqpError
-from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, get_method,
-                       method_class, require_3d)
-from ..march.grid import run
-from ..march.grid import posed_force
-from ..march.grid import coupled_step
+from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, compose_3d,
+                       get_method, method_class, require_3d)
+from ..march.grid import _previous, coupled_step, posed_force, run
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
 
@@ -63,7 +61,7 @@ class SpotObserver:
     def __call__(self, rec, contact) -> None:
         self.contact = contact
         if rec.k in self.steps and rec.FN > 0:      # out of contact (FN = 0) nothing is solved
-            before = rec.info.get("before") if rec.k == 0 else (self._last.p, self._last.t)
+            before = rec.info.get("before") if rec.k == 0 else _previous(self._last)
             self.kept[rec.k] = (rec, before)
         self._last = rec
 
@@ -134,7 +132,9 @@ class CrossCheck:
     def _nothing(self) -> str:
         if self.skipped:
             m, ks = next(iter(self.skipped.items()))
-            return (f"skipped: one {m} step takes about {self.estimate:.0f} s (estimate), beyond the budget of "
+            took = (f"one {m} step takes about {self.estimate:.0f} s (estimate)" if self.estimate is not None
+                    else f"a {m} step was stopped at the budget")   # a solve stopped mid-way: no estimate
+            return (f"skipped: {took}, beyond the budget of "
                     f"{self.budget:.1f} s (the run's own time plus {SLACK:g} s); --cross-check solves steps {', '.join(map(str, sorted(ks)))} again, "
                     "rollqp crossval every step")
         return "nothing to check"
@@ -171,7 +171,7 @@ def _key(kind, loads, previous, dq, constant_friction: bool = True) -> tuple:
     """The data a step is posed from, as bytes: two steps with equal keys are the same problem. The rolled
     distance ``loads.q`` is part of the data only where the friction law is read along the surface (a
     constant coefficient poses the same step at every ``q``)."""
-    prev = b"" if previous is None else np.asarray(previous[0]).tobytes() + np.asarray(previous[1]).tobytes()
+    prev = b"" if previous is None else b"".join(np.asarray(v).tobytes() for v in previous)   # (p, t[, μ memory])
     if constant_friction:
         loads = replace(loads, q=0.0)
     return kind, repr(loads), None if dq is None else float(dq), prev
@@ -206,6 +206,7 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
             conic = not capabilities(name, 3).matrix_free
             if deadline is not None and conic:
                 method.deadline = deadline
+            method = compose_3d(method, friction=contact.law.kind)   # a slip-velocity law: as the run composes it
             method.setup(contact)
             for k in order:
                 rec, before = kept[k]

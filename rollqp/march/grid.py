@@ -36,7 +36,7 @@ and history objects, :mod:`rollqp.histories`):
 The loads (``tangential``, ``lateral``, the creepages and ``normal_history``) are histories of τ, so "roll,
 stop, cycle Fx at rest, roll back" is one scene. ``load.tangential`` stays ``Fx/(μ·FN_ref)`` with
 ``FN_ref = load.normal``: a force proportional to the current load is the same history scaled.
-:func:`rollqp.three.loads.check_load_path` holds the scene's checks of these keys.
+:func:`rollqp.loads.check_load_path` holds the scene's checks of these keys.
 
 **The run** (:func:`prepare`, :func:`march`, :func:`run`; the arguments and meaning of the strip's):
 
@@ -61,6 +61,7 @@ from ..advice.grid import MARCH_LENGTHS
 from ..atomic import stop_once
 from ..errors import InputError, SolverError
 from ..fields import fields_for
+from ..friction import law_kind
 from ..kinematics import plan
 from ..methods import compose_3d, scene_method_3d
 from ..operators.grid import Contact, Loads
@@ -68,8 +69,8 @@ from ..problem.grid import SEPARATION, SLIP, STICK, Residuals, StepSolution, dis
 from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
 from ..scene.core import SceneBase
-from ..three.loads import has_load_path, normal_force, start_force
-from ..three.patch import moving_profile
+from ..loads import has_load_path, normal_force, start_force
+from ..patch import moving_profile
 from ..version import __version__
 from .loop import RESUME_TOL, check_earlier, check_last, drive, last_index, stored_steps, versions
 from .loop import keep_every as _keep_every
@@ -119,6 +120,8 @@ class StepRecord:
     time: float
     residual: float
     info: dict = field(default_factory=dict)
+    #: The friction coefficient a slip-velocity law left at the elements (its memory, the next step's start), else None.
+    mu: np.ndarray | None = None
 
 
 def normal(contact, method, FN: float, t=None, warm=None):
@@ -181,17 +184,27 @@ def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_stat
                       FN=contact.grid.area * float(nsol.p.sum()), Fx=Fx, Fy=Fy, Mz=Mz, xi=tsol.xi, eta=tsol.eta,
                       phi=loads.phi, delta=nsol.delta, iterations=sweeps * max(1, tsol.iterations), time=elapsed,
                       residual=max(nsol.residual, tsol.residual),
-                      info={"sweeps": sweeps, "normal": nsol.info, "tangential": tsol.info})
+                      info={"sweeps": sweeps, "normal": nsol.info, "tangential": tsol.info}, mu=tsol.mu)
 
 
-def _states(contact, p, t, s, q=0.0):
+def _previous(rec):
+    """What the step after the state ``rec`` takes as its ``previous``: ``(p, t)``, and the coefficient ``μ`` of a
+    slip-velocity law's memory where the state carries one."""
+    return (rec.p, rec.t) if rec.mu is None else (rec.p, rec.t, rec.mu)
+
+
+def _states(contact, p, t, s, q=0.0, mu=None, direction=-1):
     """0 separation, 1 stick, 2 slip (:func:`~rollqp.problem.grid.element_states`). At ``μ = 0`` (bound
     zero) as in 2D (:func:`rollqp.problem.solution.classify`): an element in contact (``p > 0``) slips
-    where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it."""
+    where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it. ``mu``: the
+    coefficient of a slip-velocity law at the solution (its bound ``μ p⁺``)."""
     if contact.mu == 0:
         moving = np.hypot(*(np.asarray(s, dtype=float).reshape(2, -1) / contact.scales.slip)) > 1e-7
         return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
-    return element_states(np.asarray(t), np.asarray(s), contact.bound(p, q), contact.scales)
+    if mu is None and contact.law.kind == "slip":   # a stored state: the law at its own slip (without memory)
+        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float).reshape(2, -1), contact=np.asarray(p) > 0)
+    bound = contact.bound(p, q, direction) if mu is None else np.asarray(mu) * np.maximum(p, 0.0)
+    return element_states(np.asarray(t), np.asarray(s), bound, contact.scales)
 
 
 def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, phi: float = 0.0, steps: int = 1,
@@ -213,10 +226,10 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
         ns, ts, sw = coupled_step(contact, method, FN, "shift", loads, previous, warm=warm, pressure=nsol)
         shift = shift + contact.scales.length * np.array([ts.xi, ts.eta])
         rec = _record(contact, j - 1, "shift", 0.0, ns, ts, loads, sw, time.perf_counter() - t0,
-                      _states(contact, ns.p, ts.t, ts.s))
+                      _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
         rec.info.update(shift=tuple(shift), loads=loads, before=previous)
         out.append(rec)
-        previous, warm = (ns.p, ts.t), (ns, ts)
+        previous, warm = (ns.p, ts.t) if ts.mu is None else (ns.p, ts.t, ts.mu), (ns, ts)   # μ: a law's memory
         if tick is not None:
             tick(j, int(steps))
     return out
@@ -240,7 +253,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
         nsol, tsol, sw = coupled_step(contact, method, FN, "steady", loads, direction=direction, warm=warm,
                                       pressure=pressure)
         return _record(contact, 0, "steady", 0.0, nsol, tsol, loads, sw, time.perf_counter() - t0,
-                       _states(contact, nsol.p, tsol.t, tsol.s))
+                       _states(contact, nsol.p, tsol.t, tsol.s, mu=tsol.mu))
     if accelerate not in ("chord", "anderson"):
         raise InputError("accelerate", f"must be 'chord' or 'anderson', got {accelerate!r}")
     if accelerate == "chord" and not contact.ops.coupled:
@@ -282,7 +295,7 @@ def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure
         change = float(np.max(np.abs(ts.t - x))) / unit
         if change <= method.tolerance:
             rec = _record(contact, 0, "steady", 0.0, nsol, ts, loads, 1, time.perf_counter() - t0,
-                          _states(contact, nsol.p, ts.t, ts.s))
+                          _states(contact, nsol.p, ts.t, ts.s, mu=ts.mu))
             rec.info.update({"marched": k, "change": change, "accelerate": "chord"})
             return rec
         if best is not None and not change <= NEWTON_DECREASE * best[0]:
@@ -325,7 +338,7 @@ def _march_to_steady(contact, method, FN, loads, direction, start, t0, memory=AN
         change = float(np.max(np.abs(gx - x) / scale))
         if change <= method.tolerance:
             rec = _record(contact, 0, "steady", 0.0, ns, ts, loads, sw, time.perf_counter() - t0,
-                          _states(contact, ns.p, ts.t, ts.s))
+                          _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
             rec.info.update({"marched": k, "change": change})
             return rec
         X.append(x)
@@ -374,11 +387,12 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
         if move is not None:
             move(q)
         try:
-            ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, (prev.p, prev.t), dq, direction,
+            ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, _previous(prev), dq, direction,
                                       warm=warm, pressure=fixed)
         except SolverError as exc:
             raise exc.with_step(k) from None
-        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q))
+        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q, ts.mu, direction))
+        rec.info["direction"] = direction       # where a friction law in the material frame was read (the mu field)
         if move is not None and hasattr(move, "check"):
             move.check(ns.p, k)
         yield rec
@@ -466,7 +480,7 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             if fixed is None or fixed[0] != FN or move is not None:
                 fixed = (FN, normal(contact, method, FN))
             pressure = fixed[1]
-        previous = (prev.p, prev.t)
+        previous = _previous(prev)
         if prev.FN != FN:       # the last step's tractions may lie outside this load's discs: a cold start
             warm = None
         stop = pl.d[k] == 0
@@ -482,10 +496,18 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             except SolverError as again:
                 raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
-                      _states(contact, ns.p, ts.t, ts.s))
+                      _states(contact, ns.p, ts.t, ts.s, mu=_step_mu(contact, ts, ld.q, d)))
         rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.crossval.grid
         yield rec
         prev, warm = rec, (ns, ts)
+
+
+def _step_mu(contact, ts, q: float, direction: int):
+    """The coefficient the step's bound had: a slip-velocity law's own (``ts.mu``), else the law at the rolled
+    distance and direction the step read it at (a material frame's patch or table moves with the material)."""
+    if ts.mu is not None or contact.law.kind == "slip":
+        return ts.mu
+    return contact.coefficient(q, direction)
 
 
 def posed_force(scene, rec) -> tuple[float, int]:
@@ -511,9 +533,12 @@ def prepare(scene, method=None):
                                               f"{scene.dimension}D (rollqp.run runs either)")
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
-    meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
+    kind = law_kind(scene.contact.friction)
+    meth = (scene_method_3d(scene.solver, friction=kind) if method is None or isinstance(method, str)
+            else compose_3d(method, friction=kind))
     contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
-                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
+                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model,
+                      layer=scene.contact.layer)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
         contact.move = moving_profile(contact, scene.shape, scene.load.direction,
                                       "discretization.extent" if scene.discretization.extent is not None
@@ -555,6 +580,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
     """
     scene, meth, contact = prepared = prepared if prepared is not None else prepare(scene, method)
     if resume is not None:
+        _resumable(scene)
         if state is None:
             state = check_resumed(scene, prepared, resume) if verify else resumed_record(scene, contact, resume)
         start, first = state, last_index(resume) + 1
@@ -661,6 +687,7 @@ def check_states(scene, contact, source) -> None:
     the friction disc and the element states those of p, t, s (to :data:`~rollqp.march.loop.RESUME_TOL` of p0 and
     μp0), the forces and moment those of the pressures and tractions, the rolled distances the scene's (checked
     with the last state, :func:`resumed_record`). (The last state is moreover solved again: :func:`check_resumed`.)"""
+    _resumable(scene)
     g, sc = contact.grid, contact.scales
     mu = float(contact.mu)
     tunit = (min(mu, 1.0) if mu > 0 else 1.0) * sc.stress
@@ -694,6 +721,16 @@ def check_states(scene, contact, source) -> None:
     check_earlier(source, ("pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "step"), inconsistent)
 
 
+def _resumable(scene) -> None:
+    """A run with a friction memory is not resumed: its result file does not hold the coefficient the material
+    carries (a one-line :class:`InputError` on ``--resume``)."""
+    law = scene.contact.friction
+    if getattr(law, "kind", None) == "slip" and law.memory > 0:
+        raise InputError("--resume", "a 3D run with a friction memory (contact.friction.memory > 0) cannot be "
+                                     "resumed: its result file does not hold the coefficient the material carries; "
+                                     "run it again")
+
+
 def _law(contact, p, t, s, states, tunit, k) -> str | None:
     """Coulomb's law at a stored state (to :data:`RESUME_TOL`): a sticking element does not slip (``|s|`` in the
     tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``None``, or what is wrong."""
@@ -702,7 +739,10 @@ def _law(contact, p, t, s, states, tunit, k) -> str | None:
     stick, slipping = states == 1, (states == 2) & (sn > 0)
     if np.any(sn[stick] > RESUME_TOL * slip_unit):
         return f"state {k}: a sticking element slips"
-    b = contact.mu * np.maximum(p, 0.0)
+    mu = contact.mu
+    if contact.law.kind == "slip":   # a slip-velocity law (without memory: a run with one is not resumed) at the slip
+        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float), contact=np.asarray(p) > 0)
+    b = mu * np.maximum(p, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.hypot(t[0] + b * s[0] / sn, t[1] + b * s[1] / sn)
     if np.any(r[slipping] > RESUME_TOL * tunit):

@@ -10,7 +10,7 @@ final forces and moment on body A, the creepages, the stick area, and the errors
 * **Kalker's linear theory** (a steady state, state 0 of a rolling start, where no more than
   :data:`LINEAR_SLIP_FRACTION` of the contact slips): the forces of the prescribed creepages against
   ``Fx = −G c² C11 ξ``, ``Fy = −G c² (C22 η + c C23 φ)`` (eq. 3D.8; Table E.3, interpolated by
-  :func:`rollqp.three.closedforms.kalker_linear`), or the creepages of the prescribed forces against
+  :func:`rollqp.closedforms.kalker.kalker_linear`), or the creepages of the prescribed forces against
   the same relations solved for them. On the grid the difference is the discretization error, first
   order in the element size (docs/validation3d.md §3 extrapolates it to within 1 %).
 
@@ -33,8 +33,9 @@ import numpy as np
 
 from . import time_row
 from ..units import unit_names
-from ..three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
-from ..three.loads import start_ellipse
+from ..closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
+from ..closedforms.kalker import kalker_linear
+from ..loads import start_ellipse
 from ..operators.grid import Loads
 from ..march.grid import normal, steady
 
@@ -161,7 +162,8 @@ def _steps_row(res, scene, u) -> str:
 
 def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
     """The table ``rollqp run`` prints for a 3D scene (module docstring); the arguments as
-    :func:`rollqp.report.summary` (``stresses`` is not computed for 3D scenes)."""
+    :func:`rollqp.report.summary` (``stresses``: a :class:`rollqp.subsurface3d.StressHistory3D` of the run, from
+    ``rollqp run --stresses``: its peak von Mises and Tresca stresses over the stored states, with place and state)."""
     u = unit_names(getattr(scene, "units", ""))
     force, moment = _force_units(u)
     e, mu = scene.ellipse, scene.mu
@@ -194,6 +196,12 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
                                   f"refined ones kept by max |dp| {raw['dp']:.1e} p0, |dt| {raw['dt']:.1e} mu p0 "
                                   f"over {raw['steps']} steps (interior point: about sqrt(gap); docs/theory3d.md §5)"))
     rows += closed_form_errors(res, scene)
+    if stresses is not None:
+        for key, label in (("von_mises", "peak von Mises"), ("tresca", "peak Tresca")):
+            v, x, y, z, k = stresses.overall[key]
+            rows.append((label, f"{v / e.p0:.4f} p0 at x = {x:.5g}, y = {y:.5g}, z = {z:.5g} {u.length}, state {k} "
+                                f"(body {stresses.body}, plane y = 0 below the grid, {stresses.section.z.size} depths "
+                                "to 2a; rollqp stresses for other sections)"))
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
 

@@ -246,9 +246,8 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     """March the 3D ``scene`` to step ``k`` with ``method`` (default the reference method) and return its
     :class:`StepFile3D`."""
     from ..methods import REFERENCE_METHOD
-    from ..march.grid import StepRecord
-    from ..three.loads import start_force
-    from ..march.grid import march, prepare
+    from ..loads import start_force
+    from ..march.grid import StepRecord, march, prepare
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene {scene.name!r}, got {k!r}")
     if scene.grid.n > MAX_ELEMENTS_3D:

@@ -17,11 +17,11 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InputError
-from ..histories import Constant, Harmonic
-from ..kinematics import plan
-from ..methods import REFERENCE_METHOD, scene_method_3d
-from .hertz import hertz
+from .errors import InputError
+from .histories import Constant, Harmonic
+from .kinematics import plan
+from .methods import REFERENCE_METHOD, scene_method_3d
+from .closedforms.hertz_ellipse import hertz
 from .patch import check_patch, computed_patch
 
 __all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "MAX_STEP_RATIO"]
