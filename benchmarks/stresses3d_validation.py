@@ -31,7 +31,7 @@ from rollqp.subsurface3d import invariants, plot_field3d, point_load, stress_com
 from rollqp.operators.grid import Contact, Loads  # noqa: E402
 from rollqp.methods.newton.disc import NewtonMethod  # noqa: E402
 from rollqp.discretization.grid import Grid  # noqa: E402
-from rollqp.three.hertz import curvatures_for_ratio, hertz  # noqa: E402
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz  # noqa: E402
 from rollqp.three.march import steady  # noqa: E402
 from rollqp.materials import Materials  # noqa: E402
 from rollqp.three.run import run  # noqa: E402

@@ -13,7 +13,7 @@ import numpy as np
 
 import rollqp
 from rollqp.kinematics import plan
-from rollqp.three.hertz import hertz
+from rollqp.closedforms.hertz_ellipse import hertz
 from rollqp.three.march import static_shift, steady
 from rollqp.three.run import prepare, run
 

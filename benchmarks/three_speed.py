@@ -17,6 +17,8 @@
 
     python benchmarks/three_speed.py --only builtins chord     # sections 4 and 5 alone (about 5 minutes)
     python benchmarks/three_speed.py --only contact startup    # CONTACT's problems (22 × 22 … 82 × 82), start-up
+    git worktree add /tmp/rollqp-1bdc107 1bdc107              # the rollqp CONTACT's ratios were measured against:
+    python benchmarks/three_speed.py --only contact --old /tmp/rollqp-1bdc107   # CONTACT's times on this machine
     python benchmarks/three_speed.py --only precision --figure docs/figures/perf-3d-work-precision.png
                                                                # Newton, FASTSIM, extrapolation against a reference
                                                                # from 75/150/300 elements (about 10 min at load 12)
@@ -35,7 +37,7 @@ from harness import pin_threads, table
 
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
-from rollqp.three.hertz import curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
 from rollqp.three.march import normal, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
@@ -153,67 +155,131 @@ def section_chord(quick):
                   "Anderson / chord", "max\\|Δt\\|/μp0"], rows)
 
 
-def _cpu(fn, repeats):
-    """(best CPU seconds of this process over ``repeats`` calls, the last result): CPU time, not wall time, so
-    that the other jobs of a shared machine weigh less (a job's CPU time still grows with the cache misses they
-    cause)."""
-    best, out = np.inf, None
+#: CONTACT's figures on the same problems (circle, partial slip; single-threaded, whole-process CPU time),
+#: measured on another machine with CONTACT (not installed here) against the rollqp of that day (commit
+#: 1bdc107): the ratio rollqp / CONTACT of the steady run's whole process, and the transient rolling step of
+#: both codes (rollqp's, CONTACT's low and high, ms).
+CONTACT_RATIO_STEADY = {10: (38.0, "SteadyGS"), 20: (3.5, "SteadyGS"), 40: (0.29, "SteadyGS")}
+CONTACT_RATIO_GD = {20: 4.9, 40: 1.0}
+CONTACT_TRANSIENT_MS = {10: (42.0, 3.0, 5.0), 20: (140.0, 21.0, 21.0)}
+#: The older checkout timed beside this one (``--old DIR``): the rollqp CONTACT's ratios were measured against.
+OLD = [None]
+
+_SCENE = """name = "circle"
+units = "N-mm"
+[bodies.A]
+radius = 30.0
+radius_y = 30.0
+E = 210000.0
+nu = 0.25
+[bodies.B]
+radius = inf
+radius_y = inf
+E = 210000.0
+nu = 0.25
+[contact]
+dimension = 3
+friction = 0.3
+[load]
+normal = 1000.0
+start = "rolling"
+creepage = {{ longitudinal = 1e-3, lateral = 0.0, spin = 0.0 }}
+[discretization]
+elements = [{n}, {n}]
+zone = [{z!r}, {z!r}]
+step = 1.0
+distance = 0.0
+"""
+
+
+def _tree_env(tree):
+    """The environment of a process on the checkout ``tree``: single-threaded BLAS (as CONTACT was timed; the
+    older checkout does not pin its pools itself), and bytecode caches allowed, as an installed package has
+    them (an environment with ``PYTHONDONTWRITEBYTECODE`` compiles every module of every process again)."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(tree)
+    for key in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        env[key] = "1"
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    return env
+
+
+def _worker(tree, pers):
+    """The lines of benchmarks/contact_problems.py run on the checkout ``tree`` (a fresh process)."""
+    import json
+    import subprocess
+    import sys
+    script = os.path.join(os.path.dirname(os.path.abspath(__file__)), "contact_problems.py")
+    out = subprocess.run([sys.executable, script, *map(str, pers)], check=True, capture_output=True, text=True,
+                         env=_tree_env(tree), cwd=tree)
+    return {(d["per"], d["case"]): d for d in map(json.loads, out.stdout.splitlines())}
+
+
+def _whole(tree, per, folder, repeats=3):
+    """Best CPU seconds (user + system) of ``rollqp run`` on the circle's steady state as a fresh process."""
+    import resource
+    import subprocess
+    import sys
+    n, z = 2 * per + 2, (per + 1) / per * (1 + 1e-9)
+    path = os.path.join(folder, f"c{n}.toml")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(_SCENE.format(n=n, z=z))
+    best = np.inf
     for _ in range(repeats):
-        t0 = time.process_time()
-        out = fn()
-        best = min(best, time.process_time() - t0)
-    return best, out
-
-
-def _circle(per, nu=0.28):
-    """A circle of ``per`` elements per semi-axis (CONTACT's count): ``2·per + 2`` elements on zone
-    ``(per + 1)/per``, one row to spare on each side."""
-    zone = (per + 1) / per
-    return Contact.hertzian(Materials.from_young(210e3, nu, 210e3, nu), (1 / 60, 1 / 60), FN, MU,
-                            elements=(2 * per + 2, 2 * per + 2), zone=(zone, zone))
-
-
-#: CONTACT's figures on the same problems (circle, partial slip; single-threaded, whole process CPU time),
-#: as measured on another machine with CONTACT (not installed here): the ratios rollqp / CONTACT then and
-#: CONTACT's own transient step times.
-CONTACT_RATIO_STEADY = {10: "38× (SteadyGS)", 20: "3.5× (SteadyGS), 4.9× (GDsteady)", 40: "0.29× (SteadyGS), 1.0× (GDsteady)"}
-CONTACT_TRANSIENT_MS = {10: (3.0, 5.0), 20: (21.0, 21.0)}
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([sys.executable, "-m", "rollqp.cli", "run", path, "--quiet", "--no-cross-check", "--out",
+                        os.path.join(folder, f"c{n}.npz")], check=True, capture_output=True, cwd=folder,
+                       env=_tree_env(tree))
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        best = min(best, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+    return best
 
 
 def section_contact(quick):
-    """The problems CONTACT was timed on: the steady rolling step (normal + steady tangential, ξ alone and ξ, η, φ
-    together, partial slip) and a transient rolling step, on circles of 10 and 20 elements per semi-axis (22 × 22
-    and 44 × 44), CPU seconds of this process (best of several), beside CONTACT's figures."""
-    from rollqp.three.march import transient
+    """The problems CONTACT was timed on (benchmarks/contact_problems.py: the steady rolling step — normal +
+    steady tangential, ξ alone and ξ, η, φ together, partial slip — and a transient rolling step on circles of
+    10, 20 and 40 elements per semi-axis), and the whole ``rollqp run`` of the steady state, CPU of this
+    checkout; with ``--old DIR`` the same on the older checkout CONTACT's ratios were measured against, and
+    from it CONTACT's time on this machine: the older rollqp's time here divided by its ratio to CONTACT."""
+    import tempfile
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    pers = (10, 20) if quick else (10, 20, 40)
+    trees = [("this", here)] + ([("old", OLD[0])] if OLD[0] else [])
+    folder = tempfile.mkdtemp()
+    res, whole = {}, {}
+    for name, tree in trees:   # one tree after the other, each grid's whole process right after its steps
+        res[name] = _worker(tree, pers)
+        for per in pers:
+            whole[name, per] = _whole(tree, per, folder)
     rows = []
-    a = 0.5857  # mm, the circle's Hertz radius (curvature 1/60 per body, FN = 1000 N)
-    cases = (("ξ", Loads(xi=-1e-3, eta=0.0, phi=0.0)), ("ξ, η, φ", Loads(xi=-1e-3, eta=5e-4, phi=5e-4 / a)))
-    for per in (10, 20) if quick else (10, 20, 40):
-        for label, loads in cases:
-            m = NewtonMethod()
-            c = _circle(per)
-            tn, p = _cpu(lambda: normal(c, m, FN), 7)
-            tt, rec = _cpu(lambda: steady(c, m, FN, loads, pressure=p), 7)
-            slip, on = int(np.sum(rec.state == 2)), int(np.sum(rec.state > 0))
-            gen, cpu = transient(c, m, FN, loads, c.grid.dx, 12), []
-            next(gen)                                        # the start (its normal step)
-            while True:
-                t0 = time.process_time()
-                try:
-                    next(gen)
-                except StopIteration:
-                    break
-                cpu.append(time.process_time() - t0)
-            step = float(np.median(cpu[1:]))
-            ratio = CONTACT_RATIO_STEADY.get(per, "–")
-            lo, hi = CONTACT_TRANSIENT_MS.get(per, (None, None))
-            tr = f"{step * 1e3:.1f}" + (f" ({step * 1e3 / hi:.1f}–{step * 1e3 / lo:.1f}× CONTACT's {lo:g}–{hi:g} ms)"
-                                        if lo else "")
-            rows.append([f"{per} ({c.grid.nx} × {c.grid.ny})", label, f"{slip}/{on}", f"{tn * 1e3:.1f}",
-                         f"{tt * 1e3:.1f}", f"{(tn + tt) * 1e3:.1f}", ratio, tr])
-    return table(["elements per semi-axis (grid)", "creepages", "slip/contact", "normal [ms CPU]",
-                  "steady tangential [ms CPU]", "steady step [ms CPU]", "CONTACT: rollqp / CONTACT then",
-                  "transient rolling step, median [ms CPU]"], rows)
+    for per in pers:
+        for case in ("ξ", "ξ, η, φ"):
+            d = res["this"][per, case]
+            row = [f"{per} ({d['grid']})", case, f"{d['slip']}/{d['contact']}", f"{d['steady'] * 1e3:.1f}",
+                   f"{whole['this', per]:.2f}" if case == "ξ" else "″",
+                   f"{d['step'] * 1e3:.2f} ({d['first'] * 1e3:.0f}; {d['mean'] * 1e3:.1f})"]
+            if "old" in res:
+                o = res["old"][per, case]
+                ratio, solver = CONTACT_RATIO_STEADY[per]
+                cw = whole["old", per] / ratio
+                gd = f", GDsteady {whole['old', per] / CONTACT_RATIO_GD[per]:.2f}" if per in CONTACT_RATIO_GD else ""
+                row += [f"{o['steady'] * 1e3:.1f}", f"{whole['old', per]:.2f}" if case == "ξ" else "″",
+                        f"{cw:.3f} ({solver}{gd})", f"{d['steady'] / cw:.2f}× / {whole['this', per] / cw:.1f}×"]
+                if per in CONTACT_TRANSIENT_MS:
+                    then, lo, hi = CONTACT_TRANSIENT_MS[per]
+                    clo, chi = o["step"] * lo / then, o["step"] * hi / then
+                    row += [f"{o['step'] * 1e3:.2f}", f"{clo * 1e3:.1f}–{chi * 1e3:.1f}",
+                            f"{d['step'] / chi:.1f}–{d['step'] / clo:.1f}× ({d['mean'] / chi:.1f}–{d['mean'] / clo:.1f}×)"]
+                else:
+                    row += ["", "", ""]
+            rows.append(row)
+    head = ["elements per semi-axis (grid)", "creepages", "slip/contact", "steady step [ms CPU]",
+            "whole run [s CPU]", "transient step, median [ms CPU] (first; mean of 12)"]
+    if "old" in res:
+        head += ["old: steady step [ms]", "old: whole run [s]", "CONTACT here: whole run [s]",
+                 "steady step / CONTACT; whole run / CONTACT", "old: transient step [ms]",
+                 "CONTACT here: transient step [ms]", "transient step / CONTACT (mean of 12)"]
+    return table(head, rows)
 
 
 def section_startup(quick):
@@ -246,7 +312,8 @@ def section_startup(quick):
         best, wall = np.inf, np.inf
         for _ in range(3):
             r0, t0 = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
-            subprocess.run(cmd, check=True, capture_output=True, cwd=folder)
+            subprocess.run(cmd, check=True, capture_output=True, cwd=folder,
+                           env=_tree_env(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
             r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
             best = min(best, r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
             wall = min(wall, time.perf_counter() - t0)
@@ -350,10 +417,13 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description="Speed of the 3D steps (ratios within one run).")
     ap.add_argument("--quick", action="store_true", help="without the 300 × 300 grid and the 30 × 30 SOCP")
     ap.add_argument("--only", nargs="+", choices=sorted(SECTIONS), help="these sections only")
+    ap.add_argument("--old", help="section contact: also time this older checkout (the rollqp CONTACT's ratios "
+                    "were measured against, commit 1bdc107) and derive CONTACT's times on this machine from it")
     ap.add_argument("--figure", default=FIGURE[0], help="the work–precision figure (section precision; "
                     "relative to the repository)")
     args = ap.parse_args(argv)
     FIGURE[0] = args.figure
+    OLD[0] = os.path.abspath(args.old) if args.old else None
     pin_threads()
     print(f"load average at start: {', '.join(f'{x:.2f}' for x in os.getloadavg())} (2 cores, shared)\n")
     for key in args.only or SECTIONS:

@@ -12,7 +12,8 @@ Sections: ``hertz`` (semi-axes, p0, approach, pressure, as the grid doubles), ``
 ``sliding`` (full sliding), ``contact`` (CONTACT's cattaneo, catt_to_cart, tractcurv on CONTACT's
 grids), ``agree`` (the conic solvers against Newton, step by step), ``coupling`` (the N–T
 alternation for dissimilar bodies), ``aspect`` (element aspect ratio), ``march`` (the SOCP route
-to the steady state).
+to the steady state), ``layer`` (the interface layer against the brush), ``tractcurv`` (CONTACT's tractcurv
+series 2 and 3: falling friction with the interface layer, FASTSIM).
 """
 from __future__ import annotations
 
@@ -21,12 +22,14 @@ import time
 
 import numpy as np
 import contact3d_cases
+import layer_cases
 from harness import pin_threads, table
 
-from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
+from rollqp.closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
+from rollqp.closedforms.kalker import kalker_linear
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
-from rollqp.three.hertz import curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
 from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
@@ -281,9 +284,46 @@ def section_march(quick):
     return table(["stepper", "Anderson memory", "steps (Δq = dx)", "max\\|t − t_direct\\|/μp0", "time [s]"], rows)
 
 
+def section_layer(quick):
+    """The interface layer against the brush (eq. B.1) as the grid doubles: 3D (a circle, n × n over 1.1·(a, b)) and
+    the strip (constant elements over ±1.1 a_H), a layer 1e4 times as compliant as the bodies' a/G or a_H/E*."""
+    rows = []
+    ns3 = (11, 22) if quick else (11, 22, 44, 88)
+    errs = [layer_cases.brush_3d(n) for n in ns3]
+    for (e, h), n in zip(errs, ns3):
+        rows.append(["3D grid", f"{n} × {n}", *(f"{v:+.2e}" for v in e)])
+    ns2 = (22, 44) if quick else (22, 44, 88, 176)
+    errs2 = [layer_cases.brush_strip(n) for n in ns2]
+    for (e, h), n in zip(errs2, ns2):
+        rows.append(["strip", n, *(f"{v:+.2e}" for v in e)])
+    orders = [[f"order ({what}, first grid to last)", "",
+               *(f"{layer_cases.order([e[0][j] for e in es], [e[1] for e in es]):.2f}" for j in range(2))]
+              for what, es in (("3D", errs), ("strip", errs2))]
+    return table(["discretization", "elements", "F/(μN)/brush − 1 at κ = 0.3", "at κ = 1"], rows + orders)
+
+
+def section_tractcurv(quick):
+    """CONTACT's tractcurv series 2 (falling friction with memory, interface layer) and series 3 (FASTSIM) on its
+    48 × 44 grid; series 1 is in section ``contact``."""
+    cases = 4 if quick else 30
+    ref, ours = contact3d_cases.tractcurv_falling(cases)
+    _, bare = contact3d_cases.tractcurv_falling(cases, memory=False)
+    rows = [[f"{r[0]:.4g}", f"{r[1]:.4g}", f"{o[0]:.6g}", f"{o[0] / r[1] - 1:+.1e}", f"{b[0] / r[1] - 1:+.1e}",
+             f"{o[1]}/{o[2]} ({r[2]}/{r[3]})", o[3]] for r, o, b in zip(ref, ours, bare)]
+    worst = max(abs(o[0] / r[1] - 1) for r, o in zip(ref, ours))
+    worst_bare = max(abs(b[0] / r[1] - 1) for r, b in zip(ref, bare))
+    out = (f"series 2 (cases 31–{30 + cases}): max |FX/CONTACT − 1| = {worst:.1e} with CONTACT's memory, {worst_bare:.1e} "
+           "without (MEMDST = 0)\n\n" +
+           table(["CKSI", "CONTACT FX", "rollqp Fx", "ratio − 1", "no memory: ratio − 1", "adh/slip (CONTACT)",
+                  "outer iterations"], rows))
+    rows3 = [[f"{x:.4g}", f"{r:.4g}", f"{o:.6g}", f"{o / r - 1:+.1e}"] for x, r, o in layer_cases.tractcurv_fastsim()[:cases]]
+    return out + "\n\nseries 3 (FASTSIM) against rollqp's fastsim\n\n" + table(["CKSI", "CONTACT FX", "rollqp fastsim Fx",
+                                                                                  "ratio − 1"], rows3)
+
+
 SECTIONS = {"hertz": section_hertz, "cattaneo": section_cattaneo, "kalker": section_kalker, "sliding": section_sliding,
             "contact": section_contact, "agree": section_agree, "coupling": section_coupling, "aspect": section_aspect,
-            "march": section_march}
+            "march": section_march, "layer": section_layer, "tractcurv": section_tractcurv}
 
 
 def main(argv=None):

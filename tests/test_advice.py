@@ -6,6 +6,7 @@ import pytest
 
 import rollqp
 from rollqp import advice, cli
+from rollqp.cli import reporting
 
 BIG = {"discretization.elements": 2500, "discretization.distance": 0.003}   # 5,001 nodes, 6 steps
 
@@ -81,9 +82,9 @@ def test_alternation_note_names_the_direct_method():
 def test_long_runs_announce_their_remaining_time(monkeypatch, capsys):
     """After the first steps, a run whose remaining time exceeds a minute says how long, once."""
     clock = iter(np.arange(0.0, 1000.0, 2.5))                     # 2.5 s a step
-    monkeypatch.setattr(cli.time, "perf_counter", lambda: float(next(clock)))
+    monkeypatch.setattr(reporting.time, "perf_counter", lambda: float(next(clock)))
     seen = []
-    cb = cli.estimate_progress(lambda k, K: seen.append(k), 384)
+    cb = reporting.estimate_progress(lambda k, K: seen.append(k), 384)
     for k in range(1, 12):
         cb(k, 384)
     err = capsys.readouterr().err

@@ -46,11 +46,12 @@ def test_capacitance_path_is_the_lu_path(monkeypatch, loads):
 
 
 def test_singular_capacitance_returns_none():
-    """``C = M + (I − M) (A⁻¹)_QQ``: the identity where ``M = 0`` (then ``J = I``), and singular → ``None``."""
+    """``C = M + (I − M) (A⁻¹)_QQ``: the identity where ``M = 0`` (then ``J = I``); a singular ``C`` → ``None``."""
     nv = 3
     S = np.eye(2 * nv)
     zero = np.zeros(nv)
-    out = capacitance.solve(np.linalg.inv(S), 1.0, np.arange(nv), zero, zero, zero, np.ones(2 * nv))
+    out = capacitance.solve(capacitance.inverse(S), 1.0, np.arange(nv), zero, zero, zero, np.ones(2 * nv))
     assert out is not None and np.allclose(out, np.ones(2 * nv))   # M = 0: J = I
-    sing = np.zeros((2 * nv, 2 * nv))                                  # C = M + (I − M)·0 = 0
-    assert capacitance.solve(sing, 1.0, np.arange(nv), zero, zero, zero, np.ones(2 * nv)) is None
+    minus = -np.ones(nv)                                               # S = 2I, M = −I: C = −I + 2I·I/2 = 0
+    assert capacitance.solve(capacitance.inverse(2 * S), 1.0, np.arange(nv), minus, zero, minus,
+                             np.ones(2 * nv)) is None

@@ -15,7 +15,7 @@ from rollqp.errors import InputError
 from rollqp.operators.grid import Contact, Loads
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.discretization.grid import Grid
-from rollqp.three.hertz import curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
 from rollqp.three.march import steady
 from rollqp.materials import Materials
 from rollqp.influence.grid import ContactOperators

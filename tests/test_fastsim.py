@@ -15,7 +15,7 @@ from rollqp import cli, load_scene
 from rollqp.errors import InputError
 from rollqp.methods import available_methods
 from rollqp.methods.fastsim import fastsim_traction, flexibilities
-from rollqp.three.closedforms import kalker_linear
+from rollqp.closedforms.kalker import kalker_linear
 from rollqp.three.run import run
 
 

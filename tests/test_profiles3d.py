@@ -1,4 +1,4 @@
-"""Non-Hertzian 3D geometry (rollqp.profiles3d, rollqp.three.patch; docs/validation3d.md, "Non-Hertzian
+"""Non-Hertzian 3D geometry (rollqp.profiles3d, rollqp.patch; docs/validation3d.md, "Non-Hertzian
 geometry"): a quadratic profile given as a table reproduces the Hertz scene to round-off, a quartic
 lateral profile gives a non-elliptic patch whose area converges as the grid is refined, features roll
 through, and bad profiles and grids are one-line errors naming the key."""

@@ -150,7 +150,7 @@ def test_elliptic_hertz_with_sliding_traction_converges(ns):
     """An ellipse a/b = 0.5 with q_x = 0.3p: the six components on the axis (8 depths 0.1a-2a) against the exact
     Hertz pressure's and traction's stresses by Gauss quadrature of the point loads; measured 1.7e-3, 3.6e-4,
     9.0e-5 p0 on 11, 21, 41 elements along x (slopes 2.42, 2.08)."""
-    from rollqp.three.hertz import curvatures_for_ratio
+    from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
     m = Materials.from_young(210e3, 0.3, 210e3, 0.3)
     errs, hs = [], []
     for n in ns:

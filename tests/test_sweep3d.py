@@ -50,7 +50,7 @@ def test_the_creep_curve_reproduces_contact_s_tractcurv_series(tmp_path):
     """CONTACT's tractcurv series 1 (Coulomb, 48 × 44 on 1.1·(a, b), a/b = 0.5, wheel radius 625 mm, FN =
     106.7 kN, μ = 0.33): the first three CKSI (1e-5, 4e-4, 8e-4) on CONTACT's grid, Fx within its printed 4
     digits (the steady solves of docs/validation3d.md §5, now through the command's preset)."""
-    from rollqp.three.hertz import curvatures_for_ratio
+    from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
     sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[1] / "benchmarks"))
     import contact3d_cases
     ref = []

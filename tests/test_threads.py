@@ -23,7 +23,6 @@ from rollqp.threads import threads
 SCRIPT = r"""
 import json, sys
 import numpy                                  # a user's numpy, loaded before rollqp (scipy's BLAS not yet)
-import dataclasses
 import rollqp, rollqp.cli
 from threadpoolctl import threadpool_info
 before = sorted((i["filepath"].rsplit("/", 1)[-1], i["num_threads"]) for i in threadpool_info())
@@ -33,8 +32,8 @@ def recording(run):
         seen.append(sorted((i["filepath"].rsplit("/", 1)[-1], i["num_threads"]) for i in threadpool_info()))
         return run(*a, **k)
     return wrapped
-make = rollqp.cli.FAMILIES[3]      # the command's own lazy imports are kept: the run is wrapped when made
-rollqp.cli.FAMILIES[3] = lambda: dataclasses.replace(make(), run=recording(make().run))
+made = rollqp.cli.FAMILIES[3]      # the run's module is still imported by the command: wrapped when it runs
+rollqp.cli.FAMILIES[3] = made.replace(run=lambda *a, **k: recording(made.run)(*a, **k))
 how = sys.argv[1]
 if how == "api":
     import rollqp.three.run as r3

@@ -10,7 +10,7 @@ import pytest
 from rollqp import load_scene
 from rollqp.errors import InputError
 from rollqp.profiles.surface import Body, curvatures
-from rollqp.three.hertz import hertz
+from rollqp.closedforms.hertz_ellipse import hertz
 from rollqp.report.grid import hertz_field_errors
 from rollqp.three.run import run
 

@@ -7,8 +7,8 @@ import importlib
 import pytest
 
 MODULES = ["discretization", "discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
-           "profiles.surface", "three.hertz", "three.closedforms", "methods.newton.disc", "operators.grid",
-           "three.loads", "methods.newton.capacitance"]
+           "profiles.surface", "closedforms.hertz_ellipse", "closedforms.kalker", "methods.newton.disc", "operators.grid",
+           "loads", "methods.newton.capacitance"]
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -23,6 +23,7 @@ import pytest
 
 import rollqp
 from rollqp import cli
+from rollqp.cli import reporting
 from rollqp.errors import InputError
 from rollqp.journal import HEAD_BYTES, Journal
 from rollqp.result import load_result, resume_source
@@ -468,8 +469,8 @@ def test_a_marched_start_reports_its_steps_and_an_estimate(tmp_path, capsys, mon
     assert ticks and ticks[0][0] == 1 and all(e == ticks[0][1] > 1 for _, e in ticks)
     assert [j for j, _ in ticks] == list(range(1, len(ticks) + 1))
     (tmp_path / "s.toml").write_text(scene.to_toml(), encoding="utf-8")
-    monkeypatch.setattr(cli, "START_ESTIMATE_SECONDS", 0.0)
-    monkeypatch.setattr(cli, "ANNOUNCE_SECONDS", 0.0)
+    monkeypatch.setattr(reporting, "START_ESTIMATE_SECONDS", 0.0)
+    monkeypatch.setattr(reporting, "ANNOUNCE_SECONDS", 0.0)
     monkeypatch.setenv("ROLLQP_PROGRESS_SECONDS", "0")
     assert cli.main(["run", str(tmp_path / "s.toml"), "--out", str(tmp_path / "r.npz")]) == 0
     err = capsys.readouterr().err

@@ -9,7 +9,7 @@ import pytest
 from rollqp.errors import InputError
 from rollqp.profiles.surface import Body, QuadraticProfile, curvatures
 from rollqp.discretization.grid import ASPECT_RANGE, Grid
-from rollqp.three.hertz import curvature_ratio, curvatures_for_ratio, hertz
+from rollqp.closedforms.hertz_ellipse import curvature_ratio, curvatures_for_ratio, hertz
 from rollqp.materials import Materials
 
 

@@ -1,4 +1,4 @@
-"""3D load paths (rollqp.three.loads, rollqp.three.loadpath): the normal load as a history (zero: out of contact),
+"""3D load paths (rollqp.loads, rollqp.loadpath): the normal load as a history (zero: out of contact),
 the rolled distance as a history (stops, reversals, variable Δq, fretting at rest), against Hertz at the current
 load, the steady state at the current load, Mindlin–Deresiewicz at rest, the 2D code on the same history and a
 second method."""
@@ -10,7 +10,7 @@ import pytest
 import rollqp
 from rollqp.errors import InputError
 from rollqp.kinematics import plan
-from rollqp.three.hertz import hertz
+from rollqp.closedforms.hertz_ellipse import hertz
 from rollqp.three.march import steady, static_shift
 from rollqp.three.run import prepare, run
 

@@ -7,7 +7,7 @@ import pytest
 
 from rollqp.errors import InputError, SolverError
 from rollqp.operators.grid import Contact, Loads
-from rollqp.three.hertz import curvatures_for_ratio
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
 from rollqp.three.march import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod

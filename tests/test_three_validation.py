@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 import contact3d_cases
-from rollqp.three.closedforms import cattaneo_shift, cattaneo_traction, kalker_coefficients
+from rollqp.closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
+from rollqp.closedforms.kalker import kalker_coefficients
 from rollqp.operators.grid import Contact, Loads
-from rollqp.three.hertz import curvatures_for_ratio
+from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
 from rollqp.three.march import static_shift, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod

@@ -14,7 +14,7 @@ import pytest
 from rollqp.errors import InputError
 from rollqp.methods import get_method
 from rollqp.scene import load_scene
-from rollqp.three.hertz import hertz
+from rollqp.closedforms.hertz_ellipse import hertz
 from rollqp.materials import Materials
 from rollqp.wheelrail.benchmark import POSITIONS, read_reference
 from rollqp.wheelrail.profiles import Profile, read_profile, resolve_file

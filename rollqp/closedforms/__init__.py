@@ -26,14 +26,19 @@ half-space formula to check against.
 
 One module per closed form, each citing its source (its ``SOURCE``) and defining its symbols:
 :mod:`.hertz`, :mod:`.cattaneo`, :mod:`.carter`, :mod:`.bentall_johnson`, :mod:`.mindlin`,
-:mod:`.rounded_punch`, :mod:`.lame`, :mod:`.mcewen`. Every function is importable from here as
+:mod:`.rounded_punch`, :mod:`.lame`, :mod:`.mcewen`, :mod:`.brush`. Every function is importable from here as
 ``rollqp.closedforms.<name>``; :data:`SOURCES` maps each function's name to its citation.
+
+The 3D closed forms are modules of their own here, not imported with the package (``import rollqp`` stays
+light): :mod:`.hertz_ellipse` (the Hertz ellipse), :mod:`.kalker` (Kalker's linear theory, Table E.3),
+:mod:`.cattaneo3d` (Cattaneo–Mindlin on the circle) and :mod:`.hertz3d` (stresses below a circular contact).
 """
 from __future__ import annotations
 from __future__ import annotations
 
-from . import bentall_johnson, carter, cattaneo, hertz, lame, mcewen, mindlin, rounded_punch
+from . import bentall_johnson, brush, carter, cattaneo, hertz, lame, mcewen, mindlin, rounded_punch
 from .bentall_johnson import BENTALL_JOHNSON_COEFFICIENT, bentall_johnson_creepage
+from .brush import brush_creep_ratio, brush_kappa
 from .carter import (carter_creepage, carter_slip, carter_stick_zone, carter_traction,
                      creep_force_ratio)
 from .cattaneo import cattaneo_stick_half_width, cattaneo_traction
@@ -55,6 +60,8 @@ __all__ = [
     "carter_slip",
     "creep_force_ratio",
     "bentall_johnson_creepage",
+    "brush_creep_ratio",
+    "brush_kappa",
     "BENTALL_JOHNSON_COEFFICIENT",
     "lame_ring_displacement",
     "SOURCES",
@@ -77,6 +84,7 @@ SOURCES: dict[str, str] = {
     **dict.fromkeys(("carter_stick_zone", "carter_traction", "carter_creepage", "carter_slip"), carter.SOURCE),
     "creep_force_ratio": carter.SOURCE + "; " + carter.KALKER,
     "bentall_johnson_creepage": bentall_johnson.SOURCE,
+    **dict.fromkeys(("brush_creep_ratio", "brush_kappa"), brush.SOURCE),
     "lame_ring_displacement": lame.SOURCE,
     **dict.fromkeys(("mindlin_turning_points", "mindlin_traction", "mindlin_dissipation", "mindlin_displacement"),
                     mindlin.SOURCE),

@@ -27,7 +27,7 @@ from ..errors import InputError, RollqpError
 from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, get_method,
                        method_class, require_3d)
 from ..three.run import run
-from ..three.loadpath import posed_force
+from ..loadpath import posed_force
 from ..three.march import coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
@@ -134,7 +134,9 @@ class CrossCheck:
     def _nothing(self) -> str:
         if self.skipped:
             m, ks = next(iter(self.skipped.items()))
-            return (f"skipped: one {m} step takes about {self.estimate:.0f} s (estimate), beyond the budget of "
+            took = (f"one {m} step takes about {self.estimate:.0f} s (estimate)" if self.estimate is not None
+                    else f"a {m} step was stopped at the budget")   # a solve stopped mid-way: no estimate
+            return (f"skipped: {took}, beyond the budget of "
                     f"{self.budget:.1f} s (the run's own time plus {SLACK:g} s); --cross-check solves steps {', '.join(map(str, sorted(ks)))} again, "
                     "rollqp crossval every step")
         return "nothing to check"
@@ -142,7 +144,7 @@ class CrossCheck:
 
 def _pose(scene, contact, rec, before):
     """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
-    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.three.loadpath)
+    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.loadpath)
         kind, _, dq, _, loads = rec.info["pose"]
         return kind, loads, before, dq
     if rec.phase == "steady":

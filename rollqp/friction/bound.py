@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["SlipBound", "step_coefficient", "steady_branches"]
+__all__ = ["SlipBound", "step_coefficient", "grid_coefficient", "steady_branches"]
 
 
 @dataclass(frozen=True)
@@ -50,9 +50,10 @@ class SlipBound:
     steady: bool = False                # the bound of a direct steady solve (its operator is not symmetric)
 
     def mu(self, s, contact=None) -> np.ndarray:
-        """``μ_i(s_i)``; ``contact`` (a mask, optional): outside it the slip velocity is taken as 0, CONTACT's
+        """``μ_i(s_i)``; ``s`` of shape ``(n,)`` (a strip) or ``(2, n)`` (a grid: ``|s_i|`` the length of the
+        element's slip vector); ``contact`` (a mask, optional): outside it the slip velocity is taken as 0, CONTACT's
         semantics (module docstring), so that the memory of separated material relaxes towards the static value."""
-        v = self.law.rolling_speed * np.abs(s)
+        v = self.law.rolling_speed * _magnitude(s)
         if contact is not None:
             v = np.where(contact, v, 0.0)
         m, _ = self.law.steady(v)
@@ -61,11 +62,24 @@ class SlipBound:
 
     def dmu(self, s) -> np.ndarray:
         """``∂μ_i/∂s_i`` (zero at ``s_i = 0``: the one-sided derivative into slip is taken by the Newton
-        method from the sign of the slip it moves to)."""
+        method from the sign of the slip it moves to). On a grid (``s`` of shape ``(2, n)``) the gradient
+        ``(1 − w) μ'(V|s_i|) V s_i/|s_i|``, shape ``(2, n)``, zero where ``s_i = 0``."""
         V = self.law.rolling_speed
-        _, d = self.law.steady(V * np.abs(s))
-        d = (1.0 - self.weight) * d * V * np.sign(s)
+        s = np.asarray(s)
+        if s.ndim == 2:
+            norm = np.hypot(s[0], s[1])
+            _, d = self.law.steady(V * norm)
+            unit = np.divide(s, norm, out=np.zeros(s.shape), where=norm > 0)
+            d = (1.0 - self.weight) * d * V * unit
+        else:
+            _, d = self.law.steady(V * np.abs(s))
+            d = (1.0 - self.weight) * d * V * np.sign(s)
         return d if self.frozen is None else self.blend * d
+
+    def take(self, idx) -> "SlipBound":
+        """This bound on the nodes ``idx`` only (the memory and the frozen coefficients taken there)."""
+        pick = lambda a: None if a is None else np.asarray(a)[idx]  # noqa: E731
+        return SlipBound(self.law, self.weight, pick(self.previous), pick(self.frozen), self.blend, self.steady)
 
     @property
     def on_path(self) -> bool:
@@ -96,8 +110,14 @@ class SlipBound:
         return (1.0 - self.weight) * m + self.weight * self.previous, (1.0 - self.weight) * d
 
     def slip_velocity(self, s) -> np.ndarray:
-        """``v = V |s|`` (length/time)."""
-        return self.law.rolling_speed * np.abs(np.asarray(s, dtype=float))
+        """``v = V |s|`` (length/time); ``s`` of shape ``(n,)`` or ``(2, n)``."""
+        return self.law.rolling_speed * _magnitude(np.asarray(s, dtype=float))
+
+
+def _magnitude(s):
+    """``|s_i|``: the absolute value on a strip (``(n,)``), the length of the slip vector on a grid (``(2, n)``)."""
+    s = np.asarray(s)
+    return np.hypot(s[0], s[1]) if s.ndim == 2 else np.abs(s)
 
 
 def _at_nodes(points, x_hat):
@@ -136,6 +156,22 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
         return law.mu, None  # the number itself (a plain float): the constant-coefficient code path
     if kind == "spatial":
         return law.coefficient(x_hat[None, :], q_hat, direction), None   # the strip's points, (1, n)
+    return _slip_bound(law, x_hat, x_hat.shape, dq_hat, direction, previous, steady)
+
+
+def grid_coefficient(law, x_hat, shape, *, dq_hat=None, direction=-1, previous=None, steady=False):
+    """:func:`step_coefficient` of a slip-velocity ``law`` on a grid: ``(μ_s, SlipBound)``.
+
+    ``x_hat`` (``(nx,)``) are the element centres along the rolling direction in the contact's length unit,
+    ``shape = (ny, nx)`` the grid's; ``previous`` (``(ny·nx,)``, row after row) the coefficient after the last
+    step. The memory is carried with the material along x on each row of elements (the material now at ``(x, y)``
+    was at ``(x − d Δq, y)``), as on a strip; entering material brings the static value."""
+    return _slip_bound(law, np.asarray(x_hat, dtype=float), tuple(shape), dq_hat, direction, previous, steady)
+
+
+def _slip_bound(law, x_hat, shape, dq_hat, direction, previous, steady):
+    """The slip-velocity branch of :func:`step_coefficient` on nodes of ``shape`` (``(n,)`` a strip, ``(ny, nx)`` a
+    grid, ``x_hat`` the positions along the last axis)."""
     static = law.steady(0.0)[0]
     if law.memory == 0.0:
         return float(static), SlipBound(law, steady=bool(steady))
@@ -143,11 +179,15 @@ def step_coefficient(law, x_hat, q_hat, direction, *, dq_hat=None, previous=None
         raise InputError("contact.friction.memory", "a direct steady solve cannot carry the friction memory "
                                                     "along the material; use load.start = 'braked' (marching) or "
                                                     "memory = 0")
+    size = int(np.prod(shape))
     if previous is None:
-        previous = np.full(x_hat.shape, float(static))
+        previous = np.full(size, float(static))
     if dq_hat is not None:  # the material now at x was at x − d Δq (Δq signed: a reversal brings it back)
-        previous = np.interp(_at_nodes(x_hat - direction * dq_hat, x_hat), x_hat, previous,
-                             left=float(static), right=float(static))
+        at = _at_nodes(x_hat - direction * dq_hat, x_hat)
+        rows = np.asarray(previous, dtype=float).reshape(-1, x_hat.size)
+        previous = np.concatenate([np.interp(at, x_hat, row, left=float(static), right=float(static))
+                                   for row in rows]).reshape(size) if len(shape) > 1 else \
+            np.interp(at, x_hat, previous, left=float(static), right=float(static))
     w = law.weight(dq_hat if dq_hat is not None else 1.0)
     return float(static), SlipBound(law, w, np.asarray(previous, dtype=float))
 

@@ -118,19 +118,22 @@ class BlockToeplitz:
         if x.shape != (self.m_in * g.n,):
             raise InputError(self.name, f"product with a vector of shape {x.shape}, expected ({self.m_in * g.n},)")
         L = self._fft_shape
-        fields = x.reshape(self.m_in, g.ny, g.nx)
-        hats = [_fft().rfft2(f, s=L) for f in fields]
-        out = np.empty((self.m_out, g.ny, g.nx))
-        for a, row in enumerate(self._transforms()):
-            acc = None
-            for b, kh in enumerate(row):
-                if kh is not None:
-                    acc = kh * hats[b] if acc is None else acc + kh * hats[b]
-            if acc is None:
-                out[a] = 0.0
-            else:
-                full = _fft().irfft2(acc, s=L)
-                out[a] = full[g.ny - 1:2 * g.ny - 1, g.nx - 1:2 * g.nx - 1]
+        hats = _fft().rfft2(x.reshape(self.m_in, g.ny, g.nx), s=L)     # every component in one call
+        rows = [a for a, row in enumerate(self._transforms()) if any(kh is not None for kh in row)]
+        out = np.zeros((self.m_out, g.ny, g.nx))
+        if rows:
+            acc = np.empty((len(rows),) + hats.shape[1:], dtype=hats.dtype)
+            for i, a in enumerate(rows):
+                first = True
+                for b, kh in enumerate(self._transforms()[a]):
+                    if kh is not None:
+                        if first:
+                            np.multiply(kh, hats[b], out=acc[i])
+                            first = False
+                        else:
+                            acc[i] += kh * hats[b]
+            full = _fft().irfft2(acc, s=L)                                # every output in one call
+            out[rows] = full[:, g.ny - 1:2 * g.ny - 1, g.nx - 1:2 * g.nx - 1]
         return out.ravel()
 
     def diagonal(self) -> np.ndarray:

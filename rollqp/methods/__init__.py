@@ -407,24 +407,33 @@ def compose(method: Method, coupled: bool, max_outer: int | None = None, frictio
     return method
 
 
-def scene_method_3d(settings, **options) -> Method:
+def scene_method_3d(settings, friction: str = "constant", **options) -> Method:
     """The method a three-dimensional scene runs with: ``settings.method``'s record for dimension 3, built
-    from the scene's solver settings and checked by :func:`compose_3d`."""
-    return compose_3d(record(settings.method, 3).make(settings, **options))
+    from the scene's solver settings and checked by :func:`compose_3d` (``friction``: the kind of the scene's
+    law, :func:`rollqp.friction.law_kind`)."""
+    return compose_3d(record(settings.method, 3).make(settings, **options), friction=friction)
 
 
-def compose_3d(method: Method) -> Method:
+def compose_3d(method: Method, friction: str = "constant") -> Method:
     """``method`` if its record can run a 3D scene: dimension 3, and tangential steps on the friction
     disc (a second-order cone per element); else an :class:`InputError` naming the methods that can.
 
     (Dissimilar bodies run the normal–tangential alternation of :mod:`rollqp.three.march` with the
-    method's own halves: every 3D method is composed so.)
+    method's own halves: every 3D method is composed so.) With a slip-dependent law (``friction = "slip"``)
+    as in 2D (:func:`compose`): a method that does not declare ``slip_dependent`` runs inside the fixed point
+    on the bound, and every method inside :class:`~rollqp.methods.continuation.SlipContinuation`.
     """
     caps = method.capabilities
     if 3 not in caps.dimensions:
         raise InputError("solver.method", f"method {method.name!r} solves {_dims(caps)}D steps (its capabilities); "
                                           f"a 3D scene needs one of {', '.join(cone_methods())}")
     _require_cones(method.name, caps)
+    if friction == "slip" and not isinstance(method, SlipContinuation):
+        if not caps.slip_dependent:
+            method = BoundFixedPoint(method)
+        # the path in λ is followed by Newton on the disc (rollqp's own arithmetic, the same for every method)
+        path = record("newton", 3).cls(tolerance=method.tolerance)
+        method = SlipContinuation(method, path_solver=path)
     return method
 
 

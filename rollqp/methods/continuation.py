@@ -44,9 +44,11 @@ says so: ``info["path"]`` is then ``{"stopped": message, "lam": λ reached}``.
 from __future__ import annotations
 
 import time
+import warnings
 
 import numpy as np
 
+from ..errors import SolverError
 from .path import FrozenBoundPath, PathStop, follow
 
 __all__ = ["SlipContinuation", "steepness", "frozen_coefficients", "STEEP"]
@@ -55,11 +57,20 @@ __all__ = ["SlipContinuation", "steepness", "frozen_coefficients", "STEEP"]
 STEEP = 0.0
 
 
+def _grid(problem) -> bool:
+    """A grid's step (two traction components: the slip of shape ``(2, n)``), else a strip's."""
+    return getattr(problem, "slip_shape", None) is not None
+
+
 def steepness(problem) -> float:
     """``κ = max_i |∂μ/∂s|_max p_i⁺ |A_ii| / Δq`` of a slip-dependent step (module docstring): the largest factor by
     which a change of one node's coefficient can feed back on itself through its own slip, with the law at its
-    steepest (:attr:`~rollqp.friction.bound.SlipBound.steepness`)."""
-    d = np.abs(np.asarray(problem.A.diagonal(), dtype=float))
+    steepest (:attr:`~rollqp.friction.bound.SlipBound.steepness`). On a grid ``A_ii`` is the larger diagonal entry of
+    the element's 2 × 2 block of the slip operator ``B``."""
+    if _grid(problem):
+        d = np.abs(np.asarray(problem.B.diagonal(), dtype=float)).reshape(2, -1).max(axis=0)
+    else:
+        d = np.abs(np.asarray(problem.A.diagonal(), dtype=float))
     return problem.law.steepness * float(np.max(np.maximum(problem.p, 0.0) * d, initial=0.0)) / problem.dq
 
 
@@ -67,8 +78,15 @@ def frozen_coefficients(problem, warm) -> np.ndarray:
     """``μ_f``: the law's coefficients at the warm start's slip (the previous state's), or at rest without one; at
     rest also where those carry less than the prescribed load (the frozen step has no solution with stick)."""
     n, law = problem.n, problem.law
-    s = warm.s if warm is not None and warm.s is not None and np.shape(warm.s) == (n,) else np.zeros(n)
+    shape = problem.slip_shape if _grid(problem) else (n,)
+    s = warm.s if warm is not None and warm.s is not None and np.shape(warm.s) == shape else np.zeros(shape)
     mu = law.mu(np.asarray(s, dtype=float))
+    if _grid(problem):
+        F = np.hypot(problem.Fx or 0.0, problem.Fy or 0.0)
+        if (problem.Fx is not None or problem.Fy is not None) and \
+                not F < problem.area * float(np.sum(mu * np.maximum(problem.p, 0.0))):
+            mu = law.mu(np.zeros(shape))
+        return mu
     if problem.Q is not None and not abs(problem.Q) < float(problem.f @ (mu * np.maximum(problem.p, 0.0))):
         mu = law.mu(np.zeros(n))
     return mu
@@ -80,10 +98,12 @@ class SlipContinuation:
     ``inner`` unchanged (a law that does not fall has κ = 0). ``info`` of a selected solution: ``path`` (points, changes of piece, turns of ``λ``, the
     largest ``λ`` before the end) and ``steepness``."""
 
-    def __init__(self, inner, threshold: float = STEEP):
+    def __init__(self, inner, threshold: float = STEEP, path_solver=None):
         self.inner = inner
         self.name, self.capabilities, self.tolerance = inner.name, inner.capabilities, inner.tolerance
         self.threshold = float(threshold)
+        #: the Newton method on the grid's steps that follows the path in λ (docs/friction.md), for grids only
+        self.path_solver = path_solver
 
     def __getattr__(self, name):
         """The inner method's settings (``max_iterations``, …): this wrapper only selects solutions."""
@@ -107,7 +127,7 @@ class SlipContinuation:
         return self.inner.single_sweeps(on)
 
     def solve(self, problem, warm=None):
-        law = problem.law
+        law = getattr(problem, "law", None)   # a grid's normal step has none
         if problem.kind != "tangential" or law is None or law.on_path or law.steady:
             # a steady solve's operator T·A is far from symmetric: its step at λ = 0 is no convex QP and need
             # not have one solution (module docstring, "Steady solves"; docs/friction.md)
@@ -115,7 +135,28 @@ class SlipContinuation:
         kappa = steepness(problem)
         if not (kappa > 0.0 and kappa >= self.threshold):
             return self.inner.solve(problem, warm=warm)
+        if _grid(problem):
+            return self._selected_grid(problem, warm, kappa)
         return self._selected(problem, warm, kappa)
+
+    def _selected_grid(self, problem, warm, kappa):
+        """A grid's step: the path from the frozen bound in ``λ`` by natural-parameter steps (module docstring,
+        :func:`follow_grid`), its end solved by the method as a point of the path."""
+        t0 = time.perf_counter()
+        frozen = frozen_coefficients(problem, warm)
+        start = self.inner.solve(problem.replace(mu=frozen, law=None), warm=warm)
+        try:
+            end, stats = follow_grid(self.path_solver, problem, frozen, start)
+        except PathStop as err:  # the method's own solution, saying that it was not selected
+            sol = self.inner.solve(problem, warm=warm)
+            sol.info.update(path={"stopped": err.message, "lam": err.lam}, steepness=kappa)
+            _warn_unselected(err)
+            return sol
+        sol = self.inner.solve(problem.replace(law=problem.law.homotopy(frozen, 1.0)), warm=end)
+        sol.info.update(path=stats, steepness=kappa)
+        sol.time = time.perf_counter() - t0
+        return sol
+
 
     def _selected(self, problem, warm, kappa):
         t0 = time.perf_counter()
@@ -137,3 +178,47 @@ class SlipContinuation:
         sol.info.update(path=stats, steepness=kappa)
         sol.time = time.perf_counter() - t0
         return sol
+
+
+#: The smallest step in ``λ`` of the grid's path (:func:`follow_grid`): below it the path has met a fold.
+MIN_LAMBDA_STEP = 1.0 / 1024
+#: A step of the grid's path is halved when it changes the tractions by more than this many times the step before
+#: it (scaled by the steps' lengths): a jump to another branch near a fold, not the smooth path.
+JUMP = 4.0
+
+
+def follow_grid(newton, problem, frozen, start):
+    """The solutions of the grid's step with the bound ``μ_λ(s) = (1 − λ) μ_f + λ μ(s)`` from ``λ = 0`` (``start``,
+    the frozen step's solution) to ``λ = 1``, by natural-parameter continuation: each ``λ`` solved by ``newton`` from
+    the last point, the step in ``λ`` halved where Newton fails or the tractions jump (:data:`JUMP`), doubled after
+    a success. Returns ``(solution at λ = 1, stats)``; raises :class:`~.path.PathStop` where the step falls below
+    :data:`MIN_LAMBDA_STEP`: the branch from the frozen bound turns back there (a fold of ``λ``), the step has
+    another solution beyond it and the path is not followed around the fold on a grid."""
+    lam, h, sol, points, halvings = 0.0, 0.25, start, 0, 0
+    rate = None      # the last accepted step's change of the tractions per unit λ
+    scale = float(np.max(np.abs(frozen) * np.maximum(problem.p, 0.0), initial=0.0)) or 1.0
+    while lam < 1.0:
+        step = min(h, 1.0 - lam)
+        nxt = lam + step
+        try:
+            cand = newton.solve(problem.replace(law=problem.law.homotopy(frozen, nxt)), warm=sol)
+            change = float(np.max(np.abs(cand.t - sol.t))) / scale / step
+            ok = rate is None or change <= JUMP * max(rate, 1e-12)
+        except SolverError:
+            ok = False
+        if not ok:
+            h = step / 2
+            halvings += 1
+            if h < MIN_LAMBDA_STEP:
+                raise PathStop(f"the path from the frozen bound turns back near λ = {lam:.4g} (a fold: the step has "
+                               "more than one solution, docs/friction.md)", lam=lam)
+            continue
+        lam, sol, rate, points = nxt, cand, change, points + 1
+        h = min(2 * step, 0.5)
+    return sol, {"points": points, "halvings": halvings, "lam_max": 1.0}
+
+
+def _warn_unselected(err):
+    """Say that a step's solution could not be selected: uniqueness fails there (docs/friction.md)."""
+    warnings.warn(f"falling friction: {err.message}; the method's own solution is returned", RuntimeWarning,
+                  stacklevel=3)

@@ -17,7 +17,7 @@ the leading edge along ``−e``:
 ellipse at the first).
 
 **The flexibilities** come from Kalker's linear creep coefficients ``C_ij`` of the scene's ellipse
-(:func:`rollqp.three.closedforms.kalker_linear`, Table E.3, at its ``a/b`` and ``ν``):
+(:func:`rollqp.closedforms.kalker.kalker_linear`, Table E.3, at its ``a/b`` and ``ν``):
 
 .. math::
     L_1 = \frac{8a}{3\,C_{11}\,G},\qquad L_2 = \frac{8a}{3\,C_{22}\,G},\qquad
@@ -59,7 +59,7 @@ import time
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..three.closedforms import kalker_linear
+from ..closedforms.kalker import kalker_linear
 from .newton.disc import NewtonMethod
 from .base import Capabilities, check_options
 

@@ -83,11 +83,11 @@ class BoundFixedPoint:
         self.inner.setup(operators)
 
     def solve(self, problem, warm=None):
-        if problem.kind != "tangential" or problem.law is None:
+        if problem.kind != "tangential" or getattr(problem, "law", None) is None:   # a grid's normal step has none
             return self.inner.solve(problem, warm=warm)
         t0 = time.perf_counter()
-        law, n = problem.law, problem.n
-        s = warm.s if warm is not None and warm.s is not None and np.shape(warm.s) == (n,) else np.zeros(n)
+        law, shape = problem.law, getattr(problem, "slip_shape", (problem.n,))   # (2, n) on a grid
+        s = warm.s if warm is not None and warm.s is not None and np.shape(warm.s) == shape else np.zeros(shape)
         mu = law.mu(s)
         history, its, sol = [], 0, warm
         for k in range(1, self.max_iterations + 1):

@@ -22,6 +22,7 @@ from .. import matrixfree
 from ..errors import InputError
 from ..influence import Memo, get_model
 from ..influence.operator import Operator, asymmetry
+from ..influence.layer import strip_tangential
 from ..problem import CoupledStep, FrictionBound, NormalStep, Scales, TangentialStep, _check_sliding_limit
 from ..strip import RowSparse, Strip
 from ..profiles import Profile
@@ -101,8 +102,9 @@ class SceneOperators:
         info["asymmetry_Ann"] = asymmetry(infl.Ann, f)
         info["asymmetry_Att"] = asymmetry(infl.Att, f)
         Ann = Operator(infl.Ann, "influence")
-        same = infl.Att is infl.Ann or np.array_equal(infl.Att, infl.Ann)
-        Att = Ann if same else Operator(infl.Att, "influence")
+        layer = scene.contact.layer    # an interface layer's compliance h/G3 on A_tt's diagonal (eq. L.2)
+        same = layer is None and (infl.Att is infl.Ann or np.array_equal(infl.Att, infl.Ann))
+        Att = Ann if same else strip_tangential(Operator(infl.Att, "influence"), layer)
         if symmetrized:
             Ann = Ann.split(f).sym
             Att = Ann if same else Att.split(f).sym
@@ -148,6 +150,7 @@ class SceneOperators:
         """FFT operators on the uniform strip (:mod:`rollqp.matrixfree`; docs/matrix-free.md)."""
         t0 = time.perf_counter()
         Ann, Att, Atn, Ant, h, info = matrixfree.build(scene, strip)
+        Att = strip_tangential(Att, scene.contact.layer)
         info["influence_seconds"] = time.perf_counter() - t0
         info["operator"] = "collocation"
         return cls(scene=scene, strip=strip, Ann=Ann, Att=Att, Atn=Atn, Ant=Ant, h=h,

@@ -19,10 +19,12 @@ import numpy as np
 
 from ..errors import InputError
 from ..friction import as_law
+from ..friction.bound import grid_coefficient
 from ..profiles.surface import QuadraticProfile
 from ..discretization.grid import Grid
-from ..three.hertz import hertz
+from ..closedforms.hertz_ellipse import hertz
 from ..influence import DEFAULT_MODEL, get_model
+from ..influence.layer import parse_layer, with_layer
 from ..problem.grid import NormalStep, Residuals, Scales, StepSolution, TangentialStep
 
 __all__ = ["Contact", "Loads"]
@@ -70,6 +72,9 @@ class Contact:
     model : str
         The influence model (``contact.model``) of 3D scenes that builds the operators from the grid and
         the materials (:func:`rollqp.influence.get_model`; default the Boussinesq–Cerruti half-space).
+    layer : rollqp.influence.layer.Layer or dict, optional
+        An interface layer between the bodies (``contact.layer``): its compliance ``h/G₃`` joins the tangential
+        operators (:mod:`rollqp.influence.layer`).
 
     Examples
     --------
@@ -81,12 +86,12 @@ class Contact:
     """
 
     def __init__(self, grid: Grid, materials, curvatures, FN: float, mu: float, profile=None,
-                 model: str = DEFAULT_MODEL):
+                 model: str = DEFAULT_MODEL, layer=None):
         # a scene's law as it is, a number checked once here (as_law)
         law = as_law(mu)
-        if law.kind not in ("constant", "spatial"):
-            raise InputError("contact.friction", f"a 3D contact takes a law of kind 'constant' or 'spatial' (μ at the "
-                                                 f"grid's points); law {law.law!r} is of kind {law.kind!r}")
+        if law.kind not in ("constant", "spatial", "slip"):
+            raise InputError("contact.friction", f"a 3D contact takes a law of kind 'constant', 'spatial' or 'slip'; "
+                                                 f"law {law.law!r} is of kind {law.kind!r}")
         self.law = law
         self.grid, self.materials, self.mu = grid, materials, law.mu if law.kind == "constant" else float(law.reference)
         self.ellipse = hertz(curvatures[0], curvatures[1], materials.Estar, FN)
@@ -98,7 +103,8 @@ class Contact:
         f = min(1.0, self.mu / MU_REFERENCE) if self.mu > 0 else 1.0
         self.tangential_scales = self.scales if f == 1.0 else Scales(self.scales.length, self.scales.stress * f,
                                                                      self.scales.modulus, dimension=3)
-        self.ops = get_model(model, "contact.model", dimension=3).build(grid, materials)
+        self.layer = parse_layer(layer)
+        self.ops = with_layer(get_model(model, "contact.model", dimension=3).build(grid, materials), self.layer)
         self.x, self.y = grid.centres()
         self.record = grid.record()   # the points, weights and components a law or a field reads
         h = np.asarray(self.profile(self.x, self.y), dtype=float)
@@ -130,7 +136,8 @@ class Contact:
 
         ``kind``: ``"shift"`` (``Δq = c``, history ``−u'(x)``), ``"rolling"`` (history
         ``−u'(x − d Δq)``, eq. 3D.16) or ``"steady"`` (eq. 3D.17, ``Δq = dx``); ``previous`` is
-        ``(p', t')`` of the last step (zero tractions if ``None``).
+        ``(p', t')`` of the last step (zero tractions if ``None``), or ``(p', t', μ')`` with the coefficient
+        ``μ'`` the last step left at the elements (a slip-velocity law's memory, :meth:`slip_bound`).
         """
         p = np.asarray(p, dtype=float)
         ops, g = self.ops, self.grid
@@ -147,15 +154,35 @@ class Contact:
                 off = -direction * float(dq)
             c = np.zeros(2 * g.n) if not ops.coupled else ops.Atn @ p
             if previous is not None:
-                pp, tp = (np.asarray(v, dtype=float) for v in previous)
+                pp, tp = (np.asarray(v, dtype=float) for v in previous[:2])
                 c = c - (ops.Att if off == 0 else ops.shifted("tt", off)) @ tp.ravel()
                 if ops.coupled:
                     c = c - (ops.Atn if off == 0 else ops.shifted("tn", off)) @ pp
         else:
             raise InputError("kind", f"must be 'shift', 'rolling' or 'steady', got {kind!r}")
+        if self.law.kind == "slip":
+            memory = previous[2] if previous is not None and len(previous) > 2 else None
+            law = self.slip_bound(kind, dq, direction, memory)
+            return TangentialStep(B, g.area, law.mu(np.zeros((2, g.n))) * np.maximum(p, 0.0), self.x, self.y,
+                                  c.reshape(2, g.n), dq, Fx=loads.Fx, xi=loads.xi, Fy=loads.Fy, eta=loads.eta,
+                                  phi=loads.phi, scales=self.tangential_scales, p=p, law=law)
         bound = self.bound(p, loads.q, direction)
         return TangentialStep(B, g.area, bound, self.x, self.y, c.reshape(2, g.n), dq, Fx=loads.Fx, xi=loads.xi,
                               Fy=loads.Fy, eta=loads.eta, phi=loads.phi, scales=self.tangential_scales)
+
+    def slip_bound(self, kind: str, dq=None, direction: int = -1, memory=None):
+        """The :class:`~rollqp.friction.bound.SlipBound` of a slip-velocity law for a step of ``kind``: ``μ(V|s_i|)``
+        with the memory ``memory`` (the coefficient the last step left at the elements, ``(n,)``; ``None``: the
+        static value) carried with the material by a rolling step's ``Δq`` (in units of ``a``, the Hertz
+        semi-axis along x, the unit of the law's ``memory``); a shift step carries nothing, a steady solve
+        cannot carry a memory (InputError) (:func:`rollqp.friction.bound.grid_coefficient`)."""
+        a = self.ellipse.a
+        dq_hat = float(dq) / a if kind == "rolling" else None
+        if memory is not None and np.shape(memory) != (self.grid.n,):
+            memory = None      # a state without the law's memory (a start, a resumed state): the static value
+        _, law = grid_coefficient(self.law, self.grid.x / a, self.grid.shape, dq_hat=dq_hat, direction=direction,
+                                  previous=memory, steady=kind == "steady")
+        return law
 
     def coefficient(self, q: float = 0.0, direction: int = -1):
         """``μ`` at the grid's points at the rolled distance ``q``: the number ``mu`` for a constant law, else
@@ -163,6 +190,8 @@ class Contact:
         the unit of the scene's distances) and ``q/a`` (:class:`rollqp.friction.FrictionLaw`)."""
         if self.law.kind == "constant":
             return self.mu
+        if self.law.kind == "slip":   # at rest (the static value); a step's own: its law at its slip
+            return float(self.law.steady(0.0)[0])
         a = self.ellipse.a
         mu = np.asarray(self.law.coefficient(self.record.points / a, float(q) / a, direction), dtype=float)
         if mu.shape != (self.grid.n,) or not np.all(np.isfinite(mu) & (mu >= 0)):

@@ -37,7 +37,8 @@ import numpy as np
 from ..errors import RollqpError
 from ..methods import REFERENCE_METHOD
 from ..units import unit_names
-from ..three.closedforms import cattaneo_stick_radius, cattaneo_traction, kalker_linear
+from ..closedforms.cattaneo3d import cattaneo_stick_radius, cattaneo_traction
+from ..closedforms.kalker import kalker_linear
 from ..report.grid import LINEAR_SLIP_FRACTION, stick_fraction
 from .style import REFERENCES, arrays, colors, finish, legend_below, meta, pyplot, scene_of, value_axis
 

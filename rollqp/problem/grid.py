@@ -29,6 +29,7 @@ load rows (eq. 3D.29).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 
@@ -176,6 +177,12 @@ class TangentialStep:
     phi : float
         The spin creepage φ (1/length), always given.
     scales : Scales
+    p : (n,) array, optional
+        The pressure ``p̄`` (required with ``law``): a slip-dependent bound is ``μ(s) p̄⁺``.
+    law : SlipBound, optional
+        A slip-dependent coefficient ``μ_i(V|s_i|)`` (:class:`rollqp.friction.bound.SlipBound`, docs/friction.md):
+        the step is then a quasi-variational inequality whose bound ``μ_i(s_i) p̄_i⁺`` moves with the slip;
+        ``bound`` is the bound at zero slip (the sliding limit's). ``None``: the bound is ``bound``.
     """
 
     B: object
@@ -191,6 +198,8 @@ class TangentialStep:
     eta: float | None = None
     phi: float = 0.0
     scales: Scales = field(default_factory=lambda: Scales(dimension=3))
+    p: np.ndarray | None = None
+    law: object = None
     kind = "tangential"
 
     def __post_init__(self):
@@ -217,6 +226,10 @@ class TangentialStep:
         _one_of(("Fy", "eta"), (self.Fy, self.eta))
         for name in ("Fx", "xi", "Fy", "eta"):
             object.__setattr__(self, name, _number(name, getattr(self, name), allow_none=True))
+        if self.p is not None:
+            object.__setattr__(self, "p", _vector("p", self.p, n))
+        if self.law is not None and self.p is None:
+            raise InputError("p", "a slip-dependent bound (law) needs the pressure p of the step")
         self._check_sliding_limit()
 
     def _check_sliding_limit(self):
@@ -230,6 +243,36 @@ class TangentialStep:
     @property
     def n(self) -> int:
         return self.bound.size
+
+    @property
+    def slip_shape(self) -> tuple[int, int]:
+        """The shape of a slip on this grid, ``(2, n)``."""
+        return (2, self.bound.size)
+
+    def bound_at(self, s) -> np.ndarray:
+        """The bound at the slip ``s`` (``(2, n)``): ``μ(s) p̄⁺`` with a slip-dependent ``law``, else :attr:`bound`."""
+        return self.bound if self.law is None else self.law.mu(s) * np.maximum(self.p, 0.0)
+
+    def coefficient(self, s=None, p=None):
+        """``μ`` at the elements: ``law.mu(s)`` at the slip ``s`` (outside the contact, ``p <= 0``, at zero slip
+        velocity: docs/friction.md), else None (the bound is data)."""
+        if self.law is None or s is None:
+            return None
+        return self.law.mu(s, contact=(self.p if p is None else p) > 0.0)
+
+    def replace(self, **kw) -> "TangentialStep":
+        """The same step with the values ``kw``, checked; ``mu`` (a number or ``(n,)`` array) sets the bound
+        ``mu p̄⁺`` (with ``law=None``: the step with its coefficient frozen, a convex SOCP)."""
+        if "mu" in kw:
+            mu = kw.pop("mu")
+            kw["bound"] = np.asarray(mu, dtype=float) * np.maximum(self.p, 0.0)
+        return dataclasses.replace(self, **kw)
+
+    derived = replace
+
+    def evaluate(self, sol: StepSolution) -> StepSolution:
+        """``sol``'s traction and creepages re-evaluated on this problem (rollqp's residuals)."""
+        return self.solution(sol.t, sol.xi, sol.eta)
 
     def creepages(self, xi=None, eta=None) -> tuple[float, float]:
         """``(ξ, η)``: the prescribed ones, else the given unknowns."""
@@ -248,7 +291,7 @@ class TangentialStep:
         sc = self.scales
         t = np.asarray(t, dtype=float).reshape(2, -1)
         s = self.slip(t, xi, eta) if s is None else s
-        th, sh, bh = t / sc.stress, s / sc.slip, self.bound / sc.stress
+        th, sh, bh = t / sc.stress, s / sc.slip, self.bound_at(s) / sc.stress
         r = th - disc_projection(th - sh, bh)
         fric = float(np.max(np.hypot(r[0], r[1])))
         lx = 0.0 if self.Fx is None else abs(self.area * float(np.sum(t[0])) - self.Fx) / sc.force
@@ -260,6 +303,8 @@ class TangentialStep:
         t = np.asarray(t, dtype=float).reshape(2, -1)
         xi, eta = self.creepages(xi, eta)
         s = self.slip(t, xi, eta, Bt)
+        if self.law is not None:   # the coefficient at the elements: the next step's memory
+            meta.setdefault("mu", self.coefficient(s))
         return StepSolution(residuals=self.residuals(t, xi, eta, s), t=t, s=s, xi=xi, eta=eta, **meta)
 
     def states(self, t, s=None) -> np.ndarray:
@@ -267,7 +312,7 @@ class TangentialStep:
         active, ``|t̂_i − ŝ_i| > b̂_i`` (the partition of the solution; ``s``: its slip if known)."""
         t = np.asarray(t, dtype=float).reshape(2, -1)
         s = self.slip(t) if s is None else np.asarray(s).reshape(2, -1)
-        return element_states(t, s, self.bound, self.scales)
+        return element_states(t, s, self.bound_at(s), self.scales)
 
 
 def element_states(t, s, bound, scales) -> np.ndarray:

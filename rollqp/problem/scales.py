@@ -57,5 +57,5 @@ class Scales:
 
     @classmethod
     def ellipse(cls, ellipse) -> "Scales":
-        """A grid's scales from a :class:`~rollqp.three.hertz.HertzEllipse`: ``c = √(ab)``, ``p0``, ``E*``."""
+        """A grid's scales from a :class:`~rollqp.closedforms.hertz_ellipse.HertzEllipse`: ``c = √(ab)``, ``p0``, ``E*``."""
         return cls(length=ellipse.c, stress=ellipse.p0, modulus=ellipse.Estar, dimension=3)

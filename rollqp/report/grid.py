@@ -10,7 +10,7 @@ final forces and moment on body A, the creepages, the stick area, and the errors
 * **Kalker's linear theory** (a steady state, state 0 of a rolling start, where no more than
   :data:`LINEAR_SLIP_FRACTION` of the contact slips): the forces of the prescribed creepages against
   ``Fx = −G c² C11 ξ``, ``Fy = −G c² (C22 η + c C23 φ)`` (eq. 3D.8; Table E.3, interpolated by
-  :func:`rollqp.three.closedforms.kalker_linear`), or the creepages of the prescribed forces against
+  :func:`rollqp.closedforms.kalker.kalker_linear`), or the creepages of the prescribed forces against
   the same relations solved for them. On the grid the difference is the discretization error, first
   order in the element size (docs/validation3d.md §3 extrapolates it to within 1 %).
 
@@ -33,8 +33,9 @@ import numpy as np
 
 from . import time_row
 from ..units import unit_names
-from ..three.closedforms import cattaneo_shift, cattaneo_traction, kalker_linear
-from ..three.loads import start_ellipse
+from ..closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
+from ..closedforms.kalker import kalker_linear
+from ..loads import start_ellipse
 from ..operators.grid import Loads
 from ..three.march import normal, steady
 

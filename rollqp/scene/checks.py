@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import InputError
 from ..histories import Constant, Harmonic, parse_history
 from ..influence import get_model
+from ..influence.layer import check_relative, parse_layer
 from ..methods import check_name as check_method
 from .schema import (AUGMENTATION_MAX, AUGMENTATION_MIN, CONVECTIVE_STEP_MAX, COUPLINGS, EDGE_ELEMENTS,
                      ELEMENT_TYPES, FORMULATION_TYPES, MAX_ELEMENTS, MAX_NODES, MAX_START_STEPS, MAX_STEPS,
@@ -96,7 +97,7 @@ def check_contact(c: Any) -> Contact:
     mesh = [None if getattr(c, k) is None else
             integer(f"contact.{k}", getattr(c, k), "in [3, 2000] or absent", lambda n: 3 <= n <= 2000)
             for k in ("bem_outer_elements", "bem_inner_elements")]
-    return Contact(mu, model, coupling, d, *mesh)
+    return Contact(mu, model, coupling, d, *mesh, parse_layer(c.layer))
 
 
 def check_load(ld: Any) -> Load:
@@ -213,6 +214,7 @@ def check_derived(scene) -> None:
                                                  f"{keys} are too extreme to compute with")
     check_strip_fits(scene)
     check_wear(scene)
+    check_relative(scene.contact.layer, scene.a_H, scene.Estar)
     ratio = scene.discretization.distance * scene.a_H / scene.dq
     if not math.isfinite(ratio) or ratio > MAX_STEPS:
         raise InputError("discretization.distance",

@@ -6,7 +6,8 @@ normal force and rolling in x with creepages or tangential forces::
 
     name, description, units
     [bodies.A] [bodies.B]   radius, radius_y (> 0 convex, < 0 concave, or inf), E, nu
-    [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace")
+    [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace"),
+                            layer = { thickness = h, shear_modulus = G3 }
     [load]                  normal (FN), tangential (Fx/(μFN)), lateral (Fy/(μFN)),
                             creepage = { longitudinal = ξ, lateral = η, spin = φ },
                             start, direction, start_steps, normal_history, rolled
@@ -40,6 +41,7 @@ from ..errors import InputError
 from ..friction import parse_friction
 from ..histories import Constant, History, parse_history
 from ..influence import DEFAULT_MODEL, get_model
+from ..influence.layer import check_relative, parse_layer
 from ..methods import DEFAULT_METHOD, require_3d
 from ..profiles3d import Shape, parse_body
 from .core import TwoBodyScene, check_top, table_keys
@@ -48,10 +50,10 @@ from ..validate import choice, integer, number
 from ..operators.grid import MU_REFERENCE, Loads
 from ..profiles.surface import Body, curvatures
 from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
-from ..three.hertz import hertz
-from ..three.loads import check_load_path, has_load_path
+from ..closedforms.hertz_ellipse import hertz
+from ..loads import check_load_path, has_load_path
 from ..materials import Materials
-from ..three.patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
+from ..patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
 from ..methods import REFERENCE_METHOD
 from ..methods import scene_method_3d
 
@@ -88,11 +90,13 @@ class Body3D:
 
 @dataclass(frozen=True)
 class Contact3D:
-    """``dimension = 3``; Coulomb's coefficient ``friction`` (a number > 0); ``model``: the half-space."""
+    """``dimension = 3``; Coulomb's coefficient ``friction`` (a number > 0); ``model``: the half-space; ``layer``: an
+    interface layer ``{ thickness, shear_modulus }`` (:mod:`rollqp.influence.layer`), None: none."""
 
     friction: float
     dimension: int = 3
     model: str = DEFAULT_MODEL
+    layer: Any = None
 
     @property
     def mu(self) -> float:
@@ -116,7 +120,7 @@ class Load3D:
     ``tangential`` = Fx/(μFN), ``lateral`` = Fy/(μFN) — or the creepages (:class:`Creepage3D`), the
     ``start`` (``"braked"``: static shift to the initial forces, then rolling; ``"rolling"``: the
     steady state), the material's ``direction`` d = ±1 and the braked start's ``start_steps``; the load path
-    (:mod:`rollqp.three.loads`): ``normal_history`` (FN(τ)/``normal``) and ``rolled`` (q(τ)/a, None: τ = q)."""
+    (:mod:`rollqp.loads`): ``normal_history`` (FN(τ)/``normal``) and ``rolled`` (q(τ)/a, None: τ = q)."""
 
     normal: float
     tangential: History | None = None
@@ -168,13 +172,9 @@ def _body(key, b: Body3D) -> Body3D:
 
 def _contact(c: Contact3D) -> Contact3D:
     law = parse_friction(c.friction)   # a number is Coulomb's coefficient; a table a law: checked once, here
-    if law.kind == "slip":
-        raise InputError("contact.friction.law", f"a 3D scene takes Coulomb's coefficient or a law along the "
-                                                 f"surface (kind 'constant' or 'spatial'); {law.law!r} depends on "
-                                                 "the slip velocity, which only 2D scenes take")
     if c.dimension != 3 or isinstance(c.dimension, bool):
         raise InputError("contact.dimension", f"must be 3 in a 3D scene, got {c.dimension!r}")
-    return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name)
+    return Contact3D(law, 3, get_model(c.model, "contact.model", dimension=3).name, parse_layer(c.layer))
 
 
 def _history(v, key):
@@ -307,7 +307,7 @@ class Scene3D(TwoBodyScene):
     def curvatures(self) -> tuple[float, float]:
         """``(A, B)`` of ``h = A x² + B y²`` (eq. 3D.3); with a profile, its curvatures at the origin where
         both are positive, else the equivalent curvatures of the computed contact
-        (:func:`rollqp.three.patch.equivalent_curvatures`)."""
+        (:func:`rollqp.patch.equivalent_curvatures`)."""
         if self.shape.hertzian:
             return curvatures(Body(self.A.radius, self.A.radius_y, "A"), Body(self.B.radius, self.B.radius_y, "B"))
         A, B = self.shape.curvatures()
@@ -318,7 +318,7 @@ class Scene3D(TwoBodyScene):
 
     @functools.cached_property
     def patch(self):
-        """The contact the normal step finds for the profile at the reference load (:mod:`rollqp.three.patch`),
+        """The contact the normal step finds for the profile at the reference load (:mod:`rollqp.patch`),
         None for two paraboloids."""
         if self.shape.hertzian:
             return None
@@ -329,14 +329,14 @@ class Scene3D(TwoBodyScene):
 
     @functools.cached_property
     def ellipse(self):
-        """The Hertz ellipse of ``load.normal`` (a, b, p0, δ, E*: :class:`~rollqp.three.hertz.HertzEllipse`)."""
+        """The Hertz ellipse of ``load.normal`` (a, b, p0, δ, E*: :class:`~rollqp.closedforms.hertz_ellipse.HertzEllipse`)."""
         A, B = self.curvatures
         return hertz(A, B, self.materials.Estar, self.load.normal)
 
     @functools.cached_property
     def grid(self) -> Grid:
         """The ``elements`` on ``zone·(a, b)`` (:meth:`Grid.for_ellipse <rollqp.discretization.grid.Grid.for_ellipse>`),
-        or on ``extent`` (:func:`rollqp.three.patch.extent_grid`)."""
+        or on ``extent`` (:func:`rollqp.patch.extent_grid`)."""
         d = self.discretization
         if d.extent is not None:
             return extent_grid(d.extent, d.elements, d.element_size)
@@ -417,7 +417,8 @@ class Scene3D(TwoBodyScene):
         return {"name": self.name, "description": self.description, **({"units": self.units} if self.units else {}),
                 "bodies": {k: {f: v for f, v in dataclasses.asdict(b).items() if v is not None}
                            for k, b in (("A", self.A), ("B", self.B))},
-                "contact": {"dimension": 3, "friction": plain(self.contact.friction), "model": self.contact.model},
+                "contact": {"dimension": 3, "friction": plain(self.contact.friction), "model": self.contact.model,
+                            **({} if self.contact.layer is None else {"layer": plain(self.contact.layer)})},
                 "load": loads,
                 "discretization": {**disc, "step": d.step, "distance": d.distance},
                 "solver": solver}
@@ -449,6 +450,7 @@ def _check_whole(scene) -> None:
                                                       "ellipse to scale discretization.zone by; give the grid in length "
                                                       "units, extent = [[x0, x1], [y0, y1]]")
     _check_ellipse(scene)
+    check_relative(scene.contact.layer, math.sqrt(scene.ellipse.a * scene.ellipse.b), scene.materials.Estar)
     for key, body in (("bodies.A", scene.A), ("bodies.B", scene.B)):  # Archard's k·p0/H <= 1, as in 2D
         if body.wear is not None and not body.wear * scene.ellipse.p0 <= 1.0:
             raise InputError(f"{key}.wear", f"must be a number in [0, 1/p0 = {1.0 / scene.ellipse.p0:.6g}] (k/H in "
@@ -464,6 +466,7 @@ def _check_whole(scene) -> None:
         check_patch(scene.patch, "discretization.extent" if scene.discretization.extent is not None
                     else "discretization.zone")
     _check_work(scene)
+    _check_memory(scene)
     if has_load_path(scene):
         check_load_path(scene)      # the sliding limit of the current load among them
     else:
@@ -532,6 +535,16 @@ def _check_work(scene) -> None:
         raise InputError("discretization.distance", f"the result of {K + 1} states of {scene.grid.n} elements would be "
                                                     f"{size / 2 ** 30:.3g} GiB, more than {MAX_RESULT_BYTES >> 30} GiB: "
                                                     "fewer steps or elements")
+
+
+def _check_memory(scene) -> None:
+    """A slip-velocity law's memory is carried with the material from step to step: the steady state of a rolling
+    start has no previous step to carry it from (as in 2D: docs/friction.md)."""
+    law = scene.contact.friction
+    if getattr(law, "kind", None) == "slip" and law.memory > 0 and scene.load.start == "rolling":
+        raise InputError("contact.friction.memory", f"= {law.memory!r} needs load.start = 'braked': a steady rolling "
+                                                    "start cannot carry the friction memory along the material "
+                                                    "(or set memory = 0)")
 
 
 def _check_sliding_limit(scene) -> None:

@@ -99,6 +99,9 @@ class Contact:
     bem_outer_elements, bem_inner_elements : int or None
         ``model = "bem"``: elements on each roller's outer circle outside the strip and on its
         shaft, in [3, 2000]; None: the paper's 19 and 16 (docs/bem.md).
+    layer : Layer or None
+        An interface layer between the bodies, ``{ thickness = h, shear_modulus = G3 }``: its compliance
+        ``h/G3`` joins the tangential influence (:mod:`rollqp.influence.layer`); None: none.
     """
 
     friction: float
@@ -107,6 +110,7 @@ class Contact:
     reference_distance: float | None = None
     bem_outer_elements: int | None = None
     bem_inner_elements: int | None = None
+    layer: object = None
 
     @property
     def mu(self) -> float:

@@ -24,7 +24,7 @@ the creepage), the forces ``Fx``, ``Fy`` and the spin moment ``Mz`` against it, 
 (:class:`CreepCurve3D`):
 
 * **Kalker's linear theory** at the origin (docs/theory3d.md): ``Fx = −G c² C11 ξ``,
-  ``Fy = −G c² (C22 η + c C23 φ)`` (:func:`rollqp.three.closedforms.kalker_linear`, ``c = √(ab)``);
+  ``Fy = −G c² (C22 η + c C23 φ)`` (:func:`rollqp.closedforms.kalker.kalker_linear`, ``c = √(ab)``);
 * **saturation**: ``|F| → μ FN`` at large creepage;
 * ``dF/dξ`` of the computed curve by finite differences (second order on the values,
   :func:`numpy.gradient`), beside Kalker's slope.
@@ -351,7 +351,7 @@ class CreepCurve3D:
 
     def kalker_slope(self) -> float | None:
         """Kalker's ``dF/dξ`` at the origin (None outside his table or for dissimilar bodies)."""
-        from ..three.closedforms import kalker_linear
+        from ..closedforms.kalker import kalker_linear
         s = self.scene
         e, m = s.ellipse, s.materials
         if m.K != 0 or not 0 <= m.nu <= 0.5:

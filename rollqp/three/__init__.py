@@ -8,8 +8,10 @@ block-Toeplitz operators of :mod:`rollqp.influence.blocktoeplitz`), :mod:`rollqp
 (radii and curvatures), :mod:`rollqp.problem.grid` and :mod:`rollqp.problem.conic` (step problems and
 their conic forms), :mod:`rollqp.operators.grid` (one contact, built once), :mod:`rollqp.methods.newton.disc`,
 :mod:`rollqp.methods.socp`, :mod:`rollqp.methods.refine`, :mod:`rollqp.methods.chord` (the methods) and
-:mod:`rollqp.scene.grid` (the scene). Here remain the closed forms (:mod:`.hertz`, :mod:`.closedforms`),
-the march and run (:mod:`.march`, :mod:`.run`, :mod:`.result`, :mod:`.fields`), the summary, advice,
+:mod:`rollqp.scene.grid` (the scene), the closed forms (:mod:`rollqp.closedforms.hertz_ellipse`,
+:mod:`rollqp.closedforms.kalker`, :mod:`rollqp.closedforms.cattaneo3d`), the load paths (:mod:`rollqp.loads`,
+:mod:`rollqp.loadpath`) and the computed contact patch (:mod:`rollqp.patch`). Here remain the march and run
+(:mod:`.march`, :mod:`.run`), the summary, advice,
 cross-check and post-processing beside their 2D siblings (:mod:`rollqp.report.grid`, :mod:`rollqp.advice.grid`,
 :mod:`rollqp.crossval.grid`).
 

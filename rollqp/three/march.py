@@ -70,6 +70,8 @@ class StepRecord:
     time: float
     residual: float
     info: dict = field(default_factory=dict)
+    #: The friction coefficient a slip-velocity law left at the elements (its memory, the next step's start), else None.
+    mu: np.ndarray | None = None
 
 
 def normal(contact, method, FN: float, t=None, warm=None):
@@ -133,17 +135,27 @@ def _record(contact, k, phase, q, nsol, tsol, loads, sweeps, elapsed, tprob_stat
                       FN=contact.grid.area * float(nsol.p.sum()), Fx=Fx, Fy=Fy, Mz=Mz, xi=tsol.xi, eta=tsol.eta,
                       phi=loads.phi, delta=nsol.delta, iterations=sweeps * max(1, tsol.iterations), time=elapsed,
                       residual=max(nsol.residual, tsol.residual),
-                      info={"sweeps": sweeps, "normal": nsol.info, "tangential": tsol.info})
+                      info={"sweeps": sweeps, "normal": nsol.info, "tangential": tsol.info}, mu=tsol.mu)
 
 
-def _states(contact, p, t, s, q=0.0):
+def _previous(rec):
+    """What the step after the state ``rec`` takes as its ``previous``: ``(p, t)``, and the coefficient ``μ`` of a
+    slip-velocity law's memory where the state carries one."""
+    return (rec.p, rec.t) if rec.mu is None else (rec.p, rec.t, rec.mu)
+
+
+def _states(contact, p, t, s, q=0.0, mu=None):
     """0 separation, 1 stick, 2 slip (:func:`~rollqp.problem.grid.element_states`). At ``μ = 0`` (bound
     zero) as in 2D (:func:`rollqp.problem.solution.classify`): an element in contact (``p > 0``) slips
-    where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it."""
+    where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it. ``mu``: the
+    coefficient of a slip-velocity law at the solution (its bound ``μ p⁺``)."""
     if contact.mu == 0:
         moving = np.hypot(*(np.asarray(s, dtype=float).reshape(2, -1) / contact.scales.slip)) > 1e-7
         return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
-    return element_states(np.asarray(t), np.asarray(s), contact.bound(p, q), contact.scales)
+    if mu is None and contact.law.kind == "slip":   # a stored state: the law at its own slip (without memory)
+        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float).reshape(2, -1), contact=np.asarray(p) > 0)
+    bound = contact.bound(p, q) if mu is None else np.asarray(mu) * np.maximum(p, 0.0)
+    return element_states(np.asarray(t), np.asarray(s), bound, contact.scales)
 
 
 def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, phi: float = 0.0, steps: int = 1,
@@ -165,7 +177,7 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
         ns, ts, sw = coupled_step(contact, method, FN, "shift", loads, previous, warm=warm, pressure=nsol)
         shift = shift + contact.scales.length * np.array([ts.xi, ts.eta])
         rec = _record(contact, j - 1, "shift", 0.0, ns, ts, loads, sw, time.perf_counter() - t0,
-                      _states(contact, ns.p, ts.t, ts.s))
+                      _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
         rec.info.update(shift=tuple(shift), loads=loads, before=previous)
         out.append(rec)
         previous, warm = (ns.p, ts.t), (ns, ts)
@@ -192,7 +204,7 @@ def steady(contact, method, FN: float, loads: Loads, direction: int = -1, start=
         nsol, tsol, sw = coupled_step(contact, method, FN, "steady", loads, direction=direction, warm=warm,
                                       pressure=pressure)
         return _record(contact, 0, "steady", 0.0, nsol, tsol, loads, sw, time.perf_counter() - t0,
-                       _states(contact, nsol.p, tsol.t, tsol.s))
+                       _states(contact, nsol.p, tsol.t, tsol.s, mu=tsol.mu))
     if accelerate not in ("chord", "anderson"):
         raise InputError("accelerate", f"must be 'chord' or 'anderson', got {accelerate!r}")
     if accelerate == "chord" and not contact.ops.coupled:
@@ -234,7 +246,7 @@ def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure
         change = float(np.max(np.abs(ts.t - x))) / unit
         if change <= method.tolerance:
             rec = _record(contact, 0, "steady", 0.0, nsol, ts, loads, 1, time.perf_counter() - t0,
-                          _states(contact, nsol.p, ts.t, ts.s))
+                          _states(contact, nsol.p, ts.t, ts.s, mu=ts.mu))
             rec.info.update({"marched": k, "change": change, "accelerate": "chord"})
             return rec
         if best is not None and not change <= NEWTON_DECREASE * best[0]:
@@ -277,7 +289,7 @@ def _march_to_steady(contact, method, FN, loads, direction, start, t0, memory=AN
         change = float(np.max(np.abs(gx - x) / scale))
         if change <= method.tolerance:
             rec = _record(contact, 0, "steady", 0.0, ns, ts, loads, sw, time.perf_counter() - t0,
-                          _states(contact, ns.p, ts.t, ts.s))
+                          _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
             rec.info.update({"marched": k, "change": change})
             return rec
         X.append(x)
@@ -326,11 +338,11 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
         if move is not None:
             move(q)
         try:
-            ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, (prev.p, prev.t), dq, direction,
+            ns, ts, sw = coupled_step(contact, method, FN, "rolling", ld, _previous(prev), dq, direction,
                                       warm=warm, pressure=fixed)
         except SolverError as exc:
             raise exc.with_step(k) from None
-        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q))
+        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q, ts.mu))
         if move is not None and hasattr(move, "check"):
             move.check(ns.p, k)
         yield rec

@@ -27,15 +27,16 @@ from ..atomic import stop_once
 from ..errors import InputError, SolverError
 from ..fields import fields_for
 from ..march import RESUME_TOL, _keep_every, _last_index, drive
+from ..friction import law_kind
 from ..methods import compose_3d, scene_method_3d
 from ..result import Layout, Result, ResumeSource, check_output, resume_source
 from ..scene import load_scene
 from ..scene.core import SceneBase
 from ..version import __version__
 from ..operators.grid import Contact
-from .loadpath import out_of_contact, rolling_steps
-from .loads import start_force
-from .patch import moving_profile
+from ..loadpath import out_of_contact, rolling_steps
+from ..loads import start_force
+from ..patch import moving_profile
 from .march import StepRecord, static_shift, steady
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
@@ -54,9 +55,12 @@ def prepare(scene, method=None):
                                               f"{scene.dimension}D (rollqp.run runs either)")
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
-    meth = scene_method_3d(scene.solver) if method is None or isinstance(method, str) else compose_3d(method)
+    kind = law_kind(scene.contact.friction)
+    meth = (scene_method_3d(scene.solver, friction=kind) if method is None or isinstance(method, str)
+            else compose_3d(method, friction=kind))
     contact = Contact(scene.grid, scene.materials, scene.curvatures, scene.load.normal, scene.contact.friction,
-                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model)
+                      profile=None if scene.shape.hertzian else scene.shape.at(0.0), model=scene.contact.model,
+                      layer=scene.contact.layer)
     if scene.shape.moves:      # a feature rolls through: the march moves the profile with the material
         contact.move = moving_profile(contact, scene.shape, scene.load.direction,
                                       "discretization.extent" if scene.discretization.extent is not None
@@ -98,6 +102,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
     """
     scene, meth, contact = prepared = prepared if prepared is not None else prepare(scene, method)
     if resume is not None:
+        _resumable(scene)
         if state is None:
             state = check_resumed(scene, prepared, resume) if verify else resumed_record(scene, contact, resume)
         start, first = state, _last_index(resume) + 1
@@ -222,6 +227,7 @@ def check_states(scene, contact, source) -> None:
     :class:`InputError` on ``--resume``, before anything is run or written. (The last state is moreover solved
     again: :func:`check_resumed`.)"""
     from .march import _states
+    _resumable(scene)
     g, sc = contact.grid, contact.scales
     mu = float(contact.mu)
     tunit = (min(mu, 1.0) if mu > 0 else 1.0) * sc.stress
@@ -261,6 +267,16 @@ def check_states(scene, contact, source) -> None:
         seen += m
 
 
+def _resumable(scene) -> None:
+    """A run with a friction memory is not resumed: its result file does not hold the coefficient the material
+    carries (a one-line :class:`InputError` on ``--resume``)."""
+    law = scene.contact.friction
+    if getattr(law, "kind", None) == "slip" and law.memory > 0:
+        raise InputError("--resume", "a 3D run with a friction memory (contact.friction.memory > 0) cannot be "
+                                     "resumed: its result file does not hold the coefficient the material carries; "
+                                     "run it again")
+
+
 def _law(contact, p, t, s, states, tunit, k) -> list:
     """Coulomb's law at a stored state (to :data:`RESUME_TOL`): a sticking element does not slip (``|s|`` in the
     tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``[]``, or what is wrong."""
@@ -269,7 +285,10 @@ def _law(contact, p, t, s, states, tunit, k) -> list:
     stick, slipping = states == 1, (states == 2) & (sn > 0)
     if np.any(sn[stick] > RESUME_TOL * slip_unit):
         return [f"state {k}: a sticking element slips"]
-    b = contact.mu * np.maximum(p, 0.0)
+    mu = contact.mu
+    if contact.law.kind == "slip":   # a slip-velocity law (without memory: a run with one is not resumed) at the slip
+        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float), contact=np.asarray(p) > 0)
+    b = mu * np.maximum(p, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.hypot(t[0] + b * s[0] / sn, t[1] + b * s[1] / sn)
     if np.any(r[slipping] > RESUME_TOL * tunit):

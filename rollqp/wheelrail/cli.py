@@ -1,28 +1,33 @@
-r"""The command line of wheel–rail scenes: their record for ``rollqp run`` and ``rollqp crossval``, and
-``rollqp wheelrail-table`` (the Manchester benchmark's positions in one command; docs/wheel-rail.md)."""
+r"""The command line of wheel–rail scenes: the parts of their record for ``rollqp run`` and ``rollqp crossval``
+(:data:`rollqp.cli.common.FAMILIES` names them), and ``rollqp wheelrail-table`` (the Manchester benchmark's positions in one command; docs/wheel-rail.md)."""
 from __future__ import annotations
 
 import json
 
+from ..atomic import written
 from ..errors import InputError
-from .run import crossval, crossval_report, figure, run, summary
+from ..scene import load_scene
+from .benchmark import read_reference, table
+from .run import crossval, crossval_report
 
-__all__ = ["family_record", "add_parser", "cmd_table"]
+__all__ = ["advise", "spot", "check", "crossval_command", "add_arguments", "main"]
 
 
-def _advise(scene) -> None:
+def advise(scene) -> None:
     """Nothing to advise before a wheel–rail run."""
 
 
-def _spot(args, scene):
+def spot(args, scene):
+    """No steps are kept for a cross-check after the run (``rollqp crossval`` compares the methods)."""
     return {}, None
 
 
-def _check(kept, scene) -> str:  # pragma: no cover - no steps are kept
+def check(kept, scene, budget=None) -> str:  # pragma: no cover - no steps are kept
     return ""
 
 
-def _crossval(scene, step, methods) -> int:
+def crossval_command(scene, step, methods) -> int:
+    """``rollqp crossval`` of a wheel–rail scene: its one state by every method; exit 1 if they disagree."""
     if step not in (None, 0):
         raise InputError("--step", f"a wheel-rail scene is one state (step 0), got {step!r}")
     rows = crossval(scene, methods, tolerance=scene.solver.tolerance)
@@ -31,14 +36,7 @@ def _crossval(scene, step, methods) -> int:
     return 0 if ok else 1
 
 
-def family_record(Family):
-    """The :class:`rollqp.cli.Family` of wheel–rail scenes."""
-    return Family(run, summary, figure, _advise, _spot, _check, None, frozenset({"crossval"}), _crossval)
-
-
-def add_parser(sub) -> None:
-    t = sub.add_parser("wheelrail-table", help="the Manchester benchmark A-2.2: its 21 positions of a wheel-rail "
-                       "scene, left and right wheels, as one table (docs/validation-wheel-rail.md)")
+def add_arguments(t) -> None:
     t.add_argument("scene", help="a wheel-rail scene (its profiles, materials, load, friction, grid)")
     t.add_argument("--cases", default="1:21", help="positions: a,b,c or first:last (default 1:21)")
     t.add_argument("--sides", default="left,right", help="left, right or left,right (default)")
@@ -58,9 +56,8 @@ def _cases(text):
         raise InputError("--cases", f"must be a,b,c or first:last (integers), got {text!r}") from None
 
 
-def cmd_table(args) -> int:
-    from ..scene import load_scene
-    from .benchmark import read_reference, table
+def main(args) -> int:
+    """``rollqp wheelrail-table``: the table of the benchmark's positions (0), its rows as JSON with ``--out``."""
     scene = load_scene(args.scene)
     if getattr(scene, "family", None) != "wheel-rail":
         raise InputError("SCENE", f"{scene.name!r} is not a wheel-rail scene ([contact] kind = \"wheel-rail\")")
@@ -97,7 +94,6 @@ def cmd_table(args) -> int:
 
     table(scene, _cases(args.cases), sides, progress=show)
     if args.out:
-        from ..atomic import written
         with written(args.out, suffix=".json") as (fh, _):
             fh.write(json.dumps(out, indent=1).encode())
         print(f"  rows          {args.out}")

@@ -8,7 +8,8 @@ from ``A`` only in the rows of the slipping elements ``Q``:
 .. math::
     J = A + E_Q\,W,\qquad W = (M_Q − I)\,E_Q^T A + (I − M_Q)\,E_Q^T
 
-so that, with ``A⁻¹`` once per contact set (:func:`inverse`, kept with the operator),
+so that, with ``A⁻¹``'s LU once per contact set (:func:`inverse`, kept with the operator) and its
+columns on the slipping elements as they are needed,
 
 .. math::
     J^{-1} b = y − (A^{-1})_{:,Q}\,C^{-1} (I − M_Q)(y_Q − b_Q),\qquad y = A^{-1} b,\qquad
@@ -16,8 +17,9 @@ so that, with ``A⁻¹`` once per contact set (:func:`inverse`, kept with the op
 
 (``C`` is the capacitance matrix, of order ``2|Q|``; ``det J = det A · det C``). An iteration
 then costs an LU of order ``2|Q|`` and products with ``A⁻¹`` instead of an LU of order ``2|V|``:
-on a small grid in partial slip (a fifth of the elements slipping) a few hundredths of it. The
-direction is the LU path's to round-off (not bit for bit: another order of operations).
+on a small grid in partial slip (a fifth of the elements slipping) a few hundredths of it; a column
+of ``A⁻¹`` is computed once (two triangular solves) the first time its element slips. The direction
+is the LU path's to round-off (not bit for bit: another order of operations).
 """
 from __future__ import annotations
 
@@ -26,20 +28,45 @@ import warnings
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["inverse", "solve", "MAX_FRACTION"]
+__all__ = ["Inverse", "inverse", "solve", "MAX_FRACTION"]
 
 #: Slipping rows ``2|Q|`` above this fraction of the traction rows: the LU of ``J`` itself (an LU
 #: of order ``2|Q|`` then costs an eighth of it or more, and the products with ``A⁻¹`` are not free).
 MAX_FRACTION = 0.5
 
 
-def inverse(S: np.ndarray) -> np.ndarray:
-    """``S⁻¹`` of the operator's dense contact block (LU, LAPACK ``getrf``/``getri``)."""
-    return sla.inv(S, check_finite=False)
+class Inverse:
+    """``S⁻¹`` of the operator's dense contact block ``S``: its LU (LAPACK ``getrf``), and the columns of
+    ``S⁻¹`` computed so far (``getrs`` on unit vectors), each once."""
+
+    def __init__(self, S: np.ndarray):
+        self.lu = sla.lu_factor(S, check_finite=False)
+        self.m = S.shape[0]
+        self._cols = np.empty((self.m, 0))
+        self._where = np.full(self.m, -1, dtype=np.intp)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """``S⁻¹ b``."""
+        return sla.lu_solve(self.lu, b, check_finite=False)
+
+    def columns(self, Q: np.ndarray) -> np.ndarray:
+        """``S⁻¹[:, Q]``."""
+        new = np.unique(Q[self._where[Q] < 0])
+        if new.size:
+            E = np.zeros((self.m, new.size))
+            E[new, np.arange(new.size)] = 1.0
+            self._where[new] = self._cols.shape[1] + np.arange(new.size)
+            self._cols = np.hstack([self._cols, self.solve(E)])
+        return self._cols[:, self._where[Q]]
 
 
-def solve(Sinv: np.ndarray, scale: float, slip: np.ndarray, mxx, mxy, myy, b: np.ndarray):
-    """``J⁻¹ b`` by eq. 3D.28a, ``A⁻¹ = Sinv/scale``; ``b``: ``(2 nv,)`` or ``(2 nv, k)``.
+def inverse(S: np.ndarray) -> Inverse:
+    """:class:`Inverse` of ``S``."""
+    return Inverse(S)
+
+
+def solve(Sinv: Inverse, scale: float, slip: np.ndarray, mxx, mxy, myy, b: np.ndarray):
+    """``J⁻¹ b`` by eq. 3D.28a, ``A⁻¹ = S⁻¹/scale``; ``b``: ``(2 nv,)`` or ``(2 nv, k)``.
 
     ``slip``: the slipping elements (indices into the ``nv`` contact elements); ``mxx, mxy, myy``:
     ``M_i``'s entries on every contact element. ``None`` where ``C`` is singular (the caller takes
@@ -55,17 +82,18 @@ def solve(Sinv: np.ndarray, scale: float, slip: np.ndarray, mxx, mxy, myy, b: np
     >>> J = np.block([[np.diag(1 - mxx), -np.diag(mxy)], [-np.diag(mxy), np.diag(1 - myy)]])
     >>> J += np.vstack([mxx[:, None] * S[:nv] + mxy[:, None] * S[nv:], mxy[:, None] * S[:nv] + myy[:, None] * S[nv:]])
     >>> b = rng.random(2 * nv)
-    >>> d = solve(np.linalg.inv(S), 1.0, np.array([1, 4]), mxx, mxy, myy, b)
+    >>> d = solve(inverse(S), 1.0, np.array([1, 4]), mxx, mxy, myy, b)
     >>> bool(np.allclose(J @ d, b, rtol=0, atol=1e-13))
     True
     """
-    y = (Sinv @ b) / scale
+    y = Sinv.solve(b) / scale
     nv = mxx.size
     if slip.size == 0:
         return y
     Q = np.concatenate([slip, nv + slip])
     ns = slip.size
-    G = Sinv[np.ix_(Q, Q)] / scale                              # (A⁻¹)_QQ
+    SQ = Sinv.columns(Q)
+    G = SQ[Q] / scale                                           # (A⁻¹)_QQ
     ax, axy, ay = mxx[slip], mxy[slip], myy[slip]
     zx, zxy, zy = 1 - ax, -axy, 1 - ay                          # I − M_Q
     C = np.empty((2 * ns, 2 * ns), order="F")
@@ -89,4 +117,4 @@ def solve(Sinv: np.ndarray, scale: float, slip: np.ndarray, mxx, mxy, myy, b: np
         c = sla.lu_solve(sla.lu_factor(C, overwrite_a=True, check_finite=False), rhs, check_finite=False)
     if not np.all(np.isfinite(c)):
         return None
-    return y - (Sinv[:, Q] @ c) / scale
+    return y - (SQ @ c) / scale

@@ -41,11 +41,11 @@ import warnings
 
 import numpy as np
 import scipy.linalg as sla
-import scipy.sparse.linalg as spla
 
 from ... import progress
 from ...errors import InputError, SolverError
 from ..base import Capabilities, check_options
+from ..fixedpoint import BoundFixedPoint
 from ...problem.grid import disc_projection
 from . import capacitance
 
@@ -65,6 +65,13 @@ TRANSIENT_DENSE_UNKNOWNS = 1200
 #: Relative tolerance of the Krylov solves, against ‖Φ‖: an inexact Newton step of this
 #: accuracy keeps the local convergence superlinear (Eisenstat–Walker forcing ≤ 1e-2 ‖Φ‖).
 KRYLOV_FORCING = 1e-3
+
+
+def _sparse_linalg():
+    """``scipy.sparse.linalg``, imported on the first Krylov solve: a small grid's run on the dense path does
+    without it (about 20 ms of CPU at start-up)."""
+    import scipy.sparse.linalg
+    return scipy.sparse.linalg
 
 
 def _line_search(theta0, phi_at, rho, sigma, max_backtracks=30):
@@ -114,7 +121,8 @@ class NewtonMethod:
     #: The registry names the instance (rollqp.methods); this is the class's default label.
     name = "newton-3d"
     capabilities = Capabilities(solves=frozenset({"normal", "tangential", "steady"}), matrix_free=True,
-                                dimensions=frozenset({3}), traction_components=2, friction_set="disc")
+                                dimensions=frozenset({3}), traction_components=2, friction_set="disc",
+                                slip_dependent=True)
 
     def __init__(self, tolerance: float = 1e-10, max_iterations: int = 100, r: float | None = None,
                  rho: float = 0.5, sigma: float = 1e-4, path: str = "auto"):
@@ -146,6 +154,8 @@ class NewtonMethod:
         t0 = time.perf_counter()
         if problem.kind == "normal":
             sol = _solve_normal(self, problem, warm)
+        elif problem.kind == "tangential" and problem.law is not None and not problem.law.on_path:
+            sol = _solve_slip_safeguarded(self, problem, warm)
         elif problem.kind == "tangential":
             sol = _solve_tangential(self, problem, warm)
         else:
@@ -252,6 +262,7 @@ def _spd_solver(method, A, s, F):
         chol = sla.cho_factor(s * A.dense(F, F), lower=False, check_finite=False)   # F changes: not kept
         return lambda b: sla.cho_solve(chol, b, check_finite=False)
     n = A.shape[0]
+    spla = _sparse_linalg()
 
     def mv(v):
         full = np.zeros(n)
@@ -301,6 +312,8 @@ def _solve_tangential(method, problem, warm):
         t0, z0, Kx = _cold_start(k, B, s0, bh, ah, free, targets, V)
     x = np.append(t0[:, V].ravel(), z0)
     sys = _TangentialSystem(method, problem, V, k, s0[:, V].ravel(), bh[V], ah, free, targets, r)
+    if problem.law is not None:   # a slip-dependent bound b_i(s_i) = μ(V|s_i|) p̄_i⁺ (eq. 3D.26s)
+        sys.slip_law(problem.law.take(V), np.maximum(problem.p[V], 0.0) / sc.stress, sc.slip)
     x, Kx, info = method._iterate(x, Kx, sys.phi, sys.step, r, "tangential")
     t = np.zeros((2, n))
     t[:, V] = x[:2 * V.size].reshape(2, V.size) * sc.stress
@@ -313,6 +326,52 @@ def _solve_tangential(method, problem, warm):
         raise SolverError("tangential Newton: rollqp's residual above 100·tolerance", method=method.name,
                           residual=sol.residual, iterations=sol.iterations)
     return sol
+
+
+#: Newton iterations allowed when polishing an iterate of the fixed point on the bound (quadratic convergence from
+#: near a solution takes a handful), as on a strip (:data:`rollqp.methods.newton.slip.POLISH_ITERATIONS`).
+POLISH_ITERATIONS = 25
+
+
+def _solve_slip_safeguarded(method, problem, warm):
+    """A step with a slip-dependent bound (eq. 3D.26s), safeguarded as on a strip
+    (:func:`rollqp.methods.newton.slip_step.solve_slip_step`): Newton from ``warm``; where its line search cannot
+    bring the merit down (a falling law's Newton direction need not descend; measured on a ramped transient:
+    stuck at ‖Φ‖ = 1.5e-2 where the fixed point converged in 11 iterations), the fixed point on the bound around
+    Newton's fixed-bound solves, each iterate that improved polished by Newton (``info["fixed_point"]``: its
+    iterations). The first error is raised if both fail."""
+    try:
+        return _solve_tangential(method, problem, warm)
+    except SolverError as first:
+        fixed = BoundFixedPoint(_FixedBound(method), polish=lambda sol: _polish(method, problem, sol))
+        try:
+            sol = fixed.solve(problem, warm)
+        except SolverError as second:
+            raise SolverError(f"{first.message}; the fixed point on the bound failed too ({second.message})",
+                              method=method.name, status=first.status, iterations=first.iterations,
+                              residual=min(r for r in (first.residual, second.residual, np.inf) if r is not None))
+        sol.info["fixed_point"] = sol.info.get("bound_iterations", 0)
+        return sol
+
+
+def _polish(method, problem, sol):
+    """Newton on the slip-dependent step from ``sol`` with at most :data:`POLISH_ITERATIONS` iterations, else None."""
+    quick = NewtonMethod(method.tolerance, POLISH_ITERATIONS, method.r, method.rho, method.sigma, method.path)
+    try:
+        return _solve_tangential(quick, problem, sol)
+    except SolverError:
+        return None
+
+
+class _FixedBound:
+    """Newton on the fixed-bound steps of the fixed point on the bound (``law`` None there)."""
+
+    def __init__(self, method):
+        self.method, self.name, self.capabilities, self.tolerance = method, method.name, method.capabilities, \
+            method.tolerance
+
+    def solve(self, problem, warm=None):
+        return self.method.solve(problem, warm=warm)
 
 
 def _cold_start(k, B, s0, bh, ah, free, targets, V):
@@ -344,6 +403,17 @@ class _TangentialSystem:
         self.dense = method._use_dense(2 * self.nv + len(free), DENSE_UNKNOWNS if steady else TRANSIENT_DENSE_UNKNOWNS)
         self.S = k * self._block() if self.dense else None
         self._rS = None
+        self.law = None
+
+    def slip_law(self, law, phat, slip_unit):
+        """Make the bound slip-dependent: ``b̂_i = μ_i(ŝ_i·slip_unit) p̂_i`` (``law`` on the contact elements)."""
+        self.law, self.phat, self.slip_unit = law, phat, slip_unit
+
+    def bound(self, sh):
+        """``b̂`` at the scaled slip ``sh`` (``(2 nv,)``): the fixed bound, or the law's at the slip."""
+        if self.law is None:
+            return self.bh
+        return self.law.mu(sh.reshape(2, self.nv) * self.slip_unit) * self.phat
 
     def _block(self):
         """The operator's dense block on the contact elements (kept with the operator)."""
@@ -365,24 +435,38 @@ class _TangentialSystem:
         t, _, sh = self.split(x, Kx)
         nv = self.nv
         zt = (t - self.r * sh).reshape(2, nv)
-        res = t - disc_projection(zt, self.bh).ravel()
+        res = t - disc_projection(zt, self.bound(sh)).ravel()
         loads = [self.ah * t[j * nv:(j + 1) * nv].sum() - F for j, F in zip(self.free, self.targets)]
         return np.concatenate([res, loads])
 
     def projection_derivative(self, x, Kx):
-        """``(m_xx, m_xy, m_yy)`` of ``M_i = ∂P(z_i)`` (eq. 3D.26), per element."""
+        """``(m_xx, m_xy, m_yy)`` of ``M_i = ∂P(z_i)`` (eq. 3D.26), per element; with a slip-dependent bound also
+        ``(u_x, u_y)`` (``ẑ_i`` on slipping elements, else 0) and the bound's gradient ``g_i = ∂b̂_i/∂ŝ_i``."""
         t, _, sh = self.split(x, Kx)
         z = (t - self.r * sh).reshape(2, self.nv)
+        bh = self.bound(sh)
         norm = np.hypot(z[0], z[1])
-        slip = norm > self.bh
+        slip = norm > bh
         with np.errstate(divide="ignore", invalid="ignore"):
-            kap = np.where(slip, self.bh / norm, 1.0)
+            kap = np.where(slip, bh / norm, 1.0)
             ux, uy = np.where(slip, z[0] / norm, 0.0), np.where(slip, z[1] / norm, 0.0)
-        return kap * (1 - ux * ux), -kap * ux * uy, kap * (1 - uy * uy)
+        m = kap * (1 - ux * ux), -kap * ux * uy, kap * (1 - uy * uy)
+        if self.law is None:
+            return m, None
+        g = self.law.dmu(sh.reshape(2, self.nv) * self.slip_unit) * (self.phat * self.slip_unit)
+        return m, (ux, uy, g)
 
     def step(self, x, Kx, phi):
-        mxx, mxy, myy = self.projection_derivative(x, Kx)
-        d = self._dense_step(mxx, mxy, myy, phi) if self.dense else self._krylov_step(mxx, mxy, myy, phi)
+        (mxx, mxy, myy), extra = self.projection_derivative(x, Kx)
+        # the coefficients of r ∂ŝ in the rows (eq. 3D.26: M_i; with a slip-dependent bound M_i − ẑ_i g_iᵀ/r,
+        # eq. 3D.26s: along ẑ_i the traction follows the bound as the slip changes it)
+        c = (mxx, mxy, mxy, myy)
+        if extra is not None:
+            ux, uy, g = extra
+            r = self.r
+            c = (mxx - ux * g[0] / r, mxy - ux * g[1] / r, mxy - uy * g[0] / r, myy - uy * g[1] / r)
+        d = (self._dense_step(c, mxx, mxy, myy, phi) if self.dense
+             else self._krylov_step(c, mxx, mxy, myy, phi))
         return d, self.product(d[:2 * self.nv])
 
     def product(self, dt):
@@ -394,13 +478,15 @@ class _TangentialSystem:
         full[:, V] = dt.reshape(2, self.nv)
         return self.k * (self.problem.B @ full.ravel()).reshape(2, n)[:, V].ravel()
 
-    def _dense_step(self, mxx, mxy, myy, phi):
+    def _dense_step(self, c, mxx, mxy, myy, phi):
+        if self.law is not None:   # a slip-dependent bound: the rows M_i − ẑ_i g_iᵀ/r (eq. 3D.26s), by LU
+            return self._lu_step(c, mxx, mxy, myy, phi)
         slip = np.flatnonzero((mxx != 1.0) | (mxy != 0.0) | (myy != 1.0))   # M_i = I: a sticking element
         if 2 * slip.size <= capacitance.MAX_FRACTION * 2 * self.nv:
             d = self._capacitance_step(slip, mxx, mxy, myy, phi)
             if d is not None:
                 return d
-        return self._lu_step(mxx, mxy, myy, phi)
+        return self._lu_step(c, mxx, mxy, myy, phi)
 
     def _capacitance_step(self, slip, mxx, mxy, myy, phi):
         """``J d = −Φ`` by eq. 3D.28a (the load rows bordered: ``d_t = X_0 + X_ζ dζ``); ``None`` where it is
@@ -422,9 +508,10 @@ class _TangentialSystem:
         dz = np.linalg.solve(LX[:, 1:], -phi[m:] - LX[:, 0])
         return np.concatenate([X[:, 0] + X[:, 1:] @ dz, dz])
 
-    def _lu_step(self, mxx, mxy, myy, phi):
+    def _lu_step(self, c, mxx, mxy, myy, phi):
         nv, r, nf = self.nv, self.r, len(self.free)
         m = 2 * nv
+        cxx, cxy, cyx, cyy = c
         if self._rS is None:   # r·[Ŝ E] once per solve (the same numbers as forming it each iteration)
             self._rS = r * np.hstack([self.S, self.E])
         R = self._rS
@@ -432,10 +519,10 @@ class _TangentialSystem:
         # J of eq. 3D.26 filled in place, row blocks and load rows (no stacking copies)
         J = np.empty((m + nf, m + nf), order="F")
         Jx, Jy = J[:nv], J[nv:m]
-        np.multiply(mxx[:, None], Rx, out=Jx)
-        Jx += mxy[:, None] * Ry
-        np.multiply(mxy[:, None], Rx, out=Jy)
-        Jy += myy[:, None] * Ry
+        np.multiply(cxx[:, None], Rx, out=Jx)
+        Jx += cxy[:, None] * Ry
+        np.multiply(cyx[:, None], Rx, out=Jy)
+        Jy += cyy[:, None] * Ry
         i = np.arange(nv)
         Jx[i, i] += 1 - mxx
         Jx[i, nv + i] -= mxy
@@ -448,16 +535,17 @@ class _TangentialSystem:
             warnings.simplefilter("ignore", sla.LinAlgWarning)
             d = sla.lu_solve(sla.lu_factor(J, overwrite_a=True, check_finite=False), -phi, check_finite=False)
         if not np.all(np.isfinite(d)):   # singular (e.g. every element slipping): least squares
-            d = self._dense_step_lstsq(mxx, mxy, myy, phi)
+            d = self._dense_step_lstsq(c, mxx, mxy, myy, phi)
         return d
 
-    def _dense_step_lstsq(self, mxx, mxy, myy, phi):
+    def _dense_step_lstsq(self, c, mxx, mxy, myy, phi):
         """The least-squares Newton direction where ``J`` is singular (built again: the LU overwrote it)."""
         nv, R, nf = self.nv, self._rS, len(self.free)
         m = 2 * nv
+        cxx, cxy, cyx, cyy = c
         Rx, Ry = R[:nv], R[nv:]
-        Jx = mxx[:, None] * Rx + mxy[:, None] * Ry
-        Jy = mxy[:, None] * Rx + myy[:, None] * Ry
+        Jx = cxx[:, None] * Rx + cxy[:, None] * Ry
+        Jy = cyx[:, None] * Rx + cyy[:, None] * Ry
         i = np.arange(nv)
         Jx[i, i] += 1 - mxx
         Jx[i, nv + i] -= mxy
@@ -468,21 +556,23 @@ class _TangentialSystem:
             L[row, j * nv:(j + 1) * nv] = self.ah
         return np.linalg.lstsq(np.vstack([Jx, Jy, L]), -phi, rcond=None)[0]
 
-    def _krylov_step(self, mxx, mxy, myy, phi):
+    def _krylov_step(self, c, mxx, mxy, myy, phi):
         """``J d = −Φ`` without the matrix: the load rows eliminated (``d_t = J_tt⁻¹(−Φ_t − J_tζ dζ)``,
         then the ``k × k`` system of the load rows for ``dζ``), each ``J_tt`` solve by GMRES on FFT
         products, preconditioned by the elements' 2 × 2 blocks ``M_i r Ŝ_ii + (I − M_i)``."""
         nv, r, nf = self.nv, self.r, len(self.free)
         m = 2 * nv
+        cxx, cxy, cyx, cyy = c
 
         def apply_J(dt):   # the rows of eq. 3D.28 on d_t (dζ = 0)
             Rd = r * self.product(dt)
             tx, ty = dt[:nv], dt[nv:]
-            return np.concatenate([mxx * Rd[:nv] + mxy * Rd[nv:] + tx - (mxx * tx + mxy * ty),
-                                   mxy * Rd[:nv] + myy * Rd[nv:] + ty - (mxy * tx + myy * ty)])
+            return np.concatenate([cxx * Rd[:nv] + cxy * Rd[nv:] + tx - (mxx * tx + mxy * ty),
+                                   cyx * Rd[:nv] + cyy * Rd[nv:] + ty - (mxy * tx + myy * ty)])
 
+        spla = _sparse_linalg()
         J = spla.LinearOperator((m, m), matvec=apply_J, dtype=float)
-        P = spla.LinearOperator((m, m), matvec=self._block_preconditioner(mxx, mxy, myy), dtype=float)
+        P = spla.LinearOperator((m, m), matvec=self._block_preconditioner(c, mxx, mxy, myy), dtype=float)
 
         def solve(b):
             # 80 × 50 iterations at most: measured ≤ 150 on the 300 × 300 grid; beyond, the inexact step
@@ -495,7 +585,7 @@ class _TangentialSystem:
         dt0 = solve(-phi[:m])
         if nf == 0:
             return dt0
-        cols = r * np.column_stack([np.concatenate([mxx * e[:nv] + mxy * e[nv:], mxy * e[:nv] + myy * e[nv:]])
+        cols = r * np.column_stack([np.concatenate([cxx * e[:nv] + cxy * e[nv:], cyx * e[:nv] + cyy * e[nv:]])
                                     for e in self.E.T])                       # J_tζ: the creepage columns
         W = np.column_stack([solve(-c) for c in cols.T])                     # J_tt⁻¹ (−J_tζ)
         L = np.zeros((nf, m))
@@ -504,15 +594,16 @@ class _TangentialSystem:
         dz = np.linalg.lstsq(L @ W, -phi[m:] - L @ dt0, rcond=1e-12)[0]   # singular: every element slipping
         return np.concatenate([dt0 + W @ dz, dz])
 
-    def _block_preconditioner(self, mxx, mxy, myy):
+    def _block_preconditioner(self, c, mxx, mxy, myy):
         """``v ↦`` the elements' 2 × 2 blocks of ``J_tt`` (with ``Ŝ``'s own diagonal), inverted."""
         nv, r = self.nv, self.r
+        cxx, cxy, cyx, cyy = c
         dg = self.k * self.problem.B.diagonal()
         n, V = self.problem.n, self.V
         sxx, syy = r * dg[V], r * dg[n + V]
-        a11 = mxx * sxx + 1 - mxx
-        a12, a21 = mxy * syy - mxy, mxy * sxx - mxy
-        a22 = myy * syy + 1 - myy
+        a11 = cxx * sxx + 1 - mxx
+        a12, a21 = cxy * syy - mxy, cyx * sxx - mxy
+        a22 = cyy * syy + 1 - myy
         det = a11 * a22 - a12 * a21
 
         def pc(v):

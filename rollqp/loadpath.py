@@ -19,7 +19,7 @@ The loads (``tangential``, ``lateral``, the creepages and ``normal_history``) ar
 stop, cycle Fx at rest, roll back" is one scene. ``load.tangential`` stays ``Fx/(μ·FN_ref)`` with
 ``FN_ref = load.normal``: a force proportional to the current load is the same history scaled.
 
-:func:`rollqp.three.loads.check_load_path` holds the scene's checks of these keys (each a one-line
+:func:`rollqp.loads.check_load_path` holds the scene's checks of these keys (each a one-line
 :class:`~rollqp.errors.InputError` naming the key); :func:`rolling_steps` is the stream of rolling steps
 the run marches (:func:`rollqp.three.march.transient` itself for a scene without a load path).
 """
@@ -30,11 +30,11 @@ import time
 
 import numpy as np
 
-from ..errors import SolverError
-from ..kinematics import plan
+from .errors import SolverError
+from .kinematics import plan
 from .loads import has_load_path, normal_force, start_force
-from .march import StepRecord, _record, _states, _warm_of, coupled_step, normal, transient
-from ..problem.grid import SEPARATION
+from .three.march import StepRecord, _previous, _record, _states, _warm_of, coupled_step, normal, transient
+from .problem.grid import SEPARATION
 
 __all__ = ["out_of_contact", "rolling_steps", "posed_force", "SHIFTED_KEPT"]
 
@@ -118,7 +118,7 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             if fixed is None or fixed[0] != FN or move is not None:
                 fixed = (FN, normal(contact, method, FN))
             pressure = fixed[1]
-        previous = (prev.p, prev.t)
+        previous = _previous(prev)
         if prev.FN != FN:       # the last step's tractions may lie outside this load's discs: a cold start
             warm = None
         stop = pl.d[k] == 0
@@ -134,7 +134,7 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             except SolverError as again:
                 raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
-                      _states(contact, ns.p, ts.t, ts.s))
+                      _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
         rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.crossval.grid
         yield rec
         prev, warm = rec, (ns, ts)

@@ -19,9 +19,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import InputError, SolverError
-from ..operators.grid import Contact
-from .hertz import curvatures_for_ratio, hertz
+from .closedforms.hertz_ellipse import curvatures_for_ratio, hertz
+from .discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
+from .errors import InputError, SolverError
+from .operators.grid import Contact
 
 __all__ = ["Patch", "computed_patch", "equivalent_curvatures", "check_patch", "guess_curvatures"]
 
@@ -144,7 +145,6 @@ def grid_extent(extent, zone, element_size, elements):
     ``element_size`` (``(dx, dy) > 0``), or None each: the grid is given by ``zone`` or by ``extent``, its
     elements by ``elements`` or ``element_size`` (one of each pair), and its elements are within
     :data:`~rollqp.discretization.grid.ASPECT_RANGE` and :data:`~rollqp.discretization.grid.MAX_ELEMENTS`."""
-    from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS
     if extent is None:
         if element_size is not None:
             raise InputError("discretization.element_size", "needs discretization.extent (the grid in length units); "
@@ -190,7 +190,6 @@ def grid_extent(extent, zone, element_size, elements):
 def extent_grid(extent, elements, element_size):
     """The :class:`~rollqp.discretization.grid.Grid` of ``extent`` with ``elements`` (or ``round(width/element_size)``
     elements of the width exactly)."""
-    from ..discretization.grid import Grid
     (x0, x1), (y0, y1) = extent
     if element_size is not None:
         nx, ny = (round((hi - lo) / d) for (lo, hi), d in zip(extent, element_size))

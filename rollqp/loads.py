@@ -1,5 +1,5 @@
 r"""The load-path keys of a 3D scene, ``load.normal_history`` and ``load.rolled``: their checks and the normal
-force they set (docs/scenes.md, "Three dimensions"). The steps they make are :mod:`rollqp.three.loadpath`'s.
+force they set (docs/scenes.md, "Three dimensions"). The steps they make are :mod:`rollqp.loadpath`'s.
 
 The same history objects as in 2D (:mod:`rollqp.histories`), functions of the time-like parameter τ in
 units of ``a`` (the rolled distance itself without ``load.rolled``). :func:`check_load_path` holds the
@@ -17,11 +17,11 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InputError
-from ..histories import Constant, Harmonic
-from ..kinematics import plan
-from ..methods import REFERENCE_METHOD, scene_method_3d
-from .hertz import hertz
+from .errors import InputError
+from .histories import Constant, Harmonic
+from .kinematics import plan
+from .methods import REFERENCE_METHOD, scene_method_3d
+from .closedforms.hertz_ellipse import hertz
 from .patch import check_patch, computed_patch
 
 __all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "MAX_STEP_RATIO"]

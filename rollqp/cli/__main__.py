@@ -1,0 +1,6 @@
+"""``python -m rollqp.cli``: the ``rollqp`` command."""
+import sys
+
+from . import main
+
+sys.exit(main())

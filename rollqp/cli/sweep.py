@@ -1,0 +1,44 @@
+"""``rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]``: a
+parameter study on dask, the product of the ``--vary`` values, its results in one labelled zarr store
+(docs/sweeps.md; extra ``sweep``: dask, xarray, zarr, imported when the study starts)."""
+from __future__ import annotations
+
+from ..scene import load_scene
+from ..sweep import sweep
+from ..sweep.three import sweep_3d as sweep_grid
+from .common import cluster_options, default_output, family, sweep_exit, sweep_signals, takes
+
+
+def add_arguments(w) -> None:
+    w.add_argument("scene", help="the base scene: a TOML file or a built-in scene")
+    w.add_argument("--vary", action="append", required=True, metavar="KEY=VALUES",
+                   help="a dotted scene key and its values: a,b,c | start:stop:count | start:stop:count:log "
+                        "(repeat for more keys; the points are the product)")
+    w.add_argument("--out", help="the zarr store (default <scene name>-sweep.zarr); run again to complete it")
+    cluster_options(w)
+
+
+def main(args) -> int:
+    scene = load_scene(args.scene)
+    takes(scene, "sweep")
+    return family(scene).sweep(scene, args)
+
+
+def sweep_2d(scene, args) -> int:
+    out = args.out or default_output(scene.name, "-sweep.zarr")
+    summary = sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
+                                          quiet=args.quiet))
+    if not args.quiet:
+        print(f"rollqp sweep of {scene.name}: {out}")
+        print(summary.table())
+    return sweep_exit(summary)
+
+
+def sweep_3d(scene, args) -> int:
+    out = args.out or default_output(scene.name, "-sweep.zarr")
+    _, summary = sweep_signals(lambda: sweep_grid(scene, args.vary, out, scheduler=args.scheduler,
+                                                  workers=args.workers, quiet=args.quiet))
+    if not args.quiet:
+        print(f"rollqp sweep of {scene.name} (3D): {out}")
+        print(summary.table())
+    return sweep_exit(summary)
