@@ -20,8 +20,9 @@ elements, and ``β`` the interior point's factorizations (about 20 of order ``2m
 Dissimilar bodies (``K ≠ 0``, eq. 3D.10) alternate the normal and the tangential step until both meet the
 tolerance (:func:`rollqp.three.march.coupled_step`): each step costs :func:`coupled_sweeps` sweeps of
 :data:`SWEEP_COST` conic steps each (:func:`step_factor`). A rolling start by a method that cannot solve the
-steady problem marches to it (:data:`MARCH_LENGTHS`
-contact lengths of ``dx`` steps). :func:`notes` prints the estimate when it exceeds :data:`NOTE_SECONDS`;
+steady problem marches to it: similar bodies from FASTSIM's steady state in about :data:`START_STEPS`
+steps, dissimilar ones from zero in :data:`MARCH_LENGTHS` contact lengths of ``dx`` steps. :func:`notes`
+prints the estimate when it exceeds :data:`NOTE_SECONDS`;
 :func:`refusal` refuses before any work a run whose estimate exceeds :data:`REFUSE_SECONDS`, or whose
 dense Hessian would not fit :data:`~rollqp.influence.blocktoeplitz.DENSE_MAX`, naming what runs instead.
 """
@@ -37,7 +38,7 @@ from ..influence.blocktoeplitz import DENSE_MAX
 from ..methods import capabilities, method_class
 
 __all__ = ["notes", "refusal", "conic_step_seconds", "conic_run", "yardstick", "NOTE_SECONDS", "REFUSE_SECONDS",
-           "QUADRATIC", "CUBIC", "MARCH_LENGTHS", "coupled_sweeps", "step_factor", "SWEEP_CONTRACTION",
+           "QUADRATIC", "CUBIC", "MARCH_LENGTHS", "START_STEPS", "coupled_sweeps", "step_factor", "SWEEP_CONTRACTION",
            "SWEEP_COST"]
 
 #: Order of the yardstick's dense Cholesky factorization (:func:`yardstick`).
@@ -54,6 +55,10 @@ REFUSE_SECONDS = 3600.0
 #: slip area (88 steps on the 24 × 24 circle, ξ = 1e-3, docs/performance.md); with everything sticking
 #: two steps reach it (the estimate is then pessimistic).
 MARCH_LENGTHS = 4.6
+#: Conic steps of the march of similar bodies from FASTSIM's steady state (rollqp.three.march.approximate_steady),
+#: the start a march takes by default: measured 2 (ξ = 1e-5, all stick), 5 (ξ = 1e-3 and 4e-3) on the 24 × 24
+#: circle and 6 on the 40 × 40 circle at ξ = 1e-3 (docs/performance.md); 8 leaves room.
+START_STEPS = 8
 #: The N–T alternation of dissimilar bodies (:func:`coupled_sweeps`): its contraction per sweep is about
 #: ``SWEEP_CONTRACTION·|K|``, and it stops about :data:`SWEEP_MARGIN` below the tolerance. Measured with
 #: socp-clarabel on cattaneo-3d at 12 × 12 (76 elements in contact, 21 steps, tolerance 1e-10; body B's E and
@@ -122,7 +127,10 @@ def conic_run(scene) -> tuple:
     per = conic_step_seconds(n) * step_factor(scene.materials.K, scene.solver.tolerance)
     steps = scene.n_steps
     if scene.load.start == "rolling" and "steady" not in caps.solves:
-        steps += int(MARCH_LENGTHS * 2 * scene.ellipse.a / scene.grid.dx) + 1
+        if scene.materials.K == 0.0:   # similar bodies: from FASTSIM's steady state (rollqp.three.march.steady)
+            steps += START_STEPS
+        else:
+            steps += int(MARCH_LENGTHS * 2 * scene.ellipse.a / scene.grid.dx) + 1
     else:
         steps += scene.load.start_steps if scene.load.start == "braked" else 1
     return steps, per, per * steps
