@@ -14,7 +14,7 @@ from rollqp.materials import Materials
 from rollqp.methods.fastsim import FastsimMethod
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.operators.grid import Contact, Loads
-from rollqp.three.hertz import hertz
+from rollqp.closedforms.hertz_ellipse import hertz
 from rollqp.three.march import steady
 
 #: The brush's κ = k|ξ|a/(μp0) of the checks: mostly stick, and stick and slip alike.

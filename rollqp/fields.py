@@ -294,3 +294,25 @@ def _friction_coefficient(rec, operators):
 register(Field("friction_coefficient", "state", "1",
                "coefficient of friction mu at each node in the step (scenes with a friction law, docs/friction.md)",
                compute=_friction_coefficient, needed=lambda scene: scene.contact.friction.kind != "constant"))
+
+
+def _grid_friction_coefficient(rec, contact):
+    """``μ`` at the elements of a 3D step, ``(ny, nx)``: a slip-velocity law's own (its memory, kept by the march in
+    ``StepRecord.mu``; else the law at the state's slip), a patch's or a table's at the rolled distance and direction
+    the step read it at (a load path's pose, else the record's ``q`` and the march's direction)."""
+    g = contact.grid
+    if rec.mu is not None:
+        mu = rec.mu
+    elif contact.law.kind == "slip":
+        mu = contact.slip_bound("shift").mu(np.asarray(rec.s, dtype=float).reshape(2, -1), contact=np.asarray(rec.p) > 0)
+    else:
+        pose = rec.info.get("pose")
+        q, d = (pose[4].q, pose[3]) if pose is not None else (rec.q, rec.info.get("direction", -1))
+        mu = contact.coefficient(q, d)
+    return g.field(np.broadcast_to(np.asarray(mu, dtype=float), (g.n,)))
+
+
+register(Field("mu", "state", "1",
+               "the friction coefficient each element had in the step (scenes with a friction law: patches, tables, "
+               "slip-velocity laws; docs/friction.md)",
+               compute=_grid_friction_coefficient, needed=lambda scene: scene.contact.friction.kind != "constant"), 3)

@@ -134,10 +134,18 @@ def rolling_steps(scene, contact, method, start, first: int = 1, last: int | Non
             except SolverError as again:
                 raise again.with_step(k) from None
         rec = _record(contact, k, phase, q, ns, ts, ld, sw, time.perf_counter() - t0,
-                      _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
+                      _states(contact, ns.p, ts.t, ts.s, mu=_step_mu(contact, ts, ld.q, d)))
         rec.info["pose"] = (phase, FN, dq, d, ld)       # how the step was posed: rollqp.crossval.grid
         yield rec
         prev, warm = rec, (ns, ts)
+
+
+def _step_mu(contact, ts, q: float, direction: int):
+    """The coefficient the step's bound had: a slip-velocity law's own (``ts.mu``), else the law at the rolled
+    distance and direction the step read it at (a material frame's patch or table moves with the material)."""
+    if ts.mu is not None or contact.law.kind == "slip":
+        return ts.mu
+    return contact.coefficient(q, direction)
 
 
 def posed_force(scene, rec) -> tuple[float, int]:

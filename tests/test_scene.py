@@ -441,6 +441,7 @@ def test_builtin_scenes_listed():
     paths |= {"kalker-circular", "kalker-elliptic", "cattaneo-3d", "ball-in-groove"}   # 3D (docs/scenes.md, "Three dimensions")
     paths.add("wheel-rail")                        # a wheelset on its track (docs/wheel-rail.md)
     paths.add("quartic-roller")                    # a 3D profile (docs/scenes.md, "Three dimensions: beyond Hertz")
+    paths.add("falling-friction-3d")               # a 3D falling-friction creep curve with an interface layer
     paths |= {"aluminium-on-steel", "rolling-stresses"}   # a dissimilar transient, the stresses below (docs/examples.md)
     assert set(b) == set(expected) | paths, f"the built-ins listed: {sorted(b)}"
     for name, section in expected.items():

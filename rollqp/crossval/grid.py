@@ -24,11 +24,11 @@ import numpy as np
 
 from ..advice.grid import conic_step_seconds, step_factor
 from ..errors import InputError, RollqpError
-from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, get_method,
-                       method_class, require_3d)
+from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, compose_3d,
+                       get_method, method_class, require_3d)
 from ..three.run import run
 from ..loadpath import posed_force
-from ..three.march import coupled_step
+from ..three.march import _previous, coupled_step
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
 
@@ -63,7 +63,7 @@ class SpotObserver:
     def __call__(self, rec, contact) -> None:
         self.contact = contact
         if rec.k in self.steps and rec.FN > 0:      # out of contact (FN = 0) nothing is solved
-            before = rec.info.get("before") if rec.k == 0 else (self._last.p, self._last.t)
+            before = rec.info.get("before") if rec.k == 0 else _previous(self._last)
             self.kept[rec.k] = (rec, before)
         self._last = rec
 
@@ -173,7 +173,7 @@ def _key(kind, loads, previous, dq, constant_friction: bool = True) -> tuple:
     """The data a step is posed from, as bytes: two steps with equal keys are the same problem. The rolled
     distance ``loads.q`` is part of the data only where the friction law is read along the surface (a
     constant coefficient poses the same step at every ``q``)."""
-    prev = b"" if previous is None else np.asarray(previous[0]).tobytes() + np.asarray(previous[1]).tobytes()
+    prev = b"" if previous is None else b"".join(np.asarray(v).tobytes() for v in previous)   # (p, t[, μ memory])
     if constant_friction:
         loads = replace(loads, q=0.0)
     return kind, repr(loads), None if dq is None else float(dq), prev
@@ -208,6 +208,7 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
             conic = not capabilities(name, 3).matrix_free
             if deadline is not None and conic:
                 method.deadline = deadline
+            method = compose_3d(method, friction=contact.law.kind)   # a slip-velocity law: as the run composes it
             method.setup(contact)
             for k in order:
                 rec, before = kept[k]

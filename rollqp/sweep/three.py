@@ -350,7 +350,9 @@ class CreepCurve3D:
         return self.Fx if CREEPAGES[self.creepage][2] == "Fx" else self.Fy
 
     def kalker_slope(self) -> float | None:
-        """Kalker's ``dF/dξ`` at the origin (None outside his table or for dissimilar bodies)."""
+        """Kalker's ``dF/dξ`` at the origin (None outside his table or for dissimilar bodies). With an interface layer
+        (``contact.layer``) the bodies' slope in series with the layer's brush, ``1/k = 1/k_Kalker + 1/k_brush``,
+        ``k_brush = (8/3) a² b G₃/h`` (docs/theory3d.md §13): an estimate, not a theory (None for the spin)."""
         from ..closedforms.kalker import kalker_linear
         s = self.scene
         e, m = s.ellipse, s.materials
@@ -360,7 +362,27 @@ class CreepCurve3D:
         if C is None:
             return None
         c2 = m.G * e.c * e.c
-        return {"longitudinal": -c2 * C[0], "lateral": -c2 * C[1], "spin": -c2 * e.c * C[2]}[self.creepage]
+        k = {"longitudinal": -c2 * C[0], "lateral": -c2 * C[1], "spin": -c2 * e.c * C[2]}[self.creepage]
+        layer = getattr(s.contact, "layer", None)
+        if layer is not None and layer.compliance > 0:
+            if self.creepage == "spin":
+                return None
+            brush = -8.0 / 3.0 * e.a * e.a * e.b / layer.compliance
+            k = 1.0 / (1.0 / k + 1.0 / brush)
+        return k
+
+    def _layered(self) -> bool:
+        layer = getattr(self.scene.contact, "layer", None)
+        return layer is not None and layer.compliance > 0
+
+    def sliding(self, values) -> np.ndarray | None:
+        """``μ(V|creepage|)/μ`` of a slip-velocity law (the coefficient at the rigid slip velocity over the scene's
+        reference μ): the level full sliding tends to at large creepage; None for other laws and the spin."""
+        law = self.scene.contact.friction
+        if getattr(law, "kind", None) != "slip" or self.creepage == "spin":
+            return None
+        v = np.abs(np.asarray(values, dtype=float)) * law.rolling_speed
+        return np.asarray(law.steady(v)[0], dtype=float) / self.scene.mu
 
     def slope(self) -> np.ndarray:
         """``dF/dξ`` of the computed curve by finite differences (NaN beside a failed point)."""
@@ -399,10 +421,21 @@ class CreepCurve3D:
                         f"{self.force[j] / (s.mu * self.FN[j]):+.5f} | {sl[j]:.5g} | {lin} |")
         o = self.origin_slope()
         rows.append("")
-        rows.append(f"slope at the origin d{comp}/d{name} = {o:.6g}" + (
-            f"; Kalker's linear theory {k:.6g} ({100 * (o / k - 1):+.2f} %: discretization, first order in dx, "
-            f"docs/validation3d.md)" if k else " (no linear theory for this scene)"))
-        rows.append(f"saturation: |({comp})| -> mu FN = {s.mu * float(np.nanmax(self.FN)):.6g}")
+        if k and self._layered():
+            rows.append(f"slope at the origin d{comp}/d{name} = {o:.6g}; Kalker's linear theory of the bodies in series "
+                        f"with the interface layer's brush {k:.6g} ({100 * (o / k - 1):+.2f} %: an estimate, "
+                        "docs/theory3d.md §13)")
+        else:
+            rows.append(f"slope at the origin d{comp}/d{name} = {o:.6g}" + (
+                f"; Kalker's linear theory {k:.6g} ({100 * (o / k - 1):+.2f} %: discretization, first order in dx, "
+                f"docs/validation3d.md)" if k else " (no linear theory for this scene)"))
+        slide = self.sliding(self.values)
+        if slide is not None:
+            j = int(np.argmax(np.abs(self.values)))
+            rows.append(f"full sliding: |({comp})| -> mu(V |{name}|) FN, the law at the rigid slip velocity: "
+                        f"{s.mu * slide[j] * float(self.FN[j]):.6g} at {name} = {self.values[j]:g}")
+        else:
+            rows.append(f"saturation: |({comp})| -> mu FN = {s.mu * float(np.nanmax(self.FN)):.6g}")
         return "\n".join(rows)
 
     def plot(self, path) -> str:
@@ -418,17 +451,24 @@ class CreepCurve3D:
             v = np.linspace(min(self.values.min(), 0.0), max(self.values.max(), 0.0), 200)
             lin = k * v / cap
             lin[np.abs(lin) > 1.2] = np.nan       # the line only where it is near the curve's range
-            ax.plot(v, lin, "k:", lw=1, label="Kalker's linear theory")
+            ax.plot(v, lin, "k:", lw=1, label=("Kalker's linear theory in series with the layer (estimate)"
+                                               if self._layered() else "Kalker's linear theory"))
         for y in (-1.0, 1.0):
             ax.axhline(y, color="0.5", lw=0.8, ls="--")
-        ax.plot([], [], color="0.5", ls="--", label="±μFN (saturation)")
+        slide = self.sliding(self.values)
+        ax.plot([], [], color="0.5", ls="--", label="±μFN (saturation)" if slide is None else "±μ_s FN (static μ)")
+        if slide is not None:
+            v = np.linspace(min(self.values.min(), 0.0), max(self.values.max(), 0.0), 200)
+            ax.plot(v, -np.sign(v) * self.sliding(v), color="tab:red", ls="--", lw=1,
+                    label="μ(V|creepage|) FN: full sliding")
         ax.set_xlabel({"longitudinal": "ξ", "lateral": "η", "spin": "φ (1/length)"}[self.creepage])
         ax.set_ylabel(f"{comp}/(μFN)")
         ax.legend(fontsize=8)
         ax.grid(alpha=0.3)
         bx.plot(self.values, self.slope(), "o-", ms=4, label=f"d{comp}/d(creepage), rollqp")
         if k is not None:
-            bx.axhline(k, color="k", ls=":", lw=1, label="Kalker's linear theory")
+            bx.axhline(k, color="k", ls=":", lw=1, label=("Kalker's linear theory in series with the layer (estimate)"
+                                                           if self._layered() else "Kalker's linear theory"))
         bx.set_xlabel(ax.get_xlabel())
         bx.set_ylabel("slope")
         bx.legend(fontsize=8)

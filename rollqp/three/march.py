@@ -145,7 +145,7 @@ def _previous(rec):
     return (rec.p, rec.t) if rec.mu is None else (rec.p, rec.t, rec.mu)
 
 
-def _states(contact, p, t, s, q=0.0, mu=None):
+def _states(contact, p, t, s, q=0.0, mu=None, direction=-1):
     """0 separation, 1 stick, 2 slip (:func:`~rollqp.problem.grid.element_states`). At ``μ = 0`` (bound
     zero) as in 2D (:func:`rollqp.problem.solution.classify`): an element in contact (``p > 0``) slips
     where its slip is not zero (``|ŝ| > 1e-7``, 2D's tolerance), else it sticks — nothing moves it. ``mu``: the
@@ -155,7 +155,7 @@ def _states(contact, p, t, s, q=0.0, mu=None):
         return np.where(np.asarray(p) > 0, np.where(moving, SLIP, STICK), SEPARATION).astype(np.int8)
     if mu is None and contact.law.kind == "slip":   # a stored state: the law at its own slip (without memory)
         mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float).reshape(2, -1), contact=np.asarray(p) > 0)
-    bound = contact.bound(p, q) if mu is None else np.asarray(mu) * np.maximum(p, 0.0)
+    bound = contact.bound(p, q, direction) if mu is None else np.asarray(mu) * np.maximum(p, 0.0)
     return element_states(np.asarray(t), np.asarray(s), bound, contact.scales)
 
 
@@ -181,7 +181,7 @@ def static_shift(contact, method, FN: float, Fx: float = 0.0, Fy: float = 0.0, p
                       _states(contact, ns.p, ts.t, ts.s, mu=ts.mu))
         rec.info.update(shift=tuple(shift), loads=loads, before=previous)
         out.append(rec)
-        previous, warm = (ns.p, ts.t), (ns, ts)
+        previous, warm = (ns.p, ts.t) if ts.mu is None else (ns.p, ts.t, ts.mu), (ns, ts)   # μ: a law's memory
         if tick is not None:
             tick(j, int(steps))
     return out
@@ -365,7 +365,8 @@ def transient(contact, method, FN: float, loads, dq: float, steps: int, directio
                                       warm=warm, pressure=fixed)
         except SolverError as exc:
             raise exc.with_step(k) from None
-        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q, ts.mu))
+        rec = _record(contact, k, "rolling", q, ns, ts, ld, sw, time.perf_counter() - t0, _states(contact, ns.p, ts.t, ts.s, q, ts.mu, direction))
+        rec.info["direction"] = direction       # where a friction law in the material frame was read (the mu field)
         if move is not None and hasattr(move, "check"):
             move.check(ns.p, k)
         yield rec

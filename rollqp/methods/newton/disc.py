@@ -49,7 +49,7 @@ from ..fixedpoint import BoundFixedPoint
 from ...problem.grid import disc_projection
 from . import capacitance
 
-__all__ = ["NewtonMethod", "DENSE_UNKNOWNS"]
+__all__ = ["NewtonMethod", "DENSE_UNKNOWNS", "tangential_rows"]
 
 #: Largest reduced system solved densely by ``path="auto"``. Measured (benchmarks/three_speed.py):
 #: on CONTACT's 48 × 44 steady case (2768 unknowns) a dense LU step takes 1.3 s, the GMRES step
@@ -328,6 +328,30 @@ def _solve_tangential(method, problem, warm):
     return sol
 
 
+def tangential_rows(problem, t, creepages=(), method=None):
+    """``(Φ, x, J)`` of a grid's tangential step at the traction ``t`` (``(2, n)``) and its free creepages
+    ``creepages`` (``ξ``, then ``η``: those the step does not prescribe), for checks of the Newton matrix: ``Φ``
+    the function ``x ↦ Φ_T(x)`` (eq. 3D.25), ``x`` the point (the scaled tractions on the contact elements, x then
+    y, then the scaled creepages) and ``J`` the dense Newton matrix there (eq. 3D.26–3D.28, with eq. 3D.26s for a
+    slip-dependent bound)."""
+    method = method if method is not None else NewtonMethod(path="dense")
+    sc = problem.scales
+    k, s0, bh, ah, free, targets = _tangential_scaled(problem)
+    n, V = problem.n, np.flatnonzero(bh > 0)
+    diag = k * problem.B.diagonal()
+    r = method.r if method.r is not None else 1.0 / float(np.mean(np.concatenate([diag[V], diag[n + V]])))
+    sys = _TangentialSystem(method, problem, V, k, s0[:, V].ravel(), bh[V], ah, free, targets, r)
+    if problem.law is not None:
+        sys.slip_law(problem.law.take(V), np.maximum(problem.p[V], 0.0) / sc.stress, sc.slip)
+    x = np.append((np.asarray(t, dtype=float) / sc.stress)[:, V].ravel(), np.asarray(creepages, float) / sc.slip)
+    (mxx, mxy, myy), extra = sys.projection_derivative(x, sys.product(x[:2 * V.size]))
+    c = (mxx, mxy, mxy, myy)
+    if extra is not None:
+        ux, uy, g = extra
+        c = (mxx - ux * g[0] / r, mxy - ux * g[1] / r, mxy - uy * g[0] / r, myy - uy * g[1] / r)
+    return (lambda y: sys.phi(y, sys.product(y[:2 * V.size]))), x, np.array(sys.matrix(c, mxx, mxy, myy))
+
+
 #: Newton iterations allowed when polishing an iterate of the fixed point on the bound (quadratic convergence from
 #: near a solution takes a handful), as on a strip (:data:`rollqp.methods.newton.slip.POLISH_ITERATIONS`).
 POLISH_ITERATIONS = 25
@@ -508,7 +532,8 @@ class _TangentialSystem:
         dz = np.linalg.solve(LX[:, 1:], -phi[m:] - LX[:, 0])
         return np.concatenate([X[:, 0] + X[:, 1:] @ dz, dz])
 
-    def _lu_step(self, c, mxx, mxy, myy, phi):
+    def matrix(self, c, mxx, mxy, myy) -> np.ndarray:
+        """The dense Newton matrix ``J`` (eq. 3D.26–3D.28; ``c`` the coefficients of ``r ∂ŝ``, eq. 3D.26s)."""
         nv, r, nf = self.nv, self.r, len(self.free)
         m = 2 * nv
         cxx, cxy, cyx, cyy = c
@@ -531,6 +556,10 @@ class _TangentialSystem:
         for row, j in enumerate(self.free):
             J[m + row] = 0.0
             J[m + row, j * nv:(j + 1) * nv] = self.ah
+        return J
+
+    def _lu_step(self, c, mxx, mxy, myy, phi):
+        J = self.matrix(c, mxx, mxy, myy)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", sla.LinAlgWarning)
             d = sla.lu_solve(sla.lu_factor(J, overwrite_a=True, check_finite=False), -phi, check_finite=False)
