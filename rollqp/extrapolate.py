@@ -24,9 +24,10 @@ error (the scatter of the positions over ``√K``), the first-order model is fit
 
 where ``σ(F₀)`` is the fit's standard error of ``F₀`` from the ``s_k``, scaled up by the fit's residual where
 the residual exceeds what the scatter explains (reduced χ² above 1), and ``F₀⁽ᵖ⁾`` the extrapolation with the
-order ``p`` measured from three grids (the estimate grows where the measured order strays from 1; where no
-order can be measured — the differences of opposite signs — the whole correction ``|F₀ − F̄_finest|`` is
-added instead). The positions are not independent draws but a stratified set: their average is closer to
+order ``p`` measured from the three finest grids: the estimate grows where the measured order strays from 1
+by more than the scatter explains (``|F₀⁽ᵖ⁾ − F₀|`` less twice its own standard error from the ``s_k``, at
+least 0); where no order can be measured — the differences of opposite signs — the whole correction
+``|F₀ − F̄_finest|`` is added instead. The positions are not independent draws but a stratified set: their average is closer to
 the smooth value than ``s_k`` says (measured: about five times), so the estimate is conservative.
 
 Examples
@@ -157,16 +158,30 @@ def fit_first_order(h, means, errors) -> Extrapolated:
             var = float(np.sum(r * r)) / dof * float(np.linalg.inv(M.T @ M)[0, 0])
         elif chi2 > 1.0:             # the residual exceeds the scatter: scale up (reduced chi-square)
             var *= chi2
-    order = model = None
-    if h.size >= 3:
-        order = _measured_order(h[-3:], F[-3:])
-        if order is not None:
-            Fp = F[-1] - (F[-2] - F[-1]) * h[-1] ** order / (h[-2] ** order - h[-1] ** order)
-            model = abs(Fp - F0)
-    if model is None:
+    order = _measured_order(h[-3:], F[-3:]) if h.size >= 3 else None
+    if order is None:
         model = abs(F0 - F[-1])
+    else:
+        # the change of F0 with the measured order, beyond what the averages' scatter alone moves it by
+        def change(values):
+            p = _measured_order(h[-3:], values[-3:])
+            if p is None:
+                return abs(F0 - values[-1])
+            Fp = values[-1] - (values[-2] - values[-1]) * h[-1] ** p / (h[-2] ** p - h[-1] ** p)
+            return Fp - _first_order_value(h, values, w)
+        g = change(F)
+        if np.all(s > 0):
+            J = [(change(F + e * si) - change(F - e * si)) / 2.0 for e, si in zip(np.eye(h.size), s)]
+            model = max(0.0, abs(g) - 2.0 * math.sqrt(float(np.sum(np.square(J)))))
+        else:
+            model = abs(g)
     return Extrapolated(tuple(float(v) for v in F), order, F0, 2.0 * math.sqrt(var) + model,
                         tuple(float(v) for v in s))
+
+
+def _first_order_value(h, F, w) -> float:
+    M = np.column_stack([np.ones_like(h), h])
+    return float(np.linalg.solve(M.T @ (w[:, None] * M), M.T @ (w * F))[0])
 
 
 @dataclass
@@ -217,8 +232,9 @@ def _grid_of(scene):
 def extrapolate(scene, grids=None, shifts: int = SHIFTS, quantities=("Fx", "Fy", "Mz")) -> Extrapolation:
     """The forces of ``scene``'s steady state extrapolated from grids averaged over positions (module docstring).
 
-    ``grids``: two or more increasing element counts along the shorter axis (default ``n, 3n/2, 2n`` of the
-    scene's ``n``); the other axis keeps the scene's proportion, the grid's extent is the scene's (moved by
+    ``grids``: two or more increasing element counts along the shorter axis (default ``n, 2n, 3n`` of the
+    scene's ``n``: the averages' scatter falls fast with ``h``, and a wide range of ``h`` measures the order
+    well); the other axis keeps the scene's proportion, the grid's extent is the scene's (moved by
     less than an element for each position). ``shifts``: positions per grid (at least 2: the scatter is
     part of the estimate). Each position's grid has one element more on each side than the scene's, so
     that the moved grid keeps the scene's margin around the contact (they are out of contact).
@@ -235,7 +251,7 @@ def extrapolate(scene, grids=None, shifts: int = SHIFTS, quantities=("Fx", "Fy",
     nx, ny, (x0, x1), (y0, y1) = _grid_of(scene)
     base = min(nx, ny)
     if grids is None:
-        grids = (base, round(1.5 * base), 2 * base)
+        grids = (base, 2 * base, 3 * base)
     grids = tuple(int(g) for g in grids)
     if len(grids) < 2 or grids[0] < 1 or any(not a < b for a, b in zip(grids, grids[1:])):
         raise InputError("--grids", f"must be two or more increasing element counts, got {grids!r}")

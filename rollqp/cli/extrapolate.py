@@ -12,7 +12,7 @@ from .common import takes
 def add_arguments(xp) -> None:
     xp.add_argument("scene", help="a TOML scene file or a built-in 3D scene with a rolling start")
     xp.add_argument("--grids", help="two or more increasing element counts along the shorter axis, e.g. "
-                    "40,60,80 (default: once, 1.5 and twice the scene's)")
+                    "40,80,120 (default: once, twice and three times the scene's)")
     xp.add_argument("--shifts", help=f"grid positions per grid, 2 to 64 (default {SHIFTS}): the forces are averaged "
                     "over them and their scatter is part of the error estimate")
 
