@@ -199,8 +199,9 @@ def test_cli_crossval_of_a_3d_scene(tmp_path, capsys):
     assert "socp-clarabel: agree" in out and "reference: newton" in out
 
 
-@pytest.mark.parametrize("argv", [["run", "kalker-circular", "--stresses"]])   # export-step, sweep, creep-curve
-# take 3D scenes (tests/test_stepfile3d.py, tests/test_sweep3d.py)
+@pytest.mark.parametrize("argv", [["creep-curve", "kalker-circular", "--ratios", "0.1", "--workers", "0"]])
+# a 2D-only option; export-step, sweep, creep-curve and run --stresses take 3D scenes (tests/test_stepfile3d.py,
+# tests/test_sweep3d.py, tests/test_beyond_hertz_scenes.py)
 def test_2d_only_commands_refuse_a_3d_scene_in_one_line(argv, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert cli.main(argv) == 2

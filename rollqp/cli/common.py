@@ -148,7 +148,7 @@ FAMILIES = {
               advise="rollqp.cli.run:advise_3d", spot="rollqp.cli.crossval:spot_3d", check="rollqp.cli.crossval:check_3d",
               crossval="rollqp.cli.crossval:crossval_3d", refuse="rollqp.advice.grid:refusal",
               export_step="rollqp.stepfile.three:export_step_3d", sweep="rollqp.cli.sweep:sweep_3d",
-              creep_curve="rollqp.cli.creep_curve:creep_3d"),
+              creep_curve="rollqp.cli.creep_curve:creep_3d", stresses="rollqp.subsurface3d:stress_history3d"),
     "wheel-rail": Family({"crossval"},
                          run="rollqp.wheelrail.run:run", summary="rollqp.wheelrail.run:summary",
                          plot="rollqp.wheelrail.run:figure", advise="rollqp.wheelrail.cli:advise",

@@ -48,6 +48,7 @@ from ..base import Capabilities, check_options
 from ..fixedpoint import BoundFixedPoint
 from ...problem.grid import disc_projection
 from . import capacitance
+from .gmres import gmres
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS", "tangential_rows"]
 
@@ -599,14 +600,12 @@ class _TangentialSystem:
             return np.concatenate([cxx * Rd[:nv] + cxy * Rd[nv:] + tx - (mxx * tx + mxy * ty),
                                    cyx * Rd[:nv] + cyy * Rd[nv:] + ty - (mxy * tx + myy * ty)])
 
-        spla = _sparse_linalg()
-        J = spla.LinearOperator((m, m), matvec=apply_J, dtype=float)
-        P = spla.LinearOperator((m, m), matvec=self._block_preconditioner(c, mxx, mxy, myy), dtype=float)
+        P = self._block_preconditioner(c, mxx, mxy, myy)
 
         def solve(b):
             # 80 × 50 iterations at most: measured ≤ 150 on the 300 × 300 grid; beyond, the inexact step
             # still goes to the line search (info > 0 is not an error)
-            x, info = spla.gmres(J, b, rtol=KRYLOV_FORCING, atol=0.0, restart=80, maxiter=50, M=P)
+            x, info = gmres(apply_J, b, P, rtol=KRYLOV_FORCING, restart=80, maxiter=50)
             if info < 0 or not np.all(np.isfinite(x)):
                 raise SolverError("tangential Newton: GMRES failed", method=self.method.name)
             return x
