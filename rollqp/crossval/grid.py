@@ -22,7 +22,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..advice.grid import conic_step_seconds
+from ..advice.grid import conic_step_seconds, step_factor
 from ..errors import InputError, RollqpError
 from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, compose_3d,
                        get_method, method_class, require_3d)
@@ -217,7 +217,9 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
                 if key not in done:
                     m = max(int(np.sum(rec.p > 0)), 1)
                     # the estimate: the model's before the first conic step, then that step's own time
-                    est = conic_step_seconds(m) if measured is None else measured[0] * (m / measured[1]) ** 2
+                    # (a step of dissimilar bodies: its N–T sweeps, rollqp.advice.grid.step_factor)
+                    est = (conic_step_seconds(m) * step_factor(scene.materials.K, tolerance) if measured is None
+                           else measured[0] * (m / measured[1]) ** 2)
                     if deadline is not None and conic and time.perf_counter() + est > deadline:
                         out.skipped.setdefault(name, []).append(k)
                         out.estimate = max(out.estimate or 0.0, est)
