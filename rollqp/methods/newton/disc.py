@@ -425,6 +425,7 @@ class _TangentialSystem:
         for i, j in enumerate(free):
             self.E[j * self.nv:(j + 1) * self.nv, i] = 1.0
         steady = str(getattr(problem.B, "name", "")).startswith("steady")   # the steady operator (eq. 3D.17)
+        self.steady, self._columns = steady, None
         self.dense = method._use_dense(2 * self.nv + len(free), DENSE_UNKNOWNS if steady else TRANSIENT_DENSE_UNKNOWNS)
         self.S = k * self._block() if self.dense else None
         self._rS = None
@@ -446,9 +447,14 @@ class _TangentialSystem:
         return B.memo(("dense", V.tobytes()), lambda: B.dense(V, V))
 
     def _inverse(self):
-        """The inverse of :meth:`_block` (kept with the operator: a march's steps on one contact set
-        share it)."""
-        return self.problem.B.memo(("inverse", self.V.tobytes()), lambda: capacitance.inverse(self._block()))
+        """The inverse of :meth:`_block`: whole and kept with the operator for the steps of a march (they share
+        it), as an LU kept with the operator and this solve's own columns for a steady state (one solve)."""
+        B, key = self.problem.B, self.V.tobytes()
+        if not self.steady:
+            return B.memo(("inverse", key), lambda: capacitance.inverse(self._block()))
+        if self._columns is None:
+            self._columns = capacitance.Columns(B.memo(("lu", key), lambda: capacitance.factor(self._block())))
+        return self._columns
 
     def split(self, x, Kx):
         m = 2 * self.nv
