@@ -48,10 +48,10 @@ def _scene(scene):
 
 
 def run(scene, method=None, progress=None, resume=None, observe=None, **options):
-    """Run a scene's transient and return its result: :func:`rollqp.march.run` for a 2D scene,
-    :func:`rollqp.three.run.run` for a 3D one (``[contact] dimension = 3``), with the same arguments
-    (``out``, ``keep_every``, and the 2D run's ``geometry``, as keywords); a wheel–rail scene
-    (``[contact] kind = "wheel-rail"``) is solved by :func:`rollqp.wheelrail.run.run`.
+    """Run a scene and return its result: :func:`rollqp.march.run`, the march of the scene's discretization (the
+    strip of a 2D scene, the grid of a 3D one, ``[contact] dimension = 3``), with the same arguments (``out``,
+    ``keep_every``, and the strip's ``geometry``, as keywords); a wheel–rail scene (``[contact] kind =
+    "wheel-rail"``) is solved by :func:`rollqp.wheelrail.run.run`.
 
     Examples
     --------
@@ -70,22 +70,12 @@ def run(scene, method=None, progress=None, resume=None, observe=None, **options)
                                                f"got {type(method).__name__}")
                 scene = scene.replace(**{"solver.method": method})
             return run_wheel_rail(scene, progress=progress, resume=resume, observe=observe, **options)
-        if scene.dimension == 3:
-            from .three.run import run as run_3d
-            return run_3d(scene, method, progress, resume, observe, **options)
         return _march.run(scene, method, progress, resume, observe, **options)
 
 
 def march(scene, method=None, **options):
-    """The transient as a stream of step records: :func:`rollqp.march.march` for a 2D scene,
-    :func:`rollqp.three.run.march` for a 3D one (``prepared``, ``resume`` as keywords)."""
-    scene = _scene(scene)
-    if getattr(scene, "family", None) == "wheel-rail":
-        raise InputError("scene", "a wheel-rail scene is one state per wheel, not a march: use rollqp.run")
-    if scene.dimension == 3:
-        from .three.run import march as march_3d
-        return march_3d(scene, method, **options)
-    return _march.march(scene, method, **options)
+    """The run as a stream of step records: :func:`rollqp.march.march` (``prepared``, ``resume`` as keywords)."""
+    return _march.march(_scene(scene), method, **options)
 
 
 def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> StepSolution:

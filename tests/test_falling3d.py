@@ -17,7 +17,7 @@ from rollqp.friction import parse_friction
 from rollqp.methods import BoundFixedPoint, SlipContinuation
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.methods.socp import ClarabelMethod
-from rollqp.three.run import march, prepare
+from rollqp.march.grid import march, prepare
 
 LAW = {"law": "exponential", "static": 0.4, "kinetic": 0.2, "velocity": 300.0, "rolling_speed": 1000.0}
 # full sliding: rigid slip w = (ξ − φy, φx), |w| between 0.1 and 0.5 over the contact (V|w| = 100–500 against
@@ -265,7 +265,7 @@ def test_the_uniqueness_factor_and_its_eigenvalue():
     against the dense eigenvalue problem; below 1 Newton from rest and from the last state find one solution."""
     from rollqp.methods.continuation import uniqueness_factor
     from rollqp.problem.grid import StepSolution
-    from rollqp.three.march import normal
+    from rollqp.march.grid import normal
     scene = _transient(0.0, velocity=4000.0, distance=1.0)
     recs, contact = _run(scene, "newton")
     prev = recs[-2]
@@ -310,7 +310,7 @@ def test_the_newton_matrix_is_the_derivative_of_its_equations():
     """eq. 3D.26s: the dense Newton matrix of a step with a falling law (partial slip, the forces prescribed) against
     central differences of Φ_T, at a point off the solution (so that the slip rows have |s| > 0)."""
     from rollqp.methods.newton.disc import tangential_rows
-    from rollqp.three.march import normal
+    from rollqp.march.grid import normal
     scene = _transient(0.3)
     recs, contact = _run(scene, "newton")
     prev = recs[-2]

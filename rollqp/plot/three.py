@@ -121,7 +121,7 @@ def _linear_forces(scene, creepage):
 def _steady_reference(scene, res):
     """The steady state of the final loads, solved directly (the reference method, Newton), or None if it
     cannot be posed."""
-    from ..three.run import run
+    from ..march.grid import run
     last = float(res["q"][-1]) / scene.ellipse.a
     ld = scene.load
     changes = {"load.start": "rolling", "discretization.distance": 0.0, "solver.method": REFERENCE_METHOD,
@@ -353,7 +353,7 @@ def field_figure(res, scene=None, path: str | None = None, k: int = -1, title: s
     Examples
     --------
     >>> from rollqp import load_scene
-    >>> from rollqp.three.run import run
+    >>> from rollqp.march.grid import run
     >>> s = load_scene("kalker-elliptic").replace(**{"discretization.elements": [18, 36]})
     >>> fig = field_figure(run(s).arrays(), s)
     >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2:]

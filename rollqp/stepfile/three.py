@@ -246,9 +246,8 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     """March the 3D ``scene`` to step ``k`` with ``method`` (default the reference method) and return its
     :class:`StepFile3D`."""
     from ..methods import REFERENCE_METHOD
-    from ..three.march import StepRecord
     from ..loads import start_force
-    from ..three.run import march, prepare
+    from ..march.grid import StepRecord, march, prepare
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene {scene.name!r}, got {k!r}")
     if scene.grid.n > MAX_ELEMENTS_3D:
@@ -278,7 +277,7 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
         kind, loads, previous, dq = "rolling", scene.loads_at(rec.q), (prev.p, prev.t), scene.dq
         B, Atn = ops.Att, (ops.Atn if ops.coupled else None)
     FN = start_force(scene) if k == 0 else ld.normal
-    if "pose" in rec.info:          # a load path's step (rollqp.loadpath): its load, Δq, direction, loads
+    if "pose" in rec.info:          # a load path's step (rollqp.march.grid): its load, Δq, direction, loads
         kind, FN, dq, direction, loads = rec.info["pose"]
     if rec.FN == 0:
         raise InputError("--step", f"step {k} of {scene.name!r} is out of contact (load.normal_history is 0 there): "

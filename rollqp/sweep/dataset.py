@@ -178,7 +178,7 @@ def _coord_names(dims) -> str:
 def _global_attrs(sweep) -> dict:
     import importlib.metadata as md
 
-    from ..march import _versions
+    from ..march.loop import versions as _versions
     from ..version import __version__
     versions = dict(_versions(), rollqp=__version__)
     for pkg in ("dask", "distributed", "xarray", "zarr"):

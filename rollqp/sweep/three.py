@@ -63,7 +63,7 @@ FINGERPRINT = "rollqp_sweep_fingerprint"
 def run_point_3d(scene: dict) -> dict:
     """One 3D point on a worker: ``{"arrays", "time"}`` or ``{"error", "time"}`` (its one-line error)."""
     from ..scene import scene_from_dict
-    from ..three.run import run
+    from ..march.grid import run
     from ..threads import limited
     t0 = time.perf_counter()
     try:

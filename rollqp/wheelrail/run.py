@@ -22,7 +22,7 @@ import numpy as np
 from ..errors import InputError
 from ..operators.grid import Loads
 from ..crossval.grid import AGREEMENT
-from ..three.march import coupled_step
+from ..march.grid import coupled_step
 from .solve import solve_wheel
 from .track import Track
 from .wheelset import Wheelset
@@ -60,7 +60,7 @@ class WheelRailResult:
         self.scene, self.wheels, self.method, self.wall = scene, wheels, method, wall
 
     def arrays(self) -> dict:
-        from ..three.run import _versions
+        from ..march.loop import versions as _versions
         from ..version import __version__
         P = [p for w in self.wheels for p in w.patches]
         a = {"patch_wheel": np.array([0 if p.wheel == "left" else 1 for p in P], dtype=np.int64)}
@@ -84,7 +84,7 @@ class WheelRailResult:
             a[f"patch{k}_px"], a[f"patch{k}_py"] = g.field(p.t[0]), g.field(p.t[1])
             a[f"patch{k}_state"] = g.field(p.state).astype(np.int8)
         a["meta"] = np.array(json.dumps({"scene": self.scene.to_dict(), "method": self.method, "kind": "wheel-rail",
-                                         "rollqp": __version__, "versions": dict(_versions()), "wall": self.wall}))
+                                         "rollqp": __version__, "versions": _versions(), "wall": self.wall}))
         return a
 
     def save(self, out) -> None:

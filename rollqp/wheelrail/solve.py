@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import InputError, SolverError
 from ..operators.grid import Contact, Loads
-from ..three.march import steady
+from ..march.grid import steady
 from ..problem.grid import NormalStep
 from .search import search
 
