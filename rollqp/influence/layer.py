@@ -28,8 +28,8 @@ collocation point (:func:`grid_kernel`): at no offset the identity, at the rolli
 element the particle came from, and in the steady slip operator ``A − A(· − d·dx)`` the upwind difference
 ``c (t_i − t_{i−d})`` (:class:`LayeredOperators`).
 
-Examples
---------
+A layer's compliance, and a bad value refused in one line naming its key:
+
 >>> layer = parse_layer({"thickness": 1.25, "shear_modulus": 8200.0})
 >>> f"{layer.compliance:.4e}"
 '1.5244e-04'

@@ -14,8 +14,8 @@ arguments and guarantees (docs/results.md):
   the checks of an earlier part of a run before it is continued (the last state solved again, every earlier
   state consistent in itself).
 
-Examples
---------
+The family of a built-in scene, by its dimension:
+
 >>> from rollqp.march import family
 >>> [family(s).__name__ for s in ("cattaneo-carter", "kalker-circular")]
 ['rollqp.march.strip', 'rollqp.march.grid']
