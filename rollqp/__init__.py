@@ -24,6 +24,8 @@ from . import threads as _threads
 
 _threads.pin_environment()  # before numpy and scipy load: their BLAS pools start at $ROLLQP_THREADS (rollqp.threads)
 
+import importlib  # noqa: E402
+
 from .version import __version__  # noqa: E402,F401
 
 from . import closedforms
@@ -32,19 +34,28 @@ from .influence import Influence, halfspace_influence
 from .methods import STEP_METHOD, available_methods, get_method
 from .problem import (NormalStep, Residuals, Scales, StepSolution, TangentialStep, classify,
                       compare)
+from .march import StepRecord
+from .operators import SceneOperators
 from .result import Result, load_result
 from .scene import Scene, builtin_scenes, load_scene
-from .strip import Strip
-from .operators import SceneOperators
-from . import march as _march
-from .march import StepRecord
 from .scene.core import SceneBase as _SceneBase
+from .strip import Strip
 from . import energy, wear  # noqa: E402,F401  (register their result fields)
 from .subsurface import stresses  # noqa: E402  (rollqp.stresses(result, step, grid))
 
 
+#: The run of each kind of scene, by module (``run`` and ``march`` in it), imported with the first scene of that
+#: kind: ``import rollqp`` loads the strip's march only (no scipy, no solver package, no 3D or wheel–rail module).
+_RUNS = {2: "rollqp.march", 3: "rollqp.three.run", "wheel-rail": "rollqp.wheelrail.run"}
+
+
 def _scene(scene):
     return scene if isinstance(scene, _SceneBase) else load_scene(scene)
+
+
+def _runs(scene):
+    """The module that runs ``scene`` (:data:`_RUNS`, by its ``family`` or its dimension)."""
+    return importlib.import_module(_RUNS[getattr(scene, "family", None) or scene.dimension])
 
 
 def run(scene, method=None, progress=None, resume=None, observe=None, **options):
@@ -63,17 +74,13 @@ def run(scene, method=None, progress=None, resume=None, observe=None, **options)
     scene = _scene(scene)
     with _threads.limited():  # every BLAS pool at $ROLLQP_THREADS (default 1) for the run (rollqp.threads)
         if getattr(scene, "family", None) == "wheel-rail":   # one state per wheel: no march (rollqp.wheelrail)
-            from .wheelrail.run import run as run_wheel_rail
             if method is not None:
                 if not isinstance(method, str):
                     raise InputError("method", "a wheel-rail scene takes a method name (e.g. 'newton'), "
                                                f"got {type(method).__name__}")
                 scene = scene.replace(**{"solver.method": method})
-            return run_wheel_rail(scene, progress=progress, resume=resume, observe=observe, **options)
-        if scene.dimension == 3:
-            from .three.run import run as run_3d
-            return run_3d(scene, method, progress, resume, observe, **options)
-        return _march.run(scene, method, progress, resume, observe, **options)
+            return _runs(scene).run(scene, progress=progress, resume=resume, observe=observe, **options)
+        return _runs(scene).run(scene, method, progress, resume, observe, **options)
 
 
 def march(scene, method=None, **options):
@@ -82,10 +89,7 @@ def march(scene, method=None, **options):
     scene = _scene(scene)
     if getattr(scene, "family", None) == "wheel-rail":
         raise InputError("scene", "a wheel-rail scene is one state per wheel, not a march: use rollqp.run")
-    if scene.dimension == 3:
-        from .three.run import march as march_3d
-        return march_3d(scene, method, **options)
-    return _march.march(scene, method, **options)
+    return _runs(scene).march(scene, method, **options)
 
 
 def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> StepSolution:
@@ -101,7 +105,7 @@ def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> Ste
 def open_result(path):
     """A result file (``.npz``) as a labelled :class:`xarray.Dataset` (:func:`rollqp.sweep.dataset.open_result`;
     needs xarray, extra ``sweep``)."""
-    from .sweep.dataset import open_result as _open
+    from .sweep.dataset import open_result as _open  # optional dependencies behind it: xarray (extra "sweep")
     return _open(path)
 
 

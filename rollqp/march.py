@@ -50,13 +50,22 @@ from typing import Iterator
 
 import numpy as np
 
+from .advice import fast_path
+from .atomic import stop_once
 from .errors import InputError, SolverError
+from .fields import fields_for
+from .friction.bound import steady_branches
 from .kinematics import HistoryCache, plan
+from .methods import compose, scene_method
+from .methods.steady_start import accelerated_start, predicting
 from .operators import SceneOperators
 from .problem import SLIP, STICK, State, StepSolution, classify
 from .result import Result, ResumeSource, _meta_of, check_output, resume_source
 from .scene import Scene, load_scene
+from .scene.checks import check_result_memory
+from .solverstate import Recorder, restore
 from .strip import RowSparse
+from .version import __version__
 
 __all__ = ["State", "StepRecord", "march", "run", "prepare"]
 
@@ -386,7 +395,6 @@ class _March:
         in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`). A QP method solves
         the guess's QPs with the active-set prediction on (:meth:`QPMethod.predicting
         <rollqp.methods._qp.QPMethod.predicting>`: a guess, not a state that is kept)."""
-        from .methods.steady_start import predicting
         was = predicting(self.method, True)
         try:
             start = self.guess()
@@ -418,7 +426,6 @@ class _March:
         self.ops.check_inside(state.p, 0)
         rec = self.record(0, "steady", 0.0, state, start, problem, sol, cnt, P=P, shift=0.0, t0=t0)
         if problem is not None and problem.law is not None and Q is not None:
-            from .friction.bound import steady_branches
             rec.note = steady_branches(problem.law.law, Q, rec.P, rec.gross_sliding)
         return rec
 
@@ -438,7 +445,6 @@ class _March:
         cnt = Counters()
         M = ops.history()
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
-        from .methods.steady_start import accelerated_start, predicting
         change = np.inf
         state = accelerated_start(self.method, ops, start, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
                                   delta=D, tol=STEADY_TOL)  # QP methods: Newton on the march's map, Anderson
@@ -550,8 +556,6 @@ def prepare(scene, method=None, *, geometry=None):
         Where the influence model keeps what depends on the bodies alone, shared by the scenes it is
         handed to (:meth:`SceneOperators.build <rollqp.operators.SceneOperators.build>`).
     """
-    from .advice import fast_path
-    from .methods import compose, scene_method
     scene = _two_d(scene if isinstance(scene, Scene) else load_scene(scene))
     if isinstance(method, str) and method != scene.solver.method:
         scene = scene.replace(**{"solver.method": method})
@@ -613,7 +617,6 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, record
     M = ops.history()  # built (on the dense path: from an n × n matrix) before the start's solver holds its systems
     recorder = None if record is None or record is False else record
     if record is True:
-        from .solverstate import Recorder
         recorder = Recorder(meth, ops)
     if resume is not None:
         if verify:
@@ -754,7 +757,6 @@ def _restore(m: _March, arrays, upto, recorder):
     and the march's history operators as they were after state ``upto``; the products of
     :func:`rollqp.solverstate.restore` (``None`` without records). A record that cannot be rebuilt leaves the
     method as set up (the march then sets out without what it carried)."""
-    from .solverstate import restore
     notes = arrays.get("_notes")
     if not notes:
         return None
@@ -850,13 +852,10 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     source = resume_source(resume) if isinstance(resume, (str, os.PathLike)) else resume
     keep = _keep_every(keep_every, source)
     if out is None:  # before any work: the states it would hold, on the operators it would build
-        from .advice import fast_path
-        from .scene.checks import check_result_memory
         check_result_memory(fast_path(asked).scene if method is None or isinstance(method, str) else asked, keep)
     scene, meth, ops = prepared = prepare(asked, None if isinstance(method, str) else method, geometry=geometry)
     tail = state = recorder = None
     if out is not None:  # a journal: each state with what the method carries (rollqp.solverstate)
-        from .solverstate import Recorder
         recorder = Recorder(meth, ops)
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
@@ -864,9 +863,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         state = check_resumed(scene, prepared, tail, march=checked, recorder=recorder)
     result = new_result(asked, ops, meth.name, keep_every=keep, out=out)  # meta: the scene as given, the method that ran it
     if scene.solver.method != asked.solver.method:
-        from .advice import fast_path
         result.meta["method_note"] = fast_path(asked).note
-    from .atomic import stop_once
     with stop_once():  # a second Ctrl-C never interrupts the writing of what the first one saves
         return _run(scene, prepared, result, source, (tail, state, recorder, checked if source is not None else None),
                     observe, progress)
@@ -932,8 +929,6 @@ def _keep_every(keep_every, source) -> int:
 def new_result(scene, ops: SceneOperators, method_name: str, keep_every: int = 1, out=None) -> Result:
     """An empty :class:`Result` with the scene's scalars, metadata and the computed fields it needs
     (``out``: written to that file through its journal, :func:`run`)."""
-    from .version import __version__
-    from .fields import fields_for
     meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info), "dimension": 2,
             "versions": _versions(), "rollqp": __version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,

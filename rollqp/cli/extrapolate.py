@@ -3,9 +3,9 @@ extrapolated with an error estimate (:func:`rollqp.extrapolate.extrapolate`; doc
 from __future__ import annotations
 
 from ..errors import InputError
-from ..scene import load_scene
 from ..extrapolate import extrapolate
-from .common import takes
+from ..scene import load_scene
+from .families import takes
 
 
 def add_arguments(xp) -> None:

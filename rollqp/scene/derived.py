@@ -12,11 +12,12 @@ import math
 
 import numpy as np
 
-from ..errors import InputError
-from ..methods import record
-from .schema import BETA_ZERO
 from ..closedforms import hertz_half_width
 from ..closedforms import hertz_peak_pressure
+from ..errors import InputError
+from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER
+from ..methods import record
+from .schema import BETA_ZERO
 
 __all__ = ["Derived"]
 
@@ -47,7 +48,6 @@ class Derived:
     @property
     def bem_mesh(self) -> tuple[int, int]:
         """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
-        from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER  # one place for the paper's counts
         c = self.contact
         return (DEFAULT_OUTER if c.bem_outer_elements is None else c.bem_outer_elements,
                 DEFAULT_INNER if c.bem_inner_elements is None else c.bem_inner_elements)
