@@ -22,10 +22,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError, SolverError
 from ..advice.grid import MARCH_LENGTHS
+from ..errors import InputError, SolverError
+from ..methods.chord import chord_step
 from ..operators.grid import Loads
-from ..problem.grid import SEPARATION, SLIP, STICK, disc_projection, element_states
+from ..problem.grid import Residuals, SEPARATION, SLIP, STICK, StepSolution, disc_projection, element_states
 
 __all__ = ["StepRecord", "normal", "coupled_step", "static_shift", "steady", "transient"]
 
@@ -124,7 +125,6 @@ def _frictionless(contact, kind, nsol, loads, previous, dq, direction):
 def _warm_of(rec):
     """``(normal, tangential)``: the warm start of the step after a resumed state ``rec``, the numbers the
     step that computed it hands to the next (pressure and approach; tractions and creepages)."""
-    from ..problem.grid import Residuals, StepSolution
     return (StepSolution(residuals=Residuals(), p=rec.p, g=rec.g, delta=rec.delta),
             StepSolution(residuals=Residuals(), t=rec.t, s=rec.s, xi=rec.xi, eta=rec.eta))
 
@@ -222,7 +222,6 @@ def _expected_march(contact) -> int:
 def _newton_to_steady(contact, method, FN, loads, direction, start, t0, pressure=None, tick=None):
     """The fixed point of the march by Newton's method on the march map (:func:`rollqp.methods.chord.chord_step`),
     a march step wherever a Newton iterate does not reduce the change by :data:`NEWTON_DECREASE`."""
-    from ..methods.chord import chord_step
     nsol = pressure or normal(contact, method, FN)
     dx, n = contact.grid.dx, contact.grid.n
     shifted = contact.ops.shifted("tt", -direction * dx)

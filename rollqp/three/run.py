@@ -37,7 +37,7 @@ from ..operators.grid import Contact
 from ..loadpath import out_of_contact, rolling_steps
 from ..loads import start_force
 from ..patch import moving_profile
-from .march import StepRecord, static_shift, steady
+from .march import StepRecord, _states, static_shift, steady
 
 __all__ = ["prepare", "march", "run", "new_result", "resumed_record", "check_resumed", "check_states", "GRID"]
 
@@ -212,7 +212,6 @@ def _compare(again: StepRecord, stored: StepRecord, contact, k: int) -> None:
             raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
                                          f"state before it, its {what} differs by {worst:.3g} {unit} (more than "
                                          f"{RESUME_TOL:g}): the file was changed or is corrupt")
-    from .march import _states
     if not np.array_equal(_states(contact, stored.p, stored.t, stored.s), np.asarray(stored.state)):
         raise InputError("--resume", f"the last state ({k}): its element states are not those of its pressure, "
                                      "traction and slip: the file was changed or is corrupt")
@@ -226,7 +225,6 @@ def check_states(scene, contact, source) -> None:
     state, :func:`resumed_record`). A state that is not is a changed or corrupt file: a one-line
     :class:`InputError` on ``--resume``, before anything is run or written. (The last state is moreover solved
     again: :func:`check_resumed`.)"""
-    from .march import _states
     _resumable(scene)
     g, sc = contact.grid, contact.scales
     mu = float(contact.mu)
