@@ -19,7 +19,7 @@ from rollqp.operators.grid import Contact, Loads
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.discretization.grid import Grid
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
-from rollqp.three.march import static_shift, steady, transient
+from rollqp.march.grid import static_shift, steady, transient
 from rollqp.materials import Materials
 
 DATA = Path(__file__).resolve().parent.parent / "tests" / "data" / "contact3d"

@@ -42,7 +42,7 @@ def _modules():
         Contact, Loads = oc.Contact, oc.Loads
         Materials = importlib.import_module("rollqp.three.materials").Materials
         Newton = importlib.import_module("rollqp.three.gnm").NewtonMethod
-    march = importlib.import_module("rollqp.three.march")
+    march = importlib.import_module("rollqp.march.grid")
     return Contact, Loads, Materials, Newton, march.normal, march.steady, march.transient
 
 

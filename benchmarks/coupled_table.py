@@ -46,7 +46,7 @@ import time
 import numpy as np
 
 import rollqp
-from rollqp.march import new_result  # noqa: E402
+from rollqp.march.strip import new_result  # noqa: E402
 from rollqp.operators import SceneOperators  # noqa: E402
 from rollqp.errors import SolverError  # noqa: E402
 from rollqp.methods.alternation import Alternation  # noqa: E402

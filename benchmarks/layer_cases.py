@@ -15,7 +15,7 @@ from rollqp.methods.fastsim import FastsimMethod
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.operators.grid import Contact, Loads
 from rollqp.closedforms.hertz_ellipse import hertz
-from rollqp.three.march import steady
+from rollqp.march.grid import steady
 
 #: The brush's κ = k|ξ|a/(μp0) of the checks: mostly stick, and stick and slip alike.
 KAPPAS = (0.3, 1.0)

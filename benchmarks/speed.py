@@ -261,7 +261,7 @@ def rolling_starts(repeats=5, methods=("newton", "qp-osqp", "qp-clarabel")) -> d
 
 
 def rows_rolling_starts(add) -> None:
-    from rollqp.march import STEADY_TOL
+    from rollqp.march.strip import STEADY_TOL
     for name, r in rolling_starts().items():
         c, d = r["cpu"], r["distance"]
         add(f"`{name}`, rolling start: a `newton` march of 1 a_H from it moves it by (μp0)",

@@ -33,9 +33,9 @@ from rollqp.operators.grid import Contact, Loads  # noqa: E402
 from rollqp.methods.newton.disc import NewtonMethod  # noqa: E402
 from rollqp.discretization.grid import Grid  # noqa: E402
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz  # noqa: E402
-from rollqp.three.march import steady  # noqa: E402
+from rollqp.march.grid import steady  # noqa: E402
 from rollqp.materials import Materials  # noqa: E402
-from rollqp.three.run import run  # noqa: E402
+from rollqp.march.grid import run  # noqa: E402
 
 
 def _gauss_disk(x, y, z, a, p0, nu, load, n=160):

@@ -14,7 +14,7 @@ from harness import pin_threads
 
 from rollqp import load_scene
 from rollqp.plot.three import field_figure
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 
 def main(argv=None):

@@ -14,8 +14,8 @@ import numpy as np
 import rollqp
 from rollqp.kinematics import plan
 from rollqp.closedforms.hertz_ellipse import hertz
-from rollqp.three.march import static_shift, steady
-from rollqp.three.run import prepare, run
+from rollqp.march.grid import static_shift, steady
+from rollqp.march.grid import prepare, run
 
 REVERSE = {"kind": "table", "q": [0, 3, 4, 10], "value": [0, 3, 3, -3]}
 

@@ -10,7 +10,7 @@
    starts from the Hertz pressure (``march.normal``), the steady step from zero traction;
 3. Clarabel's SOCP against Newton on the same tangential step, both to rollqp's residual ≤ 1e-10
    (Clarabel refined on its active set; its raw residual beside it), on 16 × 16, 24 × 24 and 30 × 30 grids;
-4. the built-in 3D scenes run as ``rollqp run`` runs them (``rollqp.three.run.run``, Newton, without the
+4. the built-in 3D scenes run as ``rollqp run`` runs them (``rollqp.march.grid.run``, Newton, without the
    cross-check), and one conic step of each (Clarabel, the cost of the cross-check per step);
 5. the conic route to a steady state on 24 × 24: Newton's method on the march map (``accelerate="chord"``)
    against the Anderson-accelerated march, at a small creepage (all stick) and a large one (partial slip).
@@ -38,7 +38,7 @@ from harness import pin_threads, table
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
-from rollqp.three.march import normal, steady
+from rollqp.march.grid import normal, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.methods.socp import ClarabelMethod
@@ -109,8 +109,8 @@ def section_builtins(quick):
     """The built-in scenes: the run as ``rollqp run`` makes it (Newton), and one Clarabel step of its end."""
     from rollqp import load_scene
     from rollqp.methods import get_method
-    from rollqp.three.march import coupled_step
-    from rollqp.three.run import prepare, run
+    from rollqp.march.grid import coupled_step
+    from rollqp.march.grid import prepare, run
     rows = []
     for name in ("kalker-circular", "kalker-elliptic", "cattaneo-3d"):
         scene = load_scene(name)
@@ -325,7 +325,7 @@ def _steady_run(n, method="newton", xi=1e-3):
     """kalker-circular's circle (zone 1.25: the edge on element boundaries for n a multiple of 5) at ξ alone, its
     steady state on n × n elements by ``method``: (Fx, CPU seconds of the run, wall seconds)."""
     from rollqp import load_scene
-    from rollqp.three.run import run
+    from rollqp.march.grid import run
     scene = load_scene("kalker-circular", {"discretization.elements": [n, n], "discretization.distance": 0.0,
                                            "load.creepage.longitudinal": xi, "solver.method": method})
     c0, w0 = time.process_time(), time.perf_counter()

@@ -30,7 +30,7 @@ from rollqp.closedforms.kalker import kalker_linear
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
-from rollqp.three.march import coupled_step, static_shift, steady, transient
+from rollqp.march.grid import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.report.grid import cattaneo_errors, creep_matrix, hertz_errors

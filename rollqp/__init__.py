@@ -34,35 +34,31 @@ from .influence import Influence, halfspace_influence
 from .methods import STEP_METHOD, available_methods, get_method
 from .problem import (NormalStep, Residuals, Scales, StepSolution, TangentialStep, classify,
                       compare)
-from .march import StepRecord
-from .operators import SceneOperators
 from .result import Result, load_result
 from .scene import Scene, builtin_scenes, load_scene
-from .scene.core import SceneBase as _SceneBase
 from .strip import Strip
+from .operators import SceneOperators
+from . import march as _march
+from .march import StepRecord
+from .scene.core import SceneBase as _SceneBase
 from . import energy, wear  # noqa: E402,F401  (register their result fields)
 from .subsurface import stresses  # noqa: E402  (rollqp.stresses(result, step, grid))
 
 
-#: The run of each kind of scene, by module (``run`` and ``march`` in it), imported with the first scene of that
-#: kind: ``import rollqp`` loads the strip's march only (no scipy, no solver package, no 3D or wheel–rail module).
-_RUNS = {2: "rollqp.march", 3: "rollqp.three.run", "wheel-rail": "rollqp.wheelrail.run"}
+#: The run of a scene of a family of its own (a wheel on its rail: one state per wheel, no march), by module,
+#: imported with the first such scene, as the march imports a discretization's (:data:`rollqp.march.MARCHES`).
+_FAMILY_RUNS = {"wheel-rail": "rollqp.wheelrail.run"}
 
 
 def _scene(scene):
     return scene if isinstance(scene, _SceneBase) else load_scene(scene)
 
 
-def _runs(scene):
-    """The module that runs ``scene`` (:data:`_RUNS`, by its ``family`` or its dimension)."""
-    return importlib.import_module(_RUNS[getattr(scene, "family", None) or scene.dimension])
-
-
 def run(scene, method=None, progress=None, resume=None, observe=None, **options):
-    """Run a scene's transient and return its result: :func:`rollqp.march.run` for a 2D scene,
-    :func:`rollqp.three.run.run` for a 3D one (``[contact] dimension = 3``), with the same arguments
-    (``out``, ``keep_every``, and the 2D run's ``geometry``, as keywords); a wheel–rail scene
-    (``[contact] kind = "wheel-rail"``) is solved by :func:`rollqp.wheelrail.run.run`.
+    """Run a scene and return its result: :func:`rollqp.march.run`, the march of the scene's discretization (the
+    strip of a 2D scene, the grid of a 3D one, ``[contact] dimension = 3``), with the same arguments (``out``,
+    ``keep_every``, and the strip's ``geometry``, as keywords); a wheel–rail scene (``[contact] kind =
+    "wheel-rail"``) is solved by :func:`rollqp.wheelrail.run.run`.
 
     Examples
     --------
@@ -79,17 +75,14 @@ def run(scene, method=None, progress=None, resume=None, observe=None, **options)
                     raise InputError("method", "a wheel-rail scene takes a method name (e.g. 'newton'), "
                                                f"got {type(method).__name__}")
                 scene = scene.replace(**{"solver.method": method})
-            return _runs(scene).run(scene, progress=progress, resume=resume, observe=observe, **options)
-        return _runs(scene).run(scene, method, progress, resume, observe, **options)
+            run_family = importlib.import_module(_FAMILY_RUNS[scene.family]).run
+            return run_family(scene, progress=progress, resume=resume, observe=observe, **options)
+        return _march.run(scene, method, progress, resume, observe, **options)
 
 
 def march(scene, method=None, **options):
-    """The transient as a stream of step records: :func:`rollqp.march.march` for a 2D scene,
-    :func:`rollqp.three.run.march` for a 3D one (``prepared``, ``resume`` as keywords)."""
-    scene = _scene(scene)
-    if getattr(scene, "family", None) == "wheel-rail":
-        raise InputError("scene", "a wheel-rail scene is one state per wheel, not a march: use rollqp.run")
-    return _runs(scene).march(scene, method, **options)
+    """The run as a stream of step records: :func:`rollqp.march.march` (``prepared``, ``resume`` as keywords)."""
+    return _march.march(_scene(scene), method, **options)
 
 
 def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> StepSolution:

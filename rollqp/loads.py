@@ -1,5 +1,5 @@
 r"""The load-path keys of a 3D scene, ``load.normal_history`` and ``load.rolled``: their checks and the normal
-force they set (docs/scenes.md, "Three dimensions"). The steps they make are :mod:`rollqp.loadpath`'s.
+force they set (docs/scenes.md, "Three dimensions"). The steps they make are :mod:`rollqp.march.grid`'s.
 
 The same history objects as in 2D (:mod:`rollqp.histories`), functions of the time-like parameter τ in
 units of ``a`` (the rolled distance itself without ``load.rolled``). :func:`check_load_path` holds the

@@ -387,7 +387,7 @@ def stresses3d(result, step: int, plane=None, line=None, depths=None, body: str 
 
     Parameters
     ----------
-    result : a 3D result (``load_result`` dict, path, or :class:`~rollqp.three.result.Result3D`)
+    result : a 3D result (``load_result`` dict, path, or :class:`~rollqp.result.Result`)
     step : int
         A stored state, 0…K (negative: from the end).
     plane : ("y", Y) or ("x", X), optional

@@ -53,3 +53,26 @@ def test_the_traction_raises_the_stress_peak_and_lifts_it():
     (v1, z1), (v0, z0) = peaks
     assert v1 == pytest.approx(0.671, abs=2e-3) and v0 == pytest.approx(0.617, abs=2e-3)
     assert z1 < z0
+
+
+def test_rollqp_run_stresses_reports_the_3d_peaks_of_the_run(tmp_path, capsys, monkeypatch):
+    """`rollqp run SCENE3D --stresses` prints the peak von Mises and Tresca stresses over the stored states on the
+    plane y = 0: the same numbers as `rollqp stresses` of that state (rollqp.subsurface3d.stresses3d)."""
+    import re
+
+    from rollqp import cli
+    monkeypatch.chdir(tmp_path)
+    scene = tmp_path / "c.toml"
+    scene.write_text(rollqp.load_scene("cattaneo-3d").replace(**{"discretization.elements": [12, 12],
+                                                                 "discretization.distance": 1.0}).to_toml())
+    assert cli.main(["run", str(scene), "--stresses", "--no-cross-check", "--out", "c.npz"]) == 0
+    out = capsys.readouterr().out
+    m = re.search(r"peak von Mises\s+(\S+) p0 at x = (\S+), y = (\S+), z = (\S+) mm, state (\d+)", out)
+    assert m, out
+    res = rollqp.load_result(tmp_path / "c.npz")
+    sf = stresses3d(res, int(m.group(5)), plane=("y", 0.0))
+    v, x, y, z = sf.maxima["von_mises"]
+    assert float(m.group(1)) == pytest.approx(v / float(res["p0"]), abs=1e-4)
+    assert float(m.group(4)) == pytest.approx(z, rel=1e-4)
+    for k in range(res["q"].size):        # no state has a larger peak
+        assert stresses3d(res, k, plane=("y", 0.0)).maxima["von_mises"][0] <= v * (1 + 1e-12)

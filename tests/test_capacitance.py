@@ -9,7 +9,7 @@ from rollqp.materials import Materials
 from rollqp.methods.newton import capacitance
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.operators.grid import Contact, Loads
-from rollqp.three.march import static_shift, steady, transient
+from rollqp.march.grid import static_shift, steady, transient
 
 FN, MU = 1000.0, 0.3
 STEEL = Materials.from_young(210e3, 0.28, 210e3, 0.28)
@@ -55,3 +55,20 @@ def test_singular_capacitance_returns_none():
     minus = -np.ones(nv)                                               # S = 2I, M = −I: C = −I + 2I·I/2 = 0
     assert capacitance.solve(capacitance.inverse(2 * S), 1.0, np.arange(nv), minus, zero, minus,
                              np.ones(2 * nv)) is None
+
+
+def test_a_resumed_march_is_the_uninterrupted_one_bit_for_bit():
+    """The inverse a march's steps share is formed whole, so a march resumed on a fresh contact (nothing kept)
+    repeats the uninterrupted one bit for bit; a steady state is the same whatever was solved before it."""
+    loads = Loads(xi=-1e-3, eta=5e-4, phi=0.8e-3)
+    c, m = _circle(10), NewtonMethod(path="dense")
+    whole = list(transient(c, m, FN, loads, c.grid.dx, 8))
+    c2 = _circle(10)
+    resumed = list(transient(c2, NewtonMethod(path="dense"), FN, loads, c2.grid.dx, 8, start=whole[4], first=5))
+    for a, b in zip(whole[5:], resumed[1:]):
+        assert np.array_equal(a.t, b.t) and np.array_equal(a.p, b.p)
+    p = m.solve(c.normal_step(FN))
+    first = steady(c, m, FN, loads, pressure=p)
+    steady(c, m, FN, Loads(xi=-4e-3, eta=0.0, phi=0.0), pressure=p)       # other elements slip in between
+    again = steady(c, m, FN, loads, pressure=p)
+    assert np.array_equal(first.t, again.t)

@@ -7,6 +7,7 @@ inject a failure deterministically).
 from __future__ import annotations
 
 import importlib
+
 import shutil
 import subprocess
 import sys
@@ -188,8 +189,7 @@ def test_injected_failure_exits_3_and_writes_partial(tmp_path, capsys, monkeypat
                     raise rollqp.SolverError("injected", method=self.name, status="test")
             return self.inner.solve(problem, warm=warm)
 
-    monkeypatch.setattr(importlib.import_module("rollqp.march"), "scene_method",  # where the march looks it up
-                        lambda settings, coupled=False, **kw: Failing(real(settings, coupled, **kw)))
+    monkeypatch.setattr(importlib.import_module("rollqp.march.strip"), "scene_method", lambda settings, coupled=False, **kw: Failing(real(settings, coupled, **kw)))
     out = tmp_path / "p.npz"
     assert cli.main(["run", str(path), "--out", str(out), "--quiet"]) == 3, "exit 3 on a solver failure"
     err = capsys.readouterr().err

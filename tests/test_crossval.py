@@ -76,7 +76,7 @@ def test_steady_step_is_marched_by_the_qp_methods():
     assert "steady" in rep.kind and "not a convex QP" in str(rep)
     for r in rep.rows:
         assert r.ok, f"{r.method}: {r.error}"
-        # the march stops when a step changes t by < 1e-8 μp0 (rollqp.march.STEADY_TOL, measured 2e-11)
+        # the march stops when a step changes t by < 1e-8 μp0 (rollqp.march.strip.STEADY_TOL, measured 2e-11)
         assert r.dt <= 1e-8 and r.dp <= 1e-8, f"{r.method}: Δp {r.dp:.1e}, Δt {r.dt:.1e}"
         assert max(r.residuals.values()) <= 1e-9, f"{r.method}: residuals on the steady step {r.residuals}"
     assert any("march to steady" in r.iterations for r in rep.rows)

@@ -13,6 +13,7 @@ backend agreement is test_qp's business.
 from __future__ import annotations
 
 import importlib
+
 import json
 import os
 
@@ -173,7 +174,7 @@ def counting(monkeypatch):
             m = Counting(real(settings, coupled, **kw), fail_at_tangential)
             made.append(m)
             return m
-        monkeypatch.setattr(importlib.import_module("rollqp.march"), "scene_method", make)  # where the march looks it up
+        monkeypatch.setattr(importlib.import_module("rollqp.march.strip"), "scene_method", make)  # where the march makes it
         return made
     return install
 

@@ -16,10 +16,10 @@ from rollqp.operators.grid import Contact, Loads
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.discretization.grid import Grid
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio, hertz
-from rollqp.three.march import steady
+from rollqp.march.grid import steady
 from rollqp.materials import Materials
 from rollqp.influence.grid import ContactOperators
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 
 def test_elastic_energy_of_contact_subsurf():

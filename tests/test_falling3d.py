@@ -17,7 +17,7 @@ from rollqp.friction import parse_friction
 from rollqp.methods import BoundFixedPoint, SlipContinuation
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.methods.socp import ClarabelMethod
-from rollqp.three.run import march, prepare
+from rollqp.march.grid import march, prepare
 
 LAW = {"law": "exponential", "static": 0.4, "kinetic": 0.2, "velocity": 300.0, "rolling_speed": 1000.0}
 # full sliding: rigid slip w = (ξ − φy, φx), |w| between 0.1 and 0.5 over the contact (V|w| = 100–500 against
@@ -128,6 +128,19 @@ def test_newton_agrees_with_the_fixed_point_on_the_conic_method(memory):
     assert all(x.residual <= 1e-10 and y.residual <= 1e-10 for x, y in zip(a, b))
     # the law is really in play: μ falls below μ_s on slipping elements
     assert min(float(np.min(r.mu[r.state == 2])) for r in a[1:] if (r.state == 2).any()) < 0.32 - 1e-3
+
+
+def test_newton_agrees_with_the_fixed_point_on_cvxpy():
+    """The fixed point on the bound around socp-cvxpy (its conic solve at tolerances set from 1e-12) against Newton on
+    the transient with memory, each step on its own."""
+    pytest.importorskip("cvxpy")
+    from rollqp.methods.socp import CvxpyMethod
+    scene = _transient(0.3, distance=1.0)
+    a, contact = _run(scene, _newton())
+    b, _ = _run(scene, SlipContinuation(BoundFixedPoint(CvxpyMethod(tolerance=1e-12)), threshold=math.inf))
+    worst = max(float(np.max(np.abs(x.t - y.t))) for x, y in zip(a, b)) / (0.32 * contact.scales.stress)
+    print(f"cvxpy: max |t_newton - t_fixed point| = {worst:.2e} mu_s p0")
+    assert worst <= 1e-8, worst      # as with Clarabel: both at rollqp's residual 1e-10 or below
 
 
 def test_newton_agrees_with_the_fixed_point_in_steady_rolling():
@@ -246,7 +259,7 @@ def test_the_uniqueness_factor_and_its_eigenvalue():
     against the dense eigenvalue problem; below 1 Newton from rest and from the last state find one solution."""
     from rollqp.methods.continuation import uniqueness_factor
     from rollqp.problem.grid import StepSolution
-    from rollqp.three.march import normal
+    from rollqp.march.grid import normal
     scene = _transient(0.0, velocity=4000.0, distance=1.0)
     recs, contact = _run(scene, "newton")
     prev = recs[-2]
@@ -291,7 +304,7 @@ def test_the_newton_matrix_is_the_derivative_of_its_equations():
     """eq. 3D.26s: the dense Newton matrix of a step with a falling law (partial slip, the forces prescribed) against
     central differences of Φ_T, at a point off the solution (so that the slip rows have |s| > 0)."""
     from rollqp.methods.newton.disc import tangential_rows
-    from rollqp.three.march import normal
+    from rollqp.march.grid import normal
     scene = _transient(0.3)
     recs, contact = _run(scene, "newton")
     prev = recs[-2]
@@ -315,3 +328,59 @@ def _traction(prob, x):
     t = np.zeros((2, prob.n))
     t[:, V] = x[:2 * V.size].reshape(2, V.size) * prob.scales.stress
     return t
+
+
+LIMIT_LAW = {"law": "exponential", "static": 0.32, "kinetic": 0.20, "velocity": 10.0, "rolling_speed": 10000.0}
+LIMIT_CREEPAGE = {"kind": "ramp", "start": 0.0, "end": -6.4e-4, "over": 1.0}   # half Carter's saturation μ a/R
+
+
+def _strip(law):
+    """The built-in 2D falling-friction scene (a_H = 1 mm) on 20 elements over 1.2 a_H, the creepage ramped."""
+    return rollqp.load_scene("falling-friction").replace(**{
+        "contact.friction": law, "load.creepage": LIMIT_CREEPAGE, "discretization.elements": 20,
+        "discretization.distance": 3.0})
+
+
+def _long_grid(law, radius_ratio):
+    """The same contact as an ellipse elongated in y (body A's lateral radius ``radius_ratio`` × 500 mm, the load set
+    for a = 1 mm): 20 elements along x as on the strip, as few along y as the aspect ratio 5 allows."""
+    from rollqp.closedforms.hertz_ellipse import hertz
+    from rollqp.scene import scene_from_dict
+    E, nu = 209920.0, 0.28
+    A, B = 2 / 1000, 1 / (1000.0 * radius_ratio)
+    Estar = E / (2 * (1 - nu * nu))
+    FN = 1000.0 / hertz(A, B, Estar, 1000.0).a ** 3      # a ∝ FN^(1/3): a = 1 mm
+    e = hertz(A, B, Estar, FN)
+    ny = max(15, int(np.ceil(e.b / e.a * 20 / 5)) + 2)
+    return scene_from_dict({
+        "name": "long", "units": "N-mm",
+        "bodies": {"A": {"radius": 500.0, "radius_y": 500.0 * radius_ratio, "E": E, "nu": nu},
+                   "B": {"radius": 500.0, "radius_y": float("inf"), "E": E, "nu": nu}},
+        "contact": {"dimension": 3, "friction": law},
+        "load": {"normal": FN, "start": "rolling",
+                 "creepage": {"longitudinal": LIMIT_CREEPAGE, "lateral": 0.0, "spin": 0.0}},
+        "discretization": {"elements": [20, ny + 1 - ny % 2], "zone": [1.2, 1.2], "step": 1.0, "distance": 3.0},
+        "solver": {"method": "newton", "tolerance": 1e-10}})
+
+
+def _line_force_gap(law, radius_ratio, strip):
+    """max over the steps of |Q/(μ_s P)| of the grid's central row (the line through y = 0) minus the strip's."""
+    r = rollqp.run(_long_grid(law, radius_ratio)).arrays()
+    j = r["px"].shape[1] // 2
+    line = np.sum(r["px"][:, j, :], axis=1) / np.sum(0.32 * r["pn"][-1][j])
+    return float(np.max(np.abs(line - strip["Q"] / (0.32 * strip["P"]))))
+
+
+@pytest.mark.slow
+def test_a_long_ellipse_tends_to_the_strip_under_the_falling_law():
+    """The 2D limit: the central row of an ellipse elongated in y against the 2D falling-friction scene at the same
+    a, p0 (to 0.2 %), creepage ramp and elements along x. Its line force approaches the strip's as b/a grows, as
+    slowly under the falling law as under Coulomb's at μ_s (the approach to plane strain is the geometry's)."""
+    fall2d, coul2d = (rollqp.run(_strip(law)).arrays() for law in (LIMIT_LAW, 0.32))
+    gaps = [(_line_force_gap(LIMIT_LAW, k, fall2d), _line_force_gap(0.32, k, coul2d)) for k in (32.0, 128.0)]
+    print(f"line force gap to the strip at b/a = 14, 31: falling {gaps[0][0]:.4f}, {gaps[1][0]:.4f}; "
+          f"Coulomb {gaps[0][1]:.4f}, {gaps[1][1]:.4f}")
+    # measured (docs/validation3d.md §20): falling 0.1162, 0.0620; Coulomb 0.1198, 0.0631 (at b/a = 6: 0.180, 0.188)
+    assert gaps[1][0] < 0.6 * gaps[0][0]
+    for fall, coul in gaps:
+        assert abs(fall - coul) <= 0.1 * coul

@@ -16,7 +16,7 @@ from rollqp.errors import InputError
 from rollqp.methods import available_methods
 from rollqp.methods.fastsim import fastsim_traction, flexibilities
 from rollqp.closedforms.kalker import kalker_linear
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 
 def steady(name="kalker-circular", method="fastsim", n=None, **changes):

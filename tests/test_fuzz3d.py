@@ -31,7 +31,7 @@ from rollqp.journal import HEAD_BYTES, Journal
 from rollqp.methods import available_methods, capabilities
 from rollqp.result import load_result, resume_source
 from rollqp.scene import scene_from_dict
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 from test_three_durable import assert_physics
 

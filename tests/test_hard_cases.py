@@ -24,6 +24,8 @@ The fast cases (``Case.fast``) run in the default suite; the rest are marked slo
 """
 from __future__ import annotations
 
+import importlib
+
 import math
 import sys
 from pathlib import Path
@@ -144,11 +146,9 @@ class _FailingAt(Delegate):
 def failing_method(monkeypatch):
     """The scene's method fails at its 6th solve: state 0 (a normal and a tangential solve,
     similar bodies) and three rolling steps (P constant: one tangential solve each) complete."""
-    import importlib
-
     import rollqp.methods
     make = rollqp.methods.scene_method
-    monkeypatch.setattr(importlib.import_module("rollqp.march"), "scene_method",  # where the march looks it up
+    monkeypatch.setattr(importlib.import_module("rollqp.march.strip"), "scene_method",   # where the march makes it
                         lambda settings, coupled=False, **kw: _FailingAt(make(settings, coupled, **kw), 5))
 
 

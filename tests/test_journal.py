@@ -235,6 +235,37 @@ def test_resume_refuses_a_last_state_that_does_not_solve_its_step(short, tmp_pat
     assert (tmp_path / "bad.npz").read_bytes() == before and not os.path.exists(journal_path(tmp_path / "bad.npz"))
 
 
+#: Forgeries of an earlier state (state 10 of a file of 30): what each makes of it, and the message's words (a
+#: field that is not finite the result reader refuses already).
+FORGED_EARLIER = {
+    "tractions beyond mu p": (lambda a: a["pt"].__setitem__(10, 3.0 * a["pt"][10]), "a traction beyond the friction bound"),
+    "a negative pressure": (lambda a: a["pn"].__setitem__((10, 40), -1e-3 * a["pn"][10].max()), "p0 < 0"),
+    "Q not that of its tractions": (lambda a: a["Q"].__setitem__(10, a["Q"][10] + 1e-9 * abs(a["P"][10])),
+                                    "state 10: its tangential load Q is not that of its tractions"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FORGED_EARLIER))
+def test_resume_refuses_a_forged_earlier_state(short, tmp_path, case):
+    """An earlier state changed (not the last one, which is solved again) is refused in one line before anything
+    is run: the strip's states are checked in themselves as the grid's are (rollqp.march.loop.check_earlier)."""
+    scene, full = short
+    part = {k: (v[:30].copy() if k in full and np.ndim(v) and len(v) == len(full["q"]) and k != "x" else v)
+            for k, v in full.items()}
+    forge, words = FORGED_EARLIER[case]
+    forge(part)
+    np.savez(tmp_path / "bad.npz", **part)
+    with pytest.raises(InputError) as err:
+        rollqp.run(scene, resume=tmp_path / "bad.npz", out=tmp_path / "bad.npz")
+    msg = str(err.value)
+    assert msg.startswith("--resume: ") and words in msg and msg.endswith("the file was changed or is corrupt"), msg
+    assert "\n" not in msg and not os.path.exists(journal_path(tmp_path / "bad.npz"))
+    clean = {k: (v[:30].copy() if k in full and np.ndim(v) and len(v) == len(full["q"]) and k != "x" else v)
+             for k, v in full.items()}
+    np.savez(tmp_path / "good.npz", **clean)     # the same file unforged resumes
+    _same(full, rollqp.run(scene, resume=tmp_path / "good.npz").arrays(), scene)
+
+
 def test_keep_every_k_keeps_the_sums(short, tmp_path):
     """keep_every = 7: states 0, 7, 14, … and the last two; works, times and iteration counts summed over the
     steps in between, the residual the largest, the rest the state's own (the same in memory and in the file)."""

@@ -13,7 +13,7 @@
   (rollqp.methods.newton.uncoupled._iterate_dense, below ``linear.PARTIAL_MIN`` nodes) against the
   general one (``_Iterate``, with products over the contact columns) on the same small scenes: the same
   iterations at every step, tractions equal to round-off.
-* The march's tangential-only rolling step (``rollqp.march.FAST_ROLLING_STEP``) against the general
+* The march's tangential-only rolling step (``rollqp.march.strip.FAST_ROLLING_STEP``) against the general
   step and record: every array of whole runs bitwise equal.
 * The QP backends' solver cache keyed by a Hessian fingerprint: a changed Hessian builds a
   new solver object, the same Hessian reuses it.
@@ -352,7 +352,7 @@ def test_tangential_only_rolling_step_is_the_general_step(monkeypatch, name, met
     """The written-out rolling step of a scene whose rolling steps are their tangential half alone (these
     scenes' are: a fixed normal half, one μ, uncoupled, a fixed profile) gives, bit for bit, every array
     the general step and record give (the same calls on the same numbers)."""
-    march_module = importlib.import_module("rollqp.march")
+    march_module = importlib.import_module("rollqp.march.strip")
     scene = rollqp.load_scene(name).replace(**{"solver.method": method, **changes})
     if scene.discretization.distance > 3.0:
         scene = scene.replace(**{"discretization.distance": 3.0})

@@ -3,7 +3,7 @@
 The upper body (G = 0.5, ν = 0) is pressed onto a rigid one (G = 1e5): Kalker's K = 0.5 couples the normal
 and tangential problems, so every stage is a shift step at zero creepage from the previous state (the
 tractions that the growing contact leaves behind stay, the history of eq. 3D.16) solved by the
-normal–tangential alternation (rollqp.three.march.coupled_step) with Newton's halves; the normal force
+normal–tangential alternation (rollqp.march.grid.coupled_step) with Newton's halves; the normal force
 grows as FN = (k/45)³ (k = 1 … 35) on CONTACT's 45 × 45 grid of DX = 0.2 from −4.4999, h = 0.004116 (x² + y²),
 μ = 0.2986. Against CONTACT's reference output: the approach and the peak pressure of every stage, and the
 contact, adhesion and slip counts where it prints them (stages 1, 6, 18, 35)."""
@@ -18,7 +18,7 @@ import pytest
 from rollqp.methods import REFERENCE_METHOD, scene_method_3d
 from rollqp.operators.grid import Contact, Loads
 from rollqp.discretization.grid import Grid
-from rollqp.three.march import coupled_step
+from rollqp.march.grid import coupled_step
 from rollqp.problem.grid import element_states
 from rollqp.materials import Materials
 from rollqp.scene.grid import Solver3D

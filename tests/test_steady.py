@@ -4,7 +4,7 @@
 (docs/formulation.md §9). Held here against:
 
 * the long-run limit of the transient at constant loads: the QP methods' rolling start (which
-  marches until the tractions change by less than ``rollqp.march.STEADY_TOL`` a step), and the Newton
+  marches until the tractions change by less than ``rollqp.march.strip.STEADY_TOL`` a step), and the Newton
   transient from a braked start rolled 12 a_H;
 * Carter's closed forms (similar bodies), with the discretization error of the mesh;
 * each other: ``newton`` (coupled GNMls) and ``nt-newton`` (N–T alternation) on a dissimilar,
@@ -35,7 +35,7 @@ import pytest
 import rollqp
 from rollqp import closedforms as cf
 from rollqp.report import rms_in_contact
-from rollqp.march import STEADY_TOL
+from rollqp.march.strip import STEADY_TOL
 from rollqp.histories import Constant
 
 RATIO = 0.75

@@ -9,7 +9,7 @@ convective-local form, ``(I − R)/Δq`` for the material one. Held here:
   equal to ``d·D_up`` off the leading node where ``R`` moves nodal values by whole node spacings,
   different where it interpolates (QCE with Δq = Le/4, the paper's §6.2.1);
 * the march from the direct steady state does not move: over 1 a_H every state stays within
-  the march's own tolerance of the start (``rollqp.march.STEADY_TOL``, μp0 a step) on
+  the march's own tolerance of the start (``rollqp.march.strip.STEADY_TOL``, μp0 a step) on
   ``goodman-bentall`` with a rolling start (material, Δq = Le/4, QCE, 2β = 1, full coupling), on
   ``harmonic`` and on the material form with steps that are not a node spacing;
 * the QP methods' marched start lands on the same state as the direct solve.
@@ -22,7 +22,7 @@ import pytest
 import rollqp
 from rollqp.errors import InputError
 from rollqp.histories import Constant
-from rollqp.march import STEADY_TOL
+from rollqp.march.strip import STEADY_TOL
 from rollqp.matrixfree import sparse_history, sparse_steady
 from rollqp.strip import Strip
 

@@ -23,7 +23,7 @@ from rollqp.methods.alternation import Alternation
 from rollqp.methods.steady_start import MapJacobian, fixed_point, sweep_map
 from refcases import bentall_scene
 
-#: Tolerance of the march on the change of t per step (rollqp.march.STEADY_TOL): the rolling start's
+#: Tolerance of the march on the change of t per step (rollqp.march.strip.STEADY_TOL): the rolling start's
 #: answer is within it of the steady state (measured 1e-12, see the test).
 MARCH_TOL = 1e-8
 

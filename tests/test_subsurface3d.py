@@ -209,7 +209,7 @@ def test_bad_input_names_the_argument():
 @pytest.fixture(scope="module")
 def result3d(tmp_path_factory):
     from rollqp import load_scene
-    from rollqp.three.run import run
+    from rollqp.march.grid import run
     scene = load_scene("cattaneo-3d").replace(**{"discretization.elements": [12, 12], "discretization.distance": 1.0,
                                                  "name": "cattaneo-3d-coarse"})
     path = tmp_path_factory.mktemp("s3") / "r.npz"

@@ -36,7 +36,7 @@ made = rollqp.cli.FAMILIES[3]      # the run's module is still imported by the c
 rollqp.cli.FAMILIES[3] = made.replace(run=lambda *a, **k: recording(made.run)(*a, **k))
 how = sys.argv[1]
 if how == "api":
-    import rollqp.three.run as r3
+    import rollqp.march.grid as r3
     r3.run = recording(r3.run)
     rollqp.run("kalker-elliptic")
     code = 0

@@ -12,7 +12,7 @@ from rollqp.errors import InputError
 from rollqp.profiles.surface import Body, curvatures
 from rollqp.closedforms.hertz_ellipse import hertz
 from rollqp.report.grid import hertz_field_errors
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 INF = float("inf")
 

@@ -8,7 +8,7 @@ import pytest
 
 MODULES = ["discretization", "discretization.grid", "materials", "influence.cerruti", "influence.blocktoeplitz", "influence.grid",
            "profiles.surface", "closedforms.hertz_ellipse", "closedforms.kalker", "methods.newton.disc", "operators.grid",
-           "loads", "methods.newton.capacitance"]
+           "loads", "methods.newton.capacitance", "methods.newton.gmres"]
 
 
 @pytest.mark.parametrize("name", MODULES)

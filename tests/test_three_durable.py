@@ -27,7 +27,7 @@ from rollqp.cli import reporting
 from rollqp.errors import InputError
 from rollqp.journal import HEAD_BYTES, Journal
 from rollqp.result import load_result, resume_source
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 
 def coarse(name: str, **changes):

@@ -8,7 +8,7 @@ import pytest
 
 from rollqp import load_scene
 from rollqp.plot.three import she_saturation, three_figure, three_kind
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 pytest.importorskip("matplotlib")
 

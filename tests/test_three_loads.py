@@ -1,4 +1,4 @@
-"""3D load paths (rollqp.loads, rollqp.loadpath): the normal load as a history (zero: out of contact),
+"""3D load paths (rollqp.loads, rollqp.march.grid): the normal load as a history (zero: out of contact),
 the rolled distance as a history (stops, reversals, variable Δq, fretting at rest), against Hertz at the current
 load, the steady state at the current load, Mindlin–Deresiewicz at rest, the 2D code on the same history and a
 second method."""
@@ -11,8 +11,8 @@ import rollqp
 from rollqp.errors import InputError
 from rollqp.kinematics import plan
 from rollqp.closedforms.hertz_ellipse import hertz
-from rollqp.three.march import steady, static_shift
-from rollqp.three.run import prepare, run
+from rollqp.march.grid import steady, static_shift
+from rollqp.march.grid import prepare, run
 
 #: the reversal path of the 2D built-in scene stop-reverse: roll 3 a, stop for 1 a, roll back 6 a
 REVERSE = {"kind": "table", "q": [0, 3, 4, 10], "value": [0, 3, 3, -3]}

@@ -13,7 +13,7 @@ from rollqp import cli, load_scene
 from rollqp.errors import InputError
 from rollqp.scene import builtin_scenes
 from rollqp.report.grid import summary
-from rollqp.three.run import run
+from rollqp.march.grid import run
 
 
 def coarse(name: str, **changes):

@@ -14,9 +14,9 @@ from rollqp import cli, load_scene
 from rollqp.errors import InputError
 from rollqp.methods import CROSSVAL_METHODS_3D, available_methods
 from rollqp.crossval.grid import AGREEMENT, crossval, spot_steps
-from rollqp.three.march import steady
+from rollqp.march.grid import steady
 from rollqp.report.grid import summary
-from rollqp.three.run import prepare, run
+from rollqp.march.grid import prepare, run
 
 #: SPEC's keys of a 3D result file (docs/results.md, "Three dimensions"): the contract's (every other key is
 #: registered in rollqp.fields.FIELDS_3D, beyond the contract).
@@ -199,8 +199,9 @@ def test_cli_crossval_of_a_3d_scene(tmp_path, capsys):
     assert "socp-clarabel: agree" in out and "reference: newton" in out
 
 
-@pytest.mark.parametrize("argv", [["run", "kalker-circular", "--stresses"]])   # export-step, sweep, creep-curve
-# take 3D scenes (tests/test_stepfile3d.py, tests/test_sweep3d.py)
+@pytest.mark.parametrize("argv", [["creep-curve", "kalker-circular", "--ratios", "0.1", "--workers", "0"]])
+# a 2D-only option; export-step, sweep, creep-curve and run --stresses take 3D scenes (tests/test_stepfile3d.py,
+# tests/test_sweep3d.py, tests/test_beyond_hertz_scenes.py)
 def test_2d_only_commands_refuse_a_3d_scene_in_one_line(argv, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     assert cli.main(argv) == 2
@@ -232,11 +233,15 @@ def test_builtin_3d_scene_runs_and_crossvalidates(name, tmp_path):
     assert math.isfinite(float(result.arrays()["Fx"][-1]))
 
 
-def test_the_2d_api_refuses_a_3d_scene_in_one_line():
-    """rollqp.march.run is the 2D run (rollqp.run dispatches on the dimension)."""
-    from rollqp.march import run as run_2d
-    with pytest.raises(InputError, match=r"^scene: 'kalker-elliptic' is a 3D scene: rollqp.three.run.run"):
+def test_the_strip_march_refuses_a_3d_scene_in_one_line():
+    """rollqp.march.strip.run is the strip's run; rollqp.march.run hands a scene to its discretization's march."""
+    from rollqp.march import family
+    from rollqp.march.strip import run as run_2d
+    with pytest.raises(InputError, match=r"^scene: 'kalker-elliptic' is a 3D scene: rollqp.march.strip runs the strip; "
+                                         r"rollqp.march.run and rollqp.march.march run either"):
         run_2d("kalker-elliptic")
+    assert family("kalker-elliptic").__name__ == "rollqp.march.grid"
+    assert family("cattaneo-carter").__name__ == "rollqp.march.strip"
 
 
 def test_load_result_reads_a_3d_file_and_the_cli_resumes_it(braked, tmp_path, capsys, monkeypatch):
@@ -328,10 +333,10 @@ def test_a_conic_run_is_cross_checked_by_the_other_route_only(tmp_path, capsys, 
 
 def test_the_package_run_and_march_take_a_scene_of_either_dimension():
     """``rollqp.run``/``rollqp.march`` dispatch on the scene's dimension: a 3D scene gives the 3D run's
-    result (the same arrays as :func:`rollqp.three.run.run`, bitwise: one deterministic computation), a
+    result (the same arrays as :func:`rollqp.march.grid.run`, bitwise: one deterministic computation), a
     2D scene the 2D run's."""
     import rollqp
-    from rollqp.march import run as run_2d
+    from rollqp.march.strip import run as run_2d
     scene = coarse("kalker-circular", **{"discretization.distance": 0.5})
     mine, theirs = rollqp.run(scene).arrays(), run(scene).arrays()
     assert _spec_keys(mine)

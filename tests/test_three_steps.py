@@ -8,7 +8,7 @@ import pytest
 from rollqp.errors import InputError, SolverError
 from rollqp.operators.grid import Contact, Loads
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
-from rollqp.three.march import coupled_step, static_shift, steady, transient
+from rollqp.march.grid import coupled_step, static_shift, steady, transient
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.problem.grid import SLIP, STICK, Scales, TangentialStep
@@ -145,9 +145,12 @@ def test_steady_direct_against_marched():
     by less than 1e-10 μp0; its distance to the fixed point is that divided by (1 − contraction)."""
     c = elliptic((10, 10))
     loads = Loads(Fx=0.5 * MU * FN, eta=0.0, phi=0.2 / c.scales.length * 1e-3)
-    marched = steady(c, ClarabelMethod(), FN, loads)
+    marched = steady(c, ClarabelMethod(), FN, loads, approximate_start=False)       # from zero tractions
     _, tu, su = units(c)
     assert marched.info["marched"] > 5
+    started = steady(c, ClarabelMethod(), FN, loads)       # from FASTSIM's steady state: fewer steps, the same point
+    assert started.info["marched"] < marched.info["marched"]
+    assert np.max(np.abs(marched.t - started.t)) / tu <= 4e-8                    # both within their stopping distance
     for path in ("dense", "krylov"):
         direct = steady(c, NewtonMethod(path=path), FN, loads)
         assert direct.residual <= 1e-10

@@ -11,7 +11,7 @@ from rollqp.closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
 from rollqp.closedforms.kalker import kalker_coefficients
 from rollqp.operators.grid import Contact, Loads
 from rollqp.closedforms.hertz_ellipse import curvatures_for_ratio
-from rollqp.three.march import static_shift, steady
+from rollqp.march.grid import static_shift, steady
 from rollqp.materials import Materials
 from rollqp.methods.newton.disc import NewtonMethod
 from rollqp.report.grid import cattaneo_errors, creep_matrix, hertz_errors
@@ -83,7 +83,10 @@ def test_kalker_coefficients_small_grid():
     assert all(abs(g / r - 1) < 0.05 for g, r in zip(got, ref)), got
     # conventions (3D.8): Fx opposes ξ; Fy couples to φ with C23 > 0 and Mz to η with the opposite sign
     assert C[0, 0] > 0 and C[1, 2] > 0 and C[2, 1] == pytest.approx(-C[1, 2], rel=1e-6)
-    assert abs(C[0, 1]) < 1e-9 and abs(C[0, 2]) < 1e-9
+    # C12 and C13 vanish by symmetry (exactly on the dense path, 1e-16); this grid (1400 unknowns) takes the
+    # Krylov path, whose solve is exact to the Newton tolerance only: at μ = 1000 that leaves 2.4e-7 in C11
+    # itself (measured: 4.150996014 dense, 4.150995778 by GMRES) and up to 5e-9 in C12, C13
+    assert abs(C[0, 1]) < 1e-7 and abs(C[0, 2]) < 1e-7
 
 
 @pytest.mark.slow

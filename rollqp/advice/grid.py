@@ -17,8 +17,12 @@ with ``α`` (forming the dense Hessian, Clarabel's assembly of its KKT system, t
 elements, and ``β`` the interior point's factorizations (about 20 of order ``2m``; :data:`QUADRATIC`,
 :data:`CUBIC`; benchmarks/three_speed.py ``--only conic-model`` measures the model against real steps).
 
-A rolling start by a method that cannot solve the steady problem marches to it (:data:`MARCH_LENGTHS`
-contact lengths of ``dx`` steps). :func:`notes` prints the estimate when it exceeds :data:`NOTE_SECONDS`;
+Dissimilar bodies (``K ≠ 0``, eq. 3D.10) alternate the normal and the tangential step until both meet the
+tolerance (:func:`rollqp.march.grid.coupled_step`): each step costs :func:`coupled_sweeps` sweeps of
+:data:`SWEEP_COST` conic steps each (:func:`step_factor`). A rolling start by a method that cannot solve the
+steady problem marches to it: similar bodies from FASTSIM's steady state in about :data:`START_STEPS`
+steps, dissimilar ones from zero in :data:`MARCH_LENGTHS` contact lengths of ``dx`` steps. :func:`notes`
+prints the estimate when it exceeds :data:`NOTE_SECONDS`;
 :func:`refusal` refuses before any work a run whose estimate exceeds :data:`REFUSE_SECONDS`, or whose
 dense Hessian would not fit :data:`~rollqp.influence.blocktoeplitz.DENSE_MAX`, naming what runs instead.
 """
@@ -34,7 +38,8 @@ from ..influence.blocktoeplitz import DENSE_MAX
 from ..methods import capabilities, method_class
 
 __all__ = ["notes", "refusal", "conic_step_seconds", "conic_run", "yardstick", "NOTE_SECONDS", "REFUSE_SECONDS",
-           "QUADRATIC", "CUBIC", "MARCH_LENGTHS"]
+           "QUADRATIC", "CUBIC", "MARCH_LENGTHS", "START_STEPS", "coupled_sweeps", "step_factor", "SWEEP_CONTRACTION",
+           "SWEEP_COST"]
 
 #: Order of the yardstick's dense Cholesky factorization (:func:`yardstick`).
 YARDSTICK_ORDER = 600
@@ -50,6 +55,22 @@ REFUSE_SECONDS = 3600.0
 #: slip area (88 steps on the 24 × 24 circle, ξ = 1e-3, docs/performance.md); with everything sticking
 #: two steps reach it (the estimate is then pessimistic).
 MARCH_LENGTHS = 4.6
+#: Conic steps of the march of similar bodies from FASTSIM's steady state (rollqp.march.grid.approximate_steady),
+#: the start a march takes by default: measured 2 (ξ = 1e-5, all stick), 5 (ξ = 1e-3 and 4e-3) on the 24 × 24
+#: circle and 6 on the 40 × 40 circle at ξ = 1e-3 (docs/performance.md); 8 leaves room.
+START_STEPS = 8
+#: The N–T alternation of dissimilar bodies (:func:`coupled_sweeps`): its contraction per sweep is about
+#: ``SWEEP_CONTRACTION·|K|``, and it stops about :data:`SWEEP_MARGIN` below the tolerance. Measured with
+#: socp-clarabel on cattaneo-3d at 12 × 12 (76 elements in contact, 21 steps, tolerance 1e-10; body B's E and
+#: ν varied): 3.8, 4.6, 5.2, 6.0 sweeps a step at |K| = 0.017, 0.070, 0.125, 0.221, which
+#: ``ln(tolerance·SWEEP_MARGIN)/ln(SWEEP_CONTRACTION·|K|)`` gives within 4 %.
+SWEEP_CONTRACTION, SWEEP_MARGIN = 0.055, 1.0 / 30.0
+#: Conic steps a sweep costs, in units of a similar-body step (whose pressure is solved once; a sweep solves
+#: the normal and the tangential step): the same runs took 1.7–1.76 times the similar-body run's CPU time per
+#: sweep.
+SWEEP_COST = 1.7
+#: Sweeps before the alternation gives up (:data:`rollqp.march.grid.MAX_SWEEPS`).
+MAX_SWEEPS = 100
 
 _YARDSTICK = []
 
@@ -80,14 +101,36 @@ def conic_step_seconds(contact_elements: int, y: float | None = None) -> float:
     return (yardstick() if y is None else y) * (QUADRATIC * x * x + CUBIC * x ** 3)
 
 
+def coupled_sweeps(K: float, tolerance: float) -> float:
+    """The N–T sweeps a step of bodies with Kalker's difference constant ``K`` takes to ``tolerance``
+    (1 for similar bodies; :data:`SWEEP_CONTRACTION`).
+
+    >>> coupled_sweeps(0.0, 1e-10), round(coupled_sweeps(-0.0698, 1e-10), 2)
+    (1.0, 4.75)
+    """
+    if K == 0.0:
+        return 1.0
+    rate = min(SWEEP_CONTRACTION * abs(float(K)), 0.9)
+    return float(min(max(np.log(float(tolerance) * SWEEP_MARGIN) / np.log(rate), 1.0), MAX_SWEEPS))
+
+
+def step_factor(K: float, tolerance: float) -> float:
+    """Conic steps of the cost model one step of bodies with ``K`` costs (1 for similar bodies)."""
+    return 1.0 if K == 0.0 else SWEEP_COST * coupled_sweeps(K, tolerance)
+
+
 def conic_run(scene) -> tuple:
-    """``(steps, seconds a step, seconds in all)`` of ``scene`` run by a conic method (estimate)."""
+    """``(steps, seconds a step, seconds in all)`` of ``scene`` run by a conic method (estimate; a step of
+    dissimilar bodies counts its N–T sweeps, :func:`step_factor`)."""
     caps = capabilities(scene.solver.method, 3)
     n = scene.contact_elements()
-    per = conic_step_seconds(n)
+    per = conic_step_seconds(n) * step_factor(scene.materials.K, scene.solver.tolerance)
     steps = scene.n_steps
     if scene.load.start == "rolling" and "steady" not in caps.solves:
-        steps += int(MARCH_LENGTHS * 2 * scene.ellipse.a / scene.grid.dx) + 1
+        if scene.materials.K == 0.0:   # similar bodies: from FASTSIM's steady state (rollqp.march.grid.steady)
+            steps += START_STEPS
+        else:
+            steps += int(MARCH_LENGTHS * 2 * scene.ellipse.a / scene.grid.dx) + 1
     else:
         steps += scene.load.start_steps if scene.load.start == "braked" else 1
     return steps, per, per * steps

@@ -7,7 +7,7 @@
     rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
     rollqp crossval SCENE [--step K] [--methods M1,M2]
-    rollqp extrapolate SCENE [--grids N1,N2,N3]   (3D: creep forces from three grids, with an error estimate)
+    rollqp extrapolate SCENE [--grids N1,N2,N3] [--shifts K]   (3D: creep forces from a few grids, with an error estimate)
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
@@ -68,8 +68,8 @@ COMMANDS = {
     "export-step": Command("rollqp.cli.export_step", "write one step's data and QP forms (docs/stepfiles.md)"),
     "check-step": Command("rollqp.cli.check_step", "check a candidate solution of an exported step"),
     "crossval": Command("rollqp.cli.crossval", "every available method on one step, side by side"),
-    "extrapolate": Command("rollqp.cli.extrapolate", "3D: the steady state's creep forces on three grids, "
-                           "extrapolated (Richardson, the order measured) with an error estimate (docs/performance.md)"),
+    "extrapolate": Command("rollqp.cli.extrapolate", "3D: the steady state's creep forces on a few grids, "
+                           "each averaged over grid positions, extrapolated with an error estimate (docs/performance.md)"),
     "stresses": Command("rollqp.cli.stresses", "subsurface stresses of one state of a result file (docs/stresses.md)"),
     "wheelrail-table": Command("rollqp.wheelrail.cli", "the Manchester benchmark A-2.2: its 21 positions of a "
                                "wheel-rail scene, left and right wheels, as one table (docs/validation-wheel-rail.md)"),

@@ -41,7 +41,24 @@ def _positive(name, v):
 
 
 def brush_kappa(xi, a, p0, mu, stiffness):
-    """``κ = k|ξ|a/(μp₀)`` of eq. B.1 (array of ``xi``'s shape)."""
+    """``κ = k|ξ|a/(μp₀)`` of eq. B.1: the brush's stick strain at the leading edge over the friction bound.
+
+    Parameters
+    ----------
+    xi : float or array_like
+        Creepage (finite).
+    a, p0, mu, stiffness : float
+        As for :func:`brush_creep_ratio` (each ``> 0``).
+
+    Returns
+    -------
+    ndarray
+        ``κ >= 0``, of ``xi``'s shape.
+
+    Notes
+    -----
+    Source: ``SOURCES["brush_kappa"]``.
+    """
     a, p0, mu, k = (_positive(n, v) for n, v in (("a", a), ("p0", p0), ("mu", mu), ("stiffness", stiffness)))
     xi = np.asarray(xi, dtype=float)
     if not np.all(np.isfinite(xi)):
@@ -63,6 +80,15 @@ def brush_creep_ratio(xi, a, p0, mu, stiffness):
         Coulomb's coefficient (``> 0``).
     stiffness : float
         ``k``, traction per displacement (``G₃/h`` of a layer).
+
+    Returns
+    -------
+    float or ndarray
+        ``F/(μN)`` in ``[−1, 1]``, of sign opposite to ``ξ``, shape of ``xi``.
+
+    Notes
+    -----
+    Source: ``SOURCES["brush_creep_ratio"]``.
 
     Examples
     --------

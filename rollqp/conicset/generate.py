@@ -29,7 +29,7 @@ from ..scene import load_scene
 from ..operators.grid import Contact, Loads
 from ..problem.conic import normal_form, tangential_form
 from ..methods.newton.disc import NewtonMethod
-from ..three.march import coupled_step, normal, static_shift
+from ..march.grid import coupled_step, normal, static_shift
 from . import cbf, fclib
 from .forms import ProgramData, from_form, objective, residual
 

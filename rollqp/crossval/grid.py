@@ -22,13 +22,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..advice.grid import conic_step_seconds
+from ..advice.grid import conic_step_seconds, step_factor
 from ..errors import InputError, RollqpError
 from ..methods import (CROSS_CHECK_METHODS_3D, CROSSVAL_METHODS_3D, available_methods, capabilities, compose_3d,
                        get_method, method_class, require_3d)
-from ..three.run import run
-from ..loadpath import posed_force
-from ..three.march import _previous, coupled_step
+from ..march.grid import _previous, coupled_step, posed_force, run
 
 __all__ = ["SpotObserver", "CrossCheck", "cross_check", "crossval", "spot_steps", "SLACK", "AGREEMENT"]
 
@@ -51,7 +49,7 @@ def spot_steps(K: int) -> list[int]:
 
 
 class SpotObserver:
-    """``observe(record, contact)`` for :func:`rollqp.three.run.run`: keeps the records of ``steps`` and
+    """``observe(record, contact)`` for :func:`rollqp.march.grid.run`: keeps the records of ``steps`` and
     the state before each (``kept[k] = (record, (p, t) before or None)``)."""
 
     def __init__(self, steps):
@@ -144,7 +142,7 @@ class CrossCheck:
 
 def _pose(scene, contact, rec, before):
     """``(kind, loads, previous, dq)`` of the step behind ``rec`` (module docstring)."""
-    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.loadpath)
+    if "pose" in rec.info:          # a load path's step, posed as it was (rollqp.march.grid)
         kind, _, dq, _, loads = rec.info["pose"]
         return kind, loads, before, dq
     if rec.phase == "steady":
@@ -217,7 +215,9 @@ def cross_check(scene, observer: SpotObserver, ran: str, methods=None, tolerance
                 if key not in done:
                     m = max(int(np.sum(rec.p > 0)), 1)
                     # the estimate: the model's before the first conic step, then that step's own time
-                    est = conic_step_seconds(m) if measured is None else measured[0] * (m / measured[1]) ** 2
+                    # (a step of dissimilar bodies: its N–T sweeps, rollqp.advice.grid.step_factor)
+                    est = (conic_step_seconds(m) * step_factor(scene.materials.K, tolerance) if measured is None
+                           else measured[0] * (m / measured[1]) ** 2)
                     if deadline is not None and conic and time.perf_counter() + est > deadline:
                         out.skipped.setdefault(name, []).append(k)
                         out.estimate = max(out.estimate or 0.0, est)

@@ -11,7 +11,7 @@
                           DAQP, quadprog, ProxQP, PIQP, HiGHS; :mod:`.qp_qpsolvers`)
 ========================  ==========================================================
 
-**Three dimensions** (a scene with ``[contact] dimension = 3``, :mod:`rollqp.three`). A name keeps
+**Three dimensions** (a scene with ``[contact] dimension = 3``, :mod:`rollqp.march.grid`). A name keeps
 its meaning across dimensions — ``newton`` is rollqp's generalized Newton method, a ``qp-*`` name the
 convex programs on that external solver — and each dimension has its own table of classes:
 
@@ -418,7 +418,7 @@ def compose_3d(method: Method, friction: str = "constant") -> Method:
     """``method`` if its record can run a 3D scene: dimension 3, and tangential steps on the friction
     disc (a second-order cone per element); else an :class:`InputError` naming the methods that can.
 
-    (Dissimilar bodies run the normal–tangential alternation of :mod:`rollqp.three.march` with the
+    (Dissimilar bodies run the normal–tangential alternation of :mod:`rollqp.march.grid` with the
     method's own halves: every 3D method is composed so.) With a slip-dependent law (``friction = "slip"``)
     as in 2D (:func:`compose`): a method that does not declare ``slip_dependent`` runs inside the fixed point
     on the bound, and every method inside :class:`~rollqp.methods.continuation.SlipContinuation`.

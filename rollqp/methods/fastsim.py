@@ -46,7 +46,7 @@ Dynamics 11 (1982) 1–13; Kalker (1990) Table E.3.
 Examples
 --------
 >>> from rollqp import load_scene
->>> from rollqp.three.run import run
+>>> from rollqp.march.grid import run
 >>> scene = load_scene("kalker-circular", {"solver.method": "fastsim", "discretization.distance": 0.0})
 >>> r = run(scene).arrays()
 >>> round(float(r["Fx"][0]) / (-0.00402 * 300.0), 1)   # the linear limit: Kalker's -G c² C11 ξ (-1.19 N)

@@ -11,7 +11,7 @@ rollqp's own residuals on the step problem. On top of the solver:
 * **symmetric–skew splitting** when ``âŜ`` is not symmetric: a sequence of conic programs with
   the skew part at the previous iterate (docs/formulation.md §8); a splitting that does not
   contract is a :class:`~rollqp.errors.SolverError` (the steady operator: its skew part dominates;
-  the SOCP route reaches the steady state by marching, :mod:`rollqp.three.steady`);
+  the SOCP route reaches the steady state by marching, :func:`rollqp.march.grid.steady`);
 * **active-set refinement** (:mod:`rollqp.methods.refine`): an interior point method ends with every
   complementary pair small but not zero, so elements at the edge of the contact or of the stick area
   are off by about ``√gap``. The answer is refined by the conic program's own KKT system on the

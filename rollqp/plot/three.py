@@ -37,9 +37,9 @@ import numpy as np
 from ..closedforms.cattaneo3d import cattaneo_stick_radius, cattaneo_traction
 from ..closedforms.kalker import kalker_linear
 from ..errors import RollqpError
+from ..march.grid import run
 from ..methods import REFERENCE_METHOD
 from ..report.grid import LINEAR_SLIP_FRACTION, stick_fraction
-from ..three.run import run
 from ..units import unit_names
 from .style import REFERENCES, arrays, colors, finish, legend_below, meta, pyplot, scene_of, value_axis
 
@@ -353,7 +353,7 @@ def field_figure(res, scene=None, path: str | None = None, k: int = -1, title: s
     Examples
     --------
     >>> from rollqp import load_scene
-    >>> from rollqp.three.run import run
+    >>> from rollqp.march.grid import run
     >>> s = load_scene("kalker-elliptic").replace(**{"discretization.elements": [18, 36]})
     >>> fig = field_figure(run(s).arrays(), s)
     >>> [t.get_text() for t in fig.axes[0].get_legend().get_texts()][2:]

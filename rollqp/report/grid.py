@@ -37,7 +37,7 @@ from ..closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
 from ..closedforms.kalker import kalker_linear
 from ..loads import start_ellipse
 from ..operators.grid import Loads
-from ..three.march import normal, steady
+from ..march.grid import normal, steady
 
 __all__ = ["summary", "closed_form_errors", "stick_fraction", "LINEAR_SLIP_FRACTION", "semi_axes", "hertz_errors",
            "hertz_field_errors", "creep_matrix", "cattaneo_errors"]
@@ -162,7 +162,8 @@ def _steps_row(res, scene, u) -> str:
 
 def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
     """The table ``rollqp run`` prints for a 3D scene (module docstring); the arguments as
-    :func:`rollqp.report.summary` (``stresses`` is not computed for 3D scenes)."""
+    :func:`rollqp.report.summary` (``stresses``: a :class:`rollqp.subsurface3d.StressHistory3D` of the run, from
+    ``rollqp run --stresses``: its peak von Mises and Tresca stresses over the stored states, with place and state)."""
     u = unit_names(getattr(scene, "units", ""))
     force, moment = _force_units(u)
     e, mu = scene.ellipse, scene.mu
@@ -195,6 +196,12 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
                                   f"refined ones kept by max |dp| {raw['dp']:.1e} p0, |dt| {raw['dt']:.1e} mu p0 "
                                   f"over {raw['steps']} steps (interior point: about sqrt(gap); docs/theory3d.md §5)"))
     rows += closed_form_errors(res, scene)
+    if stresses is not None:
+        for key, label in (("von_mises", "peak von Mises"), ("tresca", "peak Tresca")):
+            v, x, y, z, k = stresses.overall[key]
+            rows.append((label, f"{v / e.p0:.4f} p0 at x = {x:.5g}, y = {y:.5g}, z = {z:.5g} {u.length}, state {k} "
+                                f"(body {stresses.body}, plane y = 0 below the grid, {stresses.section.z.size} depths "
+                                "to 2a; rollqp stresses for other sections)"))
     w = max(len(r[0]) for r in rows)
     return "\n".join(f"  {k:<{w}}  {v}" for k, v in rows)
 

@@ -248,7 +248,7 @@ class Scene3D(TwoBodyScene):
 
     The parts are checked key by key and the scene as a whole at construction; the derived
     quantities (:attr:`materials`, :attr:`ellipse`, :attr:`grid`, :attr:`dq`, :attr:`n_steps`) are
-    what the run (:mod:`rollqp.three.run`) builds its contact from.
+    what the run (:mod:`rollqp.march.grid`) builds its contact from.
 
     Examples
     --------

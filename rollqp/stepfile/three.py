@@ -32,13 +32,12 @@ import numpy as np
 
 from ..errors import InputError
 from ..loads import start_force
+from ..march.grid import StepRecord, march, prepare
 from ..methods import REFERENCE_METHOD
 from ..npzfile import read_npz, real_array, real_scalar, text_value
 from ..problem.conic import normal_form, tangential_form
 from ..problem.grid import NormalStep, Scales, TangentialStep, disc_projection
 from ..result import META_LIMIT
-from ..three.march import StepRecord
-from ..three.run import march, prepare
 from .file import write_step_files
 
 __all__ = ["FORMAT_3D", "MAX_ELEMENTS_3D", "StepFile3D", "export_step_3d", "check_step_3d", "Check3D",
@@ -276,7 +275,7 @@ def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
         kind, loads, previous, dq = "rolling", scene.loads_at(rec.q), (prev.p, prev.t), scene.dq
         B, Atn = ops.Att, (ops.Atn if ops.coupled else None)
     FN = start_force(scene) if k == 0 else ld.normal
-    if "pose" in rec.info:          # a load path's step (rollqp.loadpath): its load, Δq, direction, loads
+    if "pose" in rec.info:          # a load path's step (rollqp.march.grid): its load, Δq, direction, loads
         kind, FN, dq, direction, loads = rec.info["pose"]
     if rec.FN == 0:
         raise InputError("--step", f"step {k} of {scene.name!r} is out of contact (load.normal_history is 0 there): "

@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import InputError, MissingBackendError
 from ..fields import FIELDS, dtype_of, fields_for
-from ..march import _versions
+from ..march.loop import versions as _versions
 from ..result import load_result
 from ..version import __version__
 

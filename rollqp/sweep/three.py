@@ -47,10 +47,10 @@ from ..atomic import OutputLock, written
 from ..closedforms.kalker import kalker_linear
 from ..errors import InputError, RollqpError
 from ..fields import registry
+from ..march.grid import run
 from ..plot import pyplot
 from ..scene import load_scene, scene_from_dict
 from ..threads import limited
-from ..three.run import run
 from .executor import close_client, connect, iter_jobs
 from .spec import Axis, MAX_POINTS, parse_values, parse_vary
 

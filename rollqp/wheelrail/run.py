@@ -22,10 +22,10 @@ import numpy as np
 from ..atomic import written
 from ..crossval.grid import AGREEMENT
 from ..errors import InputError
+from ..march.grid import coupled_step
+from ..march.loop import versions as _versions
 from ..methods import CROSSVAL_METHODS_3D, available_methods, get_method
 from ..operators.grid import Loads
-from ..three.march import coupled_step
-from ..three.run import _versions
 from ..version import __version__
 from .solve import solve_wheel
 from .track import Track
@@ -85,7 +85,7 @@ class WheelRailResult:
             a[f"patch{k}_px"], a[f"patch{k}_py"] = g.field(p.t[0]), g.field(p.t[1])
             a[f"patch{k}_state"] = g.field(p.state).astype(np.int8)
         a["meta"] = np.array(json.dumps({"scene": self.scene.to_dict(), "method": self.method, "kind": "wheel-rail",
-                                         "rollqp": __version__, "versions": dict(_versions()), "wall": self.wall}))
+                                         "rollqp": __version__, "versions": _versions(), "wall": self.wall}))
         return a
 
     def save(self, out) -> None:

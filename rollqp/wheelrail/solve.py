@@ -31,9 +31,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, SolverError
+from ..march.grid import steady
 from ..operators.grid import Contact, Loads
 from ..problem.grid import NormalStep
-from ..three.march import steady
 from .search import search, touch
 
 __all__ = ["PatchResult", "WheelResult", "solve_wheel", "LOAD_TOLERANCE", "Z_TOLERANCE"]

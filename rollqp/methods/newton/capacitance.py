@@ -8,8 +8,9 @@ from ``A`` only in the rows of the slipping elements ``Q``:
 .. math::
     J = A + E_Q\,W,\qquad W = (M_Q − I)\,E_Q^T A + (I − M_Q)\,E_Q^T
 
-so that, with ``A⁻¹``'s LU once per contact set (:func:`inverse`, kept with the operator) and its
-columns on the slipping elements as they are needed,
+so that, with ``A⁻¹`` once per contact set (:func:`inverse`, kept with the operator for a march's steps;
+for a single solve :class:`Columns`: the LU, and the columns of ``A⁻¹`` on the slipping elements as they
+are needed),
 
 .. math::
     J^{-1} b = y − (A^{-1})_{:,Q}\,C^{-1} (I − M_Q)(y_Q − b_Q),\qquad y = A^{-1} b,\qquad
@@ -17,8 +18,7 @@ columns on the slipping elements as they are needed,
 
 (``C`` is the capacitance matrix, of order ``2|Q|``; ``det J = det A · det C``). An iteration
 then costs an LU of order ``2|Q|`` and products with ``A⁻¹`` instead of an LU of order ``2|V|``:
-on a small grid in partial slip (a fifth of the elements slipping) a few hundredths of it; a column
-of ``A⁻¹`` is computed once (two triangular solves) the first time its element slips. The direction
+on a small grid in partial slip (a fifth of the elements slipping) a few hundredths of it. The direction
 is the LU path's to round-off (not bit for bit: another order of operations).
 """
 from __future__ import annotations
@@ -28,7 +28,7 @@ import warnings
 import numpy as np
 import scipy.linalg as sla
 
-__all__ = ["Inverse", "inverse", "solve", "MAX_FRACTION"]
+__all__ = ["Inverse", "Columns", "inverse", "factor", "solve", "MAX_FRACTION"]
 
 #: Slipping rows ``2|Q|`` above this fraction of the traction rows: the LU of ``J`` itself (an LU
 #: of order ``2|Q|`` then costs an eighth of it or more, and the products with ``A⁻¹`` are not free).
@@ -36,12 +36,33 @@ MAX_FRACTION = 0.5
 
 
 class Inverse:
-    """``S⁻¹`` of the operator's dense contact block ``S``: its LU (LAPACK ``getrf``), and the columns of
-    ``S⁻¹`` computed so far (``getrs`` on unit vectors), each once."""
+    """``S⁻¹`` of the operator's dense contact block ``S`` (LAPACK ``getrf``/``getri``), formed whole, for a
+    march's steps on one contact set to share: every column then comes from the same computation whatever
+    the history of the march (columns solved in batches as elements start to slip differ in the last bits
+    with the batch, which would make a resumed march differ from the uninterrupted one)."""
 
     def __init__(self, S: np.ndarray):
-        self.lu = sla.lu_factor(S, check_finite=False)
-        self.m = S.shape[0]
+        self.inv = sla.inv(S, check_finite=False)
+        self.inv.flags.writeable = False
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """``S⁻¹ b``."""
+        return self.inv @ b
+
+    def columns(self, Q: np.ndarray) -> np.ndarray:
+        """``S⁻¹[:, Q]``."""
+        return self.inv[:, Q]
+
+
+class Columns:
+    """``S⁻¹`` for one solve: ``S``'s LU (``getrf``; it may be shared) and the columns of ``S⁻¹`` on the
+    slipping elements, each solved (``getrs``) the first time its element slips in this solve. Cheaper than
+    :class:`Inverse` for a single solve (a steady state), and as repeatable: the batches follow the solve's
+    own iterates, not what was solved before."""
+
+    def __init__(self, lu):
+        self.lu = lu
+        self.m = lu[0].shape[0]
         self._cols = np.empty((self.m, 0))
         self._where = np.full(self.m, -1, dtype=np.intp)
 
@@ -60,13 +81,19 @@ class Inverse:
         return self._cols[:, self._where[Q]]
 
 
+def factor(S: np.ndarray):
+    """``S``'s LU factors (for :class:`Columns`)."""
+    return sla.lu_factor(S, check_finite=False)
+
+
 def inverse(S: np.ndarray) -> Inverse:
     """:class:`Inverse` of ``S``."""
     return Inverse(S)
 
 
-def solve(Sinv: Inverse, scale: float, slip: np.ndarray, mxx, mxy, myy, b: np.ndarray):
-    """``J⁻¹ b`` by eq. 3D.28a, ``A⁻¹ = S⁻¹/scale``; ``b``: ``(2 nv,)`` or ``(2 nv, k)``.
+def solve(Sinv, scale: float, slip: np.ndarray, mxx, mxy, myy, b: np.ndarray):
+    """``J⁻¹ b`` by eq. 3D.28a, ``A⁻¹ = S⁻¹/scale`` (``Sinv`` an :class:`Inverse` or :class:`Columns`); ``b``:
+    ``(2 nv,)`` or ``(2 nv, k)``.
 
     ``slip``: the slipping elements (indices into the ``nv`` contact elements); ``mxx, mxy, myy``:
     ``M_i``'s entries on every contact element. ``None`` where ``C`` is singular (the caller takes

@@ -48,6 +48,7 @@ from ..base import Capabilities, check_options
 from ..fixedpoint import BoundFixedPoint
 from ...problem.grid import disc_projection
 from . import capacitance
+from .gmres import gmres
 
 __all__ = ["NewtonMethod", "DENSE_UNKNOWNS", "tangential_rows"]
 
@@ -424,6 +425,7 @@ class _TangentialSystem:
         for i, j in enumerate(free):
             self.E[j * self.nv:(j + 1) * self.nv, i] = 1.0
         steady = str(getattr(problem.B, "name", "")).startswith("steady")   # the steady operator (eq. 3D.17)
+        self.steady, self._columns = steady, None
         self.dense = method._use_dense(2 * self.nv + len(free), DENSE_UNKNOWNS if steady else TRANSIENT_DENSE_UNKNOWNS)
         self.S = k * self._block() if self.dense else None
         self._rS = None
@@ -445,9 +447,14 @@ class _TangentialSystem:
         return B.memo(("dense", V.tobytes()), lambda: B.dense(V, V))
 
     def _inverse(self):
-        """The inverse of :meth:`_block` (kept with the operator: a march's steps on one contact set
-        share it)."""
-        return self.problem.B.memo(("inverse", self.V.tobytes()), lambda: capacitance.inverse(self._block()))
+        """The inverse of :meth:`_block`: whole and kept with the operator for the steps of a march (they share
+        it), as an LU kept with the operator and this solve's own columns for a steady state (one solve)."""
+        B, key = self.problem.B, self.V.tobytes()
+        if not self.steady:
+            return B.memo(("inverse", key), lambda: capacitance.inverse(self._block()))
+        if self._columns is None:
+            self._columns = capacitance.Columns(B.memo(("lu", key), lambda: capacitance.factor(self._block())))
+        return self._columns
 
     def split(self, x, Kx):
         m = 2 * self.nv
@@ -599,14 +606,12 @@ class _TangentialSystem:
             return np.concatenate([cxx * Rd[:nv] + cxy * Rd[nv:] + tx - (mxx * tx + mxy * ty),
                                    cyx * Rd[:nv] + cyy * Rd[nv:] + ty - (mxy * tx + myy * ty)])
 
-        spla = _sparse_linalg()
-        J = spla.LinearOperator((m, m), matvec=apply_J, dtype=float)
-        P = spla.LinearOperator((m, m), matvec=self._block_preconditioner(c, mxx, mxy, myy), dtype=float)
+        P = self._block_preconditioner(c, mxx, mxy, myy)
 
         def solve(b):
             # 80 × 50 iterations at most: measured ≤ 150 on the 300 × 300 grid; beyond, the inexact step
             # still goes to the line search (info > 0 is not an error)
-            x, info = spla.gmres(J, b, rtol=KRYLOV_FORCING, atol=0.0, restart=80, maxiter=50, M=P)
+            x, info = gmres(apply_J, b, P, rtol=KRYLOV_FORCING, restart=80, maxiter=50)
             if info < 0 or not np.all(np.isfinite(x)):
                 raise SolverError("tangential Newton: GMRES failed", method=self.method.name)
             return x

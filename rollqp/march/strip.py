@@ -42,7 +42,6 @@ coupling level asked for (:class:`~rollqp.operators.SceneOperators`).
 from __future__ import annotations
 
 import dataclasses
-import functools
 import os
 import time
 from dataclasses import dataclass, field
@@ -50,22 +49,24 @@ from typing import Iterator
 
 import numpy as np
 
-from .advice import fast_path
-from .atomic import stop_once
-from .errors import InputError, SolverError
-from .fields import fields_for
-from .friction.bound import steady_branches
-from .kinematics import HistoryCache, plan
-from .methods import compose, scene_method
-from .methods.steady_start import accelerated_start, predicting
-from .operators import SceneOperators
-from .problem import SLIP, STICK, State, StepSolution, classify
-from .result import Result, ResumeSource, _meta_of, check_output, resume_source
-from .scene import Scene, load_scene
-from .scene.checks import check_result_memory
-from .solverstate import Recorder, restore
-from .strip import RowSparse
-from .version import __version__
+from ..advice import fast_path
+from ..atomic import stop_once
+from ..errors import InputError, SolverError
+from ..fields import fields_for
+from ..friction.bound import steady_branches
+from ..kinematics import HistoryCache, plan
+from ..methods import compose, scene_method
+from ..methods.steady_start import accelerated_start, predicting
+from ..operators import SceneOperators
+from ..problem import SLIP, STICK, State, StepSolution, classify
+from ..result import Result, ResumeSource, check_output, resume_source
+from ..scene import Scene, load_scene
+from ..scene.checks import check_result_memory
+from ..solverstate import Recorder, restore
+from ..strip import RowSparse
+from ..version import __version__
+from .loop import RESUME_TOL, check_earlier, check_last, drive, last_index, stored_steps, versions
+from .loop import keep_every as _keep_every
 
 __all__ = ["State", "StepRecord", "march", "run", "prepare"]
 
@@ -537,8 +538,8 @@ class _March:
 def _two_d(scene) -> Scene:
     """``scene`` if it is a 2D scene, else a one-line :class:`InputError` naming the 3D entry points."""
     if not isinstance(scene, Scene):   # another dimension's scene (docs/architecture.md, three dimensions)
-        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.three.run.run and "
-                                  "rollqp.three.run.march run it (on the command line: rollqp run)")
+        raise InputError("scene", f"{scene.name!r} is a {scene.dimension}D scene: rollqp.march.strip runs the strip; "
+                                  "rollqp.march.run and rollqp.march.march run either (on the command line: rollqp run)")
     return scene
 
 
@@ -622,8 +623,8 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, record
         if verify:
             state = check_resumed(scene, (scene, meth, ops), resume, march=m, recorder=recorder)
         elif state is None:
-            state = _with_normal(m, resumed_state(scene, ops, resume), _last_index(resume))
-        first = _last_index(resume) + 1
+            state = _with_normal(m, resumed_state(scene, ops, resume), last_index(resume))
+        first = last_index(resume) + 1
     else:
         try:
             start = m.start()
@@ -645,17 +646,6 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, record
         yield rec
 
 
-def _last_index(arrays) -> int:
-    """The index k of the last stored state (``step`` if the file keeps only some states)."""
-    return int(arrays["step"][-1]) if "step" in arrays else len(arrays["q"]) - 1
-
-
-#: A resumed state must equal its step solved again from the state before it to this fraction of p0
-#: (pressures) and μp0 (tractions): ten thousand times the methods' tolerance (1e-10: two solutions
-#: of a step from different warm starts agree to ~1e-10), far below any change to a state that matters.
-RESUME_TOL = 1e-6
-
-
 def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1, products=None) -> State:
     """A stored state of a result file of ``scene`` (the last one, ``row = -1``), as the march continues from it.
 
@@ -671,7 +661,7 @@ def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1, produ
         ``--resume``: the file belongs to another scene (other nodes or rolled distances).
     """
     x, q = np.asarray(arrays["x"]), np.asarray(arrays["q"])
-    steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(q.size)
+    steps = stored_steps(arrays)
     qs = scene.q_steps
     if x.shape != (ops.n,) or not np.allclose(x, ops.strip.x, rtol=0, atol=1e-12 * scene.half_width):
         raise InputError("--resume", f"the result file's {x.size} nodes are not this scene's {ops.n}: another scene")
@@ -696,60 +686,81 @@ def resumed_state(scene, ops: SceneOperators, arrays: dict, row: int = -1, produ
 
 
 def check_resumed(scene, prepared, arrays: dict, march=None, recorder=None) -> State:
-    """The state to continue from: the last stored state of ``arrays``, checked to solve its own step.
+    """The state to continue from: the last stored state of ``arrays``, checked to solve its own step
+    (:func:`rollqp.march.loop.check_last`, as the grid's).
 
     That step is solved again from the state before it (from the start for state 0), with what the
     method carried across steps rebuilt as it was after that state (:func:`rollqp.solverstate.restore`, from
     the journal's records, ``arrays["_notes"]``): the same computation as the uninterrupted run's, so
     it gives the stored state bit for bit, and the march continues from it (and from the method as it
     was). Otherwise (a file without the records, or a method whose state is not all rebuilt: a QP
-    solver's internals) it must agree to :data:`RESUME_TOL` and the march continues from the stored
+    solver's internals) it must agree to :data:`~rollqp.march.loop.RESUME_TOL` (pressures in p0, tractions in
+    μp0; the gap, approach, slip and creepage it hands on with them) and the march continues from the stored
     state; else the file was changed or is corrupt (an :class:`InputError` on ``--resume``, one line,
     nothing run). ``recorder``: the march's :class:`~rollqp.solverstate.Recorder`, which goes on from the
     records."""
     scene, meth, ops = prepared
     m = march if march is not None else _March(scene, ops, meth)
-    k = _last_index(arrays)
-    steps = np.asarray(arrays["step"]) if "step" in arrays else np.arange(len(arrays["q"]))
-    stored = _with_normal(m, resumed_state(scene, ops, arrays, -1), k)
-    try:
-        if k == 0:
-            _restore(m, arrays, -1, recorder)
-            again = m.start().state
-        elif steps.size >= 2 and int(steps[-2]) == k - 1:
-            products = _restore(m, arrays, k - 1, recorder)
-            before = _with_normal(m, resumed_state(scene, ops, arrays, -2, products=products), k - 1)
-            again = m.rolling(k, float(m.plan.q[k]), before, ops.history()).state
-        else:
-            raise InputError("--resume", f"the result file does not hold the state before its last one ({k}), "
-                                         "which it needs to be continued")
-    except SolverError as err:
-        raise InputError("--resume", f"the last state ({k}) cannot be checked: its step, solved again, failed "
-                                     f"({str(err)[:120]})") from None
-    if _identical(again, stored):
-        return again
-    p0, mu = ops.scales.stress, max(float(getattr(ops, "mu", 0.0) or 0.0), 1e-300)
-    dp = float(np.max(np.abs(again.p - stored.p))) / p0
-    dt = float(np.max(np.abs(again.t - stored.t))) / (min(mu, 1.0) * p0) if mu > 1e-300 else 0.0
-    if not (dp <= RESUME_TOL and dt <= RESUME_TOL):
-        raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
-                                     f"state before it, its pressure differs by {dp:.3g} p0 and its traction by "
-                                     f"{dt:.3g} mu p0 (more than {RESUME_TOL:g}): the file was changed or is corrupt")
-    # the gap, approach, slip and creepage it hands on (a fixed normal half carries its solution to every later step)
+
+    def start():
+        _restore(m, arrays, -1, recorder)
+        return m.start().state
+
+    def step(k):
+        products = _restore(m, arrays, k - 1, recorder)
+        before = _with_normal(m, resumed_state(scene, ops, arrays, -2, products=products), k - 1)
+        return m.rolling(k, float(m.plan.q[k]), before, ops.history()).state
+
+    return check_last(arrays, stored=lambda row: _with_normal(m, resumed_state(scene, ops, arrays, row),
+                                                              last_index(arrays)),
+                      start=start, step=step, identical=_identical,
+                      differences=lambda again, stored: _differences(again, stored, ops), n_steps=scene.n_steps)
+
+
+def _differences(again: State, stored: State, ops) -> tuple:
+    """``(what, again, stored, scale, unit)`` of every field a resumed state is checked by: the pressure and
+    traction, and the gap, approach, slip and creepage it hands on (a fixed normal half carries its solution to
+    every later step)."""
     sc = ops.scales
-    for what, a, b, scale, unit in (("gap", again.nsol.g, stored.nsol.g, sc.displacement, "u0"),
-                                    ("approach", again.nsol.delta, stored.nsol.delta, sc.displacement, "u0"),
-                                    ("slip", again.tsol.s, stored.tsol.s, sc.slip, "p0/E*"),
-                                    ("creepage", again.tsol.xi, stored.tsol.xi, sc.slip, "p0/E*")):
-        if a is None or b is None:
-            continue
-        d = np.abs(np.asarray(a, dtype=float) - np.asarray(b, dtype=float)) / scale
-        worst = float(np.max(d)) if np.all(np.isfinite(d)) else np.inf
-        if not worst <= RESUME_TOL:
-            raise InputError("--resume", f"the last state ({k}) does not solve its own step: solved again from the "
-                                         f"state before it, its {what} differs by {worst:.3g} {unit} (more than "
-                                         f"{RESUME_TOL:g}): the file was changed or is corrupt")
-    return stored
+    mu = float(getattr(ops, "mu", 0.0) or 0.0)
+    return (("pressure", again.p, stored.p, sc.stress, "p0"),
+            ("traction", again.t, stored.t, min(mu, 1.0) * sc.stress, "mu p0") if mu > 0 else ("traction", None, None, 1.0, ""),
+            ("gap", again.nsol.g, stored.nsol.g, sc.displacement, "u0"),
+            ("approach", again.nsol.delta, stored.nsol.delta, sc.displacement, "u0"),
+            ("slip", again.tsol.s, stored.tsol.s, sc.slip, "p0/E*"),
+            ("creepage", again.tsol.xi, stored.tsol.xi, sc.slip, "p0/E*"))
+
+
+def check_states(scene, ops: SceneOperators, source) -> None:
+    """Every state of an earlier part of the run (``source``: a :class:`~rollqp.result.ResumeSource` or a result
+    file's arrays) consistent in itself (:func:`rollqp.march.loop.check_earlier`, as the grid's): its fields
+    finite, pressures >= 0 and tractions within ``μp`` (to :data:`~rollqp.march.loop.RESUME_TOL` of p0 and
+    μp0; a friction law's own ``μ`` where the file holds it), the tangential load ``Q`` that of its tractions.
+    The nodes, rolled distances and the last state are checked by :func:`resumed_state` and
+    :func:`check_resumed`."""
+    sc, f = ops.scales, ops.f
+    law = scene.contact.friction.kind != "constant"
+    mu = float(getattr(ops, "mu", 0.0) or 0.0)
+    tunit = (min(mu, 1.0) if mu > 0 else 1.0) * sc.stress
+    names = ("pn", "pt", "slip", "Q", "step") + (("friction_coefficient",) if law else ())
+
+    def inconsistent(b, k):
+        p, t = np.asarray(b["pn"], dtype=float), np.asarray(b["pt"], dtype=float)
+        if not (np.all(np.isfinite(p)) and np.all(np.isfinite(t)) and np.all(np.isfinite(np.asarray(b["slip"], dtype=float)))):
+            return "its fields are not finite"
+        if np.min(p, initial=0.0) < -RESUME_TOL * sc.stress:
+            return f"a pressure of {np.min(p) / sc.stress:.3g} p0 < 0"
+        coefficient = np.asarray(b["friction_coefficient"], dtype=float) if law and "friction_coefficient" in b else \
+            (None if law else mu)
+        if coefficient is not None and np.max(np.abs(t) - coefficient * np.maximum(p, 0.0), initial=0.0) > RESUME_TOL * tunit:
+            return "a traction beyond the friction bound mu p"
+        Q = t @ f
+        bad = np.flatnonzero(~(np.abs(Q - np.asarray(b["Q"], dtype=float)) <= 1e-12 * (np.abs(t) @ np.abs(f) + tunit * f.sum())))
+        if bad.size:
+            return f"state {int(k[bad[0]])}: its tangential load Q is not that of its tractions"
+        return None
+
+    check_earlier(source, names, inconsistent)
 
 
 def _restore(m: _March, arrays, upto, recorder):
@@ -830,7 +841,7 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
     geometry : Memo, optional
         Shared by the runs it is handed to: what the influence model keeps of the bodies (:func:`prepare`).
     start_progress : callable, optional
-        The 3D run's report of the steps of its start (:func:`rollqp.three.run.run`); a 2D start (its
+        The 3D run's report of the steps of its start (:func:`rollqp.march.grid.run`); a 2D start (its
         problems on a strip: milliseconds to seconds) is not reported.
 
     Raises
@@ -859,6 +870,8 @@ def run(scene, method=None, progress=None, resume=None, observe=None, *, out=Non
         recorder = Recorder(meth, ops)
     if source is not None:
         tail = source.tail() if isinstance(source, ResumeSource) else source
+        resumed_state(scene, ops, tail)                 # the nodes and the rolled distances: this scene's
+        check_states(scene, ops, source)                # every state consistent, before any is solved from
         checked = _March(scene, ops, meth)  # the march goes on from it (its history operators)
         state = check_resumed(scene, prepared, tail, march=checked, recorder=recorder)
     result = new_result(asked, ops, meth.name, keep_every=keep, out=out)  # meta: the scene as given, the method that ran it
@@ -873,64 +886,15 @@ def _run(scene, prepared, result, source, resumed, observe, progress) -> Result:
     """:func:`run`'s loop over the 2D march (:func:`drive`)."""
     tail, state, recorder, checked = resumed
     records = march(scene, prepared=prepared, resume=tail, verify=False, record=recorder, state=state, _march=checked)
-    return drive(result, records, source=source, resumed_from=None if tail is None else _last_index(tail),
+    return drive(result, records, source=source, resumed_from=None if tail is None else last_index(tail),
                  operators=prepared[2], observe=observe, progress=progress, steps=scene.n_steps)
-
-
-def drive(result, records, *, source=None, resumed_from=None, operators=None, observe=None, progress=None,
-          steps: int = 0) -> Result:
-    """The run's loop, in either dimension: the ``records`` (an iterator of step records, started lazily) into
-    ``result``, after the states of ``source`` (a resumed run's, :meth:`Result.resume
-    <rollqp.result.Result.resume>`; ``resumed_from``: the index of its last one). ``observe(record,
-    operators)`` with every record, ``progress(k, steps)`` after each rolling step. On a failure or a signal
-    the result is finished with a note (``failed``, ``interrupted``: its completed states are written) and the
-    error raised with ``err.partial``; call it inside :func:`rollqp.atomic.stop_once`, so that a second
-    Ctrl-C never interrupts the writing of what the first one saves."""
-    try:
-        if source is not None:
-            result.resume(source)
-            result.meta["resumed_from"] = resumed_from
-        for rec in records:
-            result.add(rec, operators)
-            if observe is not None:
-                observe(rec, operators)
-            if progress is not None and rec.k > 0:
-                progress(rec.k, steps)
-    except (SolverError, InputError, KeyboardInterrupt, MemoryError) as err:
-        note = {"interrupted": "interrupted"} if isinstance(err, KeyboardInterrupt) else \
-            {"failed": str(err) or type(err).__name__}
-        try:
-            result.finish(note)
-        except KeyboardInterrupt:  # a signal held during the write: the file is written, the first one goes on
-            pass
-        err.partial = result
-        raise
-    try:
-        return result.finish()
-    except KeyboardInterrupt as err:  # a signal while the file was written: it is complete
-        err.partial = result
-        raise
-
-
-def _keep_every(keep_every, source) -> int:
-    """``keep_every`` of a run: the resumed file's, which an explicit value must not contradict."""
-    had = source.keep_every if isinstance(source, ResumeSource) else \
-        _meta_of(source).get("keep_every", 1) if isinstance(source, dict) else None
-    if had is not None and (isinstance(had, bool) or not isinstance(had, int) or had < 1):
-        raise InputError("--resume", f"meta['keep_every'] must be a whole number >= 1, got {str(had)[:40]}")
-    if keep_every is None:
-        return had or 1
-    if had is not None and keep_every != had:
-        raise InputError("--keep-every", f"the resumed run keeps every {had}-th state; resume it with that "
-                                         f"(or without --keep-every), got {keep_every!r}")
-    return keep_every
 
 
 def new_result(scene, ops: SceneOperators, method_name: str, keep_every: int = 1, out=None) -> Result:
     """An empty :class:`Result` with the scene's scalars, metadata and the computed fields it needs
     (``out``: written to that file through its journal, :func:`run`)."""
     meta = {"scene": scene.to_dict(), "method": method_name, "model": dict(ops.info), "dimension": 2,
-            "versions": _versions(), "rollqp": __version__,
+            "versions": versions(), "rollqp": __version__,
             "dq": scene.dq, "n_nodes": ops.n, "coupling": scene.coupling_level,
             "step_problem": "coupled" if ops.coupled else "normal + tangential",
             "slip_note": ("step 0 of a braked start: static-shift slip per a_H of shift" if scene.load.start == "braked"
@@ -942,24 +906,6 @@ def new_result(scene, ops: SceneOperators, method_name: str, keep_every: int = 1
     constants = {"f": ops.f, "wear_A": scene.A.wear or 0.0, "wear_B": scene.B.wear or 0.0}
     return Result(x=ops.strip.x.copy(), scalars=scalars, meta=meta, extra=fields_for(scene), constants=constants,
                   keep_every=keep_every, out=out, operators=ops)
-
-
-def _versions() -> dict:
-    return dict(_installed_versions())
-
-
-@functools.lru_cache(maxsize=1)
-def _installed_versions() -> tuple:
-    """The versions recorded in every result's meta, read once per process (importlib.metadata
-    scans sys.path: ~5 ms, more than the stepping of a small scene)."""
-    import importlib.metadata as md
-    out = {}
-    for pkg in ("numpy", "scipy", "clarabel", "osqp", "cvxpy"):
-        try:
-            out[pkg] = md.version(pkg)
-        except md.PackageNotFoundError:
-            out[pkg] = None
-    return tuple(out.items())
 
 
 def _unloaded(ops: SceneOperators, xi=None) -> State:
