@@ -182,8 +182,9 @@ def test_at_most_two_arrows_back_up():
 #: At most this many imports of rollqp's own modules inside functions. rollqp's modules import each other at their
 #: top (a module's dependencies are read in one place, and the cycle and layer checks above see the real graph);
 #: an import inside a function is left only where an optional or heavy dependency stands behind the imported module
-#: (xarray for rollqp.open_result, scipy.sparse and clarabel for a step file's Clarabel JSON: ``import rollqp`` and
-#: the start of ``rollqp run`` load neither) or where a real cycle cannot be broken (the wheel-rail scene, built on
+#: (xarray for rollqp.open_result, scipy.sparse and clarabel for a step file's Clarabel JSON, scipy for the grid's
+#: chord start and the BEM: ``import rollqp`` and the start of ``rollqp run`` load none of them,
+#: tests/test_architecture.py) or where a real cycle cannot be broken (the wheel-rail scene, built on
 #: the scene package, read by it: the contract's one arrow back up). 20 leaves room for a few such cases; each one
 #: says why in a comment on its line or the line above (checked below).
 MAX_INNER_IMPORTS = 20

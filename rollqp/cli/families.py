@@ -28,7 +28,8 @@ class Family:
     command loads only the parts of the scene's dimension it calls: ``rollqp run`` of a 3D scene neither the
     2D march's figures nor any step file), or given as the callable itself (:meth:`replace`). The command
     line's own parts of a dimension are in one module each (:mod:`rollqp.cli.two`, :mod:`rollqp.cli.three`,
-    :mod:`rollqp.wheelrail.cli`), which import nothing of this module: the names run one way only.
+    :mod:`rollqp.wheelrail.cli`; the sweeps of both in :mod:`rollqp.cli.sweeps`), which import nothing of this
+    module: the names run one way only.
     """
 
     PARTS = ("run", "summary", "plot", "advise", "spot", "check", "stresses", "crossval", "export_step", "sweep",
@@ -62,14 +63,14 @@ FAMILIES = {
               run="rollqp.march:run", summary="rollqp.report:summary", plot="rollqp.plot:plot_result",
               advise="rollqp.cli.two:advise", spot="rollqp.cli.two:spot", check="rollqp.cli.two:check",
               stresses="rollqp.subsurface:stress_history", crossval="rollqp.cli.two:crossval",
-              export_step="rollqp.stepfile:export_step", sweep="rollqp.cli.two:sweep",
-              creep_curve="rollqp.cli.two:creep_curve", memory_policy="rollqp.cli.two:give_back_freed_memory"),
+              export_step="rollqp.stepfile:export_step", sweep="rollqp.cli.sweeps:sweep_2d",
+              creep_curve="rollqp.cli.sweeps:creep_2d", memory_policy="rollqp.cli.two:give_back_freed_memory"),
     3: Family({"crossval", "export-step", "sweep", "creep-curve", "extrapolate"},
               run="rollqp.march.grid:run", summary="rollqp.report.grid:summary", plot="rollqp.plot.three:three_figure",
               advise="rollqp.cli.three:advise", spot="rollqp.cli.three:spot", check="rollqp.cli.three:check",
               crossval="rollqp.cli.three:crossval", refuse="rollqp.advice.grid:refusal",
-              export_step="rollqp.stepfile.three:export_step_3d", sweep="rollqp.cli.three:sweep",
-              creep_curve="rollqp.cli.three:creep_curve", stresses="rollqp.subsurface3d:stress_history3d"),
+              export_step="rollqp.stepfile.three:export_step_3d", sweep="rollqp.cli.sweeps:sweep_3d",
+              creep_curve="rollqp.cli.sweeps:creep_3d", stresses="rollqp.subsurface3d:stress_history3d"),
     "wheel-rail": Family({"crossval"},
                          run="rollqp.wheelrail.run:run", summary="rollqp.wheelrail.run:summary",
                          plot="rollqp.wheelrail.run:figure", advise="rollqp.wheelrail.cli:advise",

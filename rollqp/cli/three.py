@@ -1,6 +1,5 @@
-"""The command line's parts of a 3D scene (a grid): the notes before a run, the cross-check of a few of its steps,
-``rollqp crossval``, ``rollqp sweep`` and ``rollqp creep-curve`` (:data:`rollqp.cli.families.FAMILIES` names
-them)."""
+"""The command line's parts of a 3D scene (a grid): the notes before a run, the cross-check of a few of its steps
+and ``rollqp crossval`` (:data:`rollqp.cli.families.FAMILIES` names them). Its sweeps: :mod:`rollqp.cli.sweeps`."""
 from __future__ import annotations
 
 import sys
@@ -8,9 +7,6 @@ import sys
 from ..advice.grid import notes
 from ..crossval.grid import SLACK, SpotObserver, cross_check, spot_steps
 from ..crossval.grid import crossval as crossval_steps
-from ..errors import InputError
-from ..sweep.three import creep_curve_3d, sweep_3d
-from .common import check_plot, default_output, sweep_exit, sweep_signals
 
 
 def advise(scene) -> None:
@@ -44,34 +40,3 @@ def crossval(scene, step, methods) -> int:
     print(check.table())
     print(str(check))
     return 0 if check.agrees() else 1
-
-
-def sweep(scene, args) -> int:
-    out = args.out or default_output(scene.name, "-sweep.zarr")
-    _, summary = sweep_signals(lambda: sweep_3d(scene, args.vary, out, scheduler=args.scheduler,
-                                                  workers=args.workers, quiet=args.quiet))
-    if not args.quiet:
-        print(f"rollqp sweep of {scene.name} (3D): {out}")
-        print(summary.table())
-    return sweep_exit(summary)
-
-
-def creep_curve(scene, args) -> int:
-    if args.ratios is not None or args.friction is not None:
-        raise InputError("--ratios" if args.ratios is not None else "--friction",
-                         "a 3D creep curve prescribes the creepage: --creepage longitudinal|lateral|spin --values V")
-    out = args.out or default_output(scene.name, "-creep.zarr")
-    check_plot(args.plot)
-    curve = sweep_signals(lambda: creep_curve_3d(scene, args.creepage or "longitudinal",
-                                                 args.values or "1e-4:2e-3:12", out, scheduler=args.scheduler,
-                                                 workers=args.workers, quiet=args.quiet))
-    if curve.FN is None:       # interrupted: the points done are saved in the store
-        print(curve.summary.table())
-        return sweep_exit(curve.summary)
-    if args.plot:
-        curve.plot(args.plot)
-    if not args.quiet:
-        print(curve.table())
-        print(curve.summary.table())
-        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
-    return sweep_exit(curve.summary)

@@ -1,6 +1,6 @@
-"""The command line's parts of a 2D scene (a strip): the notes before a run, the cross-check of a few of its steps,
-``rollqp crossval``, ``rollqp sweep`` and ``rollqp creep-curve`` (:data:`rollqp.cli.families.FAMILIES` names
-them), and how a dense run gives freed memory back."""
+"""The command line's parts of a 2D scene (a strip): the notes before a run, the cross-check of a few of its steps
+and ``rollqp crossval`` (:data:`rollqp.cli.families.FAMILIES` names them), and how a dense run gives freed memory
+back. Its sweeps: :mod:`rollqp.cli.sweeps`."""
 from __future__ import annotations
 
 import ctypes
@@ -8,11 +8,7 @@ import sys
 
 from ..advice import alternation_note, estimate_note, fast_path
 from ..crossval import SPOT_MAX_NODES, SPOT_METHODS, report, spot_check
-from ..errors import InputError
 from ..stepfile import from_record
-from ..sweep import sweep as sweep_points
-from ..sweep.creep import creep_curve as creep_points
-from .common import check_plot, default_output, sweep_exit, sweep_signals
 
 
 def advise(scene) -> None:
@@ -56,34 +52,6 @@ def crossval(scene, step, methods) -> int:
     """``rollqp crossval`` of a 2D scene: every method on one step (:func:`rollqp.crossval.report`)."""
     print(report(scene, step=step, methods=methods))
     return 0
-
-
-def sweep(scene, args) -> int:
-    out = args.out or default_output(scene.name, "-sweep.zarr")
-    summary = sweep_signals(lambda: sweep_points(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
-                                          quiet=args.quiet))
-    if not args.quiet:
-        print(f"rollqp sweep of {scene.name}: {out}")
-        print(summary.table())
-    return sweep_exit(summary)
-
-
-def creep_curve(scene, args) -> int:
-    if args.creepage is not None or args.values is not None:
-        raise InputError("--creepage" if args.creepage is not None else "--values",
-                         "a 2D creep curve prescribes the load ratios: --ratios (and --friction)")
-    args.ratios = "0.05:0.95:19" if args.ratios is None else args.ratios
-    out = args.out or default_output(scene.name, "-creep.zarr")
-    check_plot(args.plot)
-    curve = sweep_signals(lambda: creep_points(scene, args.ratios, args.friction, out, scheduler=args.scheduler,
-                                              workers=args.workers, quiet=args.quiet))
-    if args.plot and not curve.summary.interrupted:
-        curve.plot(args.plot)
-    if not args.quiet:
-        print(curve.table())
-        print(curve.summary.table())
-        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
-    return sweep_exit(curve.summary)
 
 
 def give_back_freed_memory() -> None:

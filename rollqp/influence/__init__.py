@@ -12,7 +12,6 @@ from __future__ import annotations
 
 from . import builtin
 from ..errors import InputError
-from .bem import bem_influence
 from .halfspace import Influence, halfspace_influence, min_eigenvalue
 from .memo import Memo
 from .model import DEFAULT as DEFAULT_MODEL
@@ -23,6 +22,12 @@ from .model import register as register_model
 
 __all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence", "Model",
            "register_model", "get_model", "model_names", "DEFAULT_MODEL", "Memo"]
+
+def bem_influence(strip, **kw) -> Influence:
+    """The BEM influence (:func:`rollqp.influence.bem.bem_influence`), imported when a scene asks for it."""
+    from .bem import bem_influence as build  # the BEM module: numpy.polynomial at its import, scipy.linalg on its solve (import rollqp stays light)
+    return build(strip, **kw)
+
 
 #: Available influence models (``contact.model``).
 MODELS = {"halfspace": halfspace_influence, "bem": bem_influence}

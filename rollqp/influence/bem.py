@@ -99,6 +99,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 
 from ..errors import InputError
 from .halfspace import COUPLINGS, Influence, min_eigenvalue
@@ -423,7 +424,6 @@ def _solve_system(body: BEMBody, rhs_tractions: np.ndarray) -> np.ndarray:
         np.add.at(Gin.transpose(1, 0, 2), mesh.conn[Eo:, a] - No, Gi[:, :, a, :].transpose(1, 0, 2))
     M = np.concatenate([body.H[:, :2 * No], -Gin.reshape(2 * N, -1)], 1)
     rhs = body.G[:, :6 * Eo] @ rhs_tractions
-    import scipy.linalg  # here, not at import: `import rollqp` stays free of scipy (a heavy dependency)
     X = scipy.linalg.lu_solve(scipy.linalg.lu_factor(M, check_finite=False), rhs, check_finite=False)
     return X[:2 * No]
 

@@ -1,7 +1,7 @@
 """The built-in influence models, as :class:`~rollqp.influence.model.Model` records: the half-space and the BEM.
 
 Each adapter reads from a scene what its builder needs (the scene is not imported: its attributes are
-read); scipy.linalg is imported only when a BEM scene is built (:func:`rollqp.influence.bem.body_matrices`).
+read); the BEM module is imported only when a BEM scene is built.
 """
 from __future__ import annotations
 
@@ -9,7 +9,6 @@ import math
 import time
 
 from ..errors import InputError
-from .bem import bem_influence
 from .grid import ContactOperators
 from .halfspace import halfspace_influence
 from .halfspace import undeformed_gap
@@ -57,6 +56,8 @@ def halfspace_operators_of(scene, strip):
 def bem_of(scene, strip, memo=None):
     """The true-geometry influence of ``scene``'s rollers on rigid shafts (:func:`rollqp.influence.bem.bem_influence`;
     ``memo``: where the rollers' compliances are kept, the scene operators' :class:`~rollqp.influence.memo.Memo`)."""
+    # the BEM module: numpy.polynomial at its import, scipy.linalg on its solve (import rollqp stays light)
+    from .bem import bem_influence
     return bem_influence(strip, Estar=scene.Estar, beta=scene.beta, R_A=scene.A.radius, R_B=scene.B.radius,
                          coupling=scene.coupling_level, d_ref=scene.reference_distance_value, A=scene.A, B=scene.B,
                          n_outer=scene.bem_mesh[0], n_inner=scene.bem_mesh[1], memo=memo)

@@ -12,12 +12,11 @@ import math
 
 import numpy as np
 
-from ..closedforms import hertz_half_width
-from ..closedforms import hertz_peak_pressure
 from ..errors import InputError
-from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER
 from ..methods import record
 from .schema import BETA_ZERO
+from ..closedforms import hertz_half_width
+from ..closedforms import hertz_peak_pressure
 
 __all__ = ["Derived"]
 
@@ -48,6 +47,9 @@ class Derived:
     @property
     def bem_mesh(self) -> tuple[int, int]:
         """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
+        # one place for the paper's counts, in the BEM module (numpy.polynomial and scipy.linalg behind it: import
+        # rollqp stays light)
+        from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER
         c = self.contact
         return (DEFAULT_OUTER if c.bem_outer_elements is None else c.bem_outer_elements,
                 DEFAULT_INNER if c.bem_inner_elements is None else c.bem_inner_elements)
