@@ -42,7 +42,10 @@ def _modules():
         Contact, Loads = oc.Contact, oc.Loads
         Materials = importlib.import_module("rollqp.three.materials").Materials
         Newton = importlib.import_module("rollqp.three.gnm").NewtonMethod
-    march = importlib.import_module("rollqp.march.grid")
+    try:
+        march = importlib.import_module("rollqp.march.grid")
+    except ImportError:   # the older layout
+        march = importlib.import_module("rollqp.three.march")
     return Contact, Loads, Materials, Newton, march.normal, march.steady, march.transient
 
 

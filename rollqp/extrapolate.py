@@ -13,8 +13,8 @@ of ``h``, their measured order is spurious, and Richardson's estimate can miss t
 fractions ``(u_j, v_j)`` of an element (``u_j = (j + ½)/K − ½`` stratified along x, ``v_j`` the golden-ratio
 sequence along y: a rank-1 lattice on the unit cell), and the forces averaged. The average is a smooth
 function of ``h``: measured on the circle at ξ = 1e-5 and 1e-3 it follows ``F₀ + C h`` to within its
-scatter from 16 to 48 elements per semi-axis, and its order-1 extrapolation agrees with a single 160-per-semi-axis
-grid corrected by the same ``C h`` to 0.01–0.04 % (docs/performance.md).
+scatter from 16 to 48 elements per semi-axis, and at ξ = 1e-3 its order-1 extrapolation agrees with a single
+160-per-semi-axis grid corrected by the same ``C h`` to 0.03 % (docs/performance.md).
 
 **The extrapolation and its estimate.** With ``F̄_k`` the average on grid ``k`` and ``s_k`` its standard
 error (the scatter of the positions over ``√K``), the first-order model is fitted by weighted least squares
@@ -28,7 +28,7 @@ order ``p`` measured from the three finest grids: the estimate grows where the m
 by more than the scatter explains (``|F₀⁽ᵖ⁾ − F₀|`` less twice its own standard error from the ``s_k``, at
 least 0); where no order can be measured — the differences of opposite signs — the whole correction
 ``|F₀ − F̄_finest|`` is added instead. The positions are not independent draws but a stratified set: their average is closer to
-the smooth value than ``s_k`` says (measured: about five times), so the estimate is conservative.
+the smooth value than ``s_k`` says (measured: the estimate 1.7–35 times the error), so it is conservative.
 
 Examples
 --------
@@ -61,7 +61,7 @@ NEGLIGIBLE = 1e-4
 #: 0.03 % of the force at 32 elements per semi-axis on the circle (measured, docs/performance.md).
 SHIFTS = 8
 #: Order of the discretization error of the position-averaged force (piecewise-constant elements; measured
-#: 1.04–1.07 on the circle from 16, 24 and 32 elements per semi-axis).
+#: 0.89–1.42 from the command's default grids on the cases of docs/performance.md, the spread the scatter's).
 THEORETICAL_ORDER = 1.0
 #: Golden ratio's conjugate: the y-fractions of the positions (``{j·g}``), evenly spread for any count.
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
@@ -145,7 +145,7 @@ def fit_first_order(h, means, errors) -> Extrapolated:
     if h.size < 2 or np.any(np.diff(h) >= 0):
         raise InputError("grids", f"need two or more grids, coarse to fine, got h = {h.tolist()!r}")
     w = 1.0 / np.maximum(s, 1e-15 * np.max(np.abs(F)) + 1e-300) ** 2 if np.all(s > 0) else np.ones_like(h)
-    M = np.column_stack([np.ones_like(h), h])
+    M = np.column_stack([np.ones_like(h), h ** THEORETICAL_ORDER])
     cov = np.linalg.inv(M.T @ (w[:, None] * M))
     coef = cov @ (M.T @ (w * F))
     F0 = float(coef[0])
@@ -180,7 +180,7 @@ def fit_first_order(h, means, errors) -> Extrapolated:
 
 
 def _first_order_value(h, F, w) -> float:
-    M = np.column_stack([np.ones_like(h), h])
+    M = np.column_stack([np.ones_like(h), h ** THEORETICAL_ORDER])
     return float(np.linalg.solve(M.T @ (w[:, None] * M), M.T @ (w * F))[0])
 
 

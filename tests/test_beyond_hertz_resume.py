@@ -60,6 +60,28 @@ def test_an_interrupted_3d_sweep_resumes_with_only_the_missing_points(tmp_path):
     _same(ds, whole)
 
 
+def test_a_failed_point_is_tried_again_by_the_same_sweep(tmp_path, monkeypatch):
+    """A point that fails (here: made to, once) leaves the Dataset with status 2 there; the same sweep again
+    computes that point only and writes the uninterrupted sweep's Dataset."""
+    import rollqp.sweep.three as three
+    whole, _ = sweep_3d(_circle(), VARY, tmp_path / "whole.zarr", workers=0)
+    real = three.run_point_3d
+
+    def flaky(scene):
+        if scene["contact"]["friction"] == 0.3 and scene["load"]["creepage"]["longitudinal"] == 3e-4:
+            return {"error": "SolverError: made to fail", "time": 0.0}
+        return real(scene)
+    monkeypatch.setattr(three, "run_point_3d", flaky)
+    ds, s1 = sweep_3d(_circle(), VARY, tmp_path / "f.zarr", workers=0)
+    assert s1.done == 5 and [i for i, _ in s1.failed] == [3] and int((ds["status"].values == 2).sum()) == 1
+    monkeypatch.setattr(three, "run_point_3d", real)
+    ran = []
+    ds, s2 = sweep_3d(_circle(), VARY, tmp_path / "f.zarr", workers=0, on_point=lambda i, out: ran.append(i))
+    assert ran == [3] and s2.kept == 5 and not s2.failed
+    _same(xr.open_zarr(tmp_path / "f.zarr", chunks=None).load(), whole)
+    assert not (tmp_path / "f.zarr" / POINTS).exists()
+
+
 def test_another_sweep_s_3d_store_is_refused_naming_out(tmp_path):
     sweep_3d(_circle(), VARY, tmp_path / "a.zarr", workers=0)
     with pytest.raises(InputError, match=r"^--out: .* holds a different sweep"):

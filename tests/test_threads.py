@@ -36,7 +36,7 @@ made = rollqp.cli.FAMILIES[3]      # the run's module is still imported by the c
 rollqp.cli.FAMILIES[3] = made.replace(run=lambda *a, **k: recording(made.run)(*a, **k))
 how = sys.argv[1]
 if how == "api":
-    import rollqp.march.grid as r3
+    from rollqp.march import grid as r3    # (rollqp.march is also the package's function: import the module by from)
     r3.run = recording(r3.run)
     rollqp.run("kalker-elliptic")
     code = 0

@@ -51,7 +51,7 @@ from ..validate import number, suggestion
 from .blocktoeplitz import BlockToeplitz
 from .operator import Operator
 
-__all__ = ["Layer", "parse_layer", "compliance_of", "strip_tangential", "LayeredDiagonal", "grid_kernel",
+__all__ = ["Layer", "parse_layer", "compliance_of", "summary_rows", "strip_tangential", "LayeredDiagonal", "grid_kernel",
            "LayeredOperators", "with_layer", "KEYS"]
 
 #: The keys of ``[contact.layer]``.
@@ -106,6 +106,15 @@ def parse_layer(value: Any, key: str = "contact.layer") -> Layer | None:
     if not math.isfinite(h / G):
         raise InputError(f"{key}.thickness", f"thickness/shear_modulus = {h!r}/{G!r} must be a finite compliance")
     return Layer(h, G)
+
+
+def summary_rows(layer: Layer | None, length: str = "length units", stress: str = "stress units") -> list:
+    """A run summary's row of the layer (both dimensions): ``[("interface layer", text)]``, none without one."""
+    if compliance_of(layer) == 0.0:
+        return []
+    return [("interface layer", f"h = {layer.thickness:.5g} {length}, G3 = {layer.shear_modulus:.5g} {stress}: "
+                                f"h/G3 = {layer.compliance:.4g} {length}/{stress} in the tangential influence "
+                                "(docs/theory3d.md §13)")]
 
 
 def compliance_of(layer: Layer | None) -> float:

@@ -602,7 +602,7 @@ def march(scene, method=None, *, prepared=None, resume=None, verify=True, state=
     """
     scene, meth, contact = prepared = prepared if prepared is not None else prepare(scene, method)
     if resume is not None:
-        _resumable(scene)
+        _resumable(scene, resume if isinstance(resume, dict) else {})
         if state is None:
             state = check_resumed(scene, prepared, resume) if verify else resumed_record(scene, contact, resume)
         start, first = state, last_index(resume) + 1
@@ -646,10 +646,12 @@ def resumed_record(scene, contact, arrays: dict, row: int = -1) -> StepRecord:
     t = np.stack([np.array(arrays[c][row], dtype=float).ravel() for c in ("px", "py")])
     s = np.stack([np.array(arrays[c][row], dtype=float).ravel() for c in ("sx", "sy")])
     xi, eta, phi = (float(v) for v in arrays["creepage"][row])
+    # a slip-velocity law's coefficient at the elements (field "mu"): the memory the next step starts from
+    mu = np.array(arrays["mu"][row], dtype=float).ravel() if "mu" in arrays and contact.law.kind == "slip" else None
     return StepRecord(k, "resumed", float(q[row]), p, np.zeros_like(p), t, s,
                       np.array(arrays["state"][row]).ravel(), float(arrays["FN"][row]), float(arrays["Fx"][row]),
                       float(arrays["Fy"][row]), float(arrays["Mz"][row]), xi, eta, phi,
-                      float(arrays["approach"][row]), 0, 0.0, float(arrays["residual"][row]))
+                      float(arrays["approach"][row]), 0, 0.0, float(arrays["residual"][row]), mu=mu)
 
 
 def check_resumed(scene, prepared, arrays: dict) -> StepRecord:
@@ -670,7 +672,7 @@ def check_resumed(scene, prepared, arrays: dict) -> StepRecord:
         return list(rolling_steps(scene, contact, meth, before, k, last=k))[-1]
 
     def consistent(stored):
-        if not np.array_equal(_states(contact, stored.p, stored.t, stored.s), np.asarray(stored.state)):
+        if not np.array_equal(_states(contact, stored.p, stored.t, stored.s, mu=stored.mu), np.asarray(stored.state)):
             return "its element states are not those of its pressure, traction and slip"
         return None
 
@@ -708,8 +710,8 @@ def check_states(scene, contact, source) -> None:
     file's arrays) consistent in itself (:func:`rollqp.march.loop.check_earlier`): pressures >= 0, tractions in
     the friction disc and the element states those of p, t, s (to :data:`~rollqp.march.loop.RESUME_TOL` of p0 and
     μp0), the forces and moment those of the pressures and tractions, the rolled distances the scene's (checked
-    with the last state, :func:`resumed_record`). (The last state is moreover solved again: :func:`check_resumed`.)"""
-    _resumable(scene)
+    with the last state, :func:`resumed_record`). (The last state is moreover solved again: :func:`check_resumed`.)
+    A slip-velocity law's states are checked with their stored coefficient (field ``mu``)."""
     g, sc = contact.grid, contact.scales
     mu = float(contact.mu)
     tunit = (min(mu, 1.0) if mu > 0 else 1.0) * sc.stress
@@ -717,6 +719,8 @@ def check_states(scene, contact, source) -> None:
 
     def inconsistent(b, k):
         m = len(b["pn"])
+        _resumable(scene, b)
+        law_mu = np.asarray(b["mu"], dtype=float).reshape(m, -1) if "mu" in b and contact.law.kind == "slip" else None
         p = np.asarray(b["pn"], dtype=float).reshape(m, -1)
         t = np.stack([np.asarray(b["px"], dtype=float).reshape(m, -1), np.asarray(b["py"], dtype=float).reshape(m, -1)], 1)
         sl = np.stack([np.asarray(b["sx"], dtype=float).reshape(m, -1), np.asarray(b["sy"], dtype=float).reshape(m, -1)], 1)
@@ -733,37 +737,40 @@ def check_states(scene, contact, source) -> None:
                     and abs(Fy - float(b["Fy"][i])) <= 1e-12 * force
                     and abs(Mz - float(b["Mz"][i])) <= 1e-12 * force * sc.length):
                 return f"state {int(k[i])}: its forces are not those of its pressure and tractions"
-            if not np.array_equal(_states(contact, p[i], t[i], sl[i]), np.asarray(b["state"][i]).ravel()):
+            mu_i = None if law_mu is None else law_mu[i]
+            if not np.array_equal(_states(contact, p[i], t[i], sl[i], mu=mu_i), np.asarray(b["state"][i]).ravel()):
                 return f"state {int(k[i])}: its element states are not those of its pressure, traction and slip"
-            bad = _law(contact, p[i], t[i], sl[i], np.asarray(b["state"][i]).ravel(), tunit, int(k[i]))
+            bad = _law(contact, p[i], t[i], sl[i], np.asarray(b["state"][i]).ravel(), tunit, int(k[i]), mu_i)
             if bad:
                 return bad
         return None
 
-    check_earlier(source, ("pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "step"), inconsistent)
+    check_earlier(source, ("pn", "px", "py", "sx", "sy", "state", "FN", "Fx", "Fy", "Mz", "step", "mu"), inconsistent)
 
 
-def _resumable(scene) -> None:
-    """A run with a friction memory is not resumed: its result file does not hold the coefficient the material
-    carries (a one-line :class:`InputError` on ``--resume``)."""
+def _resumable(scene, arrays) -> None:
+    """A run with a friction memory is resumed from the coefficient the material carries, the stored field ``mu``
+    of ``arrays``; without it, a one-line :class:`InputError` on ``--resume``."""
     law = scene.contact.friction
-    if getattr(law, "kind", None) == "slip" and law.memory > 0:
-        raise InputError("--resume", "a 3D run with a friction memory (contact.friction.memory > 0) cannot be "
-                                     "resumed: its result file does not hold the coefficient the material carries; "
+    if getattr(law, "kind", None) == "slip" and law.memory > 0 and "mu" not in arrays:
+        raise InputError("--resume", "a 3D run with a friction memory (contact.friction.memory > 0) resumes from the "
+                                     "stored friction coefficient, field 'mu', which the result file does not hold; "
                                      "run it again")
 
 
-def _law(contact, p, t, s, states, tunit, k) -> str | None:
+def _law(contact, p, t, s, states, tunit, k, mu=None) -> str | None:
     """Coulomb's law at a stored state (to :data:`RESUME_TOL`): a sticking element does not slip (``|s|`` in the
-    tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``None``, or what is wrong."""
+    tangential steps' slip unit), a slipping one's traction is ``−μp s/|s|`` (in μp0): ``None``, or what is wrong.
+    ``mu``: a slip-velocity law's stored coefficient at the elements (else the law at the slip, or the number)."""
     slip_unit = tunit / contact.materials.Estar
     sn = np.hypot(s[0], s[1])
     stick, slipping = states == 1, (states == 2) & (sn > 0)
     if np.any(sn[stick] > RESUME_TOL * slip_unit):
         return f"state {k}: a sticking element slips"
-    mu = contact.mu
-    if contact.law.kind == "slip":   # a slip-velocity law (without memory: a run with one is not resumed) at the slip
-        mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float), contact=np.asarray(p) > 0)
+    if mu is None:
+        mu = contact.mu
+        if contact.law.kind == "slip":   # a slip-velocity law without its stored coefficient: the law at the slip
+            mu = contact.slip_bound("shift").mu(np.asarray(s, dtype=float), contact=np.asarray(p) > 0)
     b = mu * np.maximum(p, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.hypot(t[0] + b * s[0] / sn, t[1] + b * s[1] / sn)

@@ -37,6 +37,12 @@ methods' own choice).
 QP and need not have one solution; the branch of a direct steady solve is chosen by its braked start
 (docs/friction.md, "Which steady state a rolling start returns").
 
+**On a grid** (two traction components, :mod:`rollqp.problem.grid`) the path is followed in ``λ`` by
+natural-parameter steps of Newton on the disc (:func:`follow_grid`), not by arclength: a path that turns back
+(a fold) stops there, and the run says so (``info["path"]``, a ``RuntimeWarning``). Each selected step reports
+:func:`uniqueness_factor` (``info["uniqueness"]``): below 1 the step with its creepages prescribed has one
+solution (docs/friction.md, "When a step's solution is unique").
+
 **Where the path stops.** A path that cannot be followed to ``λ = 1`` (it runs into gross sliding, or a
 corrector does not converge) leaves the step to the method's own solution (or its ``SolverError``), and
 says so: ``info["path"]`` is then ``{"stopped": message, "lam": λ reached}``.
@@ -214,6 +220,10 @@ MIN_LAMBDA_STEP = 1.0 / 1024
 #: A step of the grid's path is halved when it changes the tractions by more than this many times the step before
 #: it (scaled by the steps' lengths): a jump to another branch near a fold, not the smooth path.
 JUMP = 4.0
+#: A step of the grid's path that changes the tractions by less than this (in ``μ p0``) is never a jump: far below
+#: any other branch, far above the solves' tolerance (measured: a path whose tractions did not move at all, rate 0,
+#: then moved by 1e-10 from round-off, was taken for a fold before this floor).
+SMOOTH = 1e-6
 
 
 def follow_grid(newton, problem, frozen, start):
@@ -232,7 +242,7 @@ def follow_grid(newton, problem, frozen, start):
         try:
             cand = newton.solve(problem.replace(law=problem.law.homotopy(frozen, nxt)), warm=sol)
             change = float(np.max(np.abs(cand.t - sol.t))) / scale / step
-            ok = rate is None or change <= JUMP * max(rate, 1e-12)
+            ok = rate is None or change <= JUMP * rate or change * step <= SMOOTH
         except SolverError:
             ok = False
         if not ok:

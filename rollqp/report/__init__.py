@@ -6,6 +6,8 @@ import numpy as np
 from .. import closedforms as cf
 from ..units import unit_names
 from ..influence import get_model
+from ..influence.layer import compliance_of
+from ..influence.layer import summary_rows as layer_rows
 from ..kinematics import plan
 
 
@@ -37,8 +39,8 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, float, str]]:
     p00 = cf.hertz_peak_pressure(P0, a0)
     out.append(("hertz", rms_in_contact(x, a0, res["pn"][0] - cf.hertz_pressure(x, a0, p00)) / p0,
                 "rms(pn - Hertz)/p0 at q = 0"))
-    if mu <= 0 or scene.load.tangential is None:
-        return out
+    if mu <= 0 or scene.load.tangential is None or compliance_of(scene.contact.layer) > 0:
+        return out   # (an interface layer: Cattaneo's and Carter's bodies have none)
     if scene.load.start == "braked":
         r0 = float(res["Q"][0]) / (mu * P0)
         if 0 < abs(r0) < 1:
@@ -99,6 +101,7 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
             ("a_H, p0", f"{a:.6g} {u.length}, {p0:.6g} {u.stress} (Hertz at P̄ = {scene.load.normal:.6g} {u.load}, "
                         f"E* = {scene.Estar:.6g} {u.stress}, R = {scene.R:.6g} {u.length})"),
             ("beta (2beta)", f"{float(res['beta']):.6g} ({2 * float(res['beta']):.6g}), coupling {scene.coupling_level}"),
+            *layer_rows(scene.contact.layer, u.length, u.stress),
             ("iterations", iterations_row(res)),
             ("wall time", time_row(res, wall)),
             ("max residual", f"{float(res['residual'].max()):.2e} (nondimensional, docs/formulation.md §5)"),

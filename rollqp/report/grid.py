@@ -35,6 +35,8 @@ from . import time_row
 from ..units import unit_names
 from ..closedforms.cattaneo3d import cattaneo_shift, cattaneo_traction
 from ..closedforms.kalker import kalker_linear
+from ..influence.layer import compliance_of
+from ..influence.layer import summary_rows as layer_rows
 from ..loads import start_ellipse
 from ..operators.grid import Loads
 from ..march.grid import normal, steady
@@ -109,6 +111,9 @@ def _kalker_rows(res, scene) -> list[tuple[str, str]]:
     e, m = start_ellipse(scene), scene.materials
     if scene.mu == 0:
         return [("error: kalker", "not compared (mu = 0: no stick, no creep force)")]
+    if compliance_of(scene.contact.layer) > 0:
+        return [("error: kalker", "not compared: the interface layer's compliance joins the bodies' (Kalker's theory "
+                                  "is of the bodies alone; the layer against the brush: docs/validation3d.md §19)")]
     C = kalker_linear(e.a / e.b, m.nu)
     n, _, slip = stick_fraction(res["state"][0])
     if C is None or m.K != 0:
@@ -177,6 +182,7 @@ def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
             ("grid", _grid_row(res, scene, u)),
             ("Hertz", f"a = {e.a:.5g} {u.length}, b = {e.b:.5g} {u.length} (a/b = {e.a / e.b:.4g}), p0 = {e.p0:.5g} "
                       f"{u.stress}, E* = {e.Estar:.5g} {u.stress}, FN = {scene.load.normal:.6g} {force}"),
+            *layer_rows(scene.contact.layer, u.length, u.stress),
             ("steps", _steps_row(res, scene, u)),
             ("iterations", f"{int(it.sum())} in all ({int(it[0])} for the starting state)"),
             ("wall time", time_row(res, wall)),

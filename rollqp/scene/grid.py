@@ -6,7 +6,7 @@ normal force and rolling in x with creepages or tangential forces::
 
     name, description, units
     [bodies.A] [bodies.B]   radius, radius_y (> 0 convex, < 0 concave, or inf), E, nu
-    [contact]               dimension = 3, friction (Coulomb's μ > 0), model ("halfspace"),
+    [contact]               dimension = 3, friction (Coulomb's μ, or a law: docs/friction.md), model ("halfspace"),
                             layer = { thickness = h, shear_modulus = G3 }
     [load]                  normal (FN), tangential (Fx/(μFN)), lateral (Fy/(μFN)),
                             creepage = { longitudinal = ξ, lateral = η, spin = φ },

@@ -15,7 +15,8 @@ fingerprint: the base scene and the swept values); the labelled Dataset replaces
 done. A sweep that was killed (SIGKILL, Ctrl-C, SIGTERM) and is run again with the same scene and ``--vary``
 computes only the points not saved and writes the same Dataset (but for the points' wall times); a store
 of another sweep, or a folder that is no 3D sweep store, is refused naming ``--out``; a finished store of
-the same sweep is opened and nothing is computed. Failed points are not saved: a new run tries them again.
+the same sweep is opened and nothing is computed. A sweep with failed points keeps its saved points and
+manifest beside the Dataset: the same command again tries the failed points only, as a 2D sweep does.
 
 ``rollqp creep-curve SCENE --creepage longitudinal|lateral|spin --values V`` is the preset of the steady
 creep-force curve: the scene in steady rolling (``load.start = "rolling"``, ``distance = 0``) at each
@@ -234,12 +235,27 @@ def sweep_3d(scene, vary, out, *, scheduler=None, workers=None, client=None, qui
         ds = dataset_3d(base, axes, [results[i] for i in range(len(points))])
         ds.attrs[FINGERPRINT] = fp
         ds.to_zarr(path, mode="w", zarr_format=2, consolidated=True)   # as the 2D stores (docs/sweeps.md)
-        for leftover in (os.path.join(path, POINTS), os.path.join(path, MANIFEST)):   # only if zarr kept them
-            if os.path.isdir(leftover):
-                shutil.rmtree(leftover)
-            elif os.path.exists(leftover):
-                os.unlink(leftover)
+        failed = [i for i in range(len(points)) if "error" in results[i]]
+        if failed:      # as a 2D store: the same command again tries the failed points, the others kept
+            _keep_points(path, fp, {i: r for i, r in results.items() if "error" not in r})
+        else:
+            for leftover in (os.path.join(path, POINTS), os.path.join(path, MANIFEST)):   # only if zarr kept them
+                if os.path.isdir(leftover):
+                    shutil.rmtree(leftover)
+                elif os.path.exists(leftover):
+                    os.unlink(leftover)
     return ds, summary
+
+
+def _keep_points(path, fp, done) -> None:
+    """Beside the Dataset of a sweep with failed points: its manifest and the points done, so that running the
+    same sweep again computes the failed points only and rewrites the Dataset."""
+    os.makedirs(os.path.join(path, POINTS), exist_ok=True)
+    for i, r in done.items():
+        if not os.path.exists(os.path.join(path, POINTS, f"{i}.npz")):
+            _save_point(path, i, r)
+    with written(os.path.join(path, MANIFEST), ".json") as (fh, _):
+        fh.write(json.dumps({"fingerprint": fp, "format": "rollqp 3D sweep points"}).encode())
 
 
 def dataset_3d(base, axes, results):

@@ -22,6 +22,12 @@ slip rows ``(I − M_i) e_i + r M_i ∂ŝ_i`` (``M_i = ∂P``: along ``ẑ_i`` t
 the bound, across it the slip rotates). The 2D method is the special case: a disc of one
 dimension is the interval, ``I − ẑẑᵀ = 0`` and the rows are eq. 86–88 of the paper.
 
+A slip-dependent bound ``b_i = μ(V|s_i|) p̂_i`` (a falling friction law, :class:`~rollqp.friction.bound.SlipBound`)
+adds ``∂P/∂b = ẑ_i`` times the bound's gradient ``g_i = ∂b_i/∂ŝ_i`` to the slip rows: ``(I − M_i) e_i +
+(r M_i − ẑ_i g_iᵀ) ∂ŝ_i`` (eq. 3D.26s, docs/theory3d.md §7), solved by LU (the rows are not symmetric) or GMRES;
+where the line search cannot bring the merit down, the fixed point on the bound around the fixed-bound steps,
+polished by Newton, as on a strip (:func:`_solve_slip_safeguarded`).
+
 Each iteration solves ``J d = −Φ`` and takes ``α = ρ^m``, the first with
 ``θ(x + αd) ≤ (1 − 2σα) θ(x)``, ``θ = ½‖Φ‖²`` (eq. 75–79 of the paper; the full step where the
 search fails, counted in ``info["nonmonotone"]``). The linear part ``Ŝ t̂`` (``Â p̂``) is carried
