@@ -266,6 +266,21 @@ def test_resume_refuses_a_forged_earlier_state(short, tmp_path, case):
     _same(full, rollqp.run(scene, resume=tmp_path / "good.npz").arrays(), scene)
 
 
+def test_march_resume_continues_from_the_scene_in_the_file(short, tmp_path):
+    """``rollqp.march.resume(path)`` reads the scene from the file and continues it (as ``rollqp run --resume``);
+    a file without a scene is one line naming --resume."""
+    from rollqp.march import resume
+    scene, full = short
+    part = {k: (v[:30] if k in full and np.ndim(v) and len(v) == len(full["q"]) and k != "x" else v)
+            for k, v in full.items()}
+    np.savez(tmp_path / "part.npz", **part)
+    _same(full, resume(tmp_path / "part.npz").arrays(), scene)
+    part["meta"] = np.asarray(json.dumps({"method": "newton"}))
+    np.savez(tmp_path / "nameless.npz", **part)
+    with pytest.raises(InputError, match=r"^--resume: the result file holds no scene"):
+        resume(tmp_path / "nameless.npz")
+
+
 def test_keep_every_k_keeps_the_sums(short, tmp_path):
     """keep_every = 7: states 0, 7, 14, … and the last two; works, times and iteration counts summed over the
     steps in between, the residual the largest, the rest the state's own (the same in memory and in the file)."""

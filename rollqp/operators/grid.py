@@ -174,8 +174,8 @@ class Contact:
         """The :class:`~rollqp.friction.bound.SlipBound` of a slip-velocity law for a step of ``kind``: ``μ(V|s_i|)``
         with the memory ``memory`` (the coefficient the last step left at the elements, ``(n,)``; ``None``: the
         static value) carried with the material by a rolling step's ``Δq`` (in units of ``a``, the Hertz
-        semi-axis along x, the unit of the law's ``memory``); a shift step carries nothing, a steady solve
-        cannot carry a memory (InputError) (:func:`rollqp.friction.bound.grid_coefficient`)."""
+        semi-axis along x, the unit of the law's ``memory``); a shift step moves nothing (its memory relaxes in
+        place), a steady solve cannot carry a memory (InputError) (:func:`rollqp.friction.bound.grid_coefficient`)."""
         a = self.ellipse.a
         dq_hat = float(dq) / a if kind == "rolling" else None
         if memory is not None and np.shape(memory) != (self.grid.n,):
