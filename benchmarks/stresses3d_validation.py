@@ -27,7 +27,8 @@ import contact3d_cases  # noqa: E402
 from rollqp import load_scene  # noqa: E402
 from rollqp.closedforms.hertz3d import hamilton_normal, huber_axis, sliding_axis_shear  # noqa: E402
 from rollqp.energy import elastic_energy_of, grid_balance  # noqa: E402
-from rollqp.subsurface3d import invariants, plot_field3d, point_load, stress_components, stresses3d  # noqa: E402
+from rollqp.plot.stresses import plot_field3d  # noqa: E402
+from rollqp.subsurface3d import invariants, point_load, stress_components, stresses3d  # noqa: E402
 from rollqp.operators.grid import Contact, Loads  # noqa: E402
 from rollqp.methods.newton.disc import NewtonMethod  # noqa: E402
 from rollqp.discretization.grid import Grid  # noqa: E402

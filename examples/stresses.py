@@ -25,7 +25,8 @@ import numpy as np
 
 import rollqp
 from rollqp import closedforms as cf
-from rollqp.subsurface import plot_field, stress_history
+from rollqp.plot.stresses import plot_field
+from rollqp.subsurface import stress_history
 
 
 def hertz_check(scene):

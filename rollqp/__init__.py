@@ -24,6 +24,8 @@ from . import threads as _threads
 
 _threads.pin_environment()  # before numpy and scipy load: their BLAS pools start at $ROLLQP_THREADS (rollqp.threads)
 
+import importlib  # noqa: E402
+
 from .version import __version__  # noqa: E402,F401
 
 from . import closedforms
@@ -41,6 +43,11 @@ from .march import StepRecord
 from .scene.core import SceneBase as _SceneBase
 from . import energy, wear  # noqa: E402,F401  (register their result fields)
 from .subsurface import stresses  # noqa: E402  (rollqp.stresses(result, step, grid))
+
+
+#: The run of a scene of a family of its own (a wheel on its rail: one state per wheel, no march), by module,
+#: imported with the first such scene, as the march imports a discretization's (:data:`rollqp.march.MARCHES`).
+_FAMILY_RUNS = {"wheel-rail": "rollqp.wheelrail.run"}
 
 
 def _scene(scene):
@@ -63,13 +70,13 @@ def run(scene, method=None, progress=None, resume=None, observe=None, **options)
     scene = _scene(scene)
     with _threads.limited():  # every BLAS pool at $ROLLQP_THREADS (default 1) for the run (rollqp.threads)
         if getattr(scene, "family", None) == "wheel-rail":   # one state per wheel: no march (rollqp.wheelrail)
-            from .wheelrail.run import run as run_wheel_rail
             if method is not None:
                 if not isinstance(method, str):
                     raise InputError("method", "a wheel-rail scene takes a method name (e.g. 'newton'), "
                                                f"got {type(method).__name__}")
                 scene = scene.replace(**{"solver.method": method})
-            return run_wheel_rail(scene, progress=progress, resume=resume, observe=observe, **options)
+            run_family = importlib.import_module(_FAMILY_RUNS[scene.family]).run
+            return run_family(scene, progress=progress, resume=resume, observe=observe, **options)
         return _march.run(scene, method, progress, resume, observe, **options)
 
 
@@ -91,7 +98,7 @@ def solve_step(problem, method: str = STEP_METHOD, warm=None, **settings) -> Ste
 def open_result(path):
     """A result file (``.npz``) as a labelled :class:`xarray.Dataset` (:func:`rollqp.sweep.dataset.open_result`;
     needs xarray, extra ``sweep``)."""
-    from .sweep.dataset import open_result as _open
+    from .sweep.dataset import open_result as _open  # optional dependencies behind it: xarray (extra "sweep")
     return _open(path)
 
 

@@ -39,6 +39,7 @@ import zlib
 import numpy as np
 
 from .errors import InputError
+from .npzfile import NpzStream, read_npz, text_value
 
 __all__ = ["Journal", "MAGIC", "SUFFIX", "layout_dtype", "journal_path", "json_default"]
 
@@ -111,7 +112,6 @@ class Journal:
     def create(cls, path, arrays: dict, meta_text: str, info: dict) -> "Journal":
         """A new journal at ``path`` (replacing one there): written whole to a temporary file and renamed,
         so that a journal that exists always has its header."""
-        from .npzfile import NpzStream
         path = os.fspath(path)
         for key in ("S", "R"):
             layout_dtype(info["layout"][key])
@@ -365,7 +365,6 @@ def _payload_crc(fd, offset, length) -> int:
 
 def _header(payload: bytes, path, arg) -> tuple[dict, dict]:
     """The header frame's arrays, ``meta`` text and settings, and the state layouts' dtypes."""
-    from .npzfile import read_npz, text_value
     z = read_npz(payload, arg)
     try:
         info = json.loads(text_value(z, "journal", arg, limit=MAX_INFO))

@@ -33,7 +33,8 @@ from .atomic import (META_ARRAY_MIN, MAX_META_ARRAY, TEMP_PREFIX, OutputLock, al
                      encode_meta, held_signals, remove_stale_temporaries, replace, save_npz, temporary, written)
 from .errors import InputError
 from .fields import FIELDS, Rows, dtype_of, node_shape, registry
-from .journal import json_default as _json_default
+from .journal import Journal, SUFFIX, journal_path, json_default as _json_default, layout_of
+from .npzfile import NpzStream, read_npz, real_scalar, text_value
 
 __all__ = ["Result", "Layout", "STRIP", "load_result", "save_npz", "check_output", "resume_source", "OutputLock", "TEMP_PREFIX",
            "remove_stale_temporaries", "encode_meta", "decode_meta"]
@@ -461,7 +462,6 @@ class _Journaled:
     from it by :meth:`finish`, a block of rows at a time, and read from the file after that."""
 
     def __init__(self, result: Result):
-        from .journal import journal_path
         self.r = result
         self.path = journal_path(result.out)
         self.journal = None    # created with the first state (its layout is that state's)
@@ -484,7 +484,6 @@ class _Journaled:
         return int(keep.sum())
 
     def _create(self, sample: dict) -> None:
-        from .journal import Journal, layout_of
         r = self.r
         text, marrays = encode_meta(r.meta)
         arrays = {**r.coords, **{k: np.asarray(v) for k, v in r.scalars.items()},
@@ -497,7 +496,6 @@ class _Journaled:
         """Continue the journal ``source`` (read-only, of this scene): reopened for appending if it is this
         result's journal, else copied to it first."""
         import shutil
-        from .journal import Journal
         source.close()
         if os.path.abspath(source.path) != os.path.abspath(self.path):
             with written(self.path, suffix=".journal") as (fh, _):
@@ -648,7 +646,6 @@ def _assemble(journal, r: Result, path):
 
 def _write_result(path, r: Result, columns, state_blocks, K1, meta_text, marrays) -> str:
     """Write the result file atomically: a temporary file beside ``path``, then a rename."""
-    from .npzfile import NpzStream
     with written(path) as (fh, _), NpzStream(fh) as z:
         for k, v in r.coords.items():
             z.array(k, v)
@@ -732,7 +729,6 @@ def load_result(path, arg: str = "RESULT.npz", map_above: int | None = MAP_ABOVE
     InputError
         ``arg``: a missing or corrupt file, a file that is not a result file, a bad key.
     """
-    from .npzfile import read_npz, text_value
     z = read_npz(path, arg, map_above=map_above)
     for key in ("x", "q", "meta"):
         if key not in z:
@@ -829,7 +825,6 @@ _SCALAR_RANGES = {"a": ("> 0", lambda v: v > 0), "b": ("> 0", lambda v: v > 0), 
 def _check_scalars(z: dict, arg: str) -> None:
     """The result's scalars are single finite numbers in their ranges (a_H, p0, R, E* > 0; |β| <= 1/2; the
     leading edge ±1): readers divide by them (a zero a_H, a negative p0 are a corrupt or edited file)."""
-    from .npzfile import real_scalar
     for key, (allowed, ok) in _SCALAR_RANGES.items():
         if key in z:
             v = real_scalar(z, key, arg)
@@ -849,7 +844,6 @@ class ResumeSource:
         self.path, self.arg, self.journal, self.arrays = path, arg, journal, arrays
         if journal is not None:
             head = journal.header["arrays"]
-            from .npzfile import text_value
             meta = decode_meta(json.loads(text_value(head, "meta", arg, limit=META_LIMIT)), head, arg)
             for k, notes in journal.notes:
                 _apply_notes(meta, k, notes)
@@ -927,7 +921,6 @@ def resume_source(path, arg: str = "--resume") -> ResumeSource:
     """The states to continue from: ``path`` is a result file (``RESULT.npz``) or its journal
     (``RESULT.npz.journal``); the journal is taken when it holds at least as many states as the
     file (a run killed after the file was last written), each read without trusting it."""
-    from .journal import SUFFIX, Journal
     path = os.fspath(path)
     npz = path[:-len(SUFFIX)] if path.endswith(SUFFIX) else path
     jpath = npz + SUFFIX

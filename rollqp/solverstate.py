@@ -30,6 +30,8 @@ import types
 
 import numpy as np
 
+from .methods.blocks import partial_product
+
 VERSION = 1
 
 __all__ = ["Recorder", "restore", "newton_of", "VERSION"]
@@ -265,7 +267,6 @@ def restore(meth, ops, notes, upto: int, state_at, recorder: Recorder | None = N
 
 
 def _rebuild(nw, ops, summary, at, made, state_at, recorder):
-    from .methods.newton.linear import partial_product
     nw._systems, nw._last = {}, None
     nw._large, nw._dropped = int(summary["nw"]["large"]), set()
     products, tags = {}, {}

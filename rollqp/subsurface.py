@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import InputError
+from .result import Result, load_result, save_npz
+from .scene import load_scene
 from .strip import Strip
 
 __all__ = ["influence_matrices", "stress_components", "invariants", "StressField", "StressHistory",
@@ -226,8 +228,6 @@ def _maxima(values: dict, X, Z) -> dict:
 # =========================================================================== the post-processing step
 def _source(result) -> tuple[dict, object]:
     """``(arrays, scene)`` of a :class:`~rollqp.result.Result`, a ``load_result`` dict or a path."""
-    from .result import Result, load_result
-    from .scene import load_scene
     if isinstance(result, Result):
         arrays = dict(result.arrays())
         arrays["meta"] = result.meta
@@ -402,46 +402,12 @@ def _block_peaks(strip, x, z, P, T, nu, best) -> None:
 
 def save_field(sf: StressField, path) -> str:
     """Write a :class:`StressField` to a ``.npz`` (x, z, every quantity, the maxima), atomically."""
-    from .result import save_npz
     arrays = {"x": sf.x, "z": sf.z, "step": np.asarray(sf.step), "q": np.asarray(sf.q),
               "body": np.asarray(sf.body)}
     arrays.update({k: np.asarray(v) for k, v in sf.values.items()})
     for name, (v, x, z) in sf.maxima.items():
         arrays[f"max_{name}"] = np.array([v, x, z])
     return save_npz(path, arrays, "stress file")
-
-
-def plot_field(sf: StressField, arrays: dict, path, p0: float, a: float) -> str:
-    """Contour maps of von Mises and τ1 (units of p0, lengths in a_H) under the contact, with the
-    surface tractions and the stick/slip zones of the state above them (Johnson's Fig. 7.5 style)."""
-    from .plot import pyplot
-    plt = pyplot()
-    x, k = np.asarray(arrays["x"]) / a, sf.step
-    fig, axes = plt.subplots(2, 2, figsize=(11, 6.5), sharex="col",
-                             gridspec_kw=dict(height_ratios=(1, 3)), constrained_layout=True)
-    colors = {0: "0.8", 1: "tab:blue", 2: "tab:red"}
-    for col, name in enumerate(("von_mises", "tau1")):
-        top, ax = axes[0, col], axes[1, col]
-        top.plot(x, arrays["pn"][k] / p0, "k-", lw=1, label="p/p0")
-        top.plot(x, arrays["pt"][k] / p0, "k--", lw=1, label="t/p0")
-        for state, label in ((1, "stick"), (2, "slip")):
-            m = np.asarray(arrays["state"][k]) == state
-            top.plot(x[m], np.zeros(m.sum()), "s", ms=3, color=colors[state], label=label)
-        top.legend(fontsize=7, ncol=4, loc="upper left")
-        top.set_ylabel("surface")
-        cs = ax.contourf(sf.x / a, sf.z / a, sf.values[name] / p0, levels=20, cmap="viridis")
-        ax.contour(sf.x / a, sf.z / a, sf.values[name] / p0, levels=10, colors="w", linewidths=0.4)
-        v, xm, zm = sf.maxima[name]
-        ax.plot([xm / a], [zm / a], "r+", ms=10, mew=2)
-        ax.set_title(f"{'von Mises' if name == 'von_mises' else 'τ1'} / p0 (body {sf.body}, state {k}): "
-                     f"max {v / p0:.3f} at x = {xm / a:.3f} a_H, z = {zm / a:.3f} a_H", fontsize=9)
-        ax.invert_yaxis()
-        ax.set_xlabel("x / a_H")
-        ax.set_ylabel("depth z / a_H")
-        fig.colorbar(cs, ax=ax)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return str(path)
 
 
 def summary_rows(sf: StressField, p0: float, a: float) -> list[tuple[str, str]]:

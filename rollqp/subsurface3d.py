@@ -39,7 +39,7 @@ from .scene import load_scene
 from .subsurface import _step
 
 __all__ = ["COMPONENTS", "QUANTITIES", "stress_components", "point_load", "invariants", "Section", "section",
-           "StressField3D", "stresses3d", "stress_history3d", "save_field3d", "plot_field3d", "summary_rows3d",
+           "StressField3D", "stresses3d", "stress_history3d", "save_field3d", "summary_rows3d",
            "parse_plane", "parse_line", "parse_depths"]
 
 #: The six components, in the order of every array of this module (tension positive).
@@ -477,59 +477,6 @@ def summary_rows3d(sf: StressField3D, p0: float) -> list[tuple[str, str]]:
                     f"z = {sf.maxima[k][3]:.5g}") for k, label in names.items()]
 
 
-def plot_field3d(sf: StressField3D, arrays: dict, path, p0: float) -> str:
-    """Contour maps of von Mises and Tresca (in p0) on the section's plane, with the surface tractions of
-    the grid row (or column) under it above; on a line, every component against depth."""
-    from .plot import pyplot
-    plt = pyplot()
-    sec, k = sf.section, sf.step
-    if sec.kind == "line":
-        fig, ax = plt.subplots(figsize=(6.5, 5), constrained_layout=True)
-        for name in COMPONENTS + ("von_mises",):
-            ax.plot(sf.values[name][:, 0] / p0, sec.z, "-" if name != "von_mises" else "k-", lw=1.2, label=name)
-        ax.invert_yaxis()
-        ax.set_xlabel("stress / p0 (tension positive)")
-        ax.set_ylabel("depth z")
-        ax.set_title(f"body {sf.body}, state {k}: {sec.label}", fontsize=9)
-        ax.legend(fontsize=8)
-        fig.savefig(path, dpi=110)
-        plt.close(fig)
-        return str(path)
-    x, y = (np.asarray(arrays[c], dtype=float) for c in ("x", "y"))
-    if sec.kind == "y":
-        row = int(np.argmin(np.abs(y - sec.value[0])))
-        h, cut = x, (lambda f: np.asarray(f)[k][row, :])
-    else:
-        col = int(np.argmin(np.abs(x - sec.value[0])))
-        h, cut = y, (lambda f: np.asarray(f)[k][:, col])
-    fig, axes = plt.subplots(2, 2, figsize=(11, 6.5), sharex="col", gridspec_kw=dict(height_ratios=(1, 3)),
-                             constrained_layout=True)
-    for col, name in enumerate(("von_mises", "tresca")):
-        top, ax = axes[0, col], axes[1, col]
-        for key, style in (("pn", "k-"), ("px", "k--"), ("py", "k:")):
-            top.step(h, cut(arrays[key]) / p0, style, where="mid", lw=1, label=f"{key}/p0")
-        top.legend(fontsize=7, ncol=3, loc="upper left")
-        top.set_ylabel("surface")
-        v = sf.values[name] / p0
-        cs = ax.contourf(sec.along, sec.z, v, levels=20, cmap="viridis")
-        ax.contour(sec.along, sec.z, v, levels=10, colors="w", linewidths=0.4)
-        m = sf.maxima[name]
-        ax.plot([m[1] if sec.kind == "y" else m[2]], [m[3]], "r+", ms=10, mew=2)
-        ax.set_title(f"{'von Mises' if name == 'von_mises' else 'Tresca'} / p0 (body {sf.body}, state {k}, "
-                     f"{sec.label}): max {m[0] / p0:.3f} at depth {m[3]:.4g}", fontsize=9)
-        ax.invert_yaxis()
-        ax.set_xlabel("x" if sec.kind == "y" else "y")
-        ax.set_ylabel("depth z")
-        fig.colorbar(cs, ax=ax)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return str(path)
-
-
-# =========================================================================== generated kernels
-# Written by benchmarks/derive_subsurface3d.py (sympy): regenerate, do not edit. Arguments X = x − ξ,
-# Y = y − η at a corner (ξ, η), the depth z > 0 and ν; returns the 18 kernels, for p, q_x, q_y in turn the
-# six components of COMPONENTS (tension positive, per unit load).
 def _corner_kernels_0(X, Y, z, nu, x):
     x[0] = pi**(-1.0)
     x[1] = Y**2

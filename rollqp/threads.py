@@ -15,7 +15,8 @@ So rollqp runs with ``ROLLQP_THREADS`` BLAS threads (default 1):
   then limits every loaded pool to that number for the duration of the call (threadpoolctl), and
   gives the previous sizes back afterwards — also in a process that loaded numpy before rollqp.
 
-This module imports nothing but the standard library (it runs before numpy loads).
+This module imports nothing but the standard library and :mod:`rollqp.errors` (which imports nothing): it runs
+before numpy loads.
 
 Examples
 --------
@@ -28,6 +29,8 @@ Examples
 from __future__ import annotations
 
 import os
+
+from .errors import InputError
 
 __all__ = ["VARIABLE", "VARIABLES", "threads", "pin_environment", "limited", "pool_sizes"]
 
@@ -46,7 +49,6 @@ def threads(environ=None) -> int:
     env = os.environ if environ is None else environ
     text = str(env.get(VARIABLE, "1")).strip()
     if not text.isdigit() or not 1 <= int(text) <= MAX_THREADS:
-        from .errors import InputError
         shown = text if len(text) <= 20 else f"{text[:20]}…"
         raise InputError(VARIABLE, f"must be a whole number of BLAS threads in [1, {MAX_THREADS}], got {shown!r}")
     return int(text)

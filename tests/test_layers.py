@@ -176,3 +176,59 @@ def test_at_most_two_arrows_back_up():
     import tomllib
     contract = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]["contracts"][0]
     assert len(contract.get("ignore_imports", [])) <= 2
+
+
+# ----------------------------------------------------------------------------- imports inside functions
+#: At most this many imports of rollqp's own modules inside functions. rollqp's modules import each other at their
+#: top (a module's dependencies are read in one place, and the cycle and layer checks above see the real graph);
+#: an import inside a function is left only where an optional or heavy dependency stands behind the imported module
+#: (xarray for rollqp.open_result, scipy.sparse and clarabel for a step file's Clarabel JSON, scipy for the grid's
+#: chord start and the BEM: ``import rollqp`` and the start of ``rollqp run`` load none of them,
+#: tests/test_architecture.py) or where a real cycle cannot be broken (the wheel-rail scene, built on
+#: the scene package, read by it: the contract's one arrow back up). 20 leaves room for a few such cases; each one
+#: says why in a comment on its line or the line above (checked below).
+MAX_INNER_IMPORTS = 20
+
+
+def _inner_imports(root: Path = PACKAGE) -> list[tuple[str, int, str]]:
+    """``(file, line, statement)`` of each import of rollqp's own modules inside a function, counted as
+    ``count_inner_imports.py`` counts them: every ``import``/``from … import`` under a ``def`` whose module is
+    relative or starts with ``rollqp`` (a function nested in another is walked once per enclosing function, as
+    there)."""
+    found = []
+    for path in sorted(root.rglob("*.py")):
+        source = path.read_text(encoding="utf-8")
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                for sub in ast.walk(node):
+                    own = (isinstance(sub, ast.ImportFrom) and (sub.level > 0 or (sub.module or "").startswith("rollqp"))
+                           or isinstance(sub, ast.Import) and any(a.name.startswith("rollqp") for a in sub.names))
+                    if own:
+                        found.append((str(path.relative_to(root.parent)), sub.lineno, ast.get_source_segment(source, sub)))
+    return found
+
+
+def test_at_most_twenty_imports_of_rollqp_inside_functions():
+    inner = _inner_imports()
+    listing = "\n".join(f"  {f}:{line}: {text}" for f, line, text in inner)
+    assert len(inner) <= MAX_INNER_IMPORTS, f"{len(inner)} imports of rollqp's modules inside functions:\n{listing}"
+
+
+def test_each_import_inside_a_function_says_why():
+    """The reason of each import left inside a function: a comment on its line or on the line above."""
+    silent = []
+    for f, line, text in _inner_imports():
+        lines = (PACKAGE.parent / f).read_text(encoding="utf-8").splitlines()
+        if "#" not in lines[line - 1] and "#" not in lines[line - 2]:
+            silent.append(f"{f}:{line}: {text}")
+    assert silent == [], "imports inside functions without their reason:\n" + "\n".join(silent)
+
+
+def test_the_inner_import_count_can_fail(tmp_path):
+    """The count on a small package: a module-top import is not counted, a function's (nested ones too) is."""
+    pkg = tmp_path / "rollqp"
+    pkg.mkdir()
+    (pkg / "a.py").write_text("from . import b\nimport numpy\n\ndef f():\n    from .b import x  # why\n    import rollqp.b\n"
+                              "    def g():\n        from rollqp import c\n    import numpy\n", encoding="utf-8")
+    found = [(f, line) for f, line, _ in _inner_imports(pkg)]
+    assert sorted(found) == [("rollqp/a.py", 5), ("rollqp/a.py", 6), ("rollqp/a.py", 8), ("rollqp/a.py", 8)]

@@ -40,7 +40,8 @@ from ..errors import InputError, RollqpError, SolverError
 from ..threads import limited
 from ..version import __version__
 from .common import (EXIT_INPUT, EXIT_INTERRUPTED, EXIT_SOLVER, EXIT_TERMINATED, EXIT_WRITE,  # noqa: F401 - the
-                     FAMILIES, Family, default_output)                                      # command's contract
+                     default_output)                                                        # command's contract
+from .families import FAMILIES, Family
 
 __all__ = ["main", "COMMANDS", "Command", "version_text", "EXIT_INPUT", "EXIT_SOLVER", "EXIT_WRITE",
            "EXIT_INTERRUPTED", "EXIT_TERMINATED", "FAMILIES", "Family", "default_output"]

@@ -5,7 +5,8 @@ from __future__ import annotations
 from ..methods import SCENE_METHOD_NAMES
 from ..result import check_output
 from ..scene import load_scene
-from .common import default_output, family, takes
+from .common import default_output
+from .families import family, takes
 
 
 def add_arguments(e) -> None:

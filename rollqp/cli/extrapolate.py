@@ -4,9 +4,9 @@ grids, each averaged over K grid positions, extrapolated with an error estimate
 from __future__ import annotations
 
 from ..errors import InputError
-from ..scene import load_scene
 from ..extrapolate import SHIFTS, extrapolate
-from .common import takes
+from ..scene import load_scene
+from .families import takes
 
 
 def add_arguments(xp) -> None:

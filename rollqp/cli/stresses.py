@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from ..errors import InputError
 from ..influence import get_model
+from ..plot.stresses import plot_field, plot_field3d
 from ..result import check_output, load_result
-from ..subsurface import _source, default_grid, plot_field, save_field, stresses, summary_rows
-from ..subsurface3d import (parse_depths, parse_line, parse_plane, plot_field3d, save_field3d, stresses3d,
-                            summary_rows3d)
+from ..subsurface import _source, default_grid, save_field, stresses, summary_rows
+from ..subsurface3d import parse_depths, parse_line, parse_plane, save_field3d, stresses3d, summary_rows3d
 from .common import check_plot
 
 

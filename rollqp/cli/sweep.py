@@ -4,9 +4,8 @@ parameter study on dask, the product of the ``--vary`` values, its results in on
 from __future__ import annotations
 
 from ..scene import load_scene
-from ..sweep import sweep
-from ..sweep.three import sweep_3d as sweep_grid
-from .common import cluster_options, default_output, family, sweep_exit, sweep_signals, takes
+from .common import cluster_options
+from .families import family, takes
 
 
 def add_arguments(w) -> None:
@@ -22,23 +21,3 @@ def main(args) -> int:
     scene = load_scene(args.scene)
     takes(scene, "sweep")
     return family(scene).sweep(scene, args)
-
-
-def sweep_2d(scene, args) -> int:
-    out = args.out or default_output(scene.name, "-sweep.zarr")
-    summary = sweep_signals(lambda: sweep(scene, args.vary, out, scheduler=args.scheduler, workers=args.workers,
-                                          quiet=args.quiet))
-    if not args.quiet:
-        print(f"rollqp sweep of {scene.name}: {out}")
-        print(summary.table())
-    return sweep_exit(summary)
-
-
-def sweep_3d(scene, args) -> int:
-    out = args.out or default_output(scene.name, "-sweep.zarr")
-    _, summary = sweep_signals(lambda: sweep_grid(scene, args.vary, out, scheduler=args.scheduler,
-                                                  workers=args.workers, quiet=args.quiet))
-    if not args.quiet:
-        print(f"rollqp sweep of {scene.name} (3D): {out}")
-        print(summary.table())
-    return sweep_exit(summary)

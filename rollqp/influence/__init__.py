@@ -10,8 +10,8 @@ run's summary. :func:`register_model` adds one — ``contact.model`` then accept
 """
 from __future__ import annotations
 
-from ..errors import InputError
 from . import builtin
+from ..errors import InputError
 from .halfspace import Influence, halfspace_influence, min_eigenvalue
 from .memo import Memo
 from .model import DEFAULT as DEFAULT_MODEL
@@ -20,16 +20,14 @@ from .model import get as get_model
 from .model import names as model_names
 from .model import register as register_model
 
-
-def bem_influence(strip, **kw) -> Influence:
-    """The BEM influence (:func:`rollqp.influence.bem.bem_influence`), imported when a scene asks for
-    it: the BEM module and scipy.linalg stay out of ``import rollqp`` (half-space scenes never
-    load them)."""
-    from .bem import bem_influence as build
-    return build(strip, **kw)
-
 __all__ = ["Influence", "halfspace_influence", "bem_influence", "min_eigenvalue", "MODELS", "build_influence", "Model",
            "register_model", "get_model", "model_names", "DEFAULT_MODEL", "Memo"]
+
+def bem_influence(strip, **kw) -> Influence:
+    """The BEM influence (:func:`rollqp.influence.bem.bem_influence`), imported when a scene asks for it."""
+    from .bem import bem_influence as build  # the BEM module: numpy.polynomial at its import, scipy.linalg on its solve (import rollqp stays light)
+    return build(strip, **kw)
+
 
 #: Available influence models (``contact.model``).
 MODELS = {"halfspace": halfspace_influence, "bem": bem_influence}

@@ -1,7 +1,7 @@
 """The built-in influence models, as :class:`~rollqp.influence.model.Model` records: the half-space and the BEM.
 
 Each adapter reads from a scene what its builder needs (the scene is not imported: its attributes are
-read); the BEM module and scipy.linalg are imported only when a BEM scene is built.
+read); the BEM module is imported only when a BEM scene is built.
 """
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import time
 from ..errors import InputError
 from .grid import ContactOperators
 from .halfspace import halfspace_influence
-from .model import Model
 from .halfspace import undeformed_gap
+from .model import Model
 from .toeplitz import halfspace_operators
 from .toeplitz import positive_definite_threshold
 
@@ -56,6 +56,7 @@ def halfspace_operators_of(scene, strip):
 def bem_of(scene, strip, memo=None):
     """The true-geometry influence of ``scene``'s rollers on rigid shafts (:func:`rollqp.influence.bem.bem_influence`;
     ``memo``: where the rollers' compliances are kept, the scene operators' :class:`~rollqp.influence.memo.Memo`)."""
+    # the BEM module: numpy.polynomial at its import, scipy.linalg on its solve (import rollqp stays light)
     from .bem import bem_influence
     return bem_influence(strip, Estar=scene.Estar, beta=scene.beta, R_A=scene.A.radius, R_B=scene.B.radius,
                          coupling=scene.coupling_level, d_ref=scene.reference_distance_value, A=scene.A, B=scene.B,

@@ -85,6 +85,7 @@ from ..errors import InputError
 from ..validate import positive_real
 from .kernels import (FAR_FIELD, GAUSS_POINTS, assemble_elements, element_offsets,  # noqa: F401 - re-exported
                       lattice_offsets, log_moments, sgn_moments)
+from . import toeplitz
 from .operator import asymmetry
 from .toeplitz import positive_definite_threshold
 
@@ -108,7 +109,6 @@ def _kernel_matrix(strip, moments, lattice) -> np.ndarray:
     if lattice is not False:
         lat = lattice_offsets(strip)
         if lat is not None and np.all(np.diff(np.asarray(strip.edges, dtype=float)) > 0):
-            from . import toeplitz
             P, r = toeplitz.generators(strip, moments, lat)
             return toeplitz.assemble(P, r, np.asarray(strip.x).size, np.asarray(strip.connectivity).shape[0])
     return assemble_elements(strip, moments, element_offsets(strip, lattice))

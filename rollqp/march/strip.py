@@ -56,6 +56,7 @@ from ..fields import fields_for
 from ..friction.bound import steady_branches
 from ..kinematics import HistoryCache, plan
 from ..methods import compose, scene_method
+from ..methods.steady_start import accelerated_start, predicting
 from ..operators import SceneOperators
 from ..problem import SLIP, STICK, State, StepSolution, classify
 from ..result import Result, ResumeSource, check_output, resume_source
@@ -395,7 +396,6 @@ class _March:
         in ``note``: the march reaches the same discrete state, to :data:`STEADY_TOL`). A QP method solves
         the guess's QPs with the active-set prediction on (:meth:`QPMethod.predicting
         <rollqp.methods._qp.QPMethod.predicting>`: a guess, not a state that is kept)."""
-        from ..methods.steady_start import predicting   # (the QP methods' start: on first use, import rollqp stays light)
         was = predicting(self.method, True)
         try:
             start = self.guess()
@@ -446,7 +446,6 @@ class _March:
         cnt = Counters()
         M = ops.history()
         max_steps = int(np.ceil(STEADY_MAX_DISTANCE * scene.a_H / scene.dq))
-        from ..methods.steady_start import accelerated_start, predicting   # (on first use, as above)
         change = np.inf
         state = accelerated_start(self.method, ops, start, cnt, P=P, Q=Q, xi=xi, dq=scene.dq, M=M,
                                   delta=D, tol=STEADY_TOL)  # QP methods: Newton on the march's map, Anderson

@@ -39,6 +39,7 @@ from .dissimilar import (FREE_ROLLING_RATIO, SETTLED_RATE, comparison_figure, co
                          settled_q, snapshot_figure, zone_map_figure)
 from .friction import friction_figure
 from .paths import path_figure, profile_figure, rest_figure
+from .stresses import plot_field, plot_field3d
 from .style import LABELS, REFERENCES, STATE_COLORS, STATE_NAMES, arrays, pyplot, scene_of
 from .three import three_figure
 from .transient import snapshot_indices, transient_figure
@@ -47,7 +48,7 @@ __all__ = ["pyplot", "plot_result", "figure_kind", "FIGURES", "transient_figure"
            "rest_figure", "path_figure", "friction_figure", "snapshot_figure", "zone_map_figure", "dissimilar_figure",
            "comparison_figure", "draw_snapshots", "draw_zone_map", "draw_history", "draw_pressure", "draw_traction",
            "select_states", "settled_q", "snapshot_indices", "LABELS", "REFERENCES", "STATE_COLORS", "STATE_NAMES",
-           "FREE_ROLLING_RATIO", "SETTLED_RATE"]
+           "FREE_ROLLING_RATIO", "SETTLED_RATE", "plot_field", "plot_field3d"]
 
 #: The figure of each kind (:func:`figure_kind`).
 FIGURES = {"coupled": coupled_figure, "profile": profile_figure, "rest": rest_figure, "path": path_figure,

@@ -19,6 +19,7 @@ from .. import closedforms as cf
 from .dissimilar import contact_span, draw_pressure, draw_zone_map
 from .style import (LABELS, REFERENCES, Info, arrays, clock, colors, finish, legend_below, length_axis, pyplot,
                     reference, rolling_mask, stress_axis, symbol)
+from ..kinematics import hysteresis
 from .transient import coulomb
 
 
@@ -245,7 +246,6 @@ def _loop(ax, res, scene, info):
     """Q against the rigid displacement u at rest (u = −Σ shift: :func:`rollqp.kinematics.hysteresis`), its
     part linear in Q removed (it depends on the half-space's reference distance and does no work), and the
     Mindlin–Deresiewicz loop of the same path; the energy of the last closed cycle of each."""
-    from ..kinematics import hysteresis
     rest = ~rolling_mask(res, steady_start=info.start == "rolling")
     h = hysteresis(res)
     Q, u = h["Q"][rest], h["u"][rest]

@@ -15,6 +15,7 @@ import json
 import numpy as np
 
 from ..errors import MissingBackendError
+from ..scene import scene_from_dict
 from ..units import unit_names
 
 
@@ -108,7 +109,6 @@ def scene_of(res, scene=None):
     sd = meta(res).get("scene")
     if not sd:
         return None
-    from ..scene import scene_from_dict
     try:
         return scene_from_dict(sd)
     except Exception:  # noqa: BLE001 - a result of an older or foreign scene: figures from meta alone

@@ -34,12 +34,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import RollqpError
-from ..methods import REFERENCE_METHOD
-from ..units import unit_names
 from ..closedforms.cattaneo3d import cattaneo_stick_radius, cattaneo_traction
 from ..closedforms.kalker import kalker_linear
+from ..errors import RollqpError
+from ..march.grid import run
+from ..methods import REFERENCE_METHOD
 from ..report.grid import LINEAR_SLIP_FRACTION, stick_fraction
+from ..units import unit_names
 from .style import REFERENCES, arrays, colors, finish, legend_below, meta, pyplot, scene_of, value_axis
 
 __all__ = ["three_figure", "field_figure", "three_kind", "creep_force_panel", "she_saturation", "KINDS_3D"]
@@ -121,7 +122,6 @@ def _linear_forces(scene, creepage):
 def _steady_reference(scene, res):
     """The steady state of the final loads, solved directly (the reference method, Newton), or None if it
     cannot be posed."""
-    from ..march.grid import run
     last = float(res["q"][-1]) / scene.ellipse.a
     ld = scene.load
     changes = {"load.start": "rolling", "discretization.distance": 0.0, "solver.method": REFERENCE_METHOD,

@@ -47,7 +47,9 @@ class Derived:
     @property
     def bem_mesh(self) -> tuple[int, int]:
         """``(outer, inner)`` BEM element counts per roller (defaults 19, 16; docs/bem.md)."""
-        from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER  # one place for the paper's counts
+        # one place for the paper's counts, in the BEM module (numpy.polynomial and scipy.linalg behind it: import
+        # rollqp stays light)
+        from ..influence.bem import DEFAULT_INNER, DEFAULT_OUTER
         c = self.contact
         return (DEFAULT_OUTER if c.bem_outer_elements is None else c.bem_outer_elements,
                 DEFAULT_INNER if c.bem_inner_elements is None else c.bem_inner_elements)

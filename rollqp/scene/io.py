@@ -26,17 +26,18 @@ from ..validate import suggestion
 from .checks import safe_name
 from .core import Scene, SceneBase
 from .core import scene_from_dict as scene_from_dict_2d
+from .grid import Body3D
+from .grid import Contact3D
+from .grid import Discretization3D
+from .grid import Load3D
+from .grid import Solver3D
+from .grid import scene_from_dict as scene_from_dict_3d
 from .plain import part_dict, plain, scene_to_dict, scene_to_toml  # noqa: F401 - re-exported
 from .schema import Body
 from .schema import Contact
 from .schema import Discretization
 from .schema import Load
 from .schema import SolverSettings
-from .grid import Body3D
-from .grid import Contact3D
-from .grid import Discretization3D
-from .grid import Load3D
-from .grid import Solver3D
 
 __all__ = ["load_scene", "scene_from_dict", "scene_from_toml", "builtin_scenes", "scene_to_dict", "scene_to_toml"]
 
@@ -46,10 +47,11 @@ MAX_FILE_BYTES = 16 << 20
 
 def _parse_3d(d: dict, source: str, default_name: str):
     if isinstance(d.get("contact"), dict) and d["contact"].get("kind") == "wheel-rail":
-        from ..wheelrail.scene import scene_from_dict as wheel_rail  # a wheelset on its track (docs/wheel-rail.md)
+        # a real cycle, the contract's one arrow back up: the wheel-rail scene is built on SceneBase (this package)
+        # and read here; imported on its first scene (docs/wheel-rail.md)
+        from ..wheelrail.scene import scene_from_dict as wheel_rail
         return wheel_rail(d, source=source, default_name=default_name)
-    from .grid import scene_from_dict as parse  # imported on first use: import rollqp stays light
-    return parse(d, source=source, default_name=default_name)
+    return scene_from_dict_3d(d, source=source, default_name=default_name)
 
 
 #: The parser of each scene dimension (``[contact] dimension``).

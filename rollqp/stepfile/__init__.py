@@ -32,6 +32,7 @@ from __future__ import annotations
 
 from .check import (CONDITIONS, DEFAULT_TOL, SOLUTION_KEYS, CheckReport, Failure, check_step, load_solution,
                     solve_stored, validate_solution)
+from ..npzfile import read_npz
 from .export import export_step, from_record
 from .file import FORMAT, MAX_NODES, STEP_TYPES, StepFile, clarabel_json
 from .script import CVXPY_SCRIPT, cvxpy_script
@@ -47,7 +48,6 @@ def load_step(path, arg: str = "STEP.npz"):
     """A step file of either dimension (:class:`StepFile` or :class:`StepFile3D`), chosen by its ``format`` key."""
     import numpy as np
 
-    from ..npzfile import read_npz
     z = read_npz(path, arg)
     fmt = np.asarray(z.get("format", ""))
     if fmt.dtype.kind in "US" and fmt.shape == () and str(fmt) == FORMAT_3D:

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..methods import COMPARE_METHODS
+from ..methods import COMPARE_METHODS, compose, get_method
 from ..npzfile import read_npz, real_array, real_scalar
 from ..problem import SEPARATION, SLIP, STICK, StepSolution, classify, friction_residual
 from .file import FORMAT, StepFile
@@ -40,7 +40,6 @@ def solve_stored(step: StepFile, method: str, tolerance: float = 1e-10) -> StepS
     the N–T alternation (paper §6.3). ``inner_normal`` and ``inner_tangential`` count the iterations of
     the halves.
     """
-    from ..methods import compose, get_method
     pb = step.problem()
     meth = compose(get_method(method, tolerance=tolerance), pb.Ant is not None)
     warm = step.previous() if np.any(step.prev_p) else None  # none before the first load increment

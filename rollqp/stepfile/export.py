@@ -4,8 +4,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..march import march, prepare
 from ..methods import REFERENCE_METHOD
 from ..problem import CoupledStep
+from ..scene import Scene, load_scene
 from .file import StepFile
 
 __all__ = ["export_step", "from_record"]
@@ -25,8 +27,6 @@ def export_step(scene, k: int, method: str | None = None) -> "StepFile":
         :data:`rollqp.methods.REFERENCE_METHOD`, whatever the scene's ``[solver].method``); its solution of
         step ``k`` is stored as ``ref_*``.
     """
-    from ..march import march, prepare
-    from ..scene import Scene, load_scene
     scene = scene if isinstance(scene, Scene) else load_scene(scene)
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene "

@@ -8,9 +8,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, RollqpError
 from ..npzfile import read_npz, real_array, real_scalar, text_value
-from ..problem import CoupledStep, Scales, StepSolution
+from ..problem import CoupledStep, QPForm, Scales, StepSolution
+from ..result import META_LIMIT, save_npz
+from ..scene import load_scene
 from .script import cvxpy_script
 
 __all__ = ["FORMAT", "MAX_NODES", "STEP_TYPES", "StepFile", "clarabel_json"]
@@ -33,7 +35,6 @@ def write_step_files(path, arrays: dict, native: bool, clarabel_json, cvxpy_scri
     """Write a step file's ``.npz`` and (``native``) ``STEM.normal.clarabel.json``,
     ``STEM.tangential.clarabel.json`` and ``STEM.cvxpy.py`` beside it, from the dimension's writers
     ``clarabel_json(arrays, half)`` and ``cvxpy_script(npz_name)``; return the paths (both dimensions)."""
-    from ..result import save_npz
     path = save_npz(path, arrays, "step file")
     written = [path]
     if native:
@@ -204,7 +205,6 @@ class StepFile:
             kw[k] = int(kw[k])
         kind = text_value(z, "kind", arg, ("coupled", "uncoupled"))
         step_type = text_value(z, "step_type", arg, STEP_TYPES)
-        from ..result import META_LIMIT
         try:  # a scene file's size (its profile tables inline): the limit of a result file's meta
             scene = json.loads(text_value(z, "scene", arg, limit=META_LIMIT))
         except (json.JSONDecodeError, RecursionError) as exc:
@@ -241,10 +241,10 @@ def clarabel_json(arrays: dict, half: str) -> dict:
     ``x <= ub`` (finite ``ub``) and ``−x <= −lb`` (finite ``lb``). Solver settings are rollqp's
     (:func:`~rollqp.methods.qp_clarabel.clarabel_tolerances` for tolerance 1e-10).
     """
+    # scipy.sparse and clarabel behind it (heavy): loaded for a step file's Clarabel JSON only
+    from ..methods.qp_clarabel import clarabel_rows, clarabel_settings
     import scipy.sparse as sp
 
-    from ..methods.qp_clarabel import clarabel_rows, clarabel_settings
-    from ..problem import QPForm
     g = lambda k: arrays[f"{half}_qp_{k}"]  # noqa: E731
     Aeq, beq = g("A"), g("b")
     form = QPForm(H=g("P"), q=g("q_frozen"), lower=g("lb"), upper=g("ub"), a=Aeq[0] if Aeq.shape[0] else None,
@@ -267,8 +267,6 @@ def _check_scales(kw: dict, scene, arg: str) -> None:
     """A step file's scales (``a_H``, ``p0``, ``Estar``) are its scene's, and its previous state's approach and
     creepage (a warm start) are within reach of them: every form, residual and solve divides by them, so an
     edited one is an error naming the key, not an overflow or a NaN."""
-    from ..errors import RollqpError
-    from ..scene import load_scene
     try:
         sc = load_scene(scene)
     except RollqpError as err:

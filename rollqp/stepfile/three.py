@@ -31,7 +31,13 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..loads import start_force
+from ..march.grid import StepRecord, march, prepare
+from ..methods import REFERENCE_METHOD
 from ..npzfile import read_npz, real_array, real_scalar, text_value
+from ..problem.conic import normal_form, tangential_form
+from ..problem.grid import NormalStep, Scales, TangentialStep, disc_projection
+from ..result import META_LIMIT
 from .file import write_step_files
 
 __all__ = ["FORMAT_3D", "MAX_ELEMENTS_3D", "StepFile3D", "export_step_3d", "check_step_3d", "Check3D",
@@ -126,18 +132,15 @@ class StepFile3D:
         return bool(np.any(self.A_nt) or np.any(self.A_tn))
 
     def scales(self):
-        from ..problem.grid import Scales
         return Scales(self.length, self.stress, self.modulus, dimension=3)
 
     def normal(self, t):
         """The normal step (eq. 3D.14) at the traction ``t`` (its gap ``A_nt t``)."""
-        from ..problem.grid import NormalStep
         off = self.A_nt @ np.asarray(t, dtype=float).ravel() if self.coupled else None
         return NormalStep(DenseOperator(self.A_nn, self.n), self.area, self.h, FN=self.FN, offset=off, scales=self.scales())
 
     def tangential(self, p):
         """The tangential step (eq. 3D.15) at the pressure ``p`` (bound ``μp⁺``, history ``c + A_tn p``)."""
-        from ..problem.grid import TangentialStep
         p = np.asarray(p, dtype=float)
         c = self.c + (self.A_tn @ p).reshape(2, -1) if self.coupled else self.c
         return TangentialStep(DenseOperator(self.B, self.n), self.area, self.mu * np.maximum(p, 0.0), self.x, self.y, c,
@@ -146,7 +149,6 @@ class StepFile3D:
 
     def forms(self) -> dict:
         """Both halves as conic programs (:mod:`rollqp.problem.conic`) at rollqp's solution of the other half."""
-        from ..problem.conic import normal_form, tangential_form
         return {"normal": normal_form(self.normal(self.ref_t)), "tangential": tangential_form(self.tangential(self.ref_p))}
 
     def form_arrays(self) -> dict:
@@ -217,7 +219,6 @@ class StepFile3D:
                 raise InputError(arg, f"key {k!r} must be > 0, got {kw[k]!r}")
         if not 0 <= kw["mu"] <= 10:
             raise InputError(arg, f"key 'mu' must be in [0, 10], got {kw['mu']!r}")
-        from ..result import META_LIMIT
         try:
             scene = json.loads(text_value(z, "scene", arg, limit=META_LIMIT))
         except (json.JSONDecodeError, RecursionError) as exc:
@@ -245,9 +246,6 @@ class StepFile3D:
 def export_step_3d(scene, k: int, method: str | None = None) -> StepFile3D:
     """March the 3D ``scene`` to step ``k`` with ``method`` (default the reference method) and return its
     :class:`StepFile3D`."""
-    from ..methods import REFERENCE_METHOD
-    from ..loads import start_force
-    from ..march.grid import StepRecord, march, prepare
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k <= scene.n_steps:
         raise InputError("--step", f"must be an integer step in 0..{scene.n_steps} for scene {scene.name!r}, got {k!r}")
     if scene.grid.n > MAX_ELEMENTS_3D:
@@ -422,7 +420,6 @@ def check_step_3d(step, solution, tol: float = 1e-8) -> Check3D:
     g = npb.gap(p, delta)
     sig = np.abs(np.minimum(p / sc.stress, g / sc.displacement))
     s = tpb.slip(t, xi, eta)
-    from ..problem.grid import disc_projection
     th, sh, bh = t / sc.stress, s / sc.slip, tpb.bound / sc.stress
     r = th - disc_projection(th - sh, bh)
     fric = np.hypot(r[0], r[1])

@@ -13,7 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .dataset import open_result
+from ..result import OutputLock
+from .dataset import check_store_path, open_result, open_store, points_per_chunk
+from .executor import Progress, close_client, connect, run_sweep
 from .spec import MAX_POINTS, Axis, Sweep, build_sweep, parse_vary
 
 __all__ = ["sweep", "prepare", "Axis", "Sweep", "build_sweep", "parse_vary", "open_result", "VALIDATION_PROGRESS_AFTER"]
@@ -25,8 +27,6 @@ def prepare(scene, vary, out, quiet=True):
     The store is refused if it holds another sweep; the points' methods must be installed.
     Unless ``quiet``, a sweep whose validation takes more than a second shows its progress.
     """
-    from .dataset import check_store_path, open_store
-    from .executor import Progress
     bar = Progress(0, "validated point", quiet, after=VALIDATION_PROGRESS_AFTER)
     try:
         sw = build_sweep(scene, vary, progress=bar)
@@ -68,9 +68,6 @@ def sweep(scene, vary, out, *, scheduler=None, workers=None, client=None, quiet=
     """
     import time
 
-    from ..result import OutputLock
-    from .dataset import open_store, points_per_chunk
-    from .executor import close_client, connect, run_sweep
     if per_chunk is not None and (not isinstance(per_chunk, int) or isinstance(per_chunk, bool)
                                   or not 1 <= per_chunk <= MAX_POINTS):
         raise InputError("per_chunk", f"must be an integer in [1, {MAX_POINTS}], got {per_chunk!r}")

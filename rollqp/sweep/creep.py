@@ -22,8 +22,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import sweep
 from .. import closedforms as cf
 from ..errors import InputError
+from ..plot import pyplot
+from ..scene import load_scene
 from .spec import Axis, describe, parse_values
 
 __all__ = ["CreepCurve", "creep_curve", "creep_sweep"]
@@ -56,7 +59,6 @@ def _frictions(text, scene) -> tuple:
 
 def creep_sweep(scene, ratios="0.05:0.95:19", friction=None):
     """``(steady base scene, axes)`` of the creep-curve sweep (validated by :func:`~.spec.build_sweep`)."""
-    from ..scene import load_scene
     scene = load_scene(scene) if not hasattr(scene, "replace") else scene
     r, mu = _ratios(ratios), _frictions(friction, scene)
     base = scene.replace(**{"load.start": "rolling", "discretization.distance": 0.0, "load.tangential": r[0],
@@ -157,7 +159,6 @@ class CreepCurve:
 
     def plot(self, path) -> str:
         """The classic creep-force figure: Q/(μP) against ξ (left) and against ξR/(μa) (right)."""
-        from ..plot import pyplot
         plt = pyplot()
         s = self.scene
         fig, (ax, bx) = plt.subplots(1, 2, figsize=(10, 4.2))
@@ -203,7 +204,6 @@ def creep_curve(scene, ratios="0.05:0.95:19", friction=None, out="creep.zarr", *
     """
     import zarr
 
-    from . import sweep
     base, axes = creep_sweep(scene, ratios, friction)
     summary = sweep(base, axes, out, **run)
     group = zarr.open_group(str(out), mode="r")

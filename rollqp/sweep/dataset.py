@@ -27,8 +27,11 @@ import re
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, MissingBackendError
 from ..fields import FIELDS, dtype_of, fields_for
+from ..march.loop import versions as _versions
+from ..result import load_result
+from ..version import __version__
 
 __all__ = ["open_result", "create_store", "open_store", "StoreWriter", "Layout", "chunk_tasks", "write_point", "result_fields",
            "STATUS", "points_per_chunk", "chunk_shape", "FINGERPRINT", "COMPRESSOR"]
@@ -51,7 +54,6 @@ def _xr():
     try:
         import xarray as xr
     except ImportError as exc:  # pragma: no cover - the extra is missing
-        from ..errors import MissingBackendError
         raise MissingBackendError("labelled datasets need xarray: pip install 'rollqp[sweep]'") from exc
     return xr
 
@@ -74,7 +76,6 @@ def open_result(path):
     contract format; this is a view of it. Raises :class:`~rollqp.errors.InputError` as
     :func:`rollqp.load_result` does.
     """
-    from ..result import load_result
     xr = _xr()
     z = load_result(path, "RESULT.npz")
     meta = z.pop("meta")
@@ -178,8 +179,6 @@ def _coord_names(dims) -> str:
 def _global_attrs(sweep) -> dict:
     import importlib.metadata as md
 
-    from ..march.loop import versions as _versions
-    from ..version import __version__
     versions = dict(_versions(), rollqp=__version__)
     for pkg in ("dask", "distributed", "xarray", "zarr"):
         try:

@@ -38,8 +38,13 @@ import sys
 import time
 from dataclasses import dataclass, field
 
-from ..errors import InputError
+from ..errors import InputError, MissingBackendError
+from ..influence import Memo
+from ..march import run
+from ..scene import scene_from_dict
 from ..threads import limited
+from .dataset import Layout, StoreWriter, chunk_shape, chunk_tasks, create_store
+from .spec import describe
 
 __all__ = ["connect", "check_scheduler", "close_client", "InProcess", "compute_point", "compute_points", "run_sweep", "iter_jobs",
            "map_jobs", "Summary", "Progress", "CONNECT_TIMEOUT", "HANDSHAKE_BYTES"]
@@ -72,7 +77,6 @@ def _dask():
     try:
         import distributed
     except ImportError as exc:  # pragma: no cover - the extra is missing
-        from ..errors import MissingBackendError
         raise MissingBackendError("sweeps need dask.distributed: pip install 'rollqp[sweep]'") from exc
     return distributed
 
@@ -270,7 +274,6 @@ def connect(scheduler: str | None = None, workers: int | None = None, timeout: f
 
 
 def _short(value, n: int = 80) -> str:
-    from .spec import describe
     return describe(value, n)
 
 
@@ -282,7 +285,6 @@ _GEOMETRY = None
 def _geometry():
     global _GEOMETRY
     if _GEOMETRY is None:
-        from ..influence import Memo
         _GEOMETRY = Memo(size=8)
     return _GEOMETRY
 
@@ -297,8 +299,6 @@ def compute_point(scene) -> dict:
 
 def _run_point(scene) -> dict:
     """:func:`compute_point` with BLAS already pinned (by the caller, once for a task's points)."""
-    from ..march import run
-    from ..scene import scene_from_dict
     t0, c0 = time.perf_counter(), time.process_time()
     worker = f"{socket.gethostname()}:{os.getpid()}"
     try:
@@ -319,7 +319,6 @@ _WRITERS: dict = {}
 def _writer(store):
     """The :class:`~rollqp.sweep.dataset.StoreWriter` of ``store = (path, fingerprint, keys, shape)``,
     made from the store's files (:meth:`~rollqp.sweep.dataset.StoreWriter.at`)."""
-    from .dataset import Layout, StoreWriter
     path, fingerprint, keys, shape = store
     meta = os.stat(os.path.join(path, ".zmetadata"))  # a store made again at the same path is another store
     key = (path, fingerprint, meta.st_ino, meta.st_mtime_ns)
@@ -352,7 +351,6 @@ def compute_points(base, points, store=None) -> list:
 
 
 def _compute_points(base, points) -> list:
-    from ..scene import scene_from_dict
     t0 = time.perf_counter()
     try:
         scene = scene_from_dict(base)
@@ -503,7 +501,6 @@ def run_sweep(sweep, group, status, client, quiet: bool = False, on_point=None, 
     compute (a task that ends before the store exists sends its arrays, written here by a writer
     made then); else the store is made first.
     """
-    from .dataset import StoreWriter, chunk_shape, chunk_tasks, create_store
     as_completed = iter if isinstance(client, InProcess) else _dask().as_completed
     early = group is None and not isinstance(client, InProcess) and _shares_disk(client)
     made = time.perf_counter()

@@ -30,7 +30,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, RollqpError
+from ..fields import fields_for
+from ..methods import method_class
+from ..scene import Scene, load_scene
+from ..strip import Strip
 
 __all__ = ["Axis", "Sweep", "Facts", "parse_vary", "parse_values", "build_sweep", "describe", "MAX_POINTS",
            "MAX_VALUES", "MAX_VALUE_CHARS"]
@@ -267,15 +271,12 @@ class _Gather:
     """Collects :class:`Facts` point by point (grids stored once per distinct grid)."""
 
     def __init__(self, n: int):
-        from ..strip import Strip
         self.strip = Strip
         self.states, self.nodes = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.q_index, self.x_index = np.zeros(n, dtype=np.int64), np.zeros(n, dtype=np.int64)
         self.q, self.x, self.strips, self.fields, self.methods = {}, {}, {}, set(), set()
 
     def add(self, i: int, scene) -> None:
-        from ..fields import fields_for
-        from ..methods import method_class
         d = scene.discretization
         mesh = (scene.half_width, d.elements, d.element)
         if mesh not in self.strips:
@@ -301,8 +302,6 @@ def build_sweep(base, axes, progress=None) -> Sweep:
     ``axes`` are :class:`Axis` objects or ``--vary`` strings. ``progress(n, total)``, if given,
     is called after each validated point (the command's progress lines for large sweeps).
     """
-    from ..errors import RollqpError
-    from ..scene import Scene, load_scene
     base = base if isinstance(base, Scene) else load_scene(base)
     if axes and isinstance(next(iter(axes)), str):
         axes = parse_vary(axes)

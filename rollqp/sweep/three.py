@@ -45,7 +45,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..atomic import OutputLock, written
-from ..errors import InputError
+from ..closedforms.kalker import kalker_linear
+from ..errors import InputError, RollqpError
+from ..fields import registry
+from ..march.grid import run
+from ..plot import pyplot
+from ..scene import load_scene, scene_from_dict
+from ..threads import limited
+from .executor import close_client, connect, iter_jobs
 from .spec import Axis, MAX_POINTS, parse_values, parse_vary
 
 __all__ = ["sweep_3d", "run_point_3d", "creep_curve_3d", "CreepCurve3D", "CREEPAGES", "Summary3D"]
@@ -63,9 +70,6 @@ FINGERPRINT = "rollqp_sweep_fingerprint"
 
 def run_point_3d(scene: dict) -> dict:
     """One 3D point on a worker: ``{"arrays", "time"}`` or ``{"error", "time"}`` (its one-line error)."""
-    from ..scene import scene_from_dict
-    from ..march.grid import run
-    from ..threads import limited
     t0 = time.perf_counter()
     try:
         with limited(1):
@@ -100,7 +104,6 @@ class Summary3D:
 
 def _points(base, axes):
     """Every point's scene dict, validated (one bad point: an InputError naming it)."""
-    from ..errors import RollqpError
     out = []
     for i, values in enumerate(itertools.product(*(a.values for a in axes))):
         changes = dict(zip((a.key for a in axes), values))
@@ -189,8 +192,6 @@ def sweep_3d(scene, vary, out, *, scheduler=None, workers=None, client=None, qui
     return ``(dataset, Summary3D)`` (module docstring; ``dataset`` is None when interrupted).
     ``vary``: ``"KEY=VALUES"`` strings or :class:`~rollqp.sweep.spec.Axis` objects; ``on_point(i, out)``
     after point ``i`` is saved."""
-    from ..scene import load_scene
-    from .executor import close_client, connect, iter_jobs
     base = scene if hasattr(scene, "replace") else load_scene(scene)
     axes = parse_vary(vary) if vary and isinstance(next(iter(vary)), str) else tuple(vary)
     if not axes:
@@ -263,7 +264,6 @@ def dataset_3d(base, axes, results):
 
     import xarray as xr
 
-    from ..fields import registry
     fields = registry(3)
     keys = tuple(a.key for a in axes)
     shape = tuple(len(a.values) for a in axes)
@@ -334,7 +334,6 @@ def _values(text) -> tuple:
 
 def creep_sweep_3d(scene, creepage: str, values):
     """``(steady base scene, axis)`` of the 3D creep-curve sweep."""
-    from ..scene import load_scene
     scene = scene if hasattr(scene, "replace") else load_scene(scene)
     if creepage not in CREEPAGES:
         raise InputError("--creepage", f"must be one of {', '.join(CREEPAGES)}, got {creepage!r}")
@@ -369,7 +368,6 @@ class CreepCurve3D:
         """Kalker's ``dF/dξ`` at the origin (None outside his table or for dissimilar bodies). With an interface layer
         (``contact.layer``) the bodies' slope in series with the layer's brush, ``1/k = 1/k_Kalker + 1/k_brush``,
         ``k_brush = (8/3) a² b G₃/h`` (docs/theory3d.md §13): an estimate, not a theory (None for the spin)."""
-        from ..closedforms.kalker import kalker_linear
         s = self.scene
         e, m = s.ellipse, s.materials
         if m.K != 0 or not 0 <= m.nu <= 0.5:
@@ -455,7 +453,6 @@ class CreepCurve3D:
         return "\n".join(rows)
 
     def plot(self, path) -> str:
-        from ..plot import pyplot
         plt = pyplot()
         s = self.scene
         k = self.kalker_slope()

@@ -21,6 +21,7 @@ import time
 from dataclasses import dataclass
 
 from ..errors import InputError
+from .run import solve_scene
 
 __all__ = ["POSITIONS", "table", "read_reference", "Row"]
 
@@ -55,7 +56,6 @@ def table(scene, cases=None, sides=("left", "right"), progress=None):
     """Run the benchmark positions ``cases`` (1-based; default all 21) of the wheel–rail ``scene`` (its
     profiles, materials, friction, load and grid) for ``sides``: a list of :class:`Row` (``progress``: called
     with the rows of each position and wheel as they are done)."""
-    from .run import solve_scene
     cases = list(range(1, len(POSITIONS) + 1)) if cases is None else list(cases)
     for c in cases:
         if not (isinstance(c, int) and 1 <= c <= len(POSITIONS)):

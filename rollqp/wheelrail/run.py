@@ -19,10 +19,14 @@ import time
 
 import numpy as np
 
-from ..errors import InputError
-from ..operators.grid import Loads
+from ..atomic import written
 from ..crossval.grid import AGREEMENT
+from ..errors import InputError
 from ..march.grid import coupled_step
+from ..march.loop import versions as _versions
+from ..methods import CROSSVAL_METHODS_3D, available_methods, get_method
+from ..operators.grid import Loads
+from ..version import __version__
 from .solve import solve_wheel
 from .track import Track
 from .wheelset import Wheelset
@@ -31,7 +35,6 @@ __all__ = ["solve_scene", "run", "WheelRailResult", "summary", "figure", "crossv
 
 
 def _method(scene):
-    from ..methods import get_method
     return get_method(scene.solver.method, 3, tolerance=scene.solver.tolerance)
 
 
@@ -60,8 +63,6 @@ class WheelRailResult:
         self.scene, self.wheels, self.method, self.wall = scene, wheels, method, wall
 
     def arrays(self) -> dict:
-        from ..march.loop import versions as _versions
-        from ..version import __version__
         P = [p for w in self.wheels for p in w.patches]
         a = {"patch_wheel": np.array([0 if p.wheel == "left" else 1 for p in P], dtype=np.int64)}
         for key, attr in (("patch_FN", "FN"), ("patch_Fx", "Fx"), ("patch_Fy", "Fs"), ("patch_Mz", "Mn"),
@@ -88,7 +89,6 @@ class WheelRailResult:
         return a
 
     def save(self, out) -> None:
-        from ..atomic import written
         with written(out) as (fh, _):
             np.savez(fh, **self.arrays())
 
@@ -141,7 +141,6 @@ def figure(res: dict, scene, path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from .profiles import read_profile  # noqa: F401  (the profiles through the scene)
     rail, wheel = scene.profiles()
     P = len(res["patch_FN"])
     fig, axes = plt.subplots(1 + P, 2, figsize=(10, 3.2 * (1 + P)), squeeze=False)
@@ -185,7 +184,6 @@ def crossval(scene, methods=None, tolerance: float = 1e-10):
     run's steady state (one rolling step of ``Δq = dx`` from it, whose answer is that state again) and
     compared with the run's: ``[(wheel, patch, method, |dp|/p0, |dt|/(μ p0), residual, seconds, raw |dt|)]``
     (raw: the conic solver's own answer before rollqp's active-set refinement, None without one)."""
-    from ..methods import get_method
     methods = list(methods or default_crossval_methods(scene))
     wheels = solve_scene(scene)
     rows = []
@@ -212,7 +210,6 @@ def crossval(scene, methods=None, tolerance: float = 1e-10):
 
 def default_crossval_methods(scene) -> list:
     """The installed conic methods of ``rollqp crossval`` other than the scene's own."""
-    from ..methods import CROSSVAL_METHODS_3D, available_methods
     installed = set(available_methods(3))
     return [m for m in CROSSVAL_METHODS_3D if m in installed and m != scene.solver.method]
 

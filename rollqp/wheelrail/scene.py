@@ -45,9 +45,12 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from ..errors import InputError
+from ..materials import Materials
 from ..methods import DEFAULT_METHOD, require_3d
 from ..scene.core import SceneBase
 from ..validate import suggestion
+from .profiles import read_profile, resolve_file
+from .wheelset import State
 
 __all__ = ["WheelRailScene", "scene_from_dict", "KEYS"]
 
@@ -139,7 +142,6 @@ class WheelRailScene(SceneBase):
 
     def profiles(self):
         """``(rail, wheel)`` read from their files (module docstring)."""
-        from .profiles import read_profile, resolve_file
         w = self.data["wheelset"]
         out = []
         for kind in ("rail", "wheel"):
@@ -150,7 +152,6 @@ class WheelRailScene(SceneBase):
         return tuple(out)
 
     def materials(self):
-        from ..materials import Materials
         w = self.data["wheelset"]
         E = {b: w.get(f"{b}_E") if w.get(f"{b}_E") is not None else w.get("E") for b in ("wheel", "rail")}
         nu = {b: w.get(f"{b}_nu") if w.get(f"{b}_nu") is not None else w.get("nu") for b in ("wheel", "rail")}
@@ -161,7 +162,6 @@ class WheelRailScene(SceneBase):
         return Materials.from_young(E["rail"], nu["rail"], E["wheel"], nu["wheel"])
 
     def state(self):
-        from .wheelset import State
         w = self.data["wheelset"]
         return State(lateral=w["lateral"], vertical=w["vertical"] or 0.0, roll=w["roll"], yaw=w["yaw"],
                      speed=w["speed"], pitch_rate=w["pitch_rate"], vy=w["vy"], vz=w["vz"], roll_rate=w["roll_rate"],

@@ -31,10 +31,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..errors import InputError, SolverError
-from ..operators.grid import Contact, Loads
 from ..march.grid import steady
+from ..operators.grid import Contact, Loads
 from ..problem.grid import NormalStep
-from .search import search
+from .search import search, touch
 
 __all__ = ["PatchResult", "WheelResult", "solve_wheel", "LOAD_TOLERANCE", "Z_TOLERANCE"]
 
@@ -197,7 +197,6 @@ def solve_wheel(track, wheelset, state, materials, mu: float, load: float | None
     st = state.mirrored() if side == "left" else state
     key = f"wheelset ({side} wheel)"
     if load is not None:
-        from .search import touch
         _, _, g = touch(track, wheelset, replace(st, vertical=0.0))
         if not np.any(np.isfinite(g)):
             raise InputError("wheelset.lateral", f"the {side} wheel and its rail have no point in common laterally")

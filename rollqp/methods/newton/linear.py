@@ -18,6 +18,7 @@ import numpy as np
 from scipy.linalg.lapack import dgesv, dgetrf, dgetrs
 
 from ...errors import InputError
+from ..blocks import MAX_BLOCKS, RUN_GAP, partial_product, runs  # noqa: F401 - re-exported
 from .ncp import slip_rows
 
 __all__ = ["ReducedSystem", "CoupledSystem", "coupled_system", "coupled_vectors", "CoupledFactors",
@@ -26,49 +27,10 @@ __all__ = ["ReducedSystem", "CoupledSystem", "coupled_system", "coupled_vectors"
 #: From this many nodes the iteration multiplies only the blocks of ``K`` it needs
 #: (:func:`partial_product`); below, one dense product is cheaper than the bookkeeping.
 PARTIAL_MIN = 320
-#: Indices closer than this are one run (a block with a few needless zeros costs less than
-#: another BLAS call).
-RUN_GAP = 32
-#: More blocks than this: one dense product instead.
-MAX_BLOCKS = 12
 #: Columns of the reduced matrix gathered at a time into its factorization's array.
 FACTOR_COLUMNS = 256
 _NONE = np.empty(0, dtype=np.intp)  # no nodes (read-only)
 _NONE.flags.writeable = False
-
-
-def runs(idx: np.ndarray, gap: int = RUN_GAP) -> list:
-    """The sorted indices ``idx`` as ``(start, stop)`` runs, gaps up to ``gap`` bridged."""
-    if idx.size == 0:
-        return []
-    brk = np.flatnonzero(np.diff(idx) > gap)
-    starts = idx[np.concatenate(([0], brk + 1))]
-    stops = idx[np.concatenate((brk, [idx.size - 1]))] + 1
-    return list(zip(starts.tolist(), stops.tolist()))
-
-
-def partial_product(K: np.ndarray, rows: np.ndarray, v: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """``(K @ v)[rows]`` for ``v`` zero outside the sorted indices ``cols``, by blocks of ``K`` (views, no copies).
-
-    The node sets of a contact step (the stick zone, the slip zones, the contact) are a few runs
-    of consecutive nodes, so the product costs ``|rows|·|cols|`` instead of ``n²``; a set in more
-    than :data:`MAX_BLOCKS` blocks takes the dense product.
-    """
-    out = np.zeros(rows.size)
-    if rows.size == 0 or cols.size == 0:
-        return out
-    rr, cr = runs(rows), runs(cols)
-    if len(rr) * len(cr) > MAX_BLOCKS:
-        return (K @ v)[rows]
-    i0 = 0
-    for a, b in rr:
-        acc = K[a:b, cr[0][0]:cr[0][1]] @ v[cr[0][0]:cr[0][1]]
-        for c0, c1 in cr[1:]:
-            acc += K[a:b, c0:c1] @ v[c0:c1]
-        i1 = i0 + int(np.searchsorted(rows[i0:], b))
-        out[i0:i1] = acc[rows[i0:i1] - a]
-        i0 = i1
-    return out
 
 
 class ReducedSystem:
