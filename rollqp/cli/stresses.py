@@ -61,7 +61,7 @@ def main(args) -> int:
         check_output(args.out, "stress file", "--out")
     check_plot(args.plot)
     loaded = load_result(args.result, "RESULT.npz")
-    if "y" in loaded:  # a grid of elements: a 3D result
+    if loaded["meta"].get("dimension", 2) == 3:  # the result file's dimension (meta; 2 when absent)
         return _stresses_3d(args, loaded)
     for opt in ("plane", "line", "depths"):
         if getattr(args, opt) is not None:

@@ -39,13 +39,7 @@ def creep_2d(scene, args) -> int:
     check_plot(args.plot)
     curve = sweep_signals(lambda: creep_points(scene, args.ratios, args.friction, out, scheduler=args.scheduler,
                                               workers=args.workers, quiet=args.quiet))
-    if args.plot and not curve.summary.interrupted:
-        curve.plot(args.plot)
-    if not args.quiet:
-        print(curve.table())
-        print(curve.summary.table())
-        print(f"  store         {out}" + (f"\n  figure        {args.plot}" if args.plot else ""))
-    return sweep_exit(curve.summary)
+    return _report_curve(curve, args, out, plot=not curve.summary.interrupted)
 
 
 def creep_3d(scene, args) -> int:
@@ -60,7 +54,13 @@ def creep_3d(scene, args) -> int:
     if curve.FN is None:       # interrupted: the points done are saved in the store
         print(curve.summary.table())
         return sweep_exit(curve.summary)
-    if args.plot:
+    return _report_curve(curve, args, out, plot=True)
+
+
+def _report_curve(curve, args, out, plot: bool) -> int:
+    """A creep curve's figure (``--plot``, when ``plot``), its table and summary, and the exit code (either
+    dimension's curve)."""
+    if args.plot and plot:
         curve.plot(args.plot)
     if not args.quiet:
         print(curve.table())
