@@ -17,6 +17,7 @@ import pytest
 xr = pytest.importorskip("xarray")
 pytest.importorskip("zarr")
 
+import rollqp  # noqa: E402
 from rollqp import load_scene  # noqa: E402
 from rollqp.errors import InputError  # noqa: E402
 from rollqp.sweep.three import POINTS, sweep_3d  # noqa: E402
@@ -130,3 +131,31 @@ def test_a_killed_rollqp_sweep_of_a_3d_scene_resumes_to_the_same_dataset(tmp_pat
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
     _same(xr.open_zarr(store, chunks=None).load(), xr.open_zarr(tmp_path / "whole.zarr", chunks=None).load())
+
+
+def _patch_scene():
+    """cattaneo-3d on a coarse grid with a patch whose inside μ (0.6) is above the law's reference μ (0.2)."""
+    scene = load_scene("cattaneo-3d")
+    return scene.replace(**{"contact.friction": {"law": "patch", "mu": 0.2, "inside": 0.6, "start": -0.6, "end": 0.6},
+                            "load.tangential": 0.95, "discretization.elements": [10, 10],
+                            "discretization.distance": 1.0})
+
+
+def test_the_resume_check_takes_each_element_s_own_coefficient(tmp_path):
+    """An untouched 3D result whose tractions exceed the reference μ p inside a patch of larger μ is accepted by
+    the resume check of earlier states (the disc is each element's stored μ), and a traction pushed beyond its
+    own disc is still refused."""
+    from rollqp.march.grid import check_states, prepare
+    scene, _, contact = prepare(_patch_scene(), None)
+    out = tmp_path / "r.npz"
+    rollqp.run(scene, out=out)
+    arrays = dict(np.load(out))
+    t, p = np.hypot(arrays["px"], arrays["py"]), arrays["pn"]
+    assert np.max(t[p > 0] / (0.2 * p[p > 0])) > 2.0    # the patch carries more than the reference disc
+    check_states(scene, contact, arrays)                  # accepted
+    forged = dict(arrays)
+    k = np.unravel_index(np.argmax(p[1]), p[1].shape)
+    forged["px"] = arrays["px"].copy()
+    forged["px"][(1,) + k] = 0.9 * p[(1,) + k]            # beyond μ = 0.6 of every element
+    with pytest.raises(InputError, match="friction disc"):
+        check_states(scene, contact, forged)

@@ -720,7 +720,8 @@ def check_states(scene, contact, source) -> None:
     def inconsistent(b, k):
         m = len(b["pn"])
         _resumable(scene, b)
-        law_mu = np.asarray(b["mu"], dtype=float).reshape(m, -1) if "mu" in b and contact.law.kind == "slip" else None
+        # each element's own coefficient, as stored (field mu: any law's); without it the law's, at q = 0
+        law_mu = np.asarray(b["mu"], dtype=float).reshape(m, -1) if "mu" in b else None
         p = np.asarray(b["pn"], dtype=float).reshape(m, -1)
         t = np.stack([np.asarray(b["px"], dtype=float).reshape(m, -1), np.asarray(b["py"], dtype=float).reshape(m, -1)], 1)
         sl = np.stack([np.asarray(b["sx"], dtype=float).reshape(m, -1), np.asarray(b["sy"], dtype=float).reshape(m, -1)], 1)
@@ -728,7 +729,8 @@ def check_states(scene, contact, source) -> None:
             return "its fields are not finite"
         if np.min(p) < -RESUME_TOL * sc.stress:
             return f"a pressure of {np.min(p) / sc.stress:.3g} p0 < 0"
-        if np.max(np.hypot(t[:, 0], t[:, 1]) - mu * np.maximum(p, 0.0)) > RESUME_TOL * tunit:
+        bound_mu = law_mu if law_mu is not None else float(contact.law.largest)   # the disc of each element's μ
+        if np.max(np.hypot(t[:, 0], t[:, 1]) - bound_mu * np.maximum(p, 0.0)) > RESUME_TOL * tunit:
             return "a traction beyond the friction disc"
         for i in range(m):
             Fx, Fy, Mz = contact.moments(t[i])
