@@ -14,6 +14,7 @@ scene's checks, each a one-line :class:`~rollqp.errors.InputError` naming the ke
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -22,9 +23,11 @@ from .histories import Constant, Harmonic
 from .kinematics import plan
 from .methods import REFERENCE_METHOD, scene_method_3d
 from .closedforms.hertz_ellipse import hertz
+from .friction.capacity import estimate, grid_shares, near_grid, per_sample
 from .patch import check_patch, computed_patch
 
-__all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "MAX_STEP_RATIO"]
+__all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "sliding_limits",
+           "MAX_STEP_RATIO"]
 
 #: Largest ``|Δq_k|`` of a step of a load path, in elements ``dx``: the range of ``discretization.step``.
 MAX_STEP_RATIO = 8.0
@@ -116,10 +119,75 @@ def _check_sliding_limit(scene, s_end: float) -> None:
     if np.isinf(ratio[k]):
         raise InputError(key, f"must be 0 where the normal load is 0 (out of contact), but |(Fx, Fy)|/(mu FN_ref) = "
                               f"{r[k]:.6g} at τ = {s[k]:.6g} a where load.normal_history is 0")
+    lim = sliding_limits(scene, s, n, ratio)
+    if lim is not None:
+        c, limit = lim
+        with np.errstate(divide="ignore", invalid="ignore"):     # a limit of 0 (μ = 0 on the contact): inf
+            k = int(np.argmax(np.where(ratio > 0, ratio / limit, 0.0)))
+        if not ratio[k] < limit[k]:
+            raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {ratio[k]:.6g} at τ = {s[k]:.6g} a (FN the current normal "
+                                  f"load {n[k]:.6g}·load.normal) " + limit_message(scene, c[k], limit[k]))
+        return
     if not ratio[k] < 1:
         raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {ratio[k]:.6g} at τ = {s[k]:.6g} a (FN the current normal load "
                               f"{n[k]:.6g}·load.normal) must be < 1: a stick solution exists only below the sliding "
                               "limit (prescribe creepages for gross sliding)")
+
+
+def sliding_limits(scene, s, n, ratio):
+    """The sliding limit of a 3D scene's prescribed forces where its friction law varies over the contact
+    (:mod:`rollqp.friction.capacity`): ``(c, limit)`` at the samples ``s`` (τ/a) of normal loads ``n·load.normal``,
+    in units of ``μ_ref FN`` — ``c = Σ μ_i w_i/μ_ref`` of the Hertz pressure of ``FN`` on the scene's grid, with
+    ``μ_i`` at the element centres at the rolled distance ``q(τ)`` as the steps read it, and ``limit`` the force the
+    check allows below (``c`` plus the bound on the discrete pressure's difference). Computed only where
+    ``ratio > 0`` and ``n > 0`` (elsewhere 1). None where ``μ`` is the same at every element: Coulomb, and a
+    slip-velocity law (its largest value, the static one, is its reference), whose limit is ``μ FN`` itself.
+
+    Without a Hertzian shape (a body ``profile``) the pressure is that of the scene's computed contact
+    (:attr:`Scene3D.patch <rollqp.scene.grid.Scene3D.patch>`, the discrete frictionless pressure at
+    ``load.normal``) where the load is ``load.normal`` and the shape does not move; elsewhere nothing before
+    the solve gives it, and the limit is the largest ``μ`` on the grid (a load beyond it has no solution)."""
+    law = scene.contact.friction
+    if law.kind != "spatial":
+        return None
+    s, n, ratio = (np.asarray(v, dtype=float) * np.ones(np.shape(s)) for v in (s, n, ratio))
+    e, g, ref, d = scene.ellipse, scene.grid, scene.mu, int(scene.load.direction)
+    X, Y = g.centres()
+    points = np.stack([X, Y]) / e.a
+    moving = getattr(law, "frame", "fixed") == "material"
+    q = scene.rolled_distance(s * e.a) / e.a if moving else np.zeros_like(s)
+
+    @functools.lru_cache(maxsize=64)
+    def mu_at(qh):
+        return np.asarray(law.coefficient(points, qh, d), dtype=float)
+
+    def rule(nk, qh):
+        mu = mu_at(qh)
+        if scene.shape.hertzian:
+            f = nk ** (1.0 / 3.0)                         # Hertz: a, b ∝ FN^(1/3)
+            a, b = e.a * f, e.b * f
+            w = grid_shares(X, Y, g.dx, g.dy, a, b)
+            return estimate(mu, w, near_grid(X, Y, g.dx, g.dy, a, b), ref, min(a / g.dx, b / g.dy))
+        if nk == 1.0 and not scene.shape.moves:          # the computed contact's own pressure: no margin
+            w = scene.patch.p.ravel() / float(np.sum(scene.patch.p))
+            c = float(mu @ w) / ref
+            return c, c
+        top = float(np.max(mu)) / ref
+        return top, top
+
+    need = (ratio > 0) & (n > 0)
+    c, limit = np.ones_like(s), np.ones_like(s)
+    c[need], limit[need] = per_sample(n[need], q[need], rule)
+    return c, limit
+
+
+def limit_message(scene, c: float, limit: float) -> str:
+    """The end of the sliding-limit refusal of a friction law varying over the contact (:func:`sliding_limits`)."""
+    margin = limit - c
+    how = (f"(+{margin:.3g} allowed for the discrete pressure's difference from Hertz's)" if margin > 0 else "")
+    return (f"must be < {limit:.6g}: with contact.friction varying over the contact a stick solution exists only "
+            f"below its sliding limit |(Fx, Fy)| < ∫ mu p dA = {c:.6g} mu FN (mu = {scene.mu:g}, the law's "
+            f"reference) {how}; prescribe creepages for gross sliding (docs/friction.md)").replace(" ;", ";")
 
 
 def start_force(scene) -> float:

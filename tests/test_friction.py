@@ -43,9 +43,12 @@ def test_static_equals_kinetic_is_coulomb(ramp, coulomb, law, method):
 
 @pytest.mark.parametrize("method", ["newton", "qp-osqp"])
 def test_patch_over_the_whole_zone_is_constant(ramp, coulomb, method):
+    # one replace: the patch with the ramp's own tangential (0.75 of 0.3) would be beyond the patch's sliding
+    # limit 0.1 P (rollqp.scene.checks.check_tangential), so the load changes with the law
     sc = ramp.replace(**{"contact.friction": {"law": "patch", "mu": 0.3, "inside": 0.1, "start": -50.0,
-                                              "end": 50.0, "frame": "material"}})
-    r = run(sc.replace(**{"load.tangential": {"kind": "ramp", "start": 0.0, "end": 0.25, "over": 8 / 3}}), method)
+                                              "end": 50.0, "frame": "material"},
+                         "load.tangential": {"kind": "ramp", "start": 0.0, "end": 0.25, "over": 8 / 3}})
+    r = run(sc, method)
     base = run(ramp.replace(**{"contact.friction": 0.1,
                                "load.tangential": {"kind": "ramp", "start": 0.0, "end": 0.75, "over": 8 / 3}}), method)
     # Q/(μ_ref P̄) with μ_ref = 0.3 (the outside value): 0.25 of 0.3 is 0.75 of 0.1, the same loads

@@ -34,6 +34,8 @@ from ..profiles import check_cover
 from ..advice import fast_path
 from ..matrixfree import check_scene
 from ..matrixfree import memory_estimate
+from ..friction.capacity import estimate, near_strip, per_sample, strip_shares
+from ..strip import Strip
 
 #: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
 MAX_FRICTION = 1e6
@@ -419,7 +421,8 @@ def check_zone(scene) -> None:
 
 
 def check_tangential(scene) -> None:
-    """Where a tangential load is prescribed, a stick solution exists at every step: ``|Q| < μP``."""
+    """Where a tangential load is prescribed, a stick solution exists at every step: ``|Q| < μP``; with a
+    friction law varying along the strip, ``|Q|`` below its own sliding limit ``∫ μ p dx`` (:func:`sliding_limits`)."""
     load, q_end = scene.load, scene.q_end
     tang = load.tangential
     if tang is None:
@@ -431,12 +434,14 @@ def check_tangential(scene) -> None:
                              "must be 0 when contact.friction = 0 (it is Q/(mu P̄) and "
                              f"|Q| <= mu P = 0), got values in [{tmin:.6g}, {tmax:.6g}]")
         return
+    varying = scene.contact.friction.kind == "spatial"
     nmin, _ = load.normal_history.extremes(q_end)
-    if nmin > 0 and max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
+    if not varying and nmin > 0 and max(abs(tmin), abs(tmax)) / nmin < 1.0:  # a sufficient bound
         return
     q = np.unique(np.concatenate((scene.time_steps / scene.a_H, load.normal_history.critical_points(q_end),
                                   tang.critical_points(q_end))))
     Qr, Pr = np.abs(np.asarray(tang(q), dtype=float)), np.asarray(load.normal_history(q), dtype=float)
+    Qr, Pr = Qr * np.ones_like(q), Pr * np.ones_like(q)
     with np.errstate(divide="ignore", invalid="ignore"):  # P = 0 (contact lost): Q must be 0 too
         ratio = np.where(Pr > 0, Qr / np.where(Pr > 0, Pr, 1.0), np.where(Qr > 0, np.inf, 0.0))
     i = int(np.argmax(ratio))
@@ -444,11 +449,59 @@ def check_tangential(scene) -> None:
         raise InputError("load.tangential",
                          f"must be 0 where the normal load is 0 (contact lost), but Q/(mu P̄) = "
                          f"{float(tang(q[i])):.6g} at q = {q[i]:.6g} a_H where P = 0")
+    if varying:
+        c, limit = sliding_limits(scene, q, Pr, ratio)
+        with np.errstate(divide="ignore", invalid="ignore"):     # a limit of 0 (μ = 0 on the contact): inf
+            i = int(np.argmax(np.where(ratio > 0, ratio / limit, 0.0)))
+        if not ratio[i] < limit[i]:
+            raise InputError("load.tangential",
+                             f"|Q|/(mu P) = {ratio[i]:.6g} at q = {q[i]:.6g} a_H must be < {limit[i]:.6g}: with "
+                             f"contact.friction varying along the strip a stick solution exists only below its "
+                             f"sliding limit |Q| < ∫ mu p dx = {c[i]:.6g} mu P (mu = {scene.contact.mu:g}, the law's "
+                             f"reference{_margin(c[i], limit[i])}); gross sliding is not supported (docs/friction.md)")
+        return
     if not ratio[i] < 1.0:
         raise InputError("load.tangential",
                          f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"
                          f" is not supported), but it reaches {ratio[i]:.6g} at q = "
                          f"{q[i]:.6g} a_H")
+
+
+def _margin(c: float, limit: float) -> str:
+    return f"; +{limit - c:.3g} allowed for the discrete pressure's difference from Hertz's" if limit > c else ""
+
+
+def sliding_limits(scene, q, n, ratio) -> tuple[np.ndarray, np.ndarray]:
+    """The sliding limit of a 2D scene whose friction law varies along the strip
+    (:mod:`rollqp.friction.capacity`): ``(c, limit)`` at the samples ``q`` (τ/a_H) of normal loads ``n·P̄``, in
+    units of ``μ_ref P`` — ``c = Σ μ_i w_i/μ_ref`` of the Hertz pressure of ``P`` (half-width ``a_H·sqrt(n)``) at
+    the strip's nodes with their weights, ``μ_i`` at the nodes at the rolled distance ``q(τ)`` as the steps read
+    it, and ``limit`` the force the check allows below (``c`` plus the bound on the discrete pressure's
+    difference). Computed only where ``ratio > 0`` and ``n > 0`` (elsewhere 1).
+
+    Without Hertz's pressure before the solve (a body ``profile``, ``contact.model = "bem"``, a prescribed
+    ``load.approach``) the limit is the largest ``μ`` on the strip (a load beyond it has no solution)."""
+    law, d = scene.contact.friction, scene.discretization
+    strip = Strip(scene.half_width, d.elements, d.element)
+    aH, ref, Le = scene.a_H, float(scene.contact.mu), scene.element_length
+    hertzian = (scene.A.profile is None and scene.B.profile is None and scene.contact.model == "halfspace"
+                and scene.load.approach is None)
+    moving = getattr(law, "frame", "fixed") == "material"
+    q, n, ratio = (np.asarray(v, dtype=float) * np.ones(np.shape(q)) for v in (q, n, ratio))
+    qh = scene.rolled_distance(q * aH) / aH if moving else np.zeros_like(q)
+
+    def rule(nk, qk):
+        mu = np.asarray(law.coefficient(strip.x[None, :] / aH, qk, scene.load.direction), dtype=float)
+        if not hertzian:
+            top = float(np.max(mu)) / ref
+            return top, top
+        b = aH * np.sqrt(nk)                                  # 2D Hertz: the half-width ∝ sqrt(P)
+        return estimate(mu, strip_shares(strip.x, strip.weights, b), near_strip(strip.x, b, Le), ref, b / Le)
+
+    need = (ratio > 0) & (n > 0)
+    c, limit = np.ones_like(q), np.ones_like(q)
+    c[need], limit[need] = per_sample(n[need], qh[need], rule)
+    return c, limit
 
 
 def check_sampling(scene) -> None:

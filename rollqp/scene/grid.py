@@ -51,7 +51,7 @@ from ..operators.grid import MU_REFERENCE, Loads
 from ..profiles.surface import Body, curvatures
 from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
 from ..closedforms.hertz_ellipse import hertz
-from ..loads import check_load_path, has_load_path
+from ..loads import check_load_path, has_load_path, limit_message, sliding_limits
 from ..materials import Materials
 from ..patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
 from ..methods import REFERENCE_METHOD
@@ -548,7 +548,8 @@ def _check_memory(scene) -> None:
 
 
 def _check_sliding_limit(scene) -> None:
-    """Prescribed forces: ``|(Fx, Fy)|/(μFN) < 1`` at every step (and the histories' breakpoints)."""
+    """Prescribed forces: ``|(Fx, Fy)|/(μFN) < 1`` at every step (and the histories' breakpoints); with a friction
+    law varying over the contact, below its own sliding limit ``∫ μ p dA/(μ FN)`` (:func:`rollqp.loads.sliding_limits`)."""
     ld = scene.load
     if ld.tangential is None and ld.lateral is None:
         return
@@ -565,6 +566,16 @@ def _check_sliding_limit(scene) -> None:
         key = "load.tangential" if ld.tangential is not None else "load.lateral"
         raise InputError(key, f"must be 0 when contact.friction = 0 (a force over mu FN, and |(Fx, Fy)| <= mu FN = 0), "
                               f"got |(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a; prescribe creepages instead")
+    lim = sliding_limits(scene, s, 1.0, r)    # a law varying over the contact: its own limit (rollqp.loads)
+    if lim is not None:
+        c, limit = lim
+        with np.errstate(divide="ignore", invalid="ignore"):     # a limit of 0 (μ = 0 on the contact): inf
+            k = int(np.argmax(np.where(r > 0, r / limit, 0.0)))
+        if not r[k] < limit[k]:
+            key = "load.tangential" if ld.tangential is not None else "load.lateral"
+            raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a "
+                                  + limit_message(scene, c[k], limit[k]))
+        return
     if not r[k] < 1:
         key = "load.tangential" if ld.tangential is not None else "load.lateral"
         raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a must be < 1: a stick solution "
