@@ -23,7 +23,7 @@ from .histories import Constant, Harmonic
 from .kinematics import plan
 from .methods import REFERENCE_METHOD, scene_method_3d
 from .closedforms.hertz_ellipse import hertz
-from .friction.capacity import estimate, grid_shares, near_grid, per_sample
+from .friction.capacity import COUPLING_GRID, allowed, estimate, grid_shares, near_grid, per_sample
 from .patch import check_patch, computed_patch
 
 __all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "sliding_limits",
@@ -49,7 +49,8 @@ def check_load_path(scene) -> None:
     """The load path's checks: the normal load ``>= 0`` (0: out of contact), the grid covering the contact
     of the largest load, every step's ``|Δq|`` at most :data:`MAX_STEP_RATIO` elements, a harmonic history
     resolved by two steps per wavelength, and the prescribed forces below the sliding limit of the
-    current load, ``|(Fx, Fy)| < μ·FN(τ)`` (zero where ``FN(τ) = 0``)."""
+    current load, ``|(Fx, Fy)| < μ·FN(τ)`` (zero where ``FN(τ) = 0``; a law varying over the contact:
+    :func:`sliding_limits`)."""
     ld, a = scene.load, scene.ellipse.a
     tau = scene.time_steps
     s_end = float(tau[-1]) / a
@@ -146,7 +147,8 @@ def sliding_limits(scene, s, n, ratio):
     Without a Hertzian shape (a body ``profile``) the pressure is that of the scene's computed contact
     (:attr:`Scene3D.patch <rollqp.scene.grid.Scene3D.patch>`, the discrete frictionless pressure at
     ``load.normal``) where the load is ``load.normal`` and the shape does not move; elsewhere nothing before
-    the solve gives it, and the limit is the largest ``μ`` on the grid (a load beyond it has no solution)."""
+    the solve gives it, and the limit is the largest ``μ`` on the grid (a load beyond it has no solution).
+    Dissimilar bodies add the coupling's shift of the pressure (:data:`~rollqp.friction.capacity.COUPLING_GRID`)."""
     law = scene.contact.friction
     if law.kind != "spatial":
         return None
@@ -161,33 +163,35 @@ def sliding_limits(scene, s, n, ratio):
     def mu_at(qh):
         return np.asarray(law.coefficient(points, qh, d), dtype=float)
 
+    @functools.lru_cache(maxsize=64)
+    def hertz_at(nk):
+        f = nk ** (1.0 / 3.0)                             # Hertz: a, b ∝ FN^(1/3)
+        a, b = e.a * f, e.b * f
+        return grid_shares(X, Y, g.dx, g.dy, a, b), near_grid(X, Y, g.dx, g.dy, a, b), min(a / g.dx, b / g.dy)
+
     def rule(nk, qh):
         mu = mu_at(qh)
         if scene.shape.hertzian:
-            f = nk ** (1.0 / 3.0)                         # Hertz: a, b ∝ FN^(1/3)
-            a, b = e.a * f, e.b * f
-            w = grid_shares(X, Y, g.dx, g.dy, a, b)
-            return estimate(mu, w, near_grid(X, Y, g.dx, g.dy, a, b), ref, min(a / g.dx, b / g.dy))
-        if nk == 1.0 and not scene.shape.moves:          # the computed contact's own pressure: no margin
+            w, near, m = hertz_at(nk)
+            return estimate(mu, w, near, ref, m)
+        if nk == 1.0 and not scene.shape.moves:          # the computed contact's own pressure: no mesh margin
             w = scene.patch.p.ravel() / float(np.sum(scene.patch.p))
-            c = float(mu @ w) / ref
-            return c, c
+            return estimate(mu, w, w > 0, ref, np.inf)
         top = float(np.max(mu)) / ref
-        return top, top
+        return top, 0.0, top, 0.0
 
     need = (ratio > 0) & (n > 0)
-    c, limit = np.ones_like(s), np.ones_like(s)
-    c[need], limit[need] = per_sample(n[need], q[need], rule)
-    return c, limit
+    parts = np.ones((4, s.size))
+    parts[:, need] = per_sample(n[need], q[need], rule)
+    return parts[0], allowed(parts, ratio, COUPLING_GRID * abs(scene.materials.K))
 
 
 def limit_message(scene, c: float, limit: float) -> str:
     """The end of the sliding-limit refusal of a friction law varying over the contact (:func:`sliding_limits`)."""
-    margin = limit - c
-    how = (f"(+{margin:.3g} allowed for the discrete pressure's difference from Hertz's)" if margin > 0 else "")
+    margin = f"; +{limit - c:.3g} allowed for the discrete pressure's difference from this estimate" if limit > c else ""
     return (f"must be < {limit:.6g}: with contact.friction varying over the contact a stick solution exists only "
             f"below its sliding limit |(Fx, Fy)| < ∫ mu p dA = {c:.6g} mu FN (mu = {scene.mu:g}, the law's "
-            f"reference) {how}; prescribe creepages for gross sliding (docs/friction.md)").replace(" ;", ";")
+            f"reference{margin}); prescribe creepages for gross sliding (docs/friction.md)")
 
 
 def start_force(scene) -> float:

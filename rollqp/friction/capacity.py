@@ -16,7 +16,8 @@ share ``w_i`` of each element (Hertz's force on the element, integrated on :data
 The discrete pressure ``p_i A_i/FN = w'_i`` differs from ``w_i`` (its edge elements, its contact set), and
 since both sum to 1, ``|Σ μ_i (w_i − w'_i)| <= ½ (μ_max − μ_min) Σ|w_i − w'_i|`` over the elements either
 pressure reaches. The checks refuse a force only beyond ``c + min(1, MARGIN/m)·(μ_max − μ_min)/μ_ref``
-(:data:`MARGIN`, measured; ``m`` the elements per semi-axis), so a load with a stick solution is never refused
+(:data:`MARGIN`, measured; ``m`` the elements per semi-axis), plus the coupling's shift of the pressure for
+dissimilar bodies (:data:`COUPLING_GRID`, :data:`COUPLING_STRIP`), so a load with a stick solution is never refused
 for this estimate; a load between ``c`` and that bound may still be refused by the step (its own sliding limit).
 A uniform ``μ`` gives ``c = 1`` and no margin (the checks then keep their plain ``μFN`` path).
 
@@ -32,7 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["SUB", "MARGIN", "grid_shares", "strip_shares", "near_grid", "near_strip", "estimate", "per_sample"]
+__all__ = ["SUB", "MARGIN", "COUPLING_GRID", "COUPLING_STRIP", "grid_shares", "strip_shares", "near_grid",
+           "near_strip", "estimate", "allowed", "per_sample"]
 
 #: Sub-samples per direction of a grid element for its share of the Hertz force (midpoint rule on SUB × SUB
 #: points). Measured against 40 × 40 sub-samples on grids of 2 to 30 elements per semi-axis: ``Σ|Δw| <= 5.3e-3``
@@ -83,22 +85,39 @@ def near_strip(x, b: float, h: float) -> np.ndarray:
 MARGIN = 0.5
 
 
-def estimate(mu, w, near, reference: float, m: float) -> tuple[float, float]:
-    """``(c, limit)`` in units of ``μ_ref FN`` (module docstring): ``c = Σ μ_i w_i/μ_ref`` and the force the check
-    allows below, ``c + min(1, MARGIN/m)·(μ_max − μ_min)/μ_ref`` over the ``near`` elements, at most
-    ``μ_max/μ_ref`` (no pressure carries more)."""
+#: The normal–tangential coupling of dissimilar bodies moves the pressure under the tangential tractions, and the
+#: capacity with it: ``|Σ μ_i Δw_i| <= COUPLING·|K|·(|F|/(μ_ref FN))·(μ_max − μ_min)/μ_ref`` (Kalker's ``K``, 3D;
+#: Dundurs' ``β``, 2D). Measured at 0.97 of the capacity of patches at four places, |K| from 0.003 to 0.48
+#: (20 × 20, ``qp-clarabel``, four steps): at most 0.227 (3D); |β| from 0.006 to 0.49 (40 quadratic elements):
+#: at most 0.059 (2D). Taken as twice the largest.
+COUPLING_GRID = 0.5
+COUPLING_STRIP = 0.12
+
+
+def estimate(mu, w, near, reference: float, m: float) -> tuple[float, float, float, float]:
+    """``(c, spread, top, mesh)`` in units of ``μ_ref`` (module docstring): ``c = Σ μ_i w_i/μ_ref``, ``spread =
+    (μ_max − μ_min)/μ_ref`` and ``top = μ_max/μ_ref`` over the ``near`` elements, and ``mesh = min(1, MARGIN/m)``,
+    the bound on ``½ Σ|w_i − w'_i|`` (:func:`allowed` combines them)."""
     mu = np.broadcast_to(np.asarray(mu, dtype=float), np.shape(w))
     c = float(mu @ w) / reference
     hi, lo = float(np.max(mu[near])) / reference, float(np.min(mu[near])) / reference
-    return c, min(c + min(1.0, MARGIN / m) * (hi - lo), hi)
+    return c, hi - lo, hi, min(1.0, MARGIN / m)
 
 
-def per_sample(n, q, rule) -> tuple[np.ndarray, np.ndarray]:
-    """``rule(n_k, q_k) -> (c, limit)`` at each sample, evaluated once per distinct pair."""
+def allowed(parts, ratio, coupling: float) -> np.ndarray:
+    """The force (in ``μ_ref FN``) a check allows below at each sample: ``c + (mesh + coupling·ratio)·spread``, at
+    most ``top`` (no pressure carries more than the largest ``μ`` times ``FN``); ``parts`` the columns of
+    :func:`estimate` per sample, ``coupling`` the coupling constant times ``|K|`` (or ``|β|``), 0 for similar bodies."""
+    c, spread, top, mesh = parts
+    return np.minimum(c + (mesh + coupling * np.asarray(ratio, dtype=float)) * spread, top)
+
+
+def per_sample(n, q, rule) -> np.ndarray:
+    """``rule(n_k, q_k) -> (c, spread, top, mesh)`` at each sample (shape ``(4, samples)``), evaluated once per
+    distinct pair."""
     keys = np.stack([np.asarray(n, dtype=float), np.asarray(q, dtype=float)], axis=1)
     if keys.shape[0] == 0:
-        return np.zeros(0), np.zeros(0)
+        return np.zeros((4, 0))
     uniq, inv = np.unique(keys, axis=0, return_inverse=True)
-    vals = np.array([rule(float(a), float(b)) for a, b in uniq]).reshape(-1, 2)
-    inv = np.ravel(inv)
-    return vals[inv, 0], vals[inv, 1]
+    vals = np.array([rule(float(a), float(b)) for a, b in uniq]).reshape(-1, 4)
+    return vals[np.ravel(inv)].T

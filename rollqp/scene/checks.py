@@ -34,7 +34,7 @@ from ..profiles import check_cover
 from ..advice import fast_path
 from ..matrixfree import check_scene
 from ..matrixfree import memory_estimate
-from ..friction.capacity import estimate, near_strip, per_sample, strip_shares
+from ..friction.capacity import COUPLING_STRIP, allowed, estimate, near_strip, per_sample, strip_shares
 from ..strip import Strip
 
 #: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
@@ -468,7 +468,7 @@ def check_tangential(scene) -> None:
 
 
 def _margin(c: float, limit: float) -> str:
-    return f"; +{limit - c:.3g} allowed for the discrete pressure's difference from Hertz's" if limit > c else ""
+    return f"; +{limit - c:.3g} allowed for the discrete pressure's difference from this estimate" if limit > c else ""
 
 
 def sliding_limits(scene, q, n, ratio) -> tuple[np.ndarray, np.ndarray]:
@@ -480,28 +480,34 @@ def sliding_limits(scene, q, n, ratio) -> tuple[np.ndarray, np.ndarray]:
     difference). Computed only where ``ratio > 0`` and ``n > 0`` (elsewhere 1).
 
     Without Hertz's pressure before the solve (a body ``profile``, ``contact.model = "bem"``, a prescribed
-    ``load.approach``) the limit is the largest ``μ`` on the strip (a load beyond it has no solution)."""
+    ``load.approach``) the limit is the largest ``μ`` on the strip (a load beyond it has no solution). Coupled
+    dissimilar bodies add the coupling's shift of the pressure (:data:`~rollqp.friction.capacity.COUPLING_STRIP`)."""
     law, d = scene.contact.friction, scene.discretization
     strip = Strip(scene.half_width, d.elements, d.element)
     aH, ref, Le = scene.a_H, float(scene.contact.mu), scene.element_length
-    hertzian = (scene.A.profile is None and scene.B.profile is None and scene.contact.model == "halfspace"
-                and scene.load.approach is None)
+    hertzian = (scene.A.profile is None and scene.B.profile is None and scene.load.approach is None
+                and get_model(scene.contact.model).halfspace_field)      # round rollers on half-spaces
     moving = getattr(law, "frame", "fixed") == "material"
     q, n, ratio = (np.asarray(v, dtype=float) * np.ones(np.shape(q)) for v in (q, n, ratio))
     qh = scene.rolled_distance(q * aH) / aH if moving else np.zeros_like(q)
+
+    shares = {}
 
     def rule(nk, qk):
         mu = np.asarray(law.coefficient(strip.x[None, :] / aH, qk, scene.load.direction), dtype=float)
         if not hertzian:
             top = float(np.max(mu)) / ref
-            return top, top
-        b = aH * np.sqrt(nk)                                  # 2D Hertz: the half-width ∝ sqrt(P)
-        return estimate(mu, strip_shares(strip.x, strip.weights, b), near_strip(strip.x, b, Le), ref, b / Le)
+            return top, 0.0, top, 0.0
+        if nk not in shares:
+            b = aH * np.sqrt(nk)                              # 2D Hertz: the half-width ∝ sqrt(P)
+            shares[nk] = (strip_shares(strip.x, strip.weights, b), near_strip(strip.x, b, Le), b / Le)
+        return estimate(mu, *shares[nk][:2], ref, shares[nk][2])
 
     need = (ratio > 0) & (n > 0)
-    c, limit = np.ones_like(q), np.ones_like(q)
-    c[need], limit[need] = per_sample(n[need], qh[need], rule)
-    return c, limit
+    parts = np.ones((4, q.size))
+    parts[:, need] = per_sample(n[need], qh[need], rule)
+    coupling = 0.0 if scene.coupling_level == "off" else COUPLING_STRIP * abs(scene.beta)
+    return parts[0], allowed(parts, ratio, coupling)
 
 
 def check_sampling(scene) -> None:

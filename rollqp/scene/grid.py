@@ -23,7 +23,8 @@ Checked before any work, each failure an :class:`~rollqp.errors.InputError` nami
 allowed range: radii nonzero (``< 0`` concave, ``inf`` straight), a concentrated contact (the summed
 curvature positive in both directions, eq. 3D.3), the grid covering the Hertz ellipse with a row of elements to spare on every side, the
 element aspect ratio ``dx/dy`` in :data:`rollqp.discretization.grid.ASPECT_RANGE`, the forces below the sliding
-limit ``|(Fx, Fy)| < μFN`` at every step, the work bounded (elements, steps, result size), and a
+limit ``|(Fx, Fy)| < μFN`` at every step (a law varying over the contact: ``∫ μ p dA``,
+:func:`rollqp.loads.sliding_limits`), the work bounded (elements, steps, result size), and a
 method whose record solves 3D tangential steps on the friction disc
 (:func:`rollqp.methods.require_3d`).
 """
