@@ -87,8 +87,8 @@ MARGIN = 0.5
 
 #: The normal–tangential coupling of dissimilar bodies moves the pressure under the tangential tractions, and the
 #: capacity with it: ``|Σ μ_i Δw_i| <= COUPLING·|K|·(|F|/(μ_ref FN))·(μ_max − μ_min)/μ_ref`` (Kalker's ``K``, 3D;
-#: Dundurs' ``β``, 2D). Measured at 0.97 of the capacity of patches at four places, |K| from 0.003 to 0.48
-#: (20 × 20, ``qp-clarabel``, four steps): at most 0.227 (3D); |β| from 0.006 to 0.49 (40 quadratic elements):
+#: Dundurs' ``β``, 2D). Measured at 0.97 of the capacity of patches at four places, ``|K|`` from 0.003 to 0.48
+#: (20 × 20, ``qp-clarabel``, four steps): at most 0.227 (3D); ``|β|`` from 0.006 to 0.49 (40 quadratic elements):
 #: at most 0.059 (2D). Taken as twice the largest.
 COUPLING_GRID = 0.5
 COUPLING_STRIP = 0.12
