@@ -42,6 +42,7 @@ __all__ = ["SUB", "MARGIN", "COUPLING_GRID", "COUPLING_STRIP", "grid_shares", "s
 #: so finer sampling buys nothing.
 SUB = 4
 
+
 def grid_shares(x, y, dx: float, dy: float, a: float, b: float, sub: int = SUB) -> np.ndarray:
     """Each element's share of the Hertz force of the ellipse ``(a, b)`` centred at the origin (``x``, ``y``: the
     element centres, ``(n,)``; ``dx``, ``dy`` their sizes): ``∫ sqrt(1 − x²/a² − y²/b²)`` over the element on
@@ -83,7 +84,6 @@ def near_strip(x, b: float, h: float) -> np.ndarray:
 #: 2D at most 0.229 over constant, linear and quadratic elements, 4 to 400 elements, zones 1.1 to 3, loads
 #: P̄ and 0.3 P̄ (m = 0.37 to 182). Taken as 0.5, twice the largest (the bound is never above 1: both sum to 1).
 MARGIN = 0.5
-
 
 #: The normal–tangential coupling of dissimilar bodies moves the pressure under the tangential tractions, and the
 #: capacity with it: ``|Σ μ_i Δw_i| <= COUPLING·|K|·(|F|/(μ_ref FN))·(μ_max − μ_min)/μ_ref`` (Kalker's ``K``, 3D;
