@@ -231,3 +231,34 @@ def test_3d_dissimilar_bodies_the_limit_covers_the_coupled_pressure():
             for rec in rollqp.march(sc, method="qp-clarabel")]
     assert len(caps) >= 2 and min(caps) < discrete_capacity_3d(sc) - 0.01        # the coupling moved it
     assert limit >= max(caps), (c, limit, caps)
+
+
+# =========================================================================== without Hertz's pressure
+def test_3d_profile_uses_the_computed_contact_and_else_the_largest_mu():
+    """A body profile: at load.normal the computed contact's own pressure (the frictionless normal step the scene
+    checks the grid with: its capacity exactly, no mesh margin), at another load only the largest μ bounds it."""
+    law = {"law": "patch", "mu": 0.3, "inside": 0.6, "start": 0.0, "end": 50.0, "y_start": 0.0}
+    sc = rollqp.load_scene("quartic-roller", {"contact.friction": law})
+    assert not sc.shape.hertzian
+    c, limit = sliding_limits(sc, np.zeros(2), np.array([1.0, 0.5]), np.ones(2))
+    X, Y = sc.grid.centres()
+    mu = sc.contact.friction.coefficient(np.stack([X, Y]) / sc.ellipse.a, 0.0, -1)
+    exact = float(mu @ sc.patch.p.ravel()) / (sc.mu * float(np.sum(sc.patch.p)))
+    assert 1.0 < c[0] == pytest.approx(exact, rel=1e-12) and limit[0] == c[0]
+    assert c[1] == limit[1] == 2.0
+    with pytest.raises(InputError, match=r"load.tangential: .* must be < 2: "):
+        rollqp.load_scene("quartic-roller", {"contact.friction": law, "load.creepage": {"spin": 0.0},
+                                             "load.start": "braked", "load.tangential": 0.5,
+                                             "discretization.distance": 1.0,
+                                             "load.normal_history": {"kind": "ramp", "start": 1.0, "end": 0.2,
+                                                                     "over": 1.0}})
+
+
+def test_2d_profile_bounds_by_the_largest_mu():
+    sc = rollqp.load_scene("dent", {"contact.friction": {"law": "patch", "mu": 0.1, "inside": 0.05, "start": 0.0,
+                                                         "end": 5.0}})
+    c, limit = checks.sliding_limits(sc, np.zeros(1), 1.0, np.ones(1))
+    assert c[0] == limit[0] == 1.0                                            # the reference is the largest here
+    with pytest.raises(InputError, match=r"load.tangential: \|Q\|/\(mu P\) = 1.05 .* must be < 1: "):
+        rollqp.load_scene("dent", {"contact.friction": {"law": "patch", "mu": 0.1, "inside": 0.05, "start": 0.0,
+                                                        "end": 5.0}, "load.tangential": 1.05})
