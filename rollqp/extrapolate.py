@@ -1,93 +1,149 @@
-r"""Creep forces extrapolated to the fine-grid limit from a few grids, each averaged over grid positions.
+r"""Creep forces extrapolated to the fine-grid limit from a few grids, each averaged over grid positions, with
+as many positions as a target error needs.
 
 **Why one grid position is not enough.** The discrete contact area is the set of elements whose centres
 the normal step finds in contact, and the stick/slip boundary is a set of elements too: how the contact edge
 and the slip boundary cut the elements depends on where the grid lies relative to the ellipse, and that
 changes irregularly from one element count to the next (the lattice-point count of an ellipse). A force on
-one grid position is therefore a smooth first-order term plus an irregular one of 0.1–0.3 % at 16–32
-elements per semi-axis, whose sign changes from grid to grid: three centred grids do not converge as a power
-of ``h``, their measured order is spurious, and Richardson's estimate can miss the error by ten times
-(docs/performance.md, "Speed against error").
+one grid position is therefore a smooth first-order term plus an irregular one of 0.1–0.3 % at 16–48
+elements per semi-axis: three centred grids do not converge as a power of ``h``, their measured order is
+spurious, and Richardson's estimate can miss the error by ten times (docs/performance.md, "Speed against
+error"). The irregular part is the elastic staircase of the contact edge, not the pressure: it is the same
+with the cell-averaged Hertz pressure, and with no slip at all (measured, docs/performance.md).
 
-**The remedy.** Each grid is solved at ``shifts`` positions relative to the ellipse, the grid moved by
-fractions ``(u_j, v_j)`` of an element (``u_j = (j + ½)/K − ½`` stratified along x, ``v_j`` the golden-ratio
-sequence along y: a rank-1 lattice on the unit cell), and the forces averaged. The average is a smooth
-function of ``h``: measured on the circle at ξ = 1e-5 and 1e-3 it follows ``F₀ + C h`` to within its
-scatter from 16 to 48 elements per semi-axis, and at ξ = 1e-3 its order-1 extrapolation agrees with a single
-160-per-semi-axis grid corrected by the same ``C h`` to 0.03 % (docs/performance.md).
+**The remedy.** Each grid is solved at ``K`` positions relative to the ellipse, the grid moved by fractions
+``(u_j, v_j)`` of an element (:func:`positions`: the R₂ low-discrepancy sequence, every prefix of which is
+evenly spread, so that positions can be added to a grid), and the forces averaged. The average is a smooth
+function of ``h``: measured on the circle at ξ = 1e-5 and 1e-3 with 16 positions on seven grids from 16 to 48
+elements per semi-axis, ``F₀ + C h`` fits the averages within their scatter (reduced χ² 0.1–0.7).
 
-**The extrapolation and its estimate.** With ``F̄_k`` the average on grid ``k`` and ``s_k`` its standard
-error (the scatter of the positions over ``√K``), the first-order model is fitted by weighted least squares
+**The extrapolation and its estimate.** With ``F̄_k`` the average on grid ``k`` and ``s_k = σ_k/√K_k`` its
+standard error, the first-order model is fitted by weighted least squares
 
 .. math::
     \bar F_k \approx F_0 + C\,h_k,\qquad \text{estimate} = 2\,\sigma(F_0) + |F_0^{(p)} - F_0|,
 
 where ``σ(F₀)`` is the fit's standard error of ``F₀`` from the ``s_k``, scaled up by the fit's residual where
 the residual exceeds what the scatter explains (reduced χ² above 1), and ``F₀⁽ᵖ⁾`` the extrapolation with the
-order ``p`` measured from the three finest grids: the estimate grows where the measured order strays from 1
-by more than the scatter explains (``|F₀⁽ᵖ⁾ − F₀|`` less twice its own standard error from the ``s_k``, at
-least 0); where no order can be measured — the differences of opposite signs — the whole correction
-``|F₀ − F̄_finest|`` is added instead. The positions are not independent draws but a stratified set: their average is closer to
-the smooth value than ``s_k`` says (measured: the estimate 1.7–35 times the error), so it is conservative.
+order ``p`` measured from the three finest grids (where none is measurable — the differences of opposite
+signs — ``F̄_finest`` in its place: the whole correction): the estimate grows where the measured order
+strays from 1 by more than the scatter explains, ``|F₀⁽ᵖ⁾ − F₀|`` less the 95 % band of that change over
+:data:`MODEL_DRAWS` draws of the averages within their standard errors, at least 0 (with two grids the whole
+correction). A grid's scatter ``σ_k`` is the larger of its positions' standard
+deviation and a floor from the other grids (:func:`scatter`): a grid with few positions cannot make the
+estimate small by a lucky draw. The positions are evenly spread, not independent
+draws: their average is closer to the smooth value than ``s_k`` says, so the estimate is conservative.
+
+**Positions where they pay (:func:`allocate`).** ``F₀ = Σ w_k F̄_k`` (the fit's weights), so its variance is
+``Σ w_k² σ_k²/K_k``; for a solve costing ``c_k`` on grid ``k`` the variance a given time buys is least with
+``K_k ∝ |w_k| σ_k / √c_k`` (a Lagrange multiplier). The scatter falls faster than ``h`` while the cost rises
+as about ``N^1.2`` (:data:`COST_EXPONENT`), so the coarse grid, whose scatter sets the slope ``C``, takes most
+positions and the finest few. :func:`extrapolate` starts with :data:`START_SHIFTS` positions a grid (the finest
+:data:`FINEST_START`) and adds
+positions in rounds, at most doubling a grid's count in a round, until every creep force's estimate is
+within ``target`` or the time ``budget`` is spent.
 
 Examples
 --------
 >>> from rollqp import load_scene
 >>> x = extrapolate(load_scene("kalker-circular"), grids=(10, 15, 20), shifts=3)
->>> x.grids, x.forces["Fy"], len(x.forces["Fx"].values), x.runs
-((10, 15, 20), None, 3, 9)
+>>> x.grids, x.forces["Fy"], len(x.forces["Fx"].values), x.runs, x.shifts
+((10, 15, 20), None, 3, 9, (3, 3, 3))
 """
 from __future__ import annotations
 
 import math
+import os
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError
+from .errors import InputError, SolverError
 from .march.grid import run
 
 __all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "positions", "fit_first_order",
-           "ORDER_RANGE", "SHIFTS", "THEORETICAL_ORDER"]
+           "scatter", "allocate", "sensitivities", "ORDER_RANGE", "SHIFTS", "START_SHIFTS", "FINEST_START", "CONFIRM", "MAX_SHIFTS",
+           "TARGET", "BUDGET", "NEGLIGIBLE", "SMALL", "TARGETED", "THEORETICAL_ORDER", "MODEL_DRAWS", "COST_EXPONENT", "COST_OVERHEAD"]
 
 #: Observed orders accepted as asymptotic (outside it the grids are not in the asymptotic range).
 ORDER_RANGE = (0.3, 5.0)
-#: Forces whose averages are below this fraction of μFN on every grid (and no single position above ten times
-#: it; the moment: times μFN·c) are negligible — zero by symmetry where the scene is symmetric, the positions
-#: breaking it by less: not extrapolated.
+#: A quantity is negligible — zero by symmetry where the scene is symmetric, the positions breaking it by
+#: less — where on every grid its average is within the larger of this fraction of μFN (the moment: of μFN·c)
+#: and twice its standard error, and below :data:`SMALL` of it: it is not extrapolated (nor targeted).
 NEGLIGIBLE = 1e-4
-#: Grid positions per grid by default (module docstring): the scatter of 8 positions' average is below
-#: 0.03 % of the force at 32 elements per semi-axis on the circle (measured, docs/performance.md).
+#: Above this fraction of μFN (μFN·c) on some grid a quantity is extrapolated however large its scatter.
+SMALL = 1e-2
+#: Grid positions per grid where a fixed count is asked for without a number (``shifts=True`` is not a count:
+#: the CLI's ``--shifts`` without a target); kept for callers that fix the count.
 SHIFTS = 8
+#: Positions a grid starts with before positions are allocated: four give each grid's scatter three degrees of
+#: freedom, and the pooled power law (:func:`scatter`) guards the grids that keep few.
+START_SHIFTS = 4
+#: Positions the finest grid starts with: its solves cost most, and the pooled power law (:func:`scatter`)
+#: bounds its scatter from below until it has four.
+FINEST_START = 2
+#: Positions every grid has before the order's part of the estimate (which positions do not shrink) may end
+#: the rounds as out of the asymptotic range: with fewer, the order measured from the averages is mostly their
+#: scatter (measured: 4.9 from 4/4/2 positions on the circle at 5–10 elements per semi-axis, 1.1 from 16 on each).
+CONFIRM = 8
+#: Most positions on one grid (the allocation stops there; a target that needs more needs finer grids).
+MAX_SHIFTS = 512
+#: Default target of the creep forces' estimate, relative (0.1 %).
+TARGET = 1e-3
+#: Default time budget of the positions' rounds, wall-clock seconds: the rounds stop there with the estimate
+#: they reached (a run cut by the budget depends on the machine's speed; one that reaches its target does not).
+BUDGET = 120.0
+#: The quantities the target applies to (the creep forces); the spin moment is extrapolated and reported.
+TARGETED = ("Fx", "Fy")
 #: Order of the discretization error of the position-averaged force (piecewise-constant elements; measured
 #: 0.89–1.42 from the command's default grids on the cases of docs/performance.md, the spread the scatter's).
 THEORETICAL_ORDER = 1.0
-#: Golden ratio's conjugate: the y-fractions of the positions (``{j·g}``), evenly spread for any count.
-_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+#: Draws of the grids' averages within their standard errors that measure how far the scatter alone moves the
+#: order's change of ``F₀`` (:func:`fit_first_order`; seeded: the same data give the same estimate).
+MODEL_DRAWS = 400
+#: A steady solve's cost grows as ``N^COST_EXPONENT`` of the grid's ``N`` elements (measured on the circle,
+#: 40 → 120 elements across: 0.11 s → 1.56 s of CPU at 9 times the elements, N^1.2). The allocation uses this
+#: model, not measured times, so that the positions (and the result) do not depend on the machine's load.
+COST_EXPONENT = 1.2
+#: The fixed part of a solve's cost in the same unit (the scene, the operators and the start of a steady solve:
+#: about 40 ms, measured on 12 × 12 elements, against 1.56 s for ``N^1.2`` = 9.7e4 on 122 × 122).
+COST_OVERHEAD = 2500.0
+#: Bounds on the order ``q`` of the scatter's fall ``σ ∝ h^q`` (:func:`scatter`): measured 1.5–1.7 on the circle
+#: from 16 to 48 elements per semi-axis (the irregular part of one position falls faster than the grid); the
+#: floor takes it to fall no faster than ``h³`` and not to rise as the grid refines.
+SCATTER_ORDERS = (0.0, 3.0)
+#: The plastic number's inverse powers: the R₂ sequence's steps along x and y (Roberts, "The unreasonable
+#: effectiveness of quasirandom sequences", 2018): every prefix is evenly spread over the unit cell.
+_PLASTIC = 1.324717957244746
+_R2 = (1.0 / _PLASTIC, 1.0 / _PLASTIC ** 2)
 
 
 @dataclass(frozen=True)
 class Extrapolated:
     """One quantity: its averages on the grids and their standard errors, the observed order (None: not
-    measurable), the extrapolated value and its error estimate."""
+    measurable), the extrapolated value and its error estimate; ``model``: the estimate's part from the order
+    (more positions do not shrink it: finer grids do)."""
 
     values: tuple
     order: float | None
     value: float
     error: float
     scatter: tuple = ()
+    model: float = 0.0
 
 
-def positions(count: int) -> list:
-    """The grid's shifts ``(u, v)`` in elements (module docstring); one position is the centred grid.
+def positions(count: int, first: int = 0) -> list:
+    """Positions ``first … first + count − 1`` of the grid's shifts ``(u, v)`` in elements: the R₂ sequence
+    (module docstring) started at the centred grid, every prefix evenly spread over the element.
 
-    >>> positions(1), [tuple(round(c, 3) for c in p) for p in positions(2)]
-    ([(0.0, 0.0)], [(-0.25, 0.0), (0.25, -0.382)])
+    >>> positions(1), [tuple(round(c, 3) for c in p) for p in positions(3)]
+    ([(0.0, 0.0)], [(0.0, 0.0), (-0.245, -0.43), (-0.49, 0.14)])
+    >>> positions(2, first=1) == positions(3)[1:]
+    True
     """
-    if count == 1:
-        return [(0.0, 0.0)]
-    return [((j + 0.5) / count - 0.5, (0.5 + j * _GOLDEN) % 1.0 - 0.5) for j in range(count)]
+    return [((0.5 + j * _R2[0]) % 1.0 - 0.5, (0.5 + j * _R2[1]) % 1.0 - 0.5) for j in range(first, first + count)]
 
 
 def richardson(values, ratio: float) -> Extrapolated:
@@ -159,24 +215,29 @@ def fit_first_order(h, means, errors) -> Extrapolated:
         elif chi2 > 1.0:             # the residual exceeds the scatter: scale up (reduced chi-square)
             var *= chi2
     order = _measured_order(h[-3:], F[-3:]) if h.size >= 3 else None
-    if order is None:
+    if h.size < 3:                   # no order can be measured: the whole correction
         model = abs(F0 - F[-1])
     else:
-        # the change of F0 with the measured order, beyond what the averages' scatter alone moves it by
         def change(values):
+            """F₀ with the order measured from the three finest grids less the first-order F₀ (where none is
+            measurable, the whole correction ``F̄_finest − F₀``)."""
+            base = _first_order_value(h, values, w)
             p = _measured_order(h[-3:], values[-3:])
             if p is None:
-                return abs(F0 - values[-1])
-            Fp = values[-1] - (values[-2] - values[-1]) * h[-1] ** p / (h[-2] ** p - h[-1] ** p)
-            return Fp - _first_order_value(h, values, w)
+                return values[-1] - base
+            return values[-1] - (values[-2] - values[-1]) * h[-1] ** p / (h[-2] ** p - h[-1] ** p) - base
         g = change(F)
         if np.all(s > 0):
-            J = [(change(F + e * si) - change(F - e * si)) / 2.0 for e, si in zip(np.eye(h.size), s)]
-            model = max(0.0, abs(g) - 2.0 * math.sqrt(float(np.sum(np.square(J)))))
+            # beyond what the averages' scatter alone moves it by: the 95 % band of the change over draws of
+            # the averages within their standard errors (the change is far from linear in them where the
+            # order is poorly measured)
+            draws = F + np.random.default_rng(0).standard_normal((MODEL_DRAWS, h.size)) * s
+            band = float(np.quantile(np.abs([change(d) - g for d in draws]), 0.95))
+            model = max(0.0, abs(g) - band)
         else:
             model = abs(g)
     return Extrapolated(tuple(float(v) for v in F), order, F0, 2.0 * math.sqrt(var) + model,
-                        tuple(float(v) for v in s))
+                        tuple(float(v) for v in s), model)
 
 
 def _first_order_value(h, F, w) -> float:
@@ -184,42 +245,108 @@ def _first_order_value(h, F, w) -> float:
     return float(np.linalg.solve(M.T @ (w[:, None] * M), M.T @ (w * F))[0])
 
 
+def sensitivities(h, errors) -> np.ndarray:
+    """``w`` with ``F₀ = Σ w_k F̄_k`` in the weighted fit of ``F₀ + C h`` (weights ``1/errors²``).
+
+    >>> [round(float(w), 6) for w in sensitivities([0.1, 0.05], [1.0, 1.0])]    # two grids: F₀ = 2 F̄₂ − F̄₁
+    [-1.0, 2.0]
+    """
+    h, s = np.asarray(h, dtype=float), np.asarray(errors, dtype=float)
+    W = 1.0 / s ** 2
+    M = np.column_stack([np.ones_like(h), h ** THEORETICAL_ORDER])
+    return (np.linalg.inv(M.T @ (W[:, None] * M)) @ (M.T * W))[0]
+
+
+def scatter(h, samples) -> np.ndarray:
+    """Each grid's scatter of one position's value: the larger of its positions' standard deviation and a floor
+    from the other grids with four positions or more, through the bounds of :data:`SCATTER_ORDERS` on how the
+    scatter falls with ``h``: no faster than ``h³`` from a coarser grid, and not at all rising from a finer one.
+    A grid cannot lower its own scatter by a lucky draw (two positions that happen to agree), and the floor,
+    a bound rather than a fit, does not raise a grid above what the bounds allow.
+
+    >>> [round(float(s), 4) for s in scatter([0.2, 0.1], [[1.0, 1.2, 1.4, 1.0], [2.0, 2.0]])]   # a lucky draw
+    [0.1915, 0.0239]
+    """
+    h = np.asarray(h, dtype=float)
+    own = np.array([float(np.std(v, ddof=1)) if len(v) > 1 else 0.0 for v in samples])
+    ok = (own > 0) & (np.array([len(v) for v in samples]) >= 4)
+    floor = np.zeros_like(h)
+    for k in range(h.size):
+        for j in np.flatnonzero(ok):
+            if j != k:
+                q = SCATTER_ORDERS[1] if h[j] > h[k] else SCATTER_ORDERS[0]
+                floor[k] = max(floor[k], own[j] * (h[k] / h[j]) ** q)
+    return np.maximum(own, floor)
+
+
+def allocate(h, sigma, cost, counts, variance: float, most: int = MAX_SHIFTS) -> tuple:
+    """Positions per grid that bring ``F₀``'s variance ``Σ w_k² σ_k²/K_k`` to ``variance`` at least cost
+    ``Σ K_k c_k``: ``K_k = λ |w_k| σ_k / √c_k`` (module docstring; the weights ``w`` from the resulting errors,
+    three passes), never fewer than ``counts``, nor more than twice them (a round re-measures the scatter), nor
+    ``most``.
+
+    >>> allocate([1/40, 1/80, 1/120], [3.4e-3, 1.2e-3, 5e-4], [1.0, 5.3, 14.0], [4, 4, 4], (4e-4) ** 2)
+    (8, 4, 6)
+    """
+    h, sigma, cost = (np.asarray(v, dtype=float) for v in (h, sigma, cost))
+    low = np.asarray(counts, dtype=float)
+    K = low.copy()
+    for _ in range(3):
+        w = np.abs(sensitivities(h, sigma / np.sqrt(K)))
+        lam = float(np.sum(w * sigma * np.sqrt(cost))) / variance
+        K = np.maximum(lam * w * sigma / np.sqrt(cost), low)
+    return tuple(int(k) for k in np.clip(np.ceil(K - 1e-9), low, np.minimum(2 * low, most)))
+
+
 @dataclass
 class Extrapolation:
-    """The grids' averaged forces (``Fx``, ``Fy`` in force units, ``Mz``), their extrapolation, and each
-    grid's wall time; ``str()`` is the table ``rollqp extrapolate`` prints."""
+    """The grids' averaged forces (``Fx``, ``Fy`` in force units, ``Mz``), their extrapolation, the positions
+    solved on each grid (``shifts``) and each grid's wall time; ``str()`` is the table ``rollqp extrapolate``
+    prints. ``reached``: whether every creep force's estimate is within ``target`` (None: no target);
+    ``stopped``: why the rounds ended."""
 
     scene: str
     grids: tuple
-    shifts: int
+    shifts: tuple
     forces: dict = field(default_factory=dict)
     seconds: tuple = ()
     cap: float = 1.0
+    target: float | None = None
+    reached: bool | None = None
+    stopped: str = ""
+    workers: int = 1
 
     @property
     def runs(self) -> int:
-        """Steady solves made (grids × positions)."""
-        return len(self.grids) * self.shifts
+        """Steady solves made (the positions of every grid)."""
+        return int(sum(self.shifts))
 
     def __str__(self) -> str:
         g = " / ".join(f"{n}" for n in self.grids)
-        lines = [f"{self.scene}: the steady state on grids of {g} elements along the shorter axis, each at "
-                 f"{self.shifts} position(s), {' + '.join(f'{t:.2f}' for t in self.seconds)} = "
-                 f"{sum(self.seconds):.2f} s",
+        k = " / ".join(f"{n}" for n in self.shifts)
+        lines = [f"{self.scene}: the steady state on grids of {g} elements along the shorter axis, at {k} "
+                 f"position(s), {sum(self.seconds):.2f} s"
+                 + (f" on {self.workers} workers" if self.workers > 1 else ""),
                  "  " + f"{'':<4} " + " ".join(f"{'grid ' + str(n):>22}" for n in self.grids)
                  + f" {'order':>6} {'extrapolated':>14} {'error estimate':>22}"]
-        for k, e in self.forces.items():
+        for key, e in self.forces.items():
             if e is None:
-                lines.append(f"  {k:<4} negligible on every grid (below {NEGLIGIBLE:g} of mu FN: zero by symmetry)")
+                lines.append(f"  {key:<4} negligible: on every grid below {SMALL:g} of mu FN and within the larger of "
+                             f"{NEGLIGIBLE:g} of it and twice its standard error (zero by symmetry)")
                 continue
             order = f"{e.order:6.2f}" if e.order is not None else f"{'-':>6}"
             rel = e.error / abs(e.value) if e.value else math.inf
             cells = " ".join(f"{v:12.6g} ± {s:<7.2g}" for v, s in zip(e.values, e.scatter or [0.0] * len(e.values)))
-            lines.append(f"  {k:<4} {cells} {order} {e.value:14.7g} {e.error:11.3g} ({100 * rel:.3f} %)")
+            lines.append(f"  {key:<4} {cells} {order} {e.value:14.7g} {e.error:11.3g} ({100 * rel:.3f} %)")
         lines.append("  (each grid: the average over its positions ± its standard error; extrapolated: F0 of "
                      "F0 + C h; estimate: twice F0's standard error + its change with the measured order)")
         if any(e is not None and e.order is None for e in self.forces.values()):
             lines.append("  (-: no order measurable from the grids for it; the whole correction is in the estimate)")
+        if self.target is not None:
+            if self.reached:
+                lines.append(f"  target {100 * self.target:g} % of the creep forces reached")
+            else:
+                lines.append(f"  target {100 * self.target:g} % of the creep forces NOT reached: {self.stopped}")
         return "\n".join(lines)
 
 
@@ -229,63 +356,210 @@ def _grid_of(scene):
     return g.nx, g.ny, (g.xl, g.xl + g.nx * g.dx), (g.yl, g.yl + g.ny * g.dy)
 
 
-def extrapolate(scene, grids=None, shifts: int = SHIFTS, quantities=("Fx", "Fy", "Mz")) -> Extrapolation:
+def _solve(scene) -> tuple:
+    """One position's steady state: its ``(Fx, Fy, Mz)`` (a top-level function: a worker process runs it)."""
+    from .threads import limited
+    with limited():
+        res = run(scene).arrays()
+    return tuple(float(res[q][0]) for q in ("Fx", "Fy", "Mz"))
+
+
+class _Grid:
+    """One grid of the extrapolation: its size, its element ``h``, the scene of its position ``j``, and the
+    forces of the positions solved so far."""
+
+    def __init__(self, scene, n: int, base: int):
+        nx, ny, (self.x0, self.x1), (self.y0, self.y1) = _grid_of(scene)
+        k = n / base
+        self.scene, self.n = scene, n
+        self.NX, self.NY = max(round(nx * k), 1), max(round(ny * k), 1)
+        self.dx, self.dy = (self.x1 - self.x0) / self.NX, (self.y1 - self.y0) / self.NY
+        self.h = math.sqrt(self.dx * self.dy)
+        self.forces: list = []
+        self.seconds = 0.0
+
+    def at(self, j: int):
+        (u, v), = positions(1, first=j)
+        # one element more on each side: the moved grid keeps the scene's margin around the contact
+        return self.scene.replace(**{"discretization.elements": [self.NX + 2, self.NY + 2],
+                                     "discretization.zone": None, "discretization.element_size": None,
+                                     "discretization.extent": [[self.x0 + (u - 1) * self.dx, self.x1 + (u + 1) * self.dx],
+                                                               [self.y0 + (v - 1) * self.dy, self.y1 + (v + 1) * self.dy]],
+                                     "discretization.distance": 0.0})
+
+    @property
+    def cost(self) -> float:
+        """The cost model of one solve (:data:`COST_EXPONENT`, :data:`COST_OVERHEAD`), relative."""
+        return float((self.NX + 2) * (self.NY + 2)) ** COST_EXPONENT + COST_OVERHEAD
+
+
+def _check(grids, shifts, target, budget, workers):
+    if len(grids) < 2 or grids[0] < 1 or any(not a < b for a, b in zip(grids, grids[1:])):
+        raise InputError("--grids", f"must be two or more increasing element counts, got {grids!r}")
+    if shifts is not None and (isinstance(shifts, bool) or not isinstance(shifts, (int, np.integer))
+                               or not 2 <= shifts <= MAX_SHIFTS):
+        raise InputError("--shifts", f"must be an integer in [2, {MAX_SHIFTS}] (grid positions per grid), got {shifts!r}")
+    if target is not None and (isinstance(target, bool) or not isinstance(target, (int, float))
+                               or not 0 < target < 1):
+        raise InputError("--target", f"must be a relative error in (0, 1) (0.001: 0.1 %), got {target!r}")
+    if isinstance(budget, bool) or not isinstance(budget, (int, float)) or not 0 < budget <= 1e6:
+        raise InputError("--budget", f"must be a number of seconds in (0, 1e6], got {budget!r}")
+    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or not 1 <= workers <= 256:
+        raise InputError("--workers", f"must be an integer in [1, 256] (processes), got {workers!r}")
+
+
+def extrapolate(scene, grids=None, shifts: int | None = None, *, target: float | None = TARGET,
+                budget: float = BUDGET, workers: int = 1, quantities=("Fx", "Fy", "Mz"),
+                progress=None) -> Extrapolation:
     """The forces of ``scene``'s steady state extrapolated from grids averaged over positions (module docstring).
 
     ``grids``: two or more increasing element counts along the shorter axis (default ``n, 2n, 3n`` of the
-    scene's ``n``: the averages' scatter falls fast with ``h``, and a wide range of ``h`` measures the order
-    well); the other axis keeps the scene's proportion, the grid's extent is the scene's (moved by
-    less than an element for each position). ``shifts``: positions per grid (at least 2: the scatter is
-    part of the estimate). Each position's grid has one element more on each side than the scene's, so
-    that the moved grid keeps the scene's margin around the contact (they are out of contact).
+    scene's ``n``); the other axis keeps the scene's proportion, the grid's extent is the scene's (moved by
+    less than an element for each position, one element more on each side to keep the scene's margin around
+    the contact). ``shifts``: a fixed number of positions on every grid (then ``target`` is only reported);
+    ``None``: :data:`START_SHIFTS` a grid, then positions added where they pay (:func:`allocate`) until every
+    creep force (:data:`TARGETED`) has its estimate within ``target`` (relative) or ``budget`` seconds (wall
+    clock) are spent. ``workers``: processes solving the positions side by side (each at ``$ROLLQP_THREADS``
+    BLAS threads). ``progress(text)``: told of each round.
 
     Raises
     ------
     InputError
         A scene that is not a rolling start (no steady state), grids that are not two or more increasing
-        counts, or fewer than 2 positions.
+        counts, positions, a target, a budget or workers out of range.
     """
     if scene.dimension != 3 or scene.load.start != "rolling":
         raise InputError("SCENE", f"extrapolate works on the steady state of a 3D rolling start "
                                   f"(load.start = 'rolling'); {scene.name!r} is not one")
-    nx, ny, (x0, x1), (y0, y1) = _grid_of(scene)
+    nx, ny = scene.grid.nx, scene.grid.ny
     base = min(nx, ny)
-    if grids is None:
-        grids = (base, 2 * base, 3 * base)
-    grids = tuple(int(g) for g in grids)
-    if len(grids) < 2 or grids[0] < 1 or any(not a < b for a, b in zip(grids, grids[1:])):
-        raise InputError("--grids", f"must be two or more increasing element counts, got {grids!r}")
-    if isinstance(shifts, bool) or not isinstance(shifts, (int, np.integer)) or not 2 <= shifts <= 64:
-        raise InputError("--shifts", f"must be an integer in [2, 64] (grid positions per grid), got {shifts!r}")
-    values, seconds, hs = {q: [] for q in quantities}, [], []
-    for n in grids:
-        k = n / base
-        NX, NY = max(round(nx * k), 1), max(round(ny * k), 1)
-        dx, dy = (x1 - x0) / NX, (y1 - y0) / NY
-        hs.append(math.sqrt(dx * dy))
-        t0, got = time.perf_counter(), {q: [] for q in quantities}
-        for u, v in positions(int(shifts)):
-            # one element more on each side: the moved grid keeps the scene's margin around the contact
-            s = scene.replace(**{"discretization.elements": [NX + 2, NY + 2], "discretization.zone": None,
-                                 "discretization.element_size": None,
-                                 "discretization.extent": [[x0 + (u - 1) * dx, x1 + (u + 1) * dx],
-                                                           [y0 + (v - 1) * dy, y1 + (v + 1) * dy]],
-                                 "discretization.distance": 0.0})
-            res = run(s).arrays()
-            for q in quantities:
-                got[q].append(float(res[q][0]))
-        seconds.append(time.perf_counter() - t0)
-        for q in quantities:
-            values[q].append(got[q])
+    grids = (base, 2 * base, 3 * base) if grids is None else tuple(int(g) for g in grids)
+    _check(grids, shifts, target, budget, workers)
+    t0 = time.perf_counter()
+    parts = [_Grid(scene, n, base) for n in grids]
+    hs = np.array([g.h for g in parts])
     cap = scene.mu * scene.load.normal
-    out = Extrapolation(scene.name, grids, int(shifts), seconds=tuple(seconds), cap=cap)
-    for q in quantities:
-        unit = cap * (scene.ellipse.c if q == "Mz" else 1.0)
-        vals = np.asarray(values[q])
-        if np.max(np.abs(vals.mean(axis=1))) <= NEGLIGIBLE * unit and np.max(np.abs(vals)) <= 10 * NEGLIGIBLE * unit:
-            out.forces[q] = None
-            continue
-        means = vals.mean(axis=1)
-        errors = vals.std(axis=1, ddof=1) / math.sqrt(vals.shape[1])
-        out.forces[q] = fit_first_order(hs, means, errors)
+    pool = ProcessPoolExecutor(max_workers=int(workers)) if workers > 1 else None
+
+    def solve(counts):
+        # the finest grid's positions first: the workers' last solves are then the short ones (each grid's
+        # positions stay in their order, so the averages do not depend on the workers)
+        jobs = [(g, j) for g, k in reversed(list(zip(parts, counts))) for j in range(len(g.forces), k)]
+        w0 = time.perf_counter()
+        got = (pool.map(_solve, [g.at(j) for g, j in jobs]) if pool is not None
+               else (_solve(g.at(j)) for g, j in jobs))
+        it = iter(got)
+        for g, j in jobs:
+            try:
+                f = next(it)
+            except SolverError as err:      # name the grid and position, keep the solver's residual
+                (u, v), = positions(1, first=j)
+                raise SolverError(f"grid {g.n} at position {j} (u, v) = ({u:.3f}, {v:.3f}) elements: {err.message}",
+                                  method=err.method, status=err.status, residual=err.residual,
+                                  iterations=err.iterations) from None
+            w1 = time.perf_counter()
+            g.forces.append(f)
+            g.seconds += w1 - w0
+            w0 = w1
+
+    def fitted():
+        out = {}
+        for i, q in enumerate(("Fx", "Fy", "Mz")):
+            if q not in quantities:
+                continue
+            unit = cap * (scene.ellipse.c if q == "Mz" else 1.0)
+            vals = [np.array([f[i] for f in g.forces]) for g in parts]
+            means = np.array([v.mean() for v in vals])
+            sig = scatter(hs, vals)
+            counts = np.array([len(v) for v in vals], dtype=float)
+            if (np.max(np.abs(means)) <= SMALL * unit
+                    and np.all(np.abs(means) <= np.maximum(NEGLIGIBLE * unit, 2.0 * sig / np.sqrt(counts)))):
+                out[q] = None
+                continue
+            out[q] = (fit_first_order(hs, means, sig / np.sqrt(counts)), sig)
+        return out
+
+    try:
+        counts = ([int(shifts)] * len(parts) if shifts is not None
+                  else [START_SHIFTS] * (len(parts) - 1) + [FINEST_START])
+        solve(counts)
+        stopped, reached = "", None
+        while True:
+            fits = fitted()
+            short = {q: f for q, f in fits.items() if f is not None and q in TARGETED
+                     and not f[0].error <= target * abs(f[0].value)} if target is not None else {}
+            reached = None if target is None else not short
+            if shifts is not None or reached is not False:
+                break
+            elapsed = time.perf_counter() - t0
+            if elapsed >= budget:
+                stopped = f"the budget of {budget:g} s is spent (--budget, or finer --grids)"
+                break
+            cost = np.array([g.cost for g in parts])
+            new = np.array(counts)
+            for q, (e, sig) in short.items():
+                se = np.asarray(e.scatter)
+                room = target * abs(e.value) - e.model
+                if room <= 0.25 * target * abs(e.value) and min(counts) < CONFIRM:
+                    # the order's part is most of the target, from too few positions to judge the order: measure
+                    # it on every grid first
+                    room = 0.25 * target * abs(e.value)
+                    new = np.maximum(new, np.minimum(CONFIRM, 2 * np.array(counts)))
+                elif room <= 0.25 * target * abs(e.value):      # the order's part (beyond the scatter) is most of it
+                    why = (f"the order measured from the grids ({e.order:.2f})" if e.order is not None else
+                           "the averages, not monotone in h beyond their scatter,")
+                    stopped = (f"{q}: {why} alone add(s) {100 * e.model / abs(e.value):.3f} % to the estimate: the "
+                               "grids are not in the asymptotic range (finer --grids)")
+                    break
+                new = np.maximum(new, allocate(hs, sig, cost, counts, (room / 2.0) ** 2))
+                # no order measurable, the averages' differences within their scatter: the order is measured from
+                # the differences of neighbouring averages, so an inner grid's standard error no larger than the
+                # smaller of its neighbours' (where the order is measured, an inner grid's scatter only widens
+                # the order term's allowance)
+                for k in range(1, len(parts) - 1) if e.order is None else ():
+                    want = math.ceil(counts[k] * (se[k] / min(se[k - 1], se[k + 1])) ** 2 - 1e-9)
+                    new[k] = max(new[k], min(want, 2 * counts[k], MAX_SHIFTS))
+            if stopped:
+                break
+            if np.all(new == counts):   # the variance suffices by the model, the estimate not (the fit's residual
+                #                         above the scatter): more positions where they reduce the variance most per cost
+                e, sig = next(iter(short.values()))
+                w = sensitivities(hs, sig / np.sqrt(counts))
+                gain = np.where(np.array(counts) < MAX_SHIFTS, w ** 2 * sig ** 2 / (np.square(counts) * cost), -1.0)
+                if gain.max() < 0:
+                    stopped = f"every grid has {MAX_SHIFTS} positions (finer --grids)"
+                    break
+                k = int(np.argmax(gain))
+                new[k] = min(2 * counts[k], MAX_SHIFTS)
+            per = np.array([g.seconds / max(len(g.forces), 1) for g in parts])
+            more = new - np.array(counts)
+            ahead = float(np.sum(more * per))
+            if elapsed + ahead > budget:
+                scale = max(budget - elapsed, 0.0) / ahead
+                more = np.floor(more * scale).astype(int)
+                if not more.any():
+                    stopped = (f"the next positions would take about {ahead:.0f} s, beyond the budget of {budget:g} s "
+                               "(--budget, or finer --grids)")
+                    break
+                new = np.array(counts) + more
+            if progress is not None:
+                worst = max(short, key=lambda q: short[q][0].error / abs(short[q][0].value))
+                e = short[worst][0]
+                progress(f"positions {'/'.join(map(str, counts))} -> {'/'.join(str(int(k)) for k in new)}: "
+                         f"{worst} estimate {100 * e.error / abs(e.value):.3f} % > target {100 * target:g} % "
+                         f"({time.perf_counter() - t0:.1f} s)")
+            counts = [int(k) for k in new]
+            solve(counts)
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    out = Extrapolation(scene.name, grids, tuple(len(g.forces) for g in parts), seconds=tuple(g.seconds for g in parts),
+                        cap=cap, target=target, reached=reached, stopped=stopped, workers=int(workers))
+    for q, f in fitted().items():
+        out.forces[q] = None if f is None else f[0]
     return out
+
+
+def _sigma(h, e: Extrapolated, sig, counts) -> float:
+    """``σ(F₀)`` of the fit behind ``e`` (its estimate's first term is twice this, scaled by the residual)."""
+    return math.sqrt(float(np.sum(sensitivities(h, sig / np.sqrt(counts)) ** 2 * sig ** 2 / np.asarray(counts))))

@@ -10,9 +10,12 @@ combined case's small moment) is not established and not checked against.
 """
 from __future__ import annotations
 
+import itertools
 import json
+import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from rollqp import load_scene
@@ -41,3 +44,106 @@ def test_the_estimate_covers_the_error_against_the_grid_converged_value(name):
         assert e.error >= err, (row["q"], e.value, e.error, row["reference"])
         if e.error <= 1e-3 * abs(e.value):          # where the command claims 0.1 %, it holds
             assert err <= 1e-3 * abs(row["reference"])
+
+
+# --------------------------------------------------------------------------- positions where they pay
+def _variance(h, sigma, counts):
+    from rollqp.extrapolate import sensitivities
+    counts = np.asarray(counts, dtype=float)
+    w = sensitivities(h, np.asarray(sigma) / np.sqrt(counts))
+    return float(np.sum(w ** 2 * np.square(sigma) / counts))
+
+
+def test_the_allocation_reaches_the_variance_at_nearly_the_least_cost():
+    """Rounds of :func:`allocate` (each at most doubling a grid) end at the asked variance, and their cost is
+    within 25 % of the cheapest integer allocation found by search (the rounds overshoot by their doubling and
+    their ceilings: 25 %)."""
+    from rollqp.extrapolate import allocate
+    h = np.array([1 / 40, 1 / 80, 1 / 120])
+    sigma = np.array([3.4e-3, 1.2e-3, 5e-4])        # one position's scatter on the circle at xi = 1e-5 (measured)
+    cost = (1 / h) ** 2.4                            # N^1.2
+    for target in (4e-4, 2e-4):
+        counts = (4, 4, 4)
+        for _ in range(30):
+            new = allocate(h, sigma, cost, counts, target ** 2)
+            if new == counts:
+                break
+            counts = new
+        assert _variance(h, sigma, counts) <= target ** 2 * 1.0001
+        spent = float(np.dot(counts, cost))
+        best = min(float(np.dot(k, cost)) for k in itertools.product(range(4, 300, 2), range(4, 40), range(4, 40))
+                   if _variance(h, sigma, k) <= target ** 2)
+        assert spent <= 1.25 * best, (target, counts, spent / best)
+
+
+def test_a_grid_with_a_lucky_draw_keeps_the_pooled_scatter():
+    from rollqp.extrapolate import scatter
+    rng = np.random.default_rng(5)
+    h = np.array([0.04, 0.02, 0.01])
+    samples = [1.0 + rng.normal(0, s, 30) for s in 0.1 * h]       # scatter proportional to h
+    samples[2] = np.array([1.0, 1.0 + 1e-9])                      # two positions that happen to agree
+    s = scatter(h, samples)
+    assert s[2] == pytest.approx(np.std(samples[1], ddof=1) / 8)   # not 7e-10: the h³ bound from the next grid
+    assert s[0] == np.std(samples[0], ddof=1)                       # the other grids keep their own
+    assert s[1] == np.std(samples[1], ddof=1)
+
+
+def test_positions_are_added_until_the_target_is_reached_and_workers_do_not_change_the_numbers():
+    scene = load_scene("kalker-circular", {"load.creepage.longitudinal": 1e-3})
+    one = extrapolate(scene, grids=(12, 18, 24), target=0.01, budget=600, workers=1)
+    e = one.forces["Fx"]
+    assert one.reached and e.error <= 0.01 * abs(e.value) and one.runs > 12      # more than the 3 × 4 of the start
+    two = extrapolate(scene, grids=(12, 18, 24), target=0.01, budget=600, workers=2)
+    assert two.shifts == one.shifts and two.forces["Fx"] == e                     # the allocation uses no timing
+    assert "target 1 % of the creep forces reached" in str(one)
+
+
+def test_grids_outside_the_asymptotic_range_stop_the_rounds_and_say_so(monkeypatch):
+    """Forces of the second order in h (a synthetic solve: -(1 + 20 h²) μFN-scaled, a small scatter): the order
+    measured is 2, its part of the estimate does not shrink with positions, and the rounds stop once every grid
+    has CONFIRM positions, saying why."""
+    import rollqp.extrapolate as x
+
+    def second_order(scene):
+        g = scene.grid
+        wobble = 1e-5 * math.sin(1e3 * g.xl + 7e2 * g.yl)           # a position's irregular part
+        return (-100.0 * (1 + 20 * g.dx ** 2 + wobble), 0.0, 0.0)
+    monkeypatch.setattr(x, "_solve", second_order)
+    got = x.extrapolate(load_scene("kalker-circular"), grids=(10, 15, 20), target=0.001)
+    e = got.forces["Fx"]
+    assert got.reached is False and "order measured from the grids (2.0" in got.stopped, got.stopped
+    assert min(got.shifts) >= x.CONFIRM and e.model > 0.75 * 0.001 * abs(e.value)
+    assert abs(e.value - -100.0) <= e.error                           # the estimate still covers the error
+
+
+def test_a_solve_that_fails_names_its_grid_and_position(monkeypatch):
+    import rollqp.extrapolate as x
+    from rollqp.errors import SolverError
+    calls = []
+
+    def failing(scene):
+        calls.append(scene)
+        if len(calls) == 6:
+            raise SolverError("no convergence", method="newton", residual=3e-4)
+        return (-1.0, 0.0, 0.0)
+    monkeypatch.setattr(x, "_solve", failing)
+    with pytest.raises(SolverError, match=r"grid 15 at position 3 .*no convergence.*residual 3\.000e-04"):
+        x.extrapolate(load_scene("kalker-circular"), grids=(10, 15, 20))
+
+
+def test_a_budget_too_small_stops_the_rounds_and_says_so():
+    scene = load_scene("kalker-circular", {"load.creepage.longitudinal": 1e-3})
+    got = extrapolate(scene, grids=(10, 15, 20), target=1e-5, budget=0.5)
+    assert got.reached is False and "--budget" in got.stopped and "NOT reached" in str(got)
+    fixed = extrapolate(scene, grids=(10, 15, 20), shifts=3, target=1e-5)
+    assert fixed.shifts == (3, 3, 3) and fixed.reached is False
+
+
+@pytest.mark.parametrize("kw, key", [({"target": 0.0}, "--target"), ({"target": 1.5}, "--target"),
+                                     ({"budget": 0}, "--budget"), ({"budget": float("nan")}, "--budget"),
+                                     ({"workers": 0}, "--workers"), ({"shifts": 1}, "--shifts"),
+                                     ({"grids": (20, 10)}, "--grids")])
+def test_bad_arguments_name_their_key(kw, key):
+    from rollqp.errors import InputError
+    with pytest.raises(InputError, match=key):
+        extrapolate(load_scene("kalker-circular"), **{"grids": (10, 15, 20), **kw})

@@ -151,12 +151,15 @@ def test_the_first_order_fit_recovers_the_limit_and_its_estimate_covers_scatter_
     assert e.order is None and e.error >= abs(e.value - 3.03)
 
 
-def test_the_positions_are_spread_over_the_element():
+def test_the_positions_are_spread_over_the_element_for_every_count():
     from rollqp.extrapolate import positions
-    u, v = np.array(positions(8)).T
-    assert np.allclose(np.sort(u), (np.arange(8) + 0.5) / 8 - 0.5)          # stratified along x
-    assert np.all(np.abs(v) <= 0.5) and len(set(np.round(v, 9))) == 8     # distinct along y
-    assert positions(1) == [(0.0, 0.0)]
+    assert positions(1) == [(0.0, 0.0)] and positions(5, first=3) == positions(8)[3:]      # a sequence: extensible
+    for k in (4, 16, 64, 256):
+        p = np.array(positions(k))
+        assert np.all(np.abs(p) <= 0.5) and len({tuple(np.round(q, 12)) for q in p}) == k
+        for axis in (0, 1):     # evenly spread: each quarter of the element holds k/4 positions, to within 2
+            counts = np.histogram(p[:, axis], bins=4, range=(-0.5, 0.5))[0]
+            assert np.all(np.abs(counts - k / 4) <= 2), (k, axis, counts)
 
 
 def test_extrapolate_command(tmp_path, capsys, monkeypatch):
@@ -167,8 +170,14 @@ def test_extrapolate_command(tmp_path, capsys, monkeypatch):
     for bad in ("10", "a,b,c", "40,20,10", "10,10,20", "0,10"):
         assert cli.main(["extrapolate", "kalker-circular", "--grids", bad]) == cli.EXIT_INPUT
         assert "--grids" in capsys.readouterr().err
-    for bad in ("1", "x", "65"):
+    for bad in ("1", "x", "513"):
         assert cli.main(["extrapolate", "kalker-circular", "--shifts", bad]) == cli.EXIT_INPUT
         assert "--shifts" in capsys.readouterr().err
+    for key, bad in (("--target", "0"), ("--target", "100"), ("--target", "nan"), ("--target", "x"),
+                     ("--budget", "0"), ("--budget", "-1"), ("--budget", "inf"), ("--workers", "0"),
+                     ("--workers", "1.5"), ("--workers", "300")):
+        assert cli.main(["extrapolate", "kalker-circular", key, bad]) == cli.EXIT_INPUT
+        err = capsys.readouterr().err
+        assert key in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err, (key, bad, err)
     assert cli.main(["extrapolate", "cattaneo-3d"]) == cli.EXIT_INPUT        # a braked start: no steady state
     assert "rolling start" in capsys.readouterr().err
