@@ -124,14 +124,14 @@ def sources(name, n, count):
     contact edge cut smoothly), and with no slip (μ = 100)."""
     import dataclasses
 
-    from rollqp.extrapolate import _Grid
+    from rollqp.extrapolate import PositionedGrid
     from rollqp.march.grid import normal, prepare, steady
     scene_name, over, _ = CASES[name]
     scene = load_scene(scene_name, over)
     base = min(scene.discretization.elements)
     rng = np.random.default_rng(3)
     got = {"own pressure": [], "cell-averaged Hertz pressure": [], "no slip (mu = 100)": []}
-    grid, stuck = _Grid(scene, n, base), _Grid(scene.replace(**{"contact.friction": 100.0}), n, base)
+    grid, stuck = PositionedGrid(scene, n, base), PositionedGrid(scene.replace(**{"contact.friction": 100.0}), n, base)
     for _ in range(count):
         j = int(rng.integers(1, 10 ** 6))
         for g, keys in ((grid, ("own pressure", "cell-averaged Hertz pressure")), (stuck, ("no slip (mu = 100)",))):
@@ -158,14 +158,14 @@ def sources(name, n, count):
 def averages(name, count, grids):
     """The positions' averages of ``Fx`` on each grid (``count`` positions each, the command's sequence), the
     first-order fit through them and its reduced chi-square: is ``F0 + C h`` the whole smooth part?"""
-    from rollqp.extrapolate import _Grid, _solve, fit_first_order, scatter
+    from rollqp.extrapolate import PositionedGrid, fit_first_order, scatter, solve_position
     scene_name, over, _ = CASES[name]
     scene = load_scene(scene_name, over)
     base = min(scene.discretization.elements)
-    parts = [_Grid(scene, n, base) for n in grids]
+    parts = [PositionedGrid(scene, n, base) for n in grids]
     vals = []
     for g in parts:
-        (v, cpu) = _cpu_of(lambda: [_solve(g.at(j))[0] for j in range(count)])
+        (v, cpu) = _cpu_of(lambda: [solve_position(g.at(j))[0] for j in range(count)])
         vals.append(np.array(v))
         print(f"grid {g.n}: {np.mean(v):.7g} ± {np.std(v, ddof=1) / np.sqrt(count):.2g}, "
               f"one position's scatter {100 * np.std(v, ddof=1) / abs(np.mean(v)):.3f} %, {cpu:.1f} s CPU", flush=True)

@@ -62,9 +62,10 @@ import numpy as np
 
 from .errors import InputError, SolverError
 from .march.grid import run
+from .threads import limited
 
 __all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "positions", "fit_first_order",
-           "scatter", "allocate", "sensitivities", "ORDER_RANGE", "SHIFTS", "START_SHIFTS", "FINEST_START", "CONFIRM", "MAX_SHIFTS",
+           "scatter", "allocate", "sensitivities", "solve_position", "PositionedGrid", "ORDER_RANGE", "SHIFTS", "START_SHIFTS", "FINEST_START", "CONFIRM", "MAX_SHIFTS",
            "TARGET", "BUDGET", "NEGLIGIBLE", "SMALL", "TARGETED", "THEORETICAL_ORDER", "MODEL_DRAWS", "COST_EXPONENT", "COST_OVERHEAD"]
 
 #: Observed orders accepted as asymptotic (outside it the grids are not in the asymptotic range).
@@ -356,17 +357,18 @@ def _grid_of(scene):
     return g.nx, g.ny, (g.xl, g.xl + g.nx * g.dx), (g.yl, g.yl + g.ny * g.dy)
 
 
-def _solve(scene) -> tuple:
-    """One position's steady state: its ``(Fx, Fy, Mz)`` (a top-level function: a worker process runs it)."""
-    from .threads import limited
+def solve_position(scene) -> tuple:
+    """One position's steady state: its ``(Fx, Fy, Mz)`` (a top-level function: a worker process runs it), with
+    the BLAS pools at ``$ROLLQP_THREADS``."""
     with limited():
         res = run(scene).arrays()
     return tuple(float(res[q][0]) for q in ("Fx", "Fy", "Mz"))
 
 
-class _Grid:
-    """One grid of the extrapolation: its size, its element ``h``, the scene of its position ``j``, and the
-    forces of the positions solved so far."""
+class PositionedGrid:
+    """One grid of the extrapolation: ``n`` elements along the scene's shorter axis (``base`` the scene's own
+    count), its element size ``h``, the scene of its position ``j`` (:meth:`at`), and the forces of the
+    positions solved so far."""
 
     def __init__(self, scene, n: int, base: int):
         nx, ny, (self.x0, self.x1), (self.y0, self.y1) = _grid_of(scene)
@@ -379,8 +381,9 @@ class _Grid:
         self.seconds = 0.0
 
     def at(self, j: int):
+        """The scene on this grid at position ``j`` of :func:`positions`: moved by ``(u, v)`` elements, with one
+        element more on each side (the moved grid keeps the scene's margin around the contact)."""
         (u, v), = positions(1, first=j)
-        # one element more on each side: the moved grid keeps the scene's margin around the contact
         return self.scene.replace(**{"discretization.elements": [self.NX + 2, self.NY + 2],
                                      "discretization.zone": None, "discretization.element_size": None,
                                      "discretization.extent": [[self.x0 + (u - 1) * self.dx, self.x1 + (u + 1) * self.dx],
@@ -408,6 +411,109 @@ def _check(grids, shifts, target, budget, workers):
         raise InputError("--workers", f"must be an integer in [1, 256] (processes), got {workers!r}")
 
 
+def _solve_positions(parts, counts, pool) -> None:
+    """Solve the positions each grid lacks up to ``counts``, on ``pool`` (None: here). The finest grid's first:
+    the workers' last solves are then the short ones; each grid's positions stay in their order, so the
+    averages do not depend on the workers. A failed solve is reported with its grid and position."""
+    jobs = [(g, j) for g, k in reversed(list(zip(parts, counts))) for j in range(len(g.forces), k)]
+    w0 = time.perf_counter()
+    got = (pool.map(solve_position, [g.at(j) for g, j in jobs]) if pool is not None
+           else (solve_position(g.at(j)) for g, j in jobs))
+    it = iter(got)
+    for g, j in jobs:
+        try:
+            f = next(it)
+        except SolverError as err:      # name the grid and position, keep the solver's residual
+            (u, v), = positions(1, first=j)
+            raise SolverError(f"grid {g.n} at position {j} (u, v) = ({u:.3f}, {v:.3f}) elements: {err.message}",
+                              method=err.method, status=err.status, residual=err.residual,
+                              iterations=err.iterations) from None
+        w1 = time.perf_counter()
+        g.forces.append(f)
+        g.seconds += w1 - w0
+        w0 = w1
+
+
+def _fits(scene, parts, quantities) -> dict:
+    """``{q: (Extrapolated, one position's scatter per grid)}``, None for a negligible quantity."""
+    cap = scene.mu * scene.load.normal
+    hs = np.array([g.h for g in parts])
+    out = {}
+    for i, q in enumerate(("Fx", "Fy", "Mz")):
+        if q not in quantities:
+            continue
+        unit = cap * (scene.ellipse.c if q == "Mz" else 1.0)
+        vals = [np.array([f[i] for f in g.forces]) for g in parts]
+        means = np.array([v.mean() for v in vals])
+        sig = scatter(hs, vals)
+        counts = np.array([len(v) for v in vals], dtype=float)
+        if (np.max(np.abs(means)) <= SMALL * unit
+                and np.all(np.abs(means) <= np.maximum(NEGLIGIBLE * unit, 2.0 * sig / np.sqrt(counts)))):
+            out[q] = None
+            continue
+        out[q] = (fit_first_order(hs, means, sig / np.sqrt(counts)), sig)
+    return out
+
+
+def _next_counts(parts, counts, short, target) -> tuple:
+    """The positions of the next round for the forces ``short`` of their target, or why there is none:
+    ``(counts, "")`` or ``(None, why)`` (module docstring)."""
+    hs = np.array([g.h for g in parts])
+    cost = np.array([g.cost for g in parts])
+    new = np.array(counts)
+    for q, (e, sig) in short.items():
+        se, goal = np.asarray(e.scatter), target * abs(e.value)
+        room = goal - e.model
+        if room <= 0.25 * goal and min(counts) < CONFIRM:
+            # the order's part is most of the target, from too few positions to judge the order: measure
+            # it on every grid first
+            room = 0.25 * goal
+            new = np.maximum(new, np.minimum(CONFIRM, 2 * np.array(counts)))
+        elif room <= 0.25 * goal:      # the order's part (beyond the scatter) is most of the target
+            why = (f"the order measured from the grids ({e.order:.2f})" if e.order is not None else
+                   "the averages, not monotone in h beyond their scatter,")
+            return None, (f"{q}: {why} alone add(s) {100 * e.model / abs(e.value):.3f} % to the estimate: the grids "
+                          "are not in the asymptotic range (finer --grids)")
+        new = np.maximum(new, allocate(hs, sig, cost, counts, (room / 2.0) ** 2))
+        # no order measurable, the averages' differences within their scatter: the order is measured from the
+        # differences of neighbouring averages, so an inner grid's standard error no larger than the smaller
+        # of its neighbours' (where the order is measured, an inner grid's scatter only widens its allowance)
+        for k in range(1, len(parts) - 1) if e.order is None else ():
+            want = math.ceil(counts[k] * (se[k] / min(se[k - 1], se[k + 1])) ** 2 - 1e-9)
+            new[k] = max(new[k], min(want, 2 * counts[k], MAX_SHIFTS))
+    if np.all(new == counts):   # the variance suffices by the model, the estimate not (the fit's residual above
+        #                         the scatter): more positions where they reduce the variance most per cost
+        e, sig = next(iter(short.values()))
+        w = sensitivities(hs, sig / np.sqrt(counts))
+        gain = np.where(np.array(counts) < MAX_SHIFTS, w ** 2 * sig ** 2 / (np.square(counts) * cost), -1.0)
+        if gain.max() < 0:
+            return None, f"every grid has {MAX_SHIFTS} positions (finer --grids)"
+        k = int(np.argmax(gain))
+        new[k] = min(2 * counts[k], MAX_SHIFTS)
+    return tuple(int(k) for k in new), ""
+
+
+def _within_budget(parts, counts, new, elapsed, budget) -> tuple:
+    """``new`` cut to what the budget's remaining time allows (from each grid's measured time a position), or
+    ``(None, why)``."""
+    per = np.array([g.seconds / max(len(g.forces), 1) for g in parts])
+    more = np.array(new) - np.array(counts)
+    ahead = float(np.sum(more * per))
+    if elapsed + ahead <= budget:
+        return new, ""
+    more = np.floor(more * max(budget - elapsed, 0.0) / ahead).astype(int)
+    if not more.any():
+        return None, (f"the next positions would take about {ahead:.0f} s, beyond the budget of {budget:g} s "
+                      "(--budget, or finer --grids)")
+    return tuple(int(k) for k in np.array(counts) + more), ""
+
+
+def _short(fits, target) -> dict:
+    """The creep forces (:data:`TARGETED`) whose estimate is beyond ``target`` (relative)."""
+    return {q: f for q, f in fits.items()
+            if f is not None and q in TARGETED and not f[0].error <= target * abs(f[0].value)}
+
+
 def extrapolate(scene, grids=None, shifts: int | None = None, *, target: float | None = TARGET,
                 budget: float = BUDGET, workers: int = 1, quantities=("Fx", "Fy", "Mz"),
                 progress=None) -> Extrapolation:
@@ -417,149 +523,60 @@ def extrapolate(scene, grids=None, shifts: int | None = None, *, target: float |
     scene's ``n``); the other axis keeps the scene's proportion, the grid's extent is the scene's (moved by
     less than an element for each position, one element more on each side to keep the scene's margin around
     the contact). ``shifts``: a fixed number of positions on every grid (then ``target`` is only reported);
-    ``None``: :data:`START_SHIFTS` a grid, then positions added where they pay (:func:`allocate`) until every
-    creep force (:data:`TARGETED`) has its estimate within ``target`` (relative) or ``budget`` seconds (wall
-    clock) are spent. ``workers``: processes solving the positions side by side (each at ``$ROLLQP_THREADS``
-    BLAS threads). ``progress(text)``: told of each round.
+    ``None``: :data:`START_SHIFTS` a grid (the finest :data:`FINEST_START`), then positions added where they pay
+    (:func:`allocate`) until every creep force (:data:`TARGETED`) has its estimate within ``target``
+    (relative) or ``budget`` seconds (wall clock) are spent. ``workers``: processes solving the positions side
+    by side (each at ``$ROLLQP_THREADS`` BLAS threads; the numbers do not depend on them). ``progress(text)``:
+    told of each round.
 
     Raises
     ------
     InputError
         A scene that is not a rolling start (no steady state), grids that are not two or more increasing
         counts, positions, a target, a budget or workers out of range.
+    SolverError
+        A position's solve failed: the message names its grid and position.
     """
     if scene.dimension != 3 or scene.load.start != "rolling":
         raise InputError("SCENE", f"extrapolate works on the steady state of a 3D rolling start "
                                   f"(load.start = 'rolling'); {scene.name!r} is not one")
-    nx, ny = scene.grid.nx, scene.grid.ny
-    base = min(nx, ny)
+    base = min(scene.grid.nx, scene.grid.ny)
     grids = (base, 2 * base, 3 * base) if grids is None else tuple(int(g) for g in grids)
     _check(grids, shifts, target, budget, workers)
     t0 = time.perf_counter()
-    parts = [_Grid(scene, n, base) for n in grids]
-    hs = np.array([g.h for g in parts])
-    cap = scene.mu * scene.load.normal
+    parts = [PositionedGrid(scene, n, base) for n in grids]
+    counts = ((int(shifts),) * len(parts) if shifts is not None
+              else (START_SHIFTS,) * (len(parts) - 1) + (FINEST_START,))
+    stopped = ""
     pool = ProcessPoolExecutor(max_workers=int(workers)) if workers > 1 else None
-
-    def solve(counts):
-        # the finest grid's positions first: the workers' last solves are then the short ones (each grid's
-        # positions stay in their order, so the averages do not depend on the workers)
-        jobs = [(g, j) for g, k in reversed(list(zip(parts, counts))) for j in range(len(g.forces), k)]
-        w0 = time.perf_counter()
-        got = (pool.map(_solve, [g.at(j) for g, j in jobs]) if pool is not None
-               else (_solve(g.at(j)) for g, j in jobs))
-        it = iter(got)
-        for g, j in jobs:
-            try:
-                f = next(it)
-            except SolverError as err:      # name the grid and position, keep the solver's residual
-                (u, v), = positions(1, first=j)
-                raise SolverError(f"grid {g.n} at position {j} (u, v) = ({u:.3f}, {v:.3f}) elements: {err.message}",
-                                  method=err.method, status=err.status, residual=err.residual,
-                                  iterations=err.iterations) from None
-            w1 = time.perf_counter()
-            g.forces.append(f)
-            g.seconds += w1 - w0
-            w0 = w1
-
-    def fitted():
-        out = {}
-        for i, q in enumerate(("Fx", "Fy", "Mz")):
-            if q not in quantities:
-                continue
-            unit = cap * (scene.ellipse.c if q == "Mz" else 1.0)
-            vals = [np.array([f[i] for f in g.forces]) for g in parts]
-            means = np.array([v.mean() for v in vals])
-            sig = scatter(hs, vals)
-            counts = np.array([len(v) for v in vals], dtype=float)
-            if (np.max(np.abs(means)) <= SMALL * unit
-                    and np.all(np.abs(means) <= np.maximum(NEGLIGIBLE * unit, 2.0 * sig / np.sqrt(counts)))):
-                out[q] = None
-                continue
-            out[q] = (fit_first_order(hs, means, sig / np.sqrt(counts)), sig)
-        return out
-
     try:
-        counts = ([int(shifts)] * len(parts) if shifts is not None
-                  else [START_SHIFTS] * (len(parts) - 1) + [FINEST_START])
-        solve(counts)
-        stopped, reached = "", None
-        while True:
-            fits = fitted()
-            short = {q: f for q, f in fits.items() if f is not None and q in TARGETED
-                     and not f[0].error <= target * abs(f[0].value)} if target is not None else {}
-            reached = None if target is None else not short
-            if shifts is not None or reached is not False:
+        _solve_positions(parts, counts, pool)
+        while shifts is None and target is not None:
+            short = _short(_fits(scene, parts, quantities), target)
+            if not short:
                 break
             elapsed = time.perf_counter() - t0
-            if elapsed >= budget:
-                stopped = f"the budget of {budget:g} s is spent (--budget, or finer --grids)"
+            new, stopped = ((None, f"the budget of {budget:g} s is spent (--budget, or finer --grids)")
+                            if elapsed >= budget else _next_counts(parts, counts, short, target))
+            if new is not None:
+                new, stopped = _within_budget(parts, counts, new, elapsed, budget)
+            if new is None:
                 break
-            cost = np.array([g.cost for g in parts])
-            new = np.array(counts)
-            for q, (e, sig) in short.items():
-                se = np.asarray(e.scatter)
-                room = target * abs(e.value) - e.model
-                if room <= 0.25 * target * abs(e.value) and min(counts) < CONFIRM:
-                    # the order's part is most of the target, from too few positions to judge the order: measure
-                    # it on every grid first
-                    room = 0.25 * target * abs(e.value)
-                    new = np.maximum(new, np.minimum(CONFIRM, 2 * np.array(counts)))
-                elif room <= 0.25 * target * abs(e.value):      # the order's part (beyond the scatter) is most of it
-                    why = (f"the order measured from the grids ({e.order:.2f})" if e.order is not None else
-                           "the averages, not monotone in h beyond their scatter,")
-                    stopped = (f"{q}: {why} alone add(s) {100 * e.model / abs(e.value):.3f} % to the estimate: the "
-                               "grids are not in the asymptotic range (finer --grids)")
-                    break
-                new = np.maximum(new, allocate(hs, sig, cost, counts, (room / 2.0) ** 2))
-                # no order measurable, the averages' differences within their scatter: the order is measured from
-                # the differences of neighbouring averages, so an inner grid's standard error no larger than the
-                # smaller of its neighbours' (where the order is measured, an inner grid's scatter only widens
-                # the order term's allowance)
-                for k in range(1, len(parts) - 1) if e.order is None else ():
-                    want = math.ceil(counts[k] * (se[k] / min(se[k - 1], se[k + 1])) ** 2 - 1e-9)
-                    new[k] = max(new[k], min(want, 2 * counts[k], MAX_SHIFTS))
-            if stopped:
-                break
-            if np.all(new == counts):   # the variance suffices by the model, the estimate not (the fit's residual
-                #                         above the scatter): more positions where they reduce the variance most per cost
-                e, sig = next(iter(short.values()))
-                w = sensitivities(hs, sig / np.sqrt(counts))
-                gain = np.where(np.array(counts) < MAX_SHIFTS, w ** 2 * sig ** 2 / (np.square(counts) * cost), -1.0)
-                if gain.max() < 0:
-                    stopped = f"every grid has {MAX_SHIFTS} positions (finer --grids)"
-                    break
-                k = int(np.argmax(gain))
-                new[k] = min(2 * counts[k], MAX_SHIFTS)
-            per = np.array([g.seconds / max(len(g.forces), 1) for g in parts])
-            more = new - np.array(counts)
-            ahead = float(np.sum(more * per))
-            if elapsed + ahead > budget:
-                scale = max(budget - elapsed, 0.0) / ahead
-                more = np.floor(more * scale).astype(int)
-                if not more.any():
-                    stopped = (f"the next positions would take about {ahead:.0f} s, beyond the budget of {budget:g} s "
-                               "(--budget, or finer --grids)")
-                    break
-                new = np.array(counts) + more
             if progress is not None:
-                worst = max(short, key=lambda q: short[q][0].error / abs(short[q][0].value))
-                e = short[worst][0]
-                progress(f"positions {'/'.join(map(str, counts))} -> {'/'.join(str(int(k)) for k in new)}: "
-                         f"{worst} estimate {100 * e.error / abs(e.value):.3f} % > target {100 * target:g} % "
+                q = max(short, key=lambda k: short[k][0].error / abs(short[k][0].value))
+                e = short[q][0]
+                progress(f"positions {'/'.join(map(str, counts))} -> {'/'.join(map(str, new))}: {q} estimate "
+                         f"{100 * e.error / abs(e.value):.3f} % > target {100 * target:g} % "
                          f"({time.perf_counter() - t0:.1f} s)")
-            counts = [int(k) for k in new]
-            solve(counts)
+            counts = new
+            _solve_positions(parts, counts, pool)
     finally:
         if pool is not None:
             pool.shutdown()
+    fits = _fits(scene, parts, quantities)
     out = Extrapolation(scene.name, grids, tuple(len(g.forces) for g in parts), seconds=tuple(g.seconds for g in parts),
-                        cap=cap, target=target, reached=reached, stopped=stopped, workers=int(workers))
-    for q, f in fitted().items():
-        out.forces[q] = None if f is None else f[0]
+                        cap=scene.mu * scene.load.normal, target=target,
+                        reached=None if target is None else not _short(fits, target), stopped=stopped,
+                        workers=int(workers))
+    out.forces = {q: None if f is None else f[0] for q, f in fits.items()}
     return out
-
-
-def _sigma(h, e: Extrapolated, sig, counts) -> float:
-    """``σ(F₀)`` of the fit behind ``e`` (its estimate's first term is twice this, scaled by the residual)."""
-    return math.sqrt(float(np.sum(sensitivities(h, sig / np.sqrt(counts)) ** 2 * sig ** 2 / np.asarray(counts))))

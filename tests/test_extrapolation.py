@@ -108,7 +108,7 @@ def test_grids_outside_the_asymptotic_range_stop_the_rounds_and_say_so(monkeypat
         g = scene.grid
         wobble = 1e-5 * math.sin(1e3 * g.xl + 7e2 * g.yl)           # a position's irregular part
         return (-100.0 * (1 + 20 * g.dx ** 2 + wobble), 0.0, 0.0)
-    monkeypatch.setattr(x, "_solve", second_order)
+    monkeypatch.setattr(x, "solve_position", second_order)
     got = x.extrapolate(load_scene("kalker-circular"), grids=(10, 15, 20), target=0.001)
     e = got.forces["Fx"]
     assert got.reached is False and "order measured from the grids (2.0" in got.stopped, got.stopped
@@ -126,7 +126,7 @@ def test_a_solve_that_fails_names_its_grid_and_position(monkeypatch):
         if len(calls) == 6:
             raise SolverError("no convergence", method="newton", residual=3e-4)
         return (-1.0, 0.0, 0.0)
-    monkeypatch.setattr(x, "_solve", failing)
+    monkeypatch.setattr(x, "solve_position", failing)
     with pytest.raises(SolverError, match=r"grid 15 at position 3 .*no convergence.*residual 3\.000e-04"):
         x.extrapolate(load_scene("kalker-circular"), grids=(10, 15, 20))
 
