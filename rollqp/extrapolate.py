@@ -15,16 +15,19 @@ with the cell-averaged Hertz pressure, and with no slip at all (measured, docs/p
 ``(u_j, v_j)`` of an element (:func:`positions`: the R₂ low-discrepancy sequence, every prefix of which is
 evenly spread, so that positions can be added to a grid), and the forces averaged. The average is a smooth
 function of ``h``: measured on the circle at ξ = 1e-5 and 1e-3 with 16 positions on seven grids from 16 to 48
-elements per semi-axis, ``F₀ + C h`` fits the averages within their scatter (reduced χ² 0.1–0.7).
+elements per semi-axis, ``F₀ + C h`` fits the averages within their scatter (reduced χ² 0.03–0.11).
 
 **The extrapolation and its estimate.** With ``F̄_k`` the average on grid ``k`` and ``s_k = σ_k/√K_k`` its
 standard error, the first-order model is fitted by weighted least squares
 
 .. math::
-    \bar F_k \approx F_0 + C\,h_k,\qquad \text{estimate} = 2\,\sigma(F_0) + |F_0^{(p)} - F_0|,
+    \bar F_k \approx F_0 + C\,h_k,\qquad \text{estimate} = t_{95}(\nu)\,\sigma(F_0) + |F_0^{(p)} - F_0|,
 
 where ``σ(F₀)`` is the fit's standard error of ``F₀`` from the ``s_k``, scaled up by the fit's residual where
-the residual exceeds what the scatter explains (reduced χ² above 1), and ``F₀⁽ᵖ⁾`` the extrapolation with the
+the residual exceeds what the scatter explains (reduced χ² above 1); ``t₉₅(ν)`` Student's two-sided 95 %
+quantile (:func:`t95`, at least 2) with ``ν`` the Welch–Satterthwaite degrees of freedom of ``F₀`` from the
+grids' positions (:func:`welch_dof`: a grid of ``K`` positions gives its scatter ``K − 1``), so that an
+estimate from few positions is as wide as their few degrees of freedom make it; and ``F₀⁽ᵖ⁾`` the extrapolation with the
 order ``p`` measured from the three finest grids (where none is measurable — the differences of opposite
 signs — ``F̄_finest`` in its place: the whole correction): the estimate grows where the measured order
 strays from 1 by more than the scatter explains, ``|F₀⁽ᵖ⁾ − F₀|`` less the 95 % band of that change over
@@ -64,7 +67,7 @@ from .errors import InputError, SolverError
 from .march.grid import run
 from .threads import limited
 
-__all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "positions", "fit_first_order",
+__all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "positions", "fit_first_order", "t95", "welch_dof",
            "scatter", "allocate", "sensitivities", "solve_position", "PositionedGrid", "ORDER_RANGE", "SHIFTS", "START_SHIFTS", "FINEST_START", "CONFIRM", "MAX_SHIFTS",
            "TARGET", "BUDGET", "NEGLIGIBLE", "SMALL", "TARGETED", "THEORETICAL_ORDER", "MODEL_DRAWS", "COST_EXPONENT", "COST_OVERHEAD"]
 
@@ -190,9 +193,36 @@ def _measured_order(h, F):
     return 0.5 * (lo + hi)
 
 
-def fit_first_order(h, means, errors) -> Extrapolated:
-    """``F₀ + C h`` fitted to the grids' averages ``means`` (standard errors ``errors``) and the estimate of
-    the module docstring.
+def t95(dof: float) -> float:
+    """The two-sided 95 % quantile of Student's t with ``dof`` degrees of freedom, at least 2 (the normal's
+    1.96 rounded up, where ``dof`` is infinite).
+
+    >>> round(t95(3), 3), round(t95(30), 3), t95(math.inf)
+    (3.182, 2.042, 2.0)
+    """
+    if not math.isfinite(dof):
+        return 2.0
+    from scipy.special import stdtrit    # (scipy: only where an estimate is made; import rollqp stays light)
+    return max(2.0, float(stdtrit(max(dof, 1.0), 0.975)))
+
+
+def welch_dof(weights, errors, dof) -> float:
+    """Welch–Satterthwaite's degrees of freedom of ``Σ w_k F̄_k`` with standard errors ``errors`` each from
+    ``dof`` degrees of freedom (infinite where none is given).
+
+    >>> round(welch_dof([1.0, 1.0], [1.0, 1.0], [3, 3]), 6), welch_dof([1.0], [1.0], [math.inf])
+    (6.0, inf)
+    """
+    a = np.square(np.asarray(weights, dtype=float) * np.asarray(errors, dtype=float))
+    d = np.asarray(dof, dtype=float)
+    den = float(np.sum(np.where(np.isfinite(d), a * a / np.maximum(d, 1.0), 0.0)))
+    return math.inf if den == 0.0 else float(np.sum(a)) ** 2 / den
+
+
+def fit_first_order(h, means, errors, dof=None) -> Extrapolated:
+    """``F₀ + C h`` fitted to the grids' averages ``means`` (standard errors ``errors``, each from ``dof``
+    degrees of freedom: the grid's positions less one; None: known exactly) and the estimate of the module
+    docstring.
 
     >>> e = fit_first_order([0.1, 0.05, 0.025], [1.1, 1.05, 1.025], [1e-4, 1e-4, 1e-4])   # exactly 1 + h
     >>> round(e.value, 12), round(e.order, 6), bool(e.error < 5e-4)
@@ -207,12 +237,12 @@ def fit_first_order(h, means, errors) -> Extrapolated:
     coef = cov @ (M.T @ (w * F))
     F0 = float(coef[0])
     var = float(cov[0, 0]) if np.all(s > 0) else 0.0
-    dof = h.size - 2
-    if dof > 0:
+    free = h.size - 2                # the fit's residual degrees of freedom
+    if free > 0:
         r = F - M @ coef
-        chi2 = float(np.sum(w * r * r)) / dof if np.all(s > 0) else math.inf
+        chi2 = float(np.sum(w * r * r)) / free if np.all(s > 0) else math.inf
         if not np.all(s > 0):        # no scatter measured: the residual alone
-            var = float(np.sum(r * r)) / dof * float(np.linalg.inv(M.T @ M)[0, 0])
+            var = float(np.sum(r * r)) / free * float(np.linalg.inv(M.T @ M)[0, 0])
         elif chi2 > 1.0:             # the residual exceeds the scatter: scale up (reduced chi-square)
             var *= chi2
     order = _measured_order(h[-3:], F[-3:]) if h.size >= 3 else None
@@ -237,7 +267,8 @@ def fit_first_order(h, means, errors) -> Extrapolated:
             model = max(0.0, abs(g) - band)
         else:
             model = abs(g)
-    return Extrapolated(tuple(float(v) for v in F), order, F0, 2.0 * math.sqrt(var) + model,
+    t = 2.0 if dof is None or not np.all(s > 0) else t95(welch_dof(sensitivities(h, s), s, dof))
+    return Extrapolated(tuple(float(v) for v in F), order, F0, t * math.sqrt(var) + model,
                         tuple(float(v) for v in s), model)
 
 
@@ -340,7 +371,8 @@ class Extrapolation:
             cells = " ".join(f"{v:12.6g} ± {s:<7.2g}" for v, s in zip(e.values, e.scatter or [0.0] * len(e.values)))
             lines.append(f"  {key:<4} {cells} {order} {e.value:14.7g} {e.error:11.3g} ({100 * rel:.3f} %)")
         lines.append("  (each grid: the average over its positions ± its standard error; extrapolated: F0 of "
-                     "F0 + C h; estimate: twice F0's standard error + its change with the measured order)")
+                     "F0 + C h; estimate: t (Student's 95 %, the positions' degrees of freedom) times F0's standard error "
+                     "+ its change with the measured order)")
         if any(e is not None and e.order is None for e in self.forces.values()):
             lines.append("  (-: no order measurable from the grids for it; the whole correction is in the estimate)")
         if self.target is not None:
@@ -451,7 +483,7 @@ def _fits(scene, parts, quantities) -> dict:
                 and np.all(np.abs(means) <= np.maximum(NEGLIGIBLE * unit, 2.0 * sig / np.sqrt(counts)))):
             out[q] = None
             continue
-        out[q] = (fit_first_order(hs, means, sig / np.sqrt(counts)), sig)
+        out[q] = (fit_first_order(hs, means, sig / np.sqrt(counts), dof=counts - 1), sig)
     return out
 
 
@@ -474,7 +506,8 @@ def _next_counts(parts, counts, short, target) -> tuple:
                    "the averages, not monotone in h beyond their scatter,")
             return None, (f"{q}: {why} alone add(s) {100 * e.model / abs(e.value):.3f} % to the estimate: the grids "
                           "are not in the asymptotic range (finer --grids)")
-        new = np.maximum(new, allocate(hs, sig, cost, counts, (room / 2.0) ** 2))
+        t = t95(welch_dof(sensitivities(hs, se), se, np.asarray(counts) - 1.0))
+        new = np.maximum(new, allocate(hs, sig, cost, counts, (room / t) ** 2))
         # no order measurable, the averages' differences within their scatter: the order is measured from the
         # differences of neighbouring averages, so an inner grid's standard error no larger than the smaller
         # of its neighbours' (where the order is measured, an inner grid's scatter only widens its allowance)

@@ -147,3 +147,21 @@ def test_bad_arguments_name_their_key(kw, key):
     from rollqp.errors import InputError
     with pytest.raises(InputError, match=key):
         extrapolate(load_scene("kalker-circular"), **{"grids": (10, 15, 20), **kw})
+
+
+@pytest.mark.parametrize("counts", [(4, 4, 2), (8, 4, 4), (29, 4, 7)])
+def test_the_estimate_covers_the_limit_95_times_in_100_from_few_positions(counts):
+    """Positions drawn with one position's scatter as measured on the circle at xi = 1e-5 (0.28, 0.12, 0.05 % on
+    40, 80, 120 elements), averaged and fitted as the command does (the scatter's floor, Student's t on the
+    positions' degrees of freedom): the estimate misses the limit in at most 6 of 100 fits (95 % nominal; 400
+    fits: the binomial spread is 1.1 %). With twice the standard error and no floor, 9 in 100 miss at 4/4/2."""
+    from rollqp.extrapolate import fit_first_order, scatter
+    rng = np.random.default_rng(11)
+    h, sigma = np.array([1 / 40, 1 / 80, 1 / 120]), np.array([2.8e-3, 1.2e-3, 5e-4])
+    misses = 0
+    for _ in range(400):
+        vals = [1 + 0.7 * hk + rng.normal(0, s, k) for hk, s, k in zip(h, sigma, counts)]
+        K = np.array(counts, dtype=float)
+        e = fit_first_order(h, [v.mean() for v in vals], scatter(h, vals) / np.sqrt(K), dof=K - 1)
+        misses += abs(e.value - 1.0) > e.error
+    assert misses <= 24, misses

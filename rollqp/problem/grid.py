@@ -237,8 +237,8 @@ class TangentialStep:
         F = math.hypot(self.Fx or 0.0, self.Fy or 0.0)
         if (self.Fx is not None or self.Fy is not None) and not F < cap:
             key = "Fx" if self.Fx is not None else "Fy"
-            raise InputError(key, f"|(Fx, Fy)| = {F:.6g} must be below the sliding limit μ·FN = {cap:.6g} "
-                                  f"for a solution with stick")
+            raise InputError(key, f"|(Fx, Fy)| = {F:.6g} must be below the sliding limit Σ μp·area "
+                                  f"= {cap:.6g} (μ·FN where μ is uniform) for a solution with stick")
 
     @property
     def n(self) -> int:
