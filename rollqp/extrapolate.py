@@ -140,14 +140,18 @@ class Extrapolated:
 
 def positions(count: int, first: int = 0) -> list:
     """Positions ``first … first + count − 1`` of the grid's shifts ``(u, v)`` in elements: the R₂ sequence
-    (module docstring) started at the centred grid, every prefix evenly spread over the element.
+    (module docstring), every prefix evenly spread over the element. It starts one step after the centred grid:
+    the centred grid is symmetric about the ellipse's axes on every grid, a special position rather than a
+    typical one (on the circle at ξ = 1e-5 and 16 elements per semi-axis its force is 1.4 scatters off the
+    average).
 
-    >>> positions(1), [tuple(round(c, 3) for c in p) for p in positions(3)]
-    ([(0.0, 0.0)], [(0.0, 0.0), (-0.245, -0.43), (-0.49, 0.14)])
+    >>> [tuple(round(c, 3) for c in p) for p in positions(3)]
+    [(-0.245, -0.43), (-0.49, 0.14), (0.265, -0.29)]
     >>> positions(2, first=1) == positions(3)[1:]
     True
     """
-    return [((0.5 + j * _R2[0]) % 1.0 - 0.5, (0.5 + j * _R2[1]) % 1.0 - 0.5) for j in range(first, first + count)]
+    return [((0.5 + j * _R2[0]) % 1.0 - 0.5, (0.5 + j * _R2[1]) % 1.0 - 0.5)
+            for j in range(first + 1, first + count + 1)]
 
 
 def richardson(values, ratio: float) -> Extrapolated:

@@ -153,7 +153,8 @@ def test_the_first_order_fit_recovers_the_limit_and_its_estimate_covers_scatter_
 
 def test_the_positions_are_spread_over_the_element_for_every_count():
     from rollqp.extrapolate import positions
-    assert positions(1) == [(0.0, 0.0)] and positions(5, first=3) == positions(8)[3:]      # a sequence: extensible
+    assert positions(5, first=3) == positions(8)[3:]                                       # a sequence: extensible
+    assert (0.0, 0.0) not in positions(256)                       # not the centred grid: a special position
     for k in (4, 16, 64, 256):
         p = np.array(positions(k))
         assert np.all(np.abs(p) <= 0.5) and len({tuple(np.round(q, 12)) for q in p}) == k
