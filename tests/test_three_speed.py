@@ -174,7 +174,9 @@ def test_extrapolate_command(tmp_path, capsys, monkeypatch):
     for bad in ("1", "x", "513"):
         assert cli.main(["extrapolate", "kalker-circular", "--shifts", bad]) == cli.EXIT_INPUT
         assert "--shifts" in capsys.readouterr().err
-    for key, bad in (("--target", "0"), ("--target", "100"), ("--target", "nan"), ("--target", "x"),
+    assert cli.main(["extrapolate", "kalker-circular", "--grids", "10,15,20", "--target", "5%", "--workers", "1"]) == 0
+    assert "target 5 % of the creep forces" in capsys.readouterr().out
+    for key, bad in (("--target", "0"), ("--target", "100"), ("--target", "%"), ("--target", "nan"), ("--target", "x"),
                      ("--budget", "0"), ("--budget", "-1"), ("--budget", "inf"), ("--workers", "0"),
                      ("--workers", "1.5"), ("--workers", "300")):
         assert cli.main(["extrapolate", "kalker-circular", key, bad]) == cli.EXIT_INPUT

@@ -17,7 +17,7 @@ def add_arguments(xp) -> None:
     xp.add_argument("scene", help="a TOML scene file or a built-in 3D scene with a rolling start")
     xp.add_argument("--grids", help="two or more increasing element counts along the shorter axis, e.g. "
                     "40,80,120 (default: once, twice and three times the scene's)")
-    xp.add_argument("--target", help=f"the creep forces' error estimate to reach, in per cent, in (0, 100) "
+    xp.add_argument("--target", help=f"the creep forces' error estimate to reach, in per cent (0.1 or 0.1%%), in (0, 100) "
                     f"(default {100 * TARGET:g}): positions are added to the grids until it is reached")
     xp.add_argument("--budget", help=f"seconds (wall clock) the positions may take, in (0, 1e6] (default {BUDGET:g}): "
                     "the rounds stop there with the estimate they reached")
@@ -53,7 +53,8 @@ def main(args) -> int:
         shifts = _number(args.shifts, "--shifts", int, f"an integer in [2, {MAX_SHIFTS}]")
     target = TARGET
     if args.target is not None:
-        pct = _number(args.target, "--target", float, "a percentage in (0, 100)")
+        text = args.target.strip()
+        pct = _number(text[:-1] if text.endswith("%") else text, "--target", float, "a percentage in (0, 100)")
         if not 0 < pct < 100:
             raise InputError("--target", f"must be a percentage in (0, 100), got {args.target!r}")
         target = pct / 100.0
