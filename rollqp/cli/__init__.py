@@ -7,8 +7,7 @@
     rollqp export-step SCENE --step K [--out STEP.npz] [--method METHOD]
     rollqp check-step STEP.npz SOLUTION.npz [--tol T]
     rollqp crossval SCENE [--step K] [--methods M1,M2]
-    rollqp extrapolate SCENE [--grids N1,N2,N3] [--target PCT] [--budget S] [--workers N] [--shifts K]
-                                                          (3D: creep forces from a few grids, with an error estimate)
+    rollqp extrapolate SCENE [--grids N1,N2,N3] [--target PCT] [--budget S] [--workers N]   (3D: creep forces)
     rollqp bench [--quick] [--docs] [...]   (benchmarks/suite.py: work–precision and scaling)
     rollqp sweep SCENE --vary KEY=VALUES ... [--out STORE.zarr] [--scheduler ADDRESS] [--workers N]
     rollqp creep-curve SCENE [--ratios ...] [--friction ...] [--plot F.png]   (docs/sweeps.md)
