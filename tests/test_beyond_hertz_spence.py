@@ -47,6 +47,7 @@ def test_rollqp_run_reproduces_spence35(n, tmp_path):
     r = subprocess.run([sys.executable, "-m", "rollqp.cli", "run", str(scene), "--out", str(tmp_path / "s.npz")],
                        env=env, cwd=tmp_path, capture_output=True, text=True, timeout=1800)
     assert r.returncode == 0, r.stderr
+    assert f"{n - 1} steps: 0 rolling, {n - 1} at rest" in r.stdout      # static steps, not called rolling ones
     a = load_result(tmp_path / "s.npz")
     ref = _reference()[:n]
     assert a["FN"].size == n

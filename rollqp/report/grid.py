@@ -162,7 +162,11 @@ def _grid_row(res, scene, u) -> str:
 def _steps_row(res, scene, u) -> str:
     K = len(res["q"]) - 1
     start = {"rolling": "steady state (rolling start)", "braked": "braked start (static shift)"}[scene.load.start]
-    return f"{start} + {K} rolling steps of {scene.discretization.step:g} dx ({scene.dq:.4g} {u.length})"
+    rolled = int(np.count_nonzero(np.diff(np.asarray(res["q"], dtype=float))))   # a held load.rolled: at rest
+    if rolled == K:
+        return f"{start} + {K} rolling steps of {scene.discretization.step:g} dx ({scene.dq:.4g} {u.length})"
+    return (f"{start} + {K} steps: {rolled} rolling, {K - rolled} at rest (static steps: load.rolled held, the "
+            "loads changing in place)")
 
 
 def summary(res: dict, scene, method: str, wall: float, stresses=None) -> str:
