@@ -253,27 +253,49 @@ def fit_first_order(h, means, errors, dof=None) -> Extrapolated:
     if h.size < 3:                   # no order can be measured: the whole correction
         model = abs(F0 - F[-1])
     else:
-        def change(values):
-            """F₀ with the order measured from the three finest grids less the first-order F₀ (where none is
-            measurable, the whole correction ``F̄_finest − F₀``)."""
-            base = _first_order_value(h, values, w)
-            p = _measured_order(h[-3:], values[-3:])
-            if p is None:
-                return values[-1] - base
-            return values[-1] - (values[-2] - values[-1]) * h[-1] ** p / (h[-2] ** p - h[-1] ** p) - base
-        g = change(F)
+        g = float(_changes(h, F[None, :], w)[0])
         if np.all(s > 0):
             # beyond what the averages' scatter alone moves it by: the 95 % band of the change over draws of
             # the averages within their standard errors (the change is far from linear in them where the
             # order is poorly measured)
             draws = F + np.random.default_rng(0).standard_normal((MODEL_DRAWS, h.size)) * s
-            band = float(np.quantile(np.abs([change(d) - g for d in draws]), 0.95))
+            band = float(np.quantile(np.abs(_changes(h, draws, w) - g), 0.95))
             model = max(0.0, abs(g) - band)
         else:
             model = abs(g)
     t = 2.0 if dof is None or not np.all(s > 0) else t95(welch_dof(sensitivities(h, s), s, dof))
     return Extrapolated(tuple(float(v) for v in F), order, F0, t * math.sqrt(var) + model,
                         tuple(float(v) for v in s), model)
+
+
+def _orders(h, F) -> np.ndarray:
+    """:func:`_measured_order` of each row of ``F`` (three grids' values, ``h`` coarse to fine), NaN where none:
+    the same bisection, on every row at once."""
+    (h1, h2, h3), F = h, np.asarray(F, dtype=float)
+    d1, d2 = F[:, 0] - F[:, 1], F[:, 1] - F[:, 2]
+    ok = (d2 != 0.0) & (d1 * d2 > 0.0)
+    target = np.where(ok, d1 / np.where(d2 == 0.0, 1.0, d2), 0.0)
+
+    def g(p):
+        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - target
+    lo, hi = np.full(len(F), ORDER_RANGE[0]), np.full(len(F), ORDER_RANGE[1])
+    ok &= g(lo) * g(hi) <= 0
+    for _ in range(80):          # bisection: g rises monotonically with p for h1 > h2 > h3
+        mid = 0.5 * (lo + hi)
+        left = g(lo) * g(mid) <= 0
+        hi, lo = np.where(left, mid, hi), np.where(left, lo, mid)
+    return np.where(ok, 0.5 * (lo + hi), np.nan)
+
+
+def _changes(h, F, w) -> np.ndarray:
+    """For each row of ``F`` (the grids' averages): F₀ with the order measured from the three finest grids less
+    the first-order F₀ (weights ``w``); where no order is measurable, the whole correction ``F̄_finest − F₀``."""
+    F = np.asarray(F, dtype=float)
+    base = F @ sensitivities(h, 1.0 / np.sqrt(w))
+    p = _orders(h[-3:], F[:, -3:])
+    q = np.where(np.isnan(p), 1.0, p)
+    ext = F[:, -1] - (F[:, -2] - F[:, -1]) * h[-1] ** q / (h[-2] ** q - h[-1] ** q)
+    return np.where(np.isnan(p), F[:, -1], ext) - base
 
 
 def _first_order_value(h, F, w) -> float:
