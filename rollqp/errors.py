@@ -29,7 +29,12 @@ class InputError(RollqpError, ValueError):
         self.key = key
         if len(message) > self.MAX_MESSAGE:
             message = f"{message[:self.MAX_MESSAGE]}… ({len(message)} characters)"
+        self.message = message
         super().__init__(f"{key}: {message}")
+
+    def __reduce__(self):
+        """Pickled as its key and message (a worker process's error reaches the caller whole)."""
+        return (type(self), (self.key, self.message))
 
 
 class SolverError(RollqpError, RuntimeError):

@@ -400,7 +400,8 @@ class Extrapolation:
                      "F0 + C h; estimate: t (Student's 95 %, the positions' degrees of freedom) times F0's standard error "
                      "+ its change with the measured order)")
         if any(e is not None and e.order is None for e in self.forces.values()):
-            lines.append("  (-: no order measurable from the grids for it; the whole correction is in the estimate)")
+            lines.append("  (-: no order measurable from the grids for it; the whole correction, beyond what the "
+                         "scatter explains, is in the estimate)")
         if self.target is not None:
             if self.reached:
                 lines.append(f"  target {100 * self.target:g} % of the creep forces reached")
@@ -604,6 +605,11 @@ def extrapolate(scene, grids=None, shifts: int | None = None, *, target: float |
     _check(grids, shifts, target, budget, workers)
     t0 = time.perf_counter()
     parts = [PositionedGrid(scene, n, base) for n in grids]
+    for g in parts:                  # every grid's scene checked before any solve
+        try:
+            g.at(0)
+        except InputError as err:
+            raise InputError("--grids", f"the grid of {g.n} elements: {err}") from None
     counts = ((int(shifts),) * len(parts) if shifts is not None
               else (START_SHIFTS,) * (len(parts) - 1) + (FINEST_START,))
     stopped = ""

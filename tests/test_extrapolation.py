@@ -166,3 +166,14 @@ def test_the_estimate_covers_the_limit_95_times_in_100_from_few_positions(counts
         e = fit_first_order(h, [v.mean() for v in vals], scatter(h, vals) / np.sqrt(K), dof=K - 1)
         misses += abs(e.value - 1.0) > e.error
     assert misses <= 24, misses
+
+
+def test_errors_cross_worker_processes_whole():
+    """A worker's InputError or SolverError reaches the caller with its key, message and residual (pickled)."""
+    import pickle
+
+    from rollqp.errors import InputError, SolverError
+    e = pickle.loads(pickle.dumps(InputError("discretization.elements", "must be >= 2")))
+    assert isinstance(e, InputError) and e.key == "discretization.elements" and str(e).endswith("must be >= 2")
+    s = pickle.loads(pickle.dumps(SolverError("no convergence", method="newton", residual=3e-4)))
+    assert isinstance(s, SolverError) and s.residual == 3e-4 and "residual 3.000e-04" in str(s)

@@ -182,5 +182,8 @@ def test_extrapolate_command(tmp_path, capsys, monkeypatch):
         assert cli.main(["extrapolate", "kalker-circular", key, bad]) == cli.EXIT_INPUT
         err = capsys.readouterr().err
         assert key in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err, (key, bad, err)
+    assert cli.main(["extrapolate", "kalker-circular", "--grids", "40,80,2000"]) == cli.EXIT_INPUT   # too large:
+    err = capsys.readouterr().err                                                  # refused before any solve
+    assert "--grids: the grid of 2000 elements: discretization.elements" in err and len(err.splitlines()) == 1
     assert cli.main(["extrapolate", "cattaneo-3d"]) == cli.EXIT_INPUT        # a braked start: no steady state
     assert "rolling start" in capsys.readouterr().err
