@@ -48,6 +48,7 @@ def test_rollqp_run_reproduces_spence35(n, tmp_path):
                        env=env, cwd=tmp_path, capture_output=True, text=True, timeout=1800)
     assert r.returncode == 0, r.stderr
     assert f"{n - 1} steps: 0 rolling, {n - 1} at rest" in r.stdout      # static steps, not called rolling ones
+    assert "spans fewer than two elements" in r.stdout and "error: hertz" not in r.stdout   # stage 1: one element
     a = load_result(tmp_path / "s.npz")
     ref = _reference()[:n]
     assert a["FN"].size == n

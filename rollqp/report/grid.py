@@ -77,6 +77,10 @@ def closed_form_errors(res: dict, scene) -> list[tuple[str, str]]:
         area = float(on.sum()) * float(np.diff(res["x"][:2])[0]) * float(np.diff(res["y"][:2])[0])
         return [("contact (start)", f"area {area:.5g} (the normal step's; the Hertz ellipse of a, b would be "
                                     f"{np.pi * e.a * e.b:.5g}); no closed form for a non-Hertzian profile")]
+    dx, dy = float(np.diff(res["x"][:2])[0]), float(np.diff(res["y"][:2])[0])
+    if e.a < 2 * dx or e.b < 2 * dy:    # a few elements in contact: their moments are not the ellipse's
+        return [("contact (start)", f"the Hertz ellipse at FN(0) (a = {e.a:.4g}, b = {e.b:.4g}) spans fewer than "
+                                    f"two elements each way (dx = {dx:.4g}, dy = {dy:.4g}): not compared")]
     X, Y = np.meshgrid(res["x"], res["y"])
     h = hertz_field_errors(X, Y, res["pn"][0], float(res["approach"][0]), e)
     rows = [("error: hertz", f"a {100 * h['a']:+.3f} %, b {100 * h['b']:+.3f} %, p0 {100 * h['p0']:+.3f} %, "
