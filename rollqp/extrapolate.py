@@ -68,7 +68,7 @@ from .march.grid import run
 from .threads import limited
 
 __all__ = ["extrapolate", "Extrapolation", "Extrapolated", "richardson", "positions", "fit_first_order", "t95", "welch_dof",
-           "scatter", "allocate", "sensitivities", "solve_position", "PositionedGrid", "ORDER_RANGE", "SHIFTS", "START_SHIFTS", "FINEST_START", "CONFIRM", "MAX_SHIFTS",
+           "scatter", "allocate", "sensitivities", "solve_position", "PositionedGrid", "ORDER_RANGE", "START_SHIFTS", "FINEST_START", "CONFIRM", "MAX_SHIFTS",
            "TARGET", "BUDGET", "NEGLIGIBLE", "SMALL", "TARGETED", "THEORETICAL_ORDER", "MODEL_DRAWS", "COST_EXPONENT", "COST_OVERHEAD"]
 
 #: Observed orders accepted as asymptotic (outside it the grids are not in the asymptotic range).
@@ -79,9 +79,6 @@ ORDER_RANGE = (0.3, 5.0)
 NEGLIGIBLE = 1e-4
 #: Above this fraction of μFN (μFN·c) on some grid a quantity is extrapolated however large its scatter.
 SMALL = 1e-2
-#: Grid positions per grid where a fixed count is asked for without a number (``shifts=True`` is not a count:
-#: the CLI's ``--shifts`` without a target); kept for callers that fix the count.
-SHIFTS = 8
 #: Positions a grid starts with before positions are allocated: four give each grid's scatter three degrees of
 #: freedom, and the pooled power law (:func:`scatter`) guards the grids that keep few.
 START_SHIFTS = 4
@@ -175,28 +172,6 @@ def richardson(values, ratio: float) -> Extrapolated:
     return Extrapolated((F1, F2, F3), None, F3, max(abs(d1), abs(d2)))
 
 
-def _measured_order(h, F):
-    """The order ``p`` of ``F = F₀ + C h^p`` through three points (any ratios), or None (no such ``p`` in
-    :data:`ORDER_RANGE`)."""
-    (h1, h2, h3), (F1, F2, F3) = h, F
-    if (F2 - F3) == 0.0 or (F1 - F2) * (F2 - F3) <= 0.0:
-        return None
-    target = (F1 - F2) / (F2 - F3)
-
-    def g(p):
-        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - target
-    lo, hi = ORDER_RANGE
-    if g(lo) * g(hi) > 0:
-        return None
-    for _ in range(80):         # bisection: g rises monotonically with p for h1 > h2 > h3
-        mid = 0.5 * (lo + hi)
-        if g(lo) * g(mid) <= 0:
-            hi = mid
-        else:
-            lo = mid
-    return 0.5 * (lo + hi)
-
-
 def t95(dof: float) -> float:
     """The two-sided 95 % quantile of Student's t with ``dof`` degrees of freedom, at least 2 (the normal's
     1.96 rounded up, where ``dof`` is infinite).
@@ -249,7 +224,8 @@ def fit_first_order(h, means, errors, dof=None) -> Extrapolated:
             var = float(np.sum(r * r)) / free * float(np.linalg.inv(M.T @ M)[0, 0])
         elif chi2 > 1.0:             # the residual exceeds the scatter: scale up (reduced chi-square)
             var *= chi2
-    order = _measured_order(h[-3:], F[-3:]) if h.size >= 3 else None
+    order = float(_orders(h[-3:], F[None, -3:])[0]) if h.size >= 3 else math.nan
+    order = None if math.isnan(order) else order
     if h.size < 3:                   # no order can be measured: the whole correction
         model = abs(F0 - F[-1])
     else:
@@ -269,8 +245,9 @@ def fit_first_order(h, means, errors, dof=None) -> Extrapolated:
 
 
 def _orders(h, F) -> np.ndarray:
-    """:func:`_measured_order` of each row of ``F`` (three grids' values, ``h`` coarse to fine), NaN where none:
-    the same bisection, on every row at once."""
+    """The order ``p`` of ``F = F₀ + C h^p`` through each row of ``F`` (three grids' values, ``h`` coarse to fine,
+    any ratios), NaN where no ``p`` in :data:`ORDER_RANGE` fits (differences of opposite signs): a bisection on
+    every row at once."""
     (h1, h2, h3), F = h, np.asarray(F, dtype=float)
     d1, d2 = F[:, 0] - F[:, 1], F[:, 1] - F[:, 2]
     ok = (d2 != 0.0) & (d1 * d2 > 0.0)
@@ -296,11 +273,6 @@ def _changes(h, F, w) -> np.ndarray:
     q = np.where(np.isnan(p), 1.0, p)
     ext = F[:, -1] - (F[:, -2] - F[:, -1]) * h[-1] ** q / (h[-2] ** q - h[-1] ** q)
     return np.where(np.isnan(p), F[:, -1], ext) - base
-
-
-def _first_order_value(h, F, w) -> float:
-    M = np.column_stack([np.ones_like(h), h ** THEORETICAL_ORDER])
-    return float(np.linalg.solve(M.T @ (w[:, None] * M), M.T @ (w * F))[0])
 
 
 def sensitivities(h, errors) -> np.ndarray:

@@ -23,7 +23,7 @@ from .histories import Constant, Harmonic
 from .kinematics import plan
 from .methods import REFERENCE_METHOD, scene_method_3d
 from .closedforms.hertz_ellipse import hertz
-from .friction.capacity import COUPLING_GRID, allowed, estimate, grid_shares, near_grid, per_sample
+from .friction.capacity import COUPLING_GRID, estimate, grid_shares, limits, margin_note, near_grid, worst
 from .patch import check_patch, computed_patch
 
 __all__ = ["has_load_path", "normal_force", "start_force", "start_ellipse", "check_load_path", "sliding_limits",
@@ -123,8 +123,7 @@ def _check_sliding_limit(scene, s_end: float) -> None:
     lim = sliding_limits(scene, s, n, ratio)
     if lim is not None:
         c, limit = lim
-        with np.errstate(divide="ignore", invalid="ignore"):     # a limit of 0 (μ = 0 on the contact): inf
-            k = int(np.argmax(np.where(ratio > 0, ratio / limit, 0.0)))
+        k = worst(ratio, limit)
         if not ratio[k] < limit[k]:
             raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {ratio[k]:.6g} at τ = {s[k]:.6g} a (FN the current normal "
                                   f"load {n[k]:.6g}·load.normal) " + limit_message(scene, c[k], limit[k]))
@@ -180,18 +179,14 @@ def sliding_limits(scene, s, n, ratio):
         top = float(np.max(mu)) / ref
         return top, 0.0, top, 0.0
 
-    need = (ratio > 0) & (n > 0)
-    parts = np.ones((4, s.size))
-    parts[:, need] = per_sample(n[need], q[need], rule)
-    return parts[0], allowed(parts, ratio, COUPLING_GRID * abs(scene.materials.K))
+    return limits(n, q, ratio, rule, COUPLING_GRID * abs(scene.materials.K))
 
 
 def limit_message(scene, c: float, limit: float) -> str:
     """The end of the sliding-limit refusal of a friction law varying over the contact (:func:`sliding_limits`)."""
-    margin = f"; +{limit - c:.3g} allowed for the discrete pressure's difference from this estimate" if limit > c else ""
     return (f"must be < {limit:.6g}: with contact.friction varying over the contact a stick solution exists only "
             f"below its sliding limit |(Fx, Fy)| < ∫ mu p dA = {c:.6g} mu FN (mu = {scene.mu:g}, the law's "
-            f"reference{margin}); prescribe creepages for gross sliding (docs/friction.md)")
+            f"reference{margin_note(c, limit)}); prescribe creepages for gross sliding (docs/friction.md)")
 
 
 def start_force(scene) -> float:

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["SUB", "MARGIN", "COUPLING_GRID", "COUPLING_STRIP", "grid_shares", "strip_shares", "near_grid",
-           "near_strip", "estimate", "allowed", "per_sample"]
+           "near_strip", "estimate", "allowed", "per_sample", "limits", "worst", "margin_note"]
 
 #: Sub-samples per direction of a grid element for its share of the Hertz force (midpoint rule on SUB × SUB
 #: points). Measured against 40 × 40 sub-samples on grids of 2 to 30 elements per semi-axis: ``Σ|Δw| <= 5.3e-3``
@@ -121,3 +121,28 @@ def per_sample(n, q, rule) -> np.ndarray:
     uniq, inv = np.unique(keys, axis=0, return_inverse=True)
     vals = np.array([rule(float(a), float(b)) for a, b in uniq]).reshape(-1, 4)
     return vals[np.ravel(inv)].T
+
+
+def limits(n, q, ratio, rule, coupling: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(c, limit)`` at each sample of normal loads ``n`` (relative) and rolled distances ``q``: ``rule(n_k,
+    q_k)`` (:func:`estimate`'s columns) where ``ratio > 0`` and ``n > 0`` (elsewhere 1), combined by
+    :func:`allowed`. The skeleton of both dimensions' ``sliding_limits`` (:func:`rollqp.loads.sliding_limits`,
+    :func:`rollqp.scene.checks.sliding_limits`), which give the ``rule``."""
+    n, q, ratio = (np.asarray(v, dtype=float) for v in (n, q, ratio))
+    need = (ratio > 0) & (n > 0)
+    parts = np.ones((4, ratio.size))
+    parts[:, need] = per_sample(n[need], q[need], rule)
+    return parts[0], allowed(parts, ratio, coupling)
+
+
+def worst(ratio, limit) -> int:
+    """The sample whose force is nearest (or beyond) its limit: ``argmax ratio/limit`` over the loaded samples
+    (a limit of 0, ``μ = 0`` on the contact, makes any force there the worst)."""
+    ratio = np.asarray(ratio, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return int(np.argmax(np.where(ratio > 0, ratio / limit, 0.0)))
+
+
+def margin_note(c: float, limit: float) -> str:
+    """The refusals' note of the margin :func:`allowed` adds to the estimate ``c`` (empty without one)."""
+    return f"; +{limit - c:.3g} allowed for the discrete pressure's difference from this estimate" if limit > c else ""

@@ -34,7 +34,7 @@ from ..profiles import check_cover
 from ..advice import fast_path
 from ..matrixfree import check_scene
 from ..matrixfree import memory_estimate
-from ..friction.capacity import COUPLING_STRIP, allowed, estimate, near_strip, per_sample, strip_shares
+from ..friction.capacity import COUPLING_STRIP, estimate, limits, margin_note, near_strip, strip_shares, worst
 from ..strip import Strip
 
 #: Largest coefficient of friction (beyond any material; tractions of μ·p stay far from overflow).
@@ -451,24 +451,19 @@ def check_tangential(scene) -> None:
                          f"{float(tang(q[i])):.6g} at q = {q[i]:.6g} a_H where P = 0")
     if varying:
         c, limit = sliding_limits(scene, q, Pr, ratio)
-        with np.errstate(divide="ignore", invalid="ignore"):     # a limit of 0 (μ = 0 on the contact): inf
-            i = int(np.argmax(np.where(ratio > 0, ratio / limit, 0.0)))
+        i = worst(ratio, limit)
         if not ratio[i] < limit[i]:
             raise InputError("load.tangential",
                              f"|Q|/(mu P) = {ratio[i]:.6g} at q = {q[i]:.6g} a_H must be < {limit[i]:.6g}: with "
                              f"contact.friction varying along the strip a stick solution exists only below its "
                              f"sliding limit |Q| < ∫ mu p dx = {c[i]:.6g} mu P (mu = {scene.contact.mu:g}, the law's "
-                             f"reference{_margin(c[i], limit[i])}); gross sliding is not supported (docs/friction.md)")
+                             f"reference{margin_note(c[i], limit[i])}); gross sliding is not supported (docs/friction.md)")
         return
     if not ratio[i] < 1.0:
         raise InputError("load.tangential",
                          f"|Q|/(mu P) must stay below 1 for a stick solution (gross sliding"
                          f" is not supported), but it reaches {ratio[i]:.6g} at q = "
                          f"{q[i]:.6g} a_H")
-
-
-def _margin(c: float, limit: float) -> str:
-    return f"; +{limit - c:.3g} allowed for the discrete pressure's difference from this estimate" if limit > c else ""
 
 
 def sliding_limits(scene, q, n, ratio) -> tuple[np.ndarray, np.ndarray]:
@@ -503,11 +498,8 @@ def sliding_limits(scene, q, n, ratio) -> tuple[np.ndarray, np.ndarray]:
             shares[nk] = (strip_shares(strip.x, strip.weights, b), near_strip(strip.x, b, Le), b / Le)
         return estimate(mu, *shares[nk][:2], ref, shares[nk][2])
 
-    need = (ratio > 0) & (n > 0)
-    parts = np.ones((4, q.size))
-    parts[:, need] = per_sample(n[need], qh[need], rule)
     coupling = 0.0 if scene.coupling_level == "off" else COUPLING_STRIP * abs(scene.beta)
-    return parts[0], allowed(parts, ratio, coupling)
+    return limits(n, qh, ratio, rule, coupling)
 
 
 def check_sampling(scene) -> None:

@@ -53,6 +53,7 @@ from ..profiles.surface import Body, curvatures
 from ..discretization.grid import ASPECT_RANGE, MAX_ELEMENTS, Grid
 from ..closedforms.hertz_ellipse import hertz
 from ..loads import check_load_path, has_load_path, limit_message, sliding_limits
+from ..friction.capacity import worst
 from ..materials import Materials
 from ..patch import check_patch, computed_patch, equivalent_curvatures, extent_grid, grid_extent
 from ..methods import REFERENCE_METHOD
@@ -570,8 +571,7 @@ def _check_sliding_limit(scene) -> None:
     lim = sliding_limits(scene, s, 1.0, r)    # a law varying over the contact: its own limit (rollqp.loads)
     if lim is not None:
         c, limit = lim
-        with np.errstate(divide="ignore", invalid="ignore"):     # a limit of 0 (μ = 0 on the contact): inf
-            k = int(np.argmax(np.where(r > 0, r / limit, 0.0)))
+        k = worst(r, limit)
         if not r[k] < limit[k]:
             key = "load.tangential" if ld.tangential is not None else "load.lateral"
             raise InputError(key, f"|(Fx, Fy)|/(mu FN) = {r[k]:.6g} at q = {s[k]:.6g} a "
